@@ -1,0 +1,1 @@
+//! YAT's gRPC protocol. OWNER: distributed helper.

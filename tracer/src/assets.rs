@@ -1,0 +1,95 @@
+//! Where scene files come from. The parser and the build step read every file through an
+//! [`AssetSource`], keyed by the path as written in the scene (relative to the main file's
+//! folder), so a worker can serve the same scene from blobs it received over the network
+//! without ever opening a path that came over the wire.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Debug, thiserror::Error)]
+pub enum AssetError {
+    #[error("file not found: \"{written}\" (tried {tried})")]
+    NotFound { written: String, tried: String },
+    #[error("cannot read \"{written}\" ({tried}): {source}")]
+    Io {
+        written: String,
+        tried: String,
+        source: std::io::Error,
+    },
+}
+
+pub trait AssetSource: Send + Sync {
+    /// Reads the file `written` (a path as written in the scene, relative to the main file's
+    /// folder; the main file itself is read with its own name).
+    fn read(&self, written: &str) -> Result<Arc<[u8]>, AssetError>;
+}
+
+/// Reads from the filesystem, relative to the main scene file's folder.
+#[derive(Clone, Debug)]
+pub struct FsSource {
+    root: PathBuf,
+}
+
+impl FsSource {
+    pub fn new(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
+    /// The source for a main scene file: its folder is the root.
+    pub fn for_main_file(main: &Path) -> Self {
+        Self::new(main.parent().unwrap_or(Path::new(".")))
+    }
+
+    /// The filesystem path a written path resolves to. Scenes written on Windows use `\`.
+    pub fn resolve(&self, written: &str) -> PathBuf {
+        self.root.join(written.replace('\\', "/"))
+    }
+}
+
+impl AssetSource for FsSource {
+    fn read(&self, written: &str) -> Result<Arc<[u8]>, AssetError> {
+        let path = self.resolve(written);
+        let tried = path.display().to_string();
+        match std::fs::read(&path) {
+            Ok(bytes) => Ok(bytes.into()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(AssetError::NotFound {
+                written: written.to_string(),
+                tried,
+            }),
+            Err(source) => Err(AssetError::Io {
+                written: written.to_string(),
+                tried,
+                source,
+            }),
+        }
+    }
+}
+
+/// Files held in memory under their written paths (a worker's received blobs).
+#[derive(Clone, Debug, Default)]
+pub struct MemorySource {
+    files: HashMap<String, Arc<[u8]>>,
+}
+
+impl MemorySource {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn insert(&mut self, written: impl Into<String>, bytes: Arc<[u8]>) {
+        self.files.insert(written.into(), bytes);
+    }
+}
+
+impl AssetSource for MemorySource {
+    fn read(&self, written: &str) -> Result<Arc<[u8]>, AssetError> {
+        self.files
+            .get(written)
+            .cloned()
+            .ok_or_else(|| AssetError::NotFound {
+                written: written.to_string(),
+                tried: "the files received from the coordinator".to_string(),
+            })
+    }
+}

@@ -1,0 +1,1 @@
+//! Cameras: perspective, thin lens, fisheye (the course's), orthographic.

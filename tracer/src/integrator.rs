@@ -1,0 +1,1 @@
+//! Unidirectional path tracing with next-event estimation and MIS.

@@ -1,0 +1,22 @@
+//! YAT's renderer as a library. It knows nothing of the network: the worker and coordinator
+//! crates drive it through [`render`].
+//!
+//! Data flow: `.lxs` text -> [`parse`] -> [`desc::SceneDesc`] (plain data, defaults applied)
+//! -> [`render::RenderScene::build`] (world-space geometry and BVH, decoded textures, light
+//! sampling tables) -> [`render::RenderScene::render_unit`] -> [`film::SampleBuffer`]s merged
+//! into a [`film::Film`].
+
+pub mod assets;
+pub mod camera;
+pub mod desc;
+pub mod film;
+pub mod geometry;
+pub mod image_io;
+pub mod integrator;
+pub mod lights;
+pub mod material;
+pub mod math;
+pub mod parse;
+pub mod render;
+pub mod sampler;
+pub mod texture;

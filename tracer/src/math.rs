@@ -1,0 +1,94 @@
+//! Small geometric helpers shared by every module.
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3,
+    /// Unit length.
+    pub dir: Vec3,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self { origin, dir }
+    }
+
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// An orthonormal basis with `n` as its z axis; converts between world and local shading space.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    pub s: Vec3,
+    pub t: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// A frame around `n` with `s` along `tangent` projected onto the plane (any tangent if
+    /// that is degenerate).
+    pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Self {
+        let s = tangent - n * n.dot(tangent);
+        let len2 = s.length_squared();
+        if len2 > 1e-12 && len2.is_finite() {
+            let s = s / len2.sqrt();
+            Self { s, t: n.cross(s), n }
+        } else {
+            Self::from_normal(n)
+        }
+    }
+
+    /// Duff et al. 2017, "Building an Orthonormal Basis, Revisited".
+    pub fn from_normal(n: Vec3) -> Self {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Self { s, t, n }
+    }
+
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// Luminance of linear sRGB / Rec.709 primaries.
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// Offsets a ray origin along the geometric normal so it does not re-hit its own surface; the
+/// offset scales with the magnitude of the point (floating-point error grows with it).
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    if dir.dot(ng) >= 0.0 {
+        p + ng * eps
+    } else {
+        p - ng * eps
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_and_round_trips() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+            let f = Frame::from_normal(n);
+            assert!(f.s.dot(f.t).abs() < 1e-6 && f.s.dot(f.n).abs() < 1e-6);
+            assert!((f.s.length() - 1.0).abs() < 1e-5 && (f.t.length() - 1.0).abs() < 1e-5);
+            let v = Vec3::new(0.1, 0.7, -0.2);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
+            assert!((f.to_local(n) - Vec3::Z).length() < 1e-5);
+        }
+    }
+}

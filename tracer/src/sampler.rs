@@ -1,0 +1,1 @@
+//! The deterministic sampler: a sample value for (pixel, sample index, dimension, seed).

@@ -1,0 +1,1 @@
+//! The render node. OWNER: distributed helper.
