@@ -1,9 +1,17 @@
 //! The `yat` command: render (in-process or over workers), worker, check.
 
+mod check;
+mod distributed;
+mod render_cmd;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "yat", version, about = "YAT: a path tracer for LuxRender scenes, on one machine or many")]
+#[command(
+    name = "yat",
+    version,
+    about = "YAT: a path tracer for LuxRender scenes, on one machine or many"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -11,18 +19,25 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Render a scene in-process, or over gRPC workers with --workers / --local-workers.
+    Render(render_cmd::RenderArgs),
+    /// Serve renders to a coordinator over gRPC.
+    Worker(yat_worker::WorkerArgs),
     /// Parse a scene and report what it contains, without rendering.
-    Check {
-        /// The main .lxs file.
-        scene: std::path::PathBuf,
-    },
+    Check(check::CheckArgs),
 }
 
 fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
-    match cli.command {
-        Command::Check { scene } => {
-            anyhow::bail!("check {} is not implemented yet", scene.display())
-        }
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_env("YAT_LOG")
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match Cli::parse().command {
+        Command::Render(args) => render_cmd::run(args),
+        Command::Worker(args) => yat_worker::run(args),
+        Command::Check(args) => check::run(args),
     }
 }
