@@ -103,11 +103,16 @@ pub enum BuildError {
 /// Tiles of this many pixels on a side.
 pub const TILE_SIZE: u32 = 64;
 
-/// The unit plan: tiles of `TILE_SIZE` in scanline order, and sample ranges of
-/// `samples_per_unit`, ordered by sample range first so that any prefix of the plan covers the
-/// whole image. Depends on the settings only.
-pub fn plan_units(settings: &RenderSettings, samples_per_unit: u32) -> Vec<WorkUnit> {
-    let samples_per_unit = samples_per_unit.max(1);
+/// Sample ranges per tile: enough passes for useful previews and balancing, few enough that a
+/// unit's work dwarfs its network round trip.
+pub const PASSES: u32 = 8;
+
+/// The unit plan: tiles of `TILE_SIZE` in scanline order, and `PASSES` sample ranges, ordered
+/// by sample range first so that any prefix of the plan covers the whole image. It depends on
+/// the settings only: a pixel's sum is added up unit by unit, so the same plan everywhere is
+/// what makes in-process and distributed images bit-identical.
+pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
+    let samples_per_unit = settings.spp.div_ceil(PASSES).max(1);
     let mut units = Vec::new();
     let mut start = 0;
     while start < settings.spp {
