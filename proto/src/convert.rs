@@ -122,9 +122,7 @@ pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<Wor
     }
     let pixels = u64::from(u.x1 - u.x0) * u64::from(u.y1 - u.y0);
     if pixels > MAX_UNIT_PIXELS {
-        return Err(invalid(format!(
-            "{pixels} pixels exceed {MAX_UNIT_PIXELS}"
-        )));
+        return Err(invalid(format!("{pixels} pixels exceed {MAX_UNIT_PIXELS}")));
     }
     Ok(WorkUnit {
         index: u.index,
@@ -206,7 +204,10 @@ mod tests {
     #[test]
     fn settings_round_trip_and_reject_empty_images() {
         let s = settings();
-        assert_eq!(RenderSettings::try_from(&pb::RenderSettings::from(&s)).unwrap(), s);
+        assert_eq!(
+            RenderSettings::try_from(&pb::RenderSettings::from(&s)).unwrap(),
+            s
+        );
         let mut wire = pb::RenderSettings::from(&s);
         wire.height = 0;
         assert!(RenderSettings::try_from(&wire).is_err());
@@ -235,8 +236,14 @@ mod tests {
             WorkUnit { x1: 101, ..unit },
             WorkUnit { x1: 64, ..unit },
             WorkUnit { y0: 50, ..unit },
-            WorkUnit { sample_end: 17, ..unit },
-            WorkUnit { sample_start: 16, ..unit },
+            WorkUnit {
+                sample_end: 17,
+                ..unit
+            },
+            WorkUnit {
+                sample_start: 16,
+                ..unit
+            },
         ] {
             assert!(unit_from_wire(&(&bad).into(), &s).is_err(), "{bad:?}");
         }
