@@ -348,7 +348,10 @@ impl<'s> Builder<'s> {
                 let name = r.string("a coordinate system name")?;
                 match self.named_coords.get(&name) {
                     Some(m) => self.ctm = *m,
-                    None => self.warn(pos, format!("CoordSysTransform: no coordinate system named \"{name}\"")),
+                    None => self.warn(
+                        pos,
+                        format!("CoordSysTransform: no coordinate system named \"{name}\""),
+                    ),
                 }
             }
             "MotionBegin" => {
@@ -392,13 +395,13 @@ impl<'s> Builder<'s> {
                     return Ok(());
                 }
                 if keyword == "Camera" {
-                    self.named_coords.insert("camera".into(), self.ctm.inverse());
+                    self.named_coords
+                        .insert("camera".into(), self.ctm.inverse());
                 }
                 self.option(keyword, ty, params, pos)?;
             }
-            "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath" | "PortalShape" => {
-                r.skip_statement()?
-            }
+            "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath"
+            | "PortalShape" => r.skip_statement()?,
             "Volume" | "MakeNamedVolume" | "Exterior" | "Interior" => {
                 r.skip_statement()?;
                 self.warn_once(
@@ -429,7 +432,12 @@ impl<'s> Builder<'s> {
         Ok(())
     }
 
-    fn world_statement(&mut self, keyword: &str, pos: &Pos, r: &mut Reader) -> Result<(), ParseError> {
+    fn world_statement(
+        &mut self,
+        keyword: &str,
+        pos: &Pos,
+        r: &mut Reader,
+    ) -> Result<(), ParseError> {
         match keyword {
             "Texture" => {
                 let name = r.string("the texture name")?;
@@ -478,7 +486,10 @@ impl<'s> Builder<'s> {
                 let ty = r.string("the area light type")?;
                 let params = r.params(format!("AreaLightSource \"{ty}\""))?;
                 if ty != "area" {
-                    self.warn(pos, format!("AreaLightSource \"{ty}\" is treated as \"area\""));
+                    self.warn(
+                        pos,
+                        format!("AreaLightSource \"{ty}\" is treated as \"area\""),
+                    );
                 }
                 self.gs.area_light = Some(AreaLightParams {
                     l: params.color("L", Vec3::ONE)?,
@@ -500,7 +511,9 @@ impl<'s> Builder<'s> {
                 if let Some((open, _)) = &self.current_object {
                     return Err(ParseError::Invalid {
                         pos: pos.clone(),
-                        message: format!("ObjectBegin \"{name}\" inside object \"{open}\": objects cannot nest"),
+                        message: format!(
+                            "ObjectBegin \"{name}\" inside object \"{open}\": objects cannot nest"
+                        ),
                     });
                 }
                 self.push(FrameKind::Object, pos);
@@ -546,8 +559,8 @@ impl<'s> Builder<'s> {
     }
 
     fn push(&mut self, kind: FrameKind, pos: &Pos) {
-        let saved = (kind != FrameKind::Transform)
-            .then(|| (self.gs.clone(), self.textures_in_scope.len()));
+        let saved =
+            (kind != FrameKind::Transform).then(|| (self.gs.clone(), self.textures_in_scope.len()));
         self.stack.push(Frame {
             kind,
             pos: pos.clone(),
@@ -599,7 +612,12 @@ impl<'s> Builder<'s> {
     /// as a colour is splatted).
     pub(super) fn find_texture(&self, name: &str, want_color: bool) -> Option<&TexBinding> {
         let mut any = None;
-        for t in self.textures_in_scope.iter().rev().filter(|t| t.name == name) {
+        for t in self
+            .textures_in_scope
+            .iter()
+            .rev()
+            .filter(|t| t.name == name)
+        {
             if t.is_color == want_color {
                 return Some(&t.binding);
             }
@@ -622,7 +640,10 @@ impl<'s> Builder<'s> {
         match self.named_materials.get(name) {
             Some(&id) => id,
             None => {
-                self.warn(pos, format!("no material named \"{name}\"; using the default matte"));
+                self.warn(
+                    pos,
+                    format!("no material named \"{name}\"; using the default matte"),
+                );
                 self.default_material()
             }
         }
@@ -644,7 +665,12 @@ impl<'s> Builder<'s> {
     // -----------------------------------------------------------------------------------------
     // Shapes
 
-    fn shape_statement(&mut self, ty: &str, params: &ParamList, pos: &Pos) -> Result<(), ParseError> {
+    fn shape_statement(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<(), ParseError> {
         let Some(geometry) = self.geometry(ty, params, pos)? else {
             return Ok(());
         };

@@ -60,7 +60,11 @@ pub struct Lexer<'a> {
 impl<'a> Lexer<'a> {
     pub fn new(text: &'a [u8]) -> Self {
         // A UTF-8 byte order mark is not part of the first statement.
-        let offset = if text.starts_with(b"\xEF\xBB\xBF") { 3 } else { 0 };
+        let offset = if text.starts_with(b"\xEF\xBB\xBF") {
+            3
+        } else {
+            0
+        };
         Self {
             text,
             offset,
@@ -149,7 +153,10 @@ impl<'a> Lexer<'a> {
             _ => {
                 return Err(LexError {
                     at,
-                    message: format!("unexpected character {}", describe_byte(self.text, self.offset)),
+                    message: format!(
+                        "unexpected character {}",
+                        describe_byte(self.text, self.offset)
+                    ),
                 })
             }
         };

@@ -31,7 +31,12 @@ pub fn area_light(e: &AreaLightParams, area: f32) -> AreaLightDesc {
 }
 
 impl Builder<'_> {
-    pub(super) fn light(&mut self, ty: &str, params: &ParamList, pos: &Pos) -> Result<(), ParseError> {
+    pub(super) fn light(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<(), ParseError> {
         let l = params.color("L", Vec3::ONE)?;
         let gain = params.float("gain", 1.0)?;
         let light = match ty {
@@ -156,7 +161,10 @@ mod tests {
         assert!((r - e.l * expected_gain).abs().max_element() < 1e-3 * expected_gain);
         // Emitted luminous power then equals gain x power x efficacy: Y(L x gain) x area x pi.
         assert!((luminance(r) * area * PI - 2.0 * 1700.0).abs() < 0.5);
-        let off = AreaLightParams { power: 0.0, ..e.clone() };
+        let off = AreaLightParams {
+            power: 0.0,
+            ..e.clone()
+        };
         assert_eq!(area_light(&off, area).radiance, e.l * 2.0);
         // An infinite plane has no finite power: the gain stays as given.
         assert_eq!(area_light(&e, f32::INFINITY).radiance, e.l * 2.0);

@@ -23,7 +23,13 @@ impl Builder<'_> {
         Ok(self.add_material(desc))
     }
 
-    fn color(&mut self, params: &ParamList, name: &str, default: f32, clamp: bool) -> Result<Tex, ParseError> {
+    fn color(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f32,
+        clamp: bool,
+    ) -> Result<Tex, ParseError> {
         let v = params.tex_color(name, Vec3::splat(default))?;
         Ok(match self.resolve(v, true, Vec3::splat(default)) {
             Tex::Const(c) if clamp => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
@@ -37,13 +43,22 @@ impl Builder<'_> {
     }
 
     /// A parameter this renderer does not model: silent at its default, a warning otherwise.
-    fn unsupported_unless(&mut self, params: &ParamList, name: &str, default: f32) -> Result<(), ParseError> {
+    fn unsupported_unless(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f32,
+    ) -> Result<(), ParseError> {
         if let Some(p) = params.find(name) {
             let is_default = matches!(&p.values, Values::Numbers(v) if v.len() == 1 && v[0] as f32 == default)
                 && matches!(p.ty, ParamType::Float | ParamType::Integer);
             if !is_default {
                 let key = format!("unsupported|{}|{name}", params.statement);
-                let message = format!("{}: \"{}\" is not supported and is ignored", params.statement, p.decl());
+                let message = format!(
+                    "{}: \"{}\" is not supported and is ignored",
+                    params.statement,
+                    p.decl()
+                );
                 let pos = p.pos.clone();
                 self.warn_once(key, &pos, message);
             }
@@ -51,7 +66,12 @@ impl Builder<'_> {
         Ok(())
     }
 
-    fn material_desc(&mut self, ty: &str, params: &ParamList, pos: &Pos) -> Result<MaterialDesc, ParseError> {
+    fn material_desc(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<MaterialDesc, ParseError> {
         Ok(match ty {
             "matte" => MaterialDesc::Matte {
                 kd: self.color(params, "Kd", 0.9, true)?,
@@ -69,7 +89,13 @@ impl Builder<'_> {
                     }
                     Tex::Const(_) => ks,
                     Tex::Texture(_) => {
-                        self.warn(pos, format!("{}: a textured \"index\" is not supported; Ks is used as given", params.statement));
+                        self.warn(
+                            pos,
+                            format!(
+                                "{}: a textured \"index\" is not supported; Ks is used as given",
+                                params.statement
+                            ),
+                        );
                         ks
                     }
                 };
@@ -105,10 +131,22 @@ impl Builder<'_> {
                 MaterialDesc::Glass {
                     kr: self.color(params, "Kr", 1.0, false)?,
                     kt: self.color(params, "Kt", 1.0, false)?,
-                    index: if ty == "glass2" { Tex::float(1.5) } else { self.float(params, "index", 1.5)? },
+                    index: if ty == "glass2" {
+                        Tex::float(1.5)
+                    } else {
+                        self.float(params, "index", 1.5)?
+                    },
                     architectural: params.bool("architectural", false)?,
-                    uroughness: if rough > 0.0 { self.float(params, "uroughness", rough)? } else { Tex::float(0.0) },
-                    vroughness: if rough > 0.0 { self.float(params, "vroughness", rough)? } else { Tex::float(0.0) },
+                    uroughness: if rough > 0.0 {
+                        self.float(params, "uroughness", rough)?
+                    } else {
+                        Tex::float(0.0)
+                    },
+                    vroughness: if rough > 0.0 {
+                        self.float(params, "vroughness", rough)?
+                    } else {
+                        Tex::float(0.0)
+                    },
                 }
             }
             "metal" => {
@@ -174,7 +212,9 @@ impl Builder<'_> {
     fn metal2_fresnel(&mut self, params: &ParamList) -> Result<Fresnel, ParseError> {
         if let Some(p) = params.find("fresnel") {
             if p.ty == ParamType::Color {
-                return Ok(Fresnel::Reflectance(self.color(params, "fresnel", 1.0, true)?));
+                return Ok(Fresnel::Reflectance(
+                    self.color(params, "fresnel", 1.0, true)?,
+                ));
             }
             return Ok(match params.tex_float("fresnel", 5.0)? {
                 TexValue::Const(c) => Fresnel::Index(Tex::Const(c)),
@@ -185,7 +225,10 @@ impl Builder<'_> {
                     }
                     Some(TexBinding::Texture(id)) => Fresnel::Reflectance(Tex::Texture(id)),
                     None => {
-                        self.warn(&pos, format!("no fresnel texture named \"{name}\"; using index 5"));
+                        self.warn(
+                            &pos,
+                            format!("no fresnel texture named \"{name}\"; using index 5"),
+                        );
                         Fresnel::Index(Tex::float(5.0))
                     }
                 },

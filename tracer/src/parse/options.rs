@@ -28,14 +28,25 @@ pub struct OptionsState {
     sampler: Option<SamplerDesc>,
 }
 
-pub type Options = (CameraDesc, FilmDesc, FilterDesc, IntegratorDesc, SamplerDesc);
+pub type Options = (
+    CameraDesc,
+    FilmDesc,
+    FilterDesc,
+    IntegratorDesc,
+    SamplerDesc,
+);
 
 impl OptionsState {
     /// `end` names the main file, for warnings about statements it lacks.
     pub fn finish(self, b: &mut Builder, end: &Pos) -> Result<Options, ParseError> {
         let film = match self.film {
             Some(f) => f,
-            None => film(b, "fleximage", &ParamList::new(String::new(), Vec::new()), None)?,
+            None => film(
+                b,
+                "fleximage",
+                &ParamList::new(String::new(), Vec::new()),
+                None,
+            )?,
         };
         let camera = match self.camera {
             Some(c) => {
@@ -106,7 +117,9 @@ impl Builder<'_> {
             }
             "Film" => self.options.film = Some(film(self, &ty, &params, Some(pos))?),
             "PixelFilter" => self.options.filter = Some(filter(self, &ty, &params, pos)?),
-            "SurfaceIntegrator" => self.options.integrator = Some(integrator(self, &ty, &params, pos)?),
+            "SurfaceIntegrator" => {
+                self.options.integrator = Some(integrator(self, &ty, &params, pos)?)
+            }
             "Sampler" => {
                 let n = params.int("pixelsamples", 0)?;
                 // The sampler's algorithm is ours; only its sample count carries over.
@@ -125,7 +138,12 @@ impl Builder<'_> {
     }
 }
 
-fn film(b: &mut Builder, ty: &str, params: &ParamList, pos: Option<&Pos>) -> Result<FilmDesc, ParseError> {
+fn film(
+    b: &mut Builder,
+    ty: &str,
+    params: &ParamList,
+    pos: Option<&Pos>,
+) -> Result<FilmDesc, ParseError> {
     if let Some(pos) = pos {
         if ty != "fleximage" {
             b.warn(pos, format!("Film \"{ty}\" is read as \"fleximage\""));
@@ -160,7 +178,10 @@ fn film(b: &mut Builder, ty: &str, params: &ParamList, pos: Option<&Pos>) -> Res
         },
         other => {
             if let Some(pos) = pos {
-                b.warn(pos, format!("Film: unknown tonemapkernel \"{other}\"; using autolinear"));
+                b.warn(
+                    pos,
+                    format!("Film: unknown tonemapkernel \"{other}\"; using autolinear"),
+                );
             }
             ToneMap::AutoLinear
         }
@@ -191,11 +212,21 @@ fn film(b: &mut Builder, ty: &str, params: &ParamList, pos: Option<&Pos>) -> Res
     })
 }
 
-fn filter(b: &mut Builder, ty: &str, params: &ParamList, pos: &Pos) -> Result<FilterDesc, ParseError> {
+fn filter(
+    b: &mut Builder,
+    ty: &str,
+    params: &ParamList,
+    pos: &Pos,
+) -> Result<FilterDesc, ParseError> {
     let (kind, width) = match ty {
         "box" => (FilterKind::Box, 0.5),
         "triangle" => (FilterKind::Triangle, 2.0),
-        "gaussian" => (FilterKind::Gaussian { alpha: params.float("alpha", 2.0)? }, 2.0),
+        "gaussian" => (
+            FilterKind::Gaussian {
+                alpha: params.float("alpha", 2.0)?,
+            },
+            2.0,
+        ),
         "mitchell" => {
             params.ignore("supersample");
             (
@@ -209,9 +240,17 @@ fn filter(b: &mut Builder, ty: &str, params: &ParamList, pos: &Pos) -> Result<Fi
         // Catmull-Rom is the Mitchell-Netravali filter with B = 0, C = 1/2.
         "catmullrom" => (FilterKind::Mitchell { b: 0.0, c: 0.5 }, 2.0),
         "blackmanharris" => (FilterKind::BlackmanHarris, 4.0),
-        "sinc" => (FilterKind::Sinc { tau: params.float("tau", 3.0)? }, 4.0),
+        "sinc" => (
+            FilterKind::Sinc {
+                tau: params.float("tau", 3.0)?,
+            },
+            4.0,
+        ),
         other => {
-            b.warn(pos, format!("PixelFilter \"{other}\" is unknown; using mitchell"));
+            b.warn(
+                pos,
+                format!("PixelFilter \"{other}\" is unknown; using mitchell"),
+            );
             (
                 FilterKind::Mitchell {
                     b: 1.0 / 3.0,
@@ -272,7 +311,14 @@ fn integrator(
         }
         "bidirectional" => {
             let max_depth = depth("eyedepth")?;
-            for name in ["lightdepth", "lightraycount", "lightpathstrategy", "lightstrategy", "eyerrthreshold", "lightrrthreshold"] {
+            for name in [
+                "lightdepth",
+                "lightraycount",
+                "lightpathstrategy",
+                "lightstrategy",
+                "eyerrthreshold",
+                "lightrrthreshold",
+            ] {
                 params.ignore(name);
             }
             b.warn_once(
@@ -324,10 +370,16 @@ fn camera(b: &mut Builder, c: &CameraStatement, film: &FilmDesc) -> Result<Camer
         None => [-1.0, 1.0, -1.0 / frame, 1.0 / frame],
     };
     if p.bool("autofocus", false)? {
-        b.warn(&c.pos, "Camera: autofocus is not supported; focaldistance is used as given");
+        b.warn(
+            &c.pos,
+            "Camera: autofocus is not supported; focaldistance is used as given",
+        );
     }
     let camera_to_world = c.world_to_camera.inverse();
-    if !camera_to_world.to_cols_array().iter().all(|v| v.is_finite())
+    if !camera_to_world
+        .to_cols_array()
+        .iter()
+        .all(|v| v.is_finite())
         || c.world_to_camera.determinant() == 0.0
     {
         return Err(ParseError::Invalid {

@@ -170,7 +170,10 @@ impl ParamList {
         } else {
             Err(self.error(
                 p,
-                format!("value {} ({v}) is out of range for a 32-bit float", index + 1),
+                format!(
+                    "value {} ({v}) is out of range for a 32-bit float",
+                    index + 1
+                ),
             ))
         }
     }
@@ -207,7 +210,10 @@ impl ParamList {
         if v.fract() != 0.0 || !v.is_finite() || v.abs() > i32::MAX as f64 {
             return Err(self.error(
                 p,
-                format!("value {} ({v}) is not an integer in the 32-bit range", index + 1),
+                format!(
+                    "value {} ({v}) is not an integer in the 32-bit range",
+                    index + 1
+                ),
             ));
         }
         Ok(v as i64)
@@ -254,7 +260,10 @@ impl ParamList {
         match v[0].as_str() {
             "true" => Ok(true),
             "false" => Ok(false),
-            other => Err(self.error(p, format!("expected \"true\" or \"false\", got \"{other}\""))),
+            other => Err(self.error(
+                p,
+                format!("expected \"true\" or \"false\", got \"{other}\""),
+            )),
         }
     }
 
@@ -263,7 +272,9 @@ impl ParamList {
             return Ok(None);
         };
         match &p.values {
-            Values::Strings(v) if v.len() == 1 && p.ty == ParamType::String => Ok(Some(v[0].clone())),
+            Values::Strings(v) if v.len() == 1 && p.ty == ParamType::String => {
+                Ok(Some(v[0].clone()))
+            }
             _ => Err(self.type_error(p, "one string")),
         }
     }
@@ -286,7 +297,10 @@ impl ParamList {
         let Some(p) = self.find(name) else {
             return Ok(None);
         };
-        if !matches!(p.ty, ParamType::Point | ParamType::Vector | ParamType::Normal) {
+        if !matches!(
+            p.ty,
+            ParamType::Point | ParamType::Vector | ParamType::Normal
+        ) {
             return Err(self.type_error(p, "points, vectors or normals"));
         }
         let v = self.numbers(p, "3-component values")?;
@@ -336,7 +350,12 @@ impl ParamList {
     /// A texture reference: `"texture Kd" "name"` or a bare string given to a color or float.
     fn texture_name(&self, p: &Param) -> Result<Option<TexValue>, ParseError> {
         match &p.values {
-            Values::Strings(v) if matches!(p.ty, ParamType::Texture | ParamType::Color | ParamType::Float) => {
+            Values::Strings(v)
+                if matches!(
+                    p.ty,
+                    ParamType::Texture | ParamType::Color | ParamType::Float
+                ) =>
+            {
                 if v.len() != 1 {
                     return Err(self.type_error(p, "one texture name"));
                 }
@@ -376,7 +395,11 @@ impl ParamList {
 
     /// The number of values of a parameter, if present (without marking it used).
     pub fn count(&self, name: &str) -> Option<usize> {
-        self.params.iter().rev().find(|p| p.name == name).map(|p| p.values.len())
+        self.params
+            .iter()
+            .rev()
+            .find(|p| p.name == name)
+            .map(|p| p.values.len())
     }
 }
 
@@ -412,7 +435,9 @@ mod tests {
         assert_eq!(l.int("n", 0).unwrap(), 7);
         assert!(l.bool("b", false).unwrap());
         assert_eq!(l.color("Ks", Vec3::ONE).unwrap(), Vec3::splat(0.4));
-        assert!(matches!(l.tex_color("Kd", Vec3::ONE).unwrap(), TexValue::Named { name, .. } if name == "tex"));
+        assert!(
+            matches!(l.tex_color("Kd", Vec3::ONE).unwrap(), TexValue::Named { name, .. } if name == "tex")
+        );
         assert_eq!(l.unused().count(), 0);
     }
 
@@ -432,6 +457,10 @@ mod tests {
         let e = l.float("big", 1.0).unwrap_err().to_string();
         assert!(e.contains("float big") && e.contains("out of range"), "{e}");
         assert!(l.int("i", 0).unwrap_err().to_string().contains("integer i"));
-        assert!(l.ints("f").unwrap_err().to_string().contains("not an integer"));
+        assert!(l
+            .ints("f")
+            .unwrap_err()
+            .to_string()
+            .contains("not an integer"));
     }
 }

@@ -92,7 +92,11 @@ pub fn read_mesh(bytes: &[u8]) -> Result<TriangleMesh, String> {
                             mesh.indices.push([*a, *c, *d]);
                         }
                         (false, Some(v)) => {
-                            return Err(format!("face {} has {} vertices; only triangles and quads are supported", i + 1, v.len()))
+                            return Err(format!(
+                                "face {} has {} vertices; only triangles and quads are supported",
+                                i + 1,
+                                v.len()
+                            ))
                         }
                         _ => return Err(format!("face {} has no valid vertex index list", i + 1)),
                     }

@@ -79,7 +79,10 @@ impl<'a> Reader<'a> {
             TokenKind::Str(s) => Ok(s.into_owned()),
             ref other => Err(self.syntax(
                 &t,
-                format!("expected {what} (a quoted string), found {}", other.describe()),
+                format!(
+                    "expected {what} (a quoted string), found {}",
+                    other.describe()
+                ),
             )),
         }
     }
@@ -117,7 +120,10 @@ impl<'a> Reader<'a> {
                     ref other => {
                         return Err(self.syntax(
                             &t,
-                            format!("{what}: expected a number or `]`, found {}", other.describe()),
+                            format!(
+                                "{what}: expected a number or `]`, found {}",
+                                other.describe()
+                            ),
                         ))
                     }
                 }
@@ -211,13 +217,19 @@ impl<'a> Reader<'a> {
                     }
                     ref other => Err(self.syntax(
                         &first,
-                        format!("{statement} \"{decl}\": expected values, found {}", other.describe()),
+                        format!(
+                            "{statement} \"{decl}\": expected values, found {}",
+                            other.describe()
+                        ),
                     )),
                 }
             }
             ref other => Err(self.syntax(
                 &t,
-                format!("{statement} \"{decl}\": expected a value or `[`, found {}", other.describe()),
+                format!(
+                    "{statement} \"{decl}\": expected a value or `[`, found {}",
+                    other.describe()
+                ),
             )),
         }
     }

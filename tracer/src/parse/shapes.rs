@@ -12,7 +12,12 @@ use crate::desc::{AssetKind, Geometry, ShapeDesc, TriangleMesh};
 
 impl Builder<'_> {
     /// The geometry of `Shape "ty"`, or `None` (with a warning) for unsupported shapes.
-    pub(super) fn geometry(&mut self, ty: &str, params: &ParamList, pos: &Pos) -> Result<Option<Geometry>, ParseError> {
+    pub(super) fn geometry(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<Option<Geometry>, ParseError> {
         Ok(Some(match ty {
             "trianglemesh" | "mesh" => Geometry::Mesh(Arc::new(inline_mesh(params, pos)?)),
             "plymesh" => {
@@ -47,7 +52,11 @@ impl Builder<'_> {
                 phimax: params.float("phimax", 360.0)?,
             },
             "plane" => {
-                let name = if params.count("n").is_some() { "n" } else { "N" };
+                let name = if params.count("n").is_some() {
+                    "n"
+                } else {
+                    "N"
+                };
                 let n = params.vec3(name, Vec3::Z)?;
                 let Some(normal) = n.try_normalize() else {
                     let p = params.find(name).expect("a zero normal was given");
@@ -59,7 +68,10 @@ impl Builder<'_> {
                 for p in &params.params {
                     params.ignore(&p.name);
                 }
-                self.warn(pos, format!("Shape \"{other}\" is not supported; the shape is skipped"));
+                self.warn(
+                    pos,
+                    format!("Shape \"{other}\" is not supported; the shape is skipped"),
+                );
                 return Ok(None);
             }
         }))
@@ -96,11 +108,17 @@ fn inline_mesh(params: &ParamList, pos: &Pos) -> Result<TriangleMesh, ParseError
     for name in ["indices", "triindices"] {
         if let Some((v, p)) = params.ints(name)? {
             if any_indices {
-                return Err(params.error(p, "give the triangles once, as \"indices\" or \"triindices\""));
+                return Err(params.error(
+                    p,
+                    "give the triangles once, as \"indices\" or \"triindices\"",
+                ));
             }
             any_indices = true;
             if v.len() % 3 != 0 {
-                return Err(params.error(p, format!("expected a multiple of 3 indices, got {}", v.len())));
+                return Err(params.error(
+                    p,
+                    format!("expected a multiple of 3 indices, got {}", v.len()),
+                ));
             }
             let v = checked_indices(params, p, &v, n)?;
             indices.extend(v.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
@@ -109,7 +127,10 @@ fn inline_mesh(params: &ParamList, pos: &Pos) -> Result<TriangleMesh, ParseError
     if let Some((v, p)) = params.ints("quadindices")? {
         any_indices = true;
         if v.len() % 4 != 0 {
-            return Err(params.error(p, format!("expected a multiple of 4 indices, got {}", v.len())));
+            return Err(params.error(
+                p,
+                format!("expected a multiple of 4 indices, got {}", v.len()),
+            ));
         }
         let v = checked_indices(params, p, &v, n)?;
         for q in v.chunks_exact(4) {
@@ -121,22 +142,35 @@ fn inline_mesh(params: &ParamList, pos: &Pos) -> Result<TriangleMesh, ParseError
         if n != 3 {
             return Err(ParseError::Invalid {
                 pos: pos.clone(),
-                message: format!("{}: missing \"integer indices\" (only a 3-vertex mesh may omit them)", params.statement),
+                message: format!(
+                    "{}: missing \"integer indices\" (only a 3-vertex mesh may omit them)",
+                    params.statement
+                ),
             });
         }
         indices.push([0, 1, 2]);
     }
     let normals = match params.vec3s("N")? {
         Some((v, p)) if v.len() != n => {
-            return Err(params.error(p, format!("expected one normal per vertex ({n}), got {}", v.len())))
+            return Err(params.error(
+                p,
+                format!("expected one normal per vertex ({n}), got {}", v.len()),
+            ))
         }
         Some((v, _)) => Some(v),
         None => None,
     };
-    let uv_name = if params.count("uv").is_some() { "uv" } else { "st" };
+    let uv_name = if params.count("uv").is_some() {
+        "uv"
+    } else {
+        "st"
+    };
     let uvs = match params.floats(uv_name)? {
         Some((v, p)) if v.len() != 2 * n => {
-            return Err(params.error(p, format!("expected 2 values per vertex ({}), got {}", 2 * n, v.len())))
+            return Err(params.error(
+                p,
+                format!("expected 2 values per vertex ({}), got {}", 2 * n, v.len()),
+            ))
         }
         Some((v, _)) => Some(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect()),
         None => None,
@@ -173,8 +207,17 @@ fn checked_indices(
 /// Checks a mesh read from a file: indices in range, attribute counts, finite values.
 fn validate_mesh(m: &TriangleMesh) -> Result<(), String> {
     let n = m.positions.len();
-    if let Some((i, v)) = m.indices.iter().flatten().enumerate().find(|(_, &v)| v as usize >= n) {
-        return Err(format!("face index {} (value {v}) is out of range: {n} vertices", i + 1));
+    if let Some((i, v)) = m
+        .indices
+        .iter()
+        .flatten()
+        .enumerate()
+        .find(|(_, &v)| v as usize >= n)
+    {
+        return Err(format!(
+            "face index {} (value {v}) is out of range: {n} vertices",
+            i + 1
+        ));
     }
     if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
         return Err(format!("vertex {} has a non-finite position", i + 1));
@@ -185,8 +228,14 @@ fn validate_mesh(m: &TriangleMesh) -> Result<(), String> {
         }
     }
     if let Some(uvs) = &m.uvs {
-        if let Some(i) = uvs.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
-            return Err(format!("vertex {} has a non-finite texture coordinate", i + 1));
+        if let Some(i) = uvs
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(format!(
+                "vertex {} has a non-finite texture coordinate",
+                i + 1
+            ));
         }
     }
     Ok(())
@@ -222,7 +271,9 @@ pub fn world_area(shape: &ShapeDesc) -> f32 {
             inner_radius,
             phimax,
             ..
-        } => 0.5 * phi(*phimax) * (radius * radius - inner_radius * inner_radius).abs() * area_scale,
+        } => {
+            0.5 * phi(*phimax) * (radius * radius - inner_radius * inner_radius).abs() * area_scale
+        }
         Geometry::Cylinder {
             radius,
             zmin,

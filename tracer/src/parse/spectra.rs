@@ -81,7 +81,10 @@ mod tests {
     fn metal_presets_have_the_expected_colours() {
         let (e, k) = metal_preset("gold").unwrap();
         let gold = f0(e, k);
-        assert!(gold.x > 0.9 && gold.x > gold.y && gold.y > gold.z && gold.z < 0.5, "{gold}");
+        assert!(
+            gold.x > 0.9 && gold.x > gold.y && gold.y > gold.z && gold.z < 0.5,
+            "{gold}"
+        );
         let (e, k) = metal_preset("aluminium").unwrap();
         let al = f0(e, k);
         assert!(al.min_element() > 0.85, "{al}");

@@ -66,7 +66,10 @@ impl Builder<'_> {
                     "white" => Wrap::White,
                     "clamp" => Wrap::Clamp,
                     other => {
-                        self.warn(pos, format!("Texture \"{name}\": unknown wrap \"{other}\"; using repeat"));
+                        self.warn(
+                            pos,
+                            format!("Texture \"{name}\": unknown wrap \"{other}\"; using repeat"),
+                        );
                         Wrap::Repeat
                     }
                 };
@@ -124,7 +127,9 @@ impl Builder<'_> {
                     amount: self.resolve(amount, false, Vec3::splat(0.5)),
                 }
             }
-            "blackbody" => TextureKind::Constant(blackbody_rgb(params.float("temperature", 6500.0)?)),
+            "blackbody" => {
+                TextureKind::Constant(blackbody_rgb(params.float("temperature", 6500.0)?))
+            }
             other => {
                 for p in &params.params {
                     params.ignore(&p.name);
@@ -194,7 +199,12 @@ impl Builder<'_> {
         let mapping = params.string_or("mapping", "uv")?;
         Ok(match mapping.as_str() {
             "spherical" | "cylindrical" => {
-                for (name, default) in [("uscale", 1.0), ("vscale", 1.0), ("udelta", 0.0), ("vdelta", 0.0)] {
+                for (name, default) in [
+                    ("uscale", 1.0),
+                    ("vscale", 1.0),
+                    ("udelta", 0.0),
+                    ("vdelta", 0.0),
+                ] {
                     let v = params.float(name, default)?;
                     if v != default {
                         self.warn_once(
@@ -225,7 +235,10 @@ impl Builder<'_> {
             }
             other => {
                 if other != "uv" {
-                    self.warn(pos, format!("unknown texture mapping \"{other}\"; using uv"));
+                    self.warn(
+                        pos,
+                        format!("unknown texture mapping \"{other}\"; using uv"),
+                    );
                 }
                 Mapping2D::Uv {
                     uscale: params.float("uscale", 1.0)?,
@@ -249,7 +262,10 @@ impl Builder<'_> {
                     Tex::Const(default)
                 }
                 None => {
-                    self.warn(&pos, format!("no texture named \"{name}\"; using the default"));
+                    self.warn(
+                        &pos,
+                        format!("no texture named \"{name}\"; using the default"),
+                    );
                     Tex::Const(default)
                 }
             },
