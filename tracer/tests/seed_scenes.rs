@@ -19,7 +19,10 @@ fn seed_dir() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        println!("seed scenes not found at {} (set YAT_SEED_SCENES); skipping", dir.display());
+        println!(
+            "seed scenes not found at {} (set YAT_SEED_SCENES); skipping",
+            dir.display()
+        );
         None
     }
 }
@@ -92,7 +95,9 @@ fn every_complete_seed_scene_parses() {
         for w in &d.warnings {
             // Only warnings about what the files really ask for: no exporter noise.
             assert!(
-                !w.message.contains("write_") && !w.message.contains("colorspace") && !w.message.contains("importance"),
+                !w.message.contains("write_")
+                    && !w.message.contains("colorspace")
+                    && !w.message.contains("importance"),
                 "{scene}: {w}"
             );
         }
@@ -127,8 +132,14 @@ fn every_main_file_is_listed() {
 }
 
 const INCOMPLETE: &[(&str, &str)] = &[
-    ("Dragon/dragon.lxs", "dragon/Scene/00001/LuxRender-Geometry.lxo"),
-    ("Sponza/sponza.lxs", "sponza/Scene/00001/LuxRender-Geometry.lxo"),
+    (
+        "Dragon/dragon.lxs",
+        "dragon/Scene/00001/LuxRender-Geometry.lxo",
+    ),
+    (
+        "Sponza/sponza.lxs",
+        "sponza/Scene/00001/LuxRender-Geometry.lxo",
+    ),
     ("StanfordBunny.lxs", "Meshes/Bunny.lxo"),
     ("2StanfordBunnies.lxs", "Meshes/Bunny.lxo"),
     ("4StanfordBunnies.lxs", "Meshes/Bunny.lxo"),
@@ -143,7 +154,10 @@ fn incomplete_seed_scenes_fail_naming_the_missing_file() {
         let ParseError::Asset { error, .. } = &e else {
             panic!("{scene}: expected a missing-file error, got {e}")
         };
-        assert!(e.to_string().contains(&format!("\"{missing}\"")), "{scene}: {e}");
+        assert!(
+            e.to_string().contains(&format!("\"{missing}\"")),
+            "{scene}: {e}"
+        );
         assert!(error.to_string().contains("tried"), "{e}");
     }
 }
@@ -162,7 +176,10 @@ fn cornell_box_contents() {
     let area = (0.1 * 12.080_707f32).powi(2);
     let expected = l * 2.0 * 100.0 * 17.0 / (area * PI * luminance(l));
     let r = lamps[0].area_light.as_ref().unwrap().radiance;
-    assert!(((r - expected) / expected).abs().max_element() < 1e-3, "{r} vs {expected}");
+    assert!(
+        ((r - expected) / expected).abs().max_element() < 1e-3,
+        "{r} vs {expected}"
+    );
     assert_eq!((d.film.xresolution, d.film.yresolution), (960, 540));
     assert_eq!(d.integrator.max_depth, 16);
     let eye = d.camera.camera_to_world.transform_point3(Vec3::ZERO);
@@ -180,7 +197,11 @@ fn depth_of_field_spheres_and_lens() {
         ("DepthOfField/depth-of-field-high.lxs", 0.1),
     ] {
         let d = load(&dir, scene).unwrap();
-        let spheres = d.shapes.iter().filter(|s| matches!(s.geometry, Geometry::Sphere { .. })).count();
+        let spheres = d
+            .shapes
+            .iter()
+            .filter(|s| matches!(s.geometry, Geometry::Sphere { .. }))
+            .count();
         assert_eq!(spheres, 3, "{scene}");
         assert_eq!(d.camera.lens_radius, lens, "{scene}");
         assert_eq!(d.textures.len(), 1, "{scene}: the checkerboard floor");
