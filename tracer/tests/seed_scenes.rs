@@ -172,7 +172,7 @@ fn cornell_box_contents() {
     let lamps: Vec<_> = d.shapes.iter().filter(|s| s.area_light.is_some()).collect();
     assert_eq!(lamps.len(), 1);
     // A 0.1 x 0.1 quad scaled by 12.0807: L x gain x power x efficacy / (area x pi x Y(L)).
-    let l = Vec3::new(1.0, 0.919_171_93, 0.623_396_5);
+    let l = Vec3::new(1.0, 0.919_171_9, 0.623_396_5);
     let area = (0.1 * 12.080_707f32).powi(2);
     let expected = l * 2.0 * 100.0 * 17.0 / (area * PI * luminance(l));
     let r = lamps[0].area_light.as_ref().unwrap().radiance;
