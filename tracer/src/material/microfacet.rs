@@ -64,13 +64,15 @@ impl TrowbridgeReitz {
         1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
     }
 
-    /// Density of visible normals seen from `w` (either hemisphere).
+    /// Density of the normals visible from `w`. From below the surface (w.z < 0) the
+    /// visible normals are those `-w` sees, as `sample_wm` draws them.
     pub fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         let cos = w.z.abs();
         if cos == 0.0 {
             return 0.0;
         }
-        self.g1(w) / cos * self.d(wm) * w.dot(wm).abs()
+        let facing = (w.dot(wm) * w.z.signum()).max(0.0);
+        self.g1(w) / cos * self.d(wm) * facing
     }
 
     /// Samples a microfacet normal (upper hemisphere) visible from `w` with density
