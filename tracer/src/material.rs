@@ -61,7 +61,13 @@ impl Materials {
     }
 
     /// The BSDF of material `id` at `hit`. `u_mix` resolves `mix` materials stochastically.
-    pub fn bsdf(&self, _id: MaterialId, _hit: &SurfaceHit, _textures: &Textures, _u_mix: f32) -> Bsdf {
+    pub fn bsdf(
+        &self,
+        _id: MaterialId,
+        _hit: &SurfaceHit,
+        _textures: &Textures,
+        _u_mix: f32,
+    ) -> Bsdf {
         todo!("materials helper")
     }
 }
