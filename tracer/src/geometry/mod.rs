@@ -266,7 +266,10 @@ impl SceneGeometry {
                 let PrimSource::Triangle { mesh, tri } = self.sources[slot as usize] else {
                     unreachable!("triangle slots have triangle sources")
                 };
-                Some(self.meshes[mesh as usize].hit(tri, t_closest, b1, b2, slot))
+                let Prim::Triangle(edges) = &self.prims[slot as usize] else {
+                    unreachable!("triangle slots hold triangles")
+                };
+                Some(self.meshes[mesh as usize].hit(tri, edges, t_closest, b1, b2, slot))
             }
             Closest::Analytic { slot, hit } => {
                 let PrimSource::Analytic(a) = self.sources[slot as usize] else {

@@ -614,3 +614,133 @@ fn quadric_area_sampling_density_integrates_to_the_world_area() {
         "mean {mean}, area {quadrature}"
     );
 }
+
+/// A closed bumpy sphere of about 4 x segments^2 triangles.
+fn bumpy_sphere(segments: u32) -> TriangleMesh {
+    let (rows, columns) = (segments, 2 * segments);
+    let mut positions = Vec::new();
+    for i in 0..=rows {
+        let theta = i as f32 / rows as f32 * PI;
+        for j in 0..columns {
+            let phi = j as f32 / columns as f32 * 2.0 * PI;
+            let r = 1.0 + 0.05 * (7.0 * theta).sin() * (9.0 * phi).sin();
+            positions.push(
+                r * Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                ),
+            );
+        }
+    }
+    let mut indices = Vec::new();
+    for i in 0..rows {
+        for j in 0..columns {
+            let (a, b) = (i * columns + j, i * columns + (j + 1) % columns);
+            let (c, d) = (a + columns, b + columns);
+            indices.push([a, c, b]);
+            indices.push([b, c, d]);
+        }
+    }
+    mesh(positions, indices)
+}
+
+/// Build time and incoherent-ray throughput on generated meshes of ~100k and ~1M triangles,
+/// next to obvhs's own triangle BVH and intersector on the same triangles. Rays from inside
+/// the closed surface must all hit (misses are leaks between triangles); rays from outside aim
+/// at random points of the unit ball.
+/// `cargo test --release -p yat-tracer bvh_throughput -- --ignored --nocapture`
+#[test]
+#[ignore = "benchmark: run in release with --ignored --nocapture"]
+fn bvh_throughput() {
+    use rayon::prelude::*;
+    use std::time::Instant;
+
+    for segments in [158, 500] {
+        let desc = scene_desc(
+            vec![shape(
+                Geometry::Mesh(Arc::new(bumpy_sphere(segments))),
+                Mat4::IDENTITY,
+            )],
+            vec![],
+        );
+        let geometry = SceneGeometry::build(&desc);
+        println!(
+            "{} triangles: build {:.0} ms",
+            geometry.triangle_count(),
+            geometry.build_time().as_secs_f64() * 1e3
+        );
+        let tris: Vec<obvhs::triangle::Triangle> = geometry
+            .prims
+            .iter()
+            .filter_map(|p| match *p {
+                Prim::Triangle(t) => {
+                    let [v0, v1, v2] = t.vertices();
+                    Some(obvhs::triangle::Triangle { v0, v1, v2 })
+                }
+                Prim::Analytic(_) => None,
+            })
+            .collect();
+        let start = Instant::now();
+        let reference = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut Duration::ZERO,
+        );
+        println!(
+            "  obvhs reference build {:.0} ms",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+
+        let mut rng = fastrand::Rng::with_seed(5);
+        let inside: Vec<Ray> = (0..1_000_000)
+            .map(|_| {
+                Ray::new(
+                    random_unit(&mut rng) * rng.f32() * 0.9,
+                    random_unit(&mut rng),
+                )
+            })
+            .collect();
+        let outside: Vec<Ray> = (0..1_000_000)
+            .map(|_| {
+                let origin = random_unit(&mut rng) * 3.0;
+                let target = random_unit(&mut rng) * rng.f32();
+                Ray::new(origin, (target - origin).normalize())
+            })
+            .collect();
+        let intersect = |r: &Ray| geometry.intersect(r, f32::INFINITY).is_some();
+        let occluded = |r: &Ray| geometry.occluded(r, f32::INFINITY);
+        let reference_intersect = |r: &Ray| {
+            let ray = obvhs::ray::Ray::new_inf(r.origin.into(), canonical_dir(r.dir));
+            let mut hit = RayHit::none();
+            reference.ray_traverse(ray, &mut hit, |ray, id| {
+                tris[reference.primitive_indices[id] as usize].intersect(ray)
+            })
+        };
+        type Query<'a> = &'a (dyn Fn(&Ray) -> bool + Sync);
+        let queries: [(&str, Query, bool); 4] = [
+            ("intersect", &intersect, false),
+            ("occluded", &occluded, false),
+            ("intersect, all threads", &intersect, true),
+            ("obvhs reference intersect", &reference_intersect, false),
+        ];
+        for (rays_name, rays) in [("inside", &inside), ("outside", &outside)] {
+            for &(name, query, parallel) in &queries {
+                let start = Instant::now();
+                let hits = if parallel {
+                    rays.par_iter().filter(|r| query(r)).count()
+                } else {
+                    rays.iter().filter(|r| query(r)).count()
+                };
+                let rate = rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6;
+                println!("  {rays_name:<8} {name:<26} {rate:6.2} M rays/s, hits {hits}");
+                if rays_name == "inside" {
+                    assert!(
+                        rays.len() - hits < rays.len() / 50_000,
+                        "leaky: {hits} hits"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -33,28 +33,26 @@ impl TriangleEdges {
         }
     }
 
+    #[cfg(test)]
+    pub fn vertices(&self) -> [Vec3A; 3] {
+        [self.p0, self.p0 + self.e1, self.p0 + self.e2]
+    }
+
     /// Möller-Trumbore. Returns (t, b1, b2) for a hit with t in (0, tmax); b1 and b2 are the
-    /// barycentric weights of the second and third vertices.
+    /// barycentric weights of the second and third vertices. Branch-free until the end:
+    /// incoherent rays make early exits mispredict. A zero determinant gives infinite or NaN
+    /// values, which fail the comparisons.
     #[inline(always)]
     pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<(f32, f32, f32)> {
         let pvec = dir.cross(self.e2);
-        let det = self.e1.dot(pvec);
-        if det == 0.0 {
-            return None;
-        }
-        let inv_det = 1.0 / det;
+        let inv_det = 1.0 / self.e1.dot(pvec);
         let tvec = origin - self.p0;
-        let b1 = tvec.dot(pvec) * inv_det;
-        if !(0.0..=1.0).contains(&b1) {
-            return None;
-        }
         let qvec = tvec.cross(self.e1);
+        let b1 = tvec.dot(pvec) * inv_det;
         let b2 = dir.dot(qvec) * inv_det;
-        if b2 < 0.0 || b1 + b2 > 1.0 {
-            return None;
-        }
         let t = self.e2.dot(qvec) * inv_det;
-        (t > 0.0 && t < tmax).then_some((t, b1, b2))
+        let inside = (b1 >= 0.0) & (b2 >= 0.0) & (b1 + b2 <= 1.0);
+        (inside & (t > 0.0) & (t < tmax)).then_some((t, b1, b2))
     }
 }
 
@@ -166,29 +164,51 @@ impl WorldMesh {
         }
     }
 
-    pub fn hit(&self, tri: u32, t: f32, b1: f32, b2: f32, prim: u32) -> SurfaceHit {
-        let idx = self.indices[tri as usize];
-        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
+    /// The hit on triangle `tri` whose hot data is `edges`. Position and normal come from
+    /// `edges` (already in cache); the vertex indices, a likely cache miss, are read only for
+    /// meshes with normals or uvs.
+    pub fn hit(
+        &self,
+        tri: u32,
+        edges: &TriangleEdges,
+        t: f32,
+        b1: f32,
+        b2: f32,
+        prim: u32,
+    ) -> SurfaceHit {
         let b0 = 1.0 - b1 - b2;
-        let ng = self.geometric_normal(tri);
-        let [uv0, uv1, uv2] = match &self.uvs {
-            Some(uvs) => idx.map(|i| uvs[i as usize]),
-            None => DEFAULT_UVS,
+        let (p0, e1, e2) = (
+            Vec3::from(edges.p0),
+            Vec3::from(edges.e1),
+            Vec3::from(edges.e2),
+        );
+        let ng = e1.cross(e2).normalize() * self.orientation;
+        let idx =
+            (self.normals.is_some() || self.uvs.is_some()).then(|| self.indices[tri as usize]);
+        let [uv0, uv1, uv2] = match (&self.uvs, idx) {
+            (Some(uvs), Some(idx)) => idx.map(|i| uvs[i as usize]),
+            _ => DEFAULT_UVS,
         };
-        let ns = self
-            .normals
-            .as_ref()
-            .map(|n| b0 * n[idx[0] as usize] + b1 * n[idx[1] as usize] + b2 * n[idx[2] as usize])
-            .map(Vec3::normalize_or_zero)
-            .filter(|ns| *ns != Vec3::ZERO)
-            .map_or(ng, |ns| if ns.dot(ng) < 0.0 { -ns } else { ns });
+        let ns = match (&self.normals, idx) {
+            (Some(n), Some(idx)) => {
+                let ns =
+                    (b0 * n[idx[0] as usize] + b1 * n[idx[1] as usize] + b2 * n[idx[2] as usize])
+                        .normalize_or_zero();
+                match ns.dot(ng) {
+                    d if d < 0.0 => -ns,
+                    d if d > 0.0 => ns,
+                    _ => ng,
+                }
+            }
+            _ => ng,
+        };
         SurfaceHit {
             t,
-            p: b0 * p0 + b1 * p1 + b2 * p2,
+            p: p0 + b1 * e1 + b2 * e2,
             ng,
             ns,
             uv: b0 * uv0 + b1 * uv1 + b2 * uv2,
-            dpdu: dpdu([p0, p1, p2], [uv0, uv1, uv2], ng),
+            dpdu: dpdu([p0, p0 + e1, p0 + e2], [uv0, uv1, uv2], ng),
             shape: self.shape,
             prim,
         }
