@@ -685,7 +685,7 @@ fn bvh_throughput() {
         let reference = obvhs::cwbvh::builder::build_cwbvh_from_tris(
             &tris,
             BvhBuildParams::medium_build(),
-            &mut Duration::ZERO,
+            &mut Duration::default(),
         );
         println!(
             "  obvhs reference build {:.0} ms",
