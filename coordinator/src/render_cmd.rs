@@ -1,19 +1,78 @@
-//! `yat render`: in-process rendering and image output. OWNER: renderer (lead).
+//! `yat render`: parse, build, render in-process on all cores (or hand the job to workers),
+//! then write the image the scene's Film names.
 
 use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
-use yat_tracer::desc::SceneDesc;
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use yat_tracer::assets::FsSource;
+use yat_tracer::desc::{LatLongConvention, SceneDesc};
 use yat_tracer::film::Film;
-use yat_tracer::render::{RenderSettings, UnitStats};
+use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings, UnitStats};
 
 use crate::distributed::DistributedArgs;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum LatLongArg {
+    /// The course tracer's u = (pi + phi) / 2pi: seed scenes look as their authors made them.
+    Seed,
+    /// LuxRender's s = phi / 2pi, for scenes made in LuxRender.
+    Luxrender,
+}
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// The main .lxs file.
     pub scene: PathBuf,
+    /// Output PNG (default: the Film's filename plus .png, in the current folder).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write linear radiance as OpenEXR next to the PNG.
+    #[arg(long)]
+    pub exr: bool,
+    /// Samples per pixel (default: the Film's haltspp, else 64).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Maximum path depth (default: the scene's integrator depth).
+    #[arg(long)]
+    pub maxdepth: Option<u32>,
+    /// Render threads for an in-process render (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seed of the sampler: the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Image size WxH, overriding the Film (the camera's screen window is kept).
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// LatLong environment-map convention.
+    #[arg(long, value_enum, default_value = "seed")]
+    pub latlong: LatLongArg,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Write the render's figures (times, samples/s, rays/s, memory) as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
     #[command(flatten)]
     pub distributed: DistributedArgs,
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, got {s:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=65_536).contains(&n))
+            .ok_or_else(|| format!("bad size {v:?} in {s:?} (1 to 65536)"))
+    };
+    Ok((parse(w)?, parse(h)?))
 }
 
 /// What a render needs, whoever renders it.
@@ -33,5 +92,221 @@ pub struct RenderOutcome {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    anyhow::bail!("render {} is not implemented yet", args.scene.display())
+    let started = Instant::now();
+    let main_name = args
+        .scene
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("not a scene file path: {}", args.scene.display()))?
+        .to_string();
+    let source = FsSource::for_main_file(&args.scene);
+    let desc = yat_tracer::parse::parse_scene(&main_name, &source)
+        .with_context(|| format!("cannot load {}", args.scene.display()))?;
+    let parse_time = started.elapsed();
+    if !args.quiet {
+        for w in &desc.warnings {
+            eprintln!("{w}");
+        }
+    }
+    let overrides = RenderOverrides {
+        spp: args.spp,
+        max_depth: args.maxdepth,
+        seed: Some(args.seed),
+        resolution: args.resolution,
+        latlong: match args.latlong {
+            LatLongArg::Seed => LatLongConvention::Seed,
+            LatLongArg::Luxrender => LatLongConvention::LuxRender,
+        },
+    };
+    let settings = RenderSettings::resolve(&desc, &overrides);
+    let output_png = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", desc.film.filename)));
+    let job = RenderJob {
+        main_file: args.scene.clone(),
+        desc,
+        settings,
+        output_png,
+        quiet: args.quiet,
+    };
+
+    let (outcome, build_time, triangles) = if args.distributed.is_active() {
+        (
+            crate::distributed::render(&args.distributed, &job)?,
+            None,
+            None,
+        )
+    } else {
+        let build_start = Instant::now();
+        let scene = RenderScene::build(&job.desc, &source, &job.settings)
+            .with_context(|| format!("cannot build {}", args.scene.display()))?;
+        let build_time = build_start.elapsed();
+        let triangles = scene.triangle_count();
+        (
+            render_in_process(&scene, args.threads, args.quiet)?,
+            Some(build_time),
+            Some(triangles),
+        )
+    };
+    let render_time = started.elapsed() - parse_time - build_time.unwrap_or_default();
+
+    write_outputs(&job, &outcome.film, args.exr)?;
+    let render_secs = render_time.as_secs_f64().max(1e-9);
+    let report = RenderReport {
+        scene: args.scene.display().to_string(),
+        width: job.settings.width,
+        height: job.settings.height,
+        spp: job.settings.spp,
+        max_depth: job.settings.max_depth,
+        triangles,
+        parse_seconds: parse_time.as_secs_f64(),
+        build_seconds: build_time.map(|b| b.as_secs_f64()),
+        render_seconds: render_secs,
+        samples: outcome.stats.samples,
+        rays: outcome.stats.rays,
+        dropped_samples: outcome.stats.dropped,
+        samples_per_second: outcome.stats.samples as f64 / render_secs,
+        rays_per_second: outcome.stats.rays as f64 / render_secs,
+        peak_memory_bytes: peak_memory_bytes(),
+    };
+    if let Some(path) = &args.stats_json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if !args.quiet {
+        println!("wrote {}", job.output_png.display());
+        report.print();
+    }
+    Ok(())
+}
+
+/// Renders every unit of the plan on a rayon pool, merging as units finish.
+pub fn render_in_process(
+    scene: &RenderScene,
+    threads: Option<usize>,
+    quiet: bool,
+) -> anyhow::Result<RenderOutcome> {
+    let settings = scene.settings();
+    let units = plan_units(settings);
+    let total_samples: u64 = units.iter().map(|u| u.sample_count()).sum();
+    let progress = progress_bar(total_samples, quiet);
+    let film = Mutex::new(Film::new(settings.width, settings.height));
+    let stats = Mutex::new(UnitStats::default());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .context("cannot start the render threads")?;
+    pool.install(|| {
+        units.par_iter().try_for_each(|unit| {
+            let (buffer, unit_stats) = scene.render_unit(unit);
+            film.lock()
+                .map_err(|_| anyhow::anyhow!("a render thread panicked"))?
+                .add(&buffer)?;
+            *stats
+                .lock()
+                .map_err(|_| anyhow::anyhow!("a render thread panicked"))? += unit_stats;
+            progress.inc(unit_stats.samples);
+            anyhow::Ok(())
+        })
+    })?;
+    progress.finish_and_clear();
+    Ok(RenderOutcome {
+        film: film
+            .into_inner()
+            .map_err(|_| anyhow::anyhow!("a render thread panicked"))?,
+        stats: stats
+            .into_inner()
+            .map_err(|_| anyhow::anyhow!("a render thread panicked"))?,
+    })
+}
+
+/// A progress bar over samples (hidden when quiet).
+pub fn progress_bar(total_samples: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total_samples);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+/// Writes the PNG (and the linear EXR when asked) exactly the same way for every render path.
+pub fn write_outputs(job: &RenderJob, film: &Film, exr: bool) -> anyhow::Result<()> {
+    film.write_png(&job.output_png, &job.desc.film)
+        .with_context(|| format!("cannot write {}", job.output_png.display()))?;
+    if exr {
+        let path = job.output_png.with_extension("exr");
+        film.write_exr(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The figures of one render, printed at the end and written by `--stats-json`.
+#[derive(serde::Serialize)]
+pub struct RenderReport {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub triangles: Option<usize>,
+    pub parse_seconds: f64,
+    pub build_seconds: Option<f64>,
+    pub render_seconds: f64,
+    pub samples: u64,
+    pub rays: u64,
+    pub dropped_samples: u64,
+    pub samples_per_second: f64,
+    pub rays_per_second: f64,
+    pub peak_memory_bytes: Option<u64>,
+}
+
+impl RenderReport {
+    fn print(&self) {
+        println!(
+            "{}x{} at {} spp, depth {}{}",
+            self.width,
+            self.height,
+            self.spp,
+            self.max_depth,
+            self.triangles
+                .map_or(String::new(), |t| format!(", {t} triangles"))
+        );
+        println!(
+            "parse {:.3} s{}, render {:.3} s",
+            self.parse_seconds,
+            self.build_seconds
+                .map_or(String::new(), |b| format!(", build {b:.3} s")),
+            self.render_seconds
+        );
+        println!(
+            "{:.3} M samples/s, {:.3} M rays/s{}{}",
+            self.samples_per_second / 1e6,
+            self.rays_per_second / 1e6,
+            self.peak_memory_bytes
+                .map_or(String::new(), |m| format!(", peak memory {} MB", m >> 20)),
+            if self.dropped_samples > 0 {
+                format!(", {} NaN/Inf samples dropped", self.dropped_samples)
+            } else {
+                String::new()
+            }
+        );
+    }
+}
+
+/// The process's peak resident set size, where the OS reports it (Linux).
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

@@ -96,11 +96,15 @@ pub struct SceneDesc {
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraKind {
     /// `fov` in degrees; spans the shorter screen-window axis (LuxRender rule).
-    Perspective { fov: f32 },
+    Perspective {
+        fov: f32,
+    },
     Orthographic,
     /// The course's fisheye (DESIGN.md): `fov` in degrees is the angle off the axis at the
     /// circle's edge.
-    Fisheye { fov: f32 },
+    Fisheye {
+        fov: f32,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,12 @@
 //! Sample buffers and the film: per-pixel sums from units, merged in an order-independent way
 //! (exact fixed-point sums), tone mapped and written as PNG or linear EXR.
 
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::desc::{FilmDesc, ToneMap};
+use crate::math::luminance;
 use crate::render::WorkUnit;
 
 /// A unit's result: per pixel of its tile (row-major), the sum of sample radiance and the sum
@@ -12,26 +18,280 @@ pub struct SampleBuffer {
     pub weight: Vec<f32>,
 }
 
-/// The accumulated image.
-pub struct Film {}
+impl SampleBuffer {
+    pub fn new(unit: WorkUnit) -> Self {
+        let n = unit.pixel_count();
+        Self {
+            unit,
+            rgb: vec![[0.0; 3]; n],
+            weight: vec![0.0; n],
+        }
+    }
+}
+
+/// Fixed-point scale of the film's sums: 2^-24 resolution, and room for sums up to 5e11.
+const FIXED_ONE: f64 = (1u64 << 24) as f64;
+
+fn to_fixed(v: f32) -> i64 {
+    // `as` saturates and maps NaN to 0, so a hostile buffer cannot wrap the sums.
+    (f64::from(v) * FIXED_ONE).round() as i64
+}
+
+/// The accumulated image. Sums are integers, so adding buffers is associative and commutative:
+/// the image does not depend on the order in which units arrive.
+#[derive(Clone, Debug)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    /// Per pixel: R, G, B and weight sums in fixed point.
+    sums: Vec<[i64; 4]>,
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("sample buffer of unit {index} does not fit the {width}x{height} film")]
+pub struct BufferMismatch {
+    pub index: u32,
+    pub width: u32,
+    pub height: u32,
+}
 
 impl Film {
-    pub fn new(_width: u32, _height: u32) -> Self {
-        todo!("renderer")
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            sums: vec![[0; 4]; width as usize * height as usize],
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
     }
 
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
-    /// gives the same bits.
-    pub fn add(&mut self, _buffer: &SampleBuffer) {
-        todo!("renderer")
+    /// gives the same bits. A buffer that does not fit (wrong tile or length) is refused.
+    pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
+        let u = &buffer.unit;
+        let fits = u.x0 < u.x1
+            && u.y0 < u.y1
+            && u.x1 <= self.width
+            && u.y1 <= self.height
+            && buffer.rgb.len() == u.pixel_count()
+            && buffer.weight.len() == u.pixel_count();
+        if !fits {
+            return Err(BufferMismatch {
+                index: u.index,
+                width: self.width,
+                height: self.height,
+            });
+        }
+        let tile_width = (u.x1 - u.x0) as usize;
+        for (row, y) in (u.y0..u.y1).enumerate() {
+            let film_row = y as usize * self.width as usize + u.x0 as usize;
+            let tile_row = row * tile_width;
+            for i in 0..tile_width {
+                let [r, g, b] = buffer.rgb[tile_row + i];
+                let s = &mut self.sums[film_row + i];
+                for (sum, v) in s.iter_mut().zip([r, g, b, buffer.weight[tile_row + i]]) {
+                    *sum = sum.saturating_add(to_fixed(v));
+                }
+            }
+        }
+        Ok(())
     }
 
-    /// Tone maps as the scene's film asks and writes an sRGB PNG.
-    pub fn write_png(
-        &self,
-        _path: &std::path::Path,
-        _film: &crate::desc::FilmDesc,
-    ) -> Result<(), image::ImageError> {
-        todo!("renderer")
+    /// The pixel's radiance estimate (weighted mean of its samples; black without samples).
+    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
+        let [r, g, b, w] = self.sums[(y * self.width + x) as usize];
+        if w <= 0 {
+            return Vec3::ZERO;
+        }
+        let w = w as f64;
+        Vec3::new(
+            (r as f64 / w) as f32,
+            (g as f64 / w) as f32,
+            (b as f64 / w) as f32,
+        )
+    }
+
+    /// Linear radiance of every pixel, rows top to bottom.
+    pub fn radiance(&self) -> Vec<Vec3> {
+        (0..self.height)
+            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+            .map(|(x, y)| self.pixel(x, y))
+            .collect()
+    }
+
+    /// Tone maps as the scene's film asks and applies its gamma: 8-bit RGB, rows top to bottom.
+    pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
+        let radiance = self.radiance();
+        let mapped = tone_map(&radiance, &film.tonemap, film.gamma);
+        let inv_gamma = 1.0 / film.gamma.max(1e-3);
+        let mut img = image::RgbImage::new(self.width, self.height);
+        for (px, c) in img.pixels_mut().zip(mapped) {
+            let encode = |v: f32| (v.clamp(0.0, 1.0).powf(inv_gamma) * 255.0 + 0.5) as u8;
+            *px = image::Rgb([encode(c.x), encode(c.y), encode(c.z)]);
+        }
+        img
+    }
+
+    pub fn write_png(&self, path: &Path, film: &FilmDesc) -> Result<(), image::ImageError> {
+        self.to_display(film)
+            .save_with_format(path, image::ImageFormat::Png)
+    }
+
+    /// Linear radiance as 32-bit float OpenEXR, no tone mapping.
+    pub fn write_exr(&self, path: &Path) -> Result<(), image::ImageError> {
+        let data: Vec<f32> = self
+            .radiance()
+            .into_iter()
+            .flat_map(|c| [c.x, c.y, c.z])
+            .collect();
+        let img = image::Rgb32FImage::from_raw(self.width, self.height, data)
+            .expect("buffer has width x height pixels");
+        image::DynamicImage::ImageRgb32F(img).save_with_format(path, image::ImageFormat::OpenExr)
+    }
+}
+
+/// LuxRender's tone mapping kernels, giving values to be gamma encoded.
+pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
+    // The mid-grey LuxRender aims autolinear and linear exposure at.
+    let middle_grey = (118.0f32 / 255.0).powf(gamma);
+    match *tonemap {
+        ToneMap::AutoLinear => {
+            let (sum, n) = radiance
+                .iter()
+                .map(|&c| luminance(c))
+                .filter(|&y| y > 0.0 && y.is_finite())
+                .fold((0.0f64, 0u64), |(s, n), y| (s + f64::from(y), n + 1));
+            let y_avg = if n > 0 { (sum / n as f64) as f32 } else { 1.0 };
+            let scale = 1.25 / y_avg * middle_grey;
+            radiance.iter().map(|&c| c * scale).collect()
+        }
+        ToneMap::Linear {
+            sensitivity,
+            exposure,
+            fstop,
+        } => {
+            let scale = exposure / (fstop * fstop) * sensitivity * 0.65 / 10.0 * middle_grey;
+            radiance.iter().map(|&c| c * scale).collect()
+        }
+        ToneMap::Reinhard {
+            prescale,
+            postscale,
+            burn,
+        } => {
+            let (log_sum, n) = radiance
+                .iter()
+                .map(|&c| luminance(c))
+                .filter(|&y| y > 0.0 && y.is_finite())
+                .fold((0.0f64, 0u64), |(s, n), y| (s + f64::from(y).ln(), n + 1));
+            let y_wa = if n > 0 {
+                (log_sum / n as f64).exp() as f32
+            } else {
+                1.0
+            };
+            // LuxRender's global Reinhard (2002, equation 4) with key 0.1 over the log-average
+            // luminance; burn is the white point, prescale divides the compressed luminance.
+            let key = 0.1 / y_wa;
+            let pre = key / prescale;
+            let post = key * postscale;
+            let inv_burn2 = if burn > 0.0 { 1.0 / (burn * burn) } else { 1e5 };
+            radiance
+                .iter()
+                .map(|&c| {
+                    let y = luminance(c) * pre;
+                    c * (post * (1.0 + y * inv_burn2) / (1.0 + y))
+                })
+                .collect()
+        }
+        ToneMap::Contrast { ywa } => {
+            // Ward's contrast-based scale factor for display luminance 100 cd/m2.
+            let ywa = ywa.max(1e-6);
+            let scale = ((1.219 + 50f32.powf(0.4)) / (1.219 + ywa.powf(0.4))).powf(2.5) / 100.0;
+            radiance.iter().map(|&c| c * scale).collect()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit(index: u32, x0: u32, y0: u32, x1: u32, y1: u32) -> WorkUnit {
+        WorkUnit {
+            index,
+            x0,
+            y0,
+            x1,
+            y1,
+            sample_start: 0,
+            sample_end: 1,
+        }
+    }
+
+    fn buffer(u: WorkUnit, seed: u32) -> SampleBuffer {
+        let mut b = SampleBuffer::new(u);
+        for (i, (c, w)) in b.rgb.iter_mut().zip(&mut b.weight).enumerate() {
+            let v = ((i as u32).wrapping_mul(2_654_435_761) ^ seed) as f32 / u32::MAX as f32;
+            *c = [v * 1e3, v * 1e-4, 0.1 + v];
+            *w = 3.0;
+        }
+        b
+    }
+
+    #[test]
+    fn merging_is_order_independent_and_exact() {
+        let bufs: Vec<_> = (0..5)
+            .map(|i| buffer(unit(i, 0, 0, 4, 3), i * 977))
+            .collect();
+        let mut forward = Film::new(4, 3);
+        let mut backward = Film::new(4, 3);
+        bufs.iter().for_each(|b| forward.add(b).unwrap());
+        bufs.iter().rev().for_each(|b| backward.add(b).unwrap());
+        assert_eq!(forward.sums, backward.sums);
+        let expected: f32 = bufs.iter().map(|b| b.rgb[5][2]).sum::<f32>() / 15.0;
+        assert!((forward.pixel(1, 1).z - expected).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_misfit_buffer_is_refused() {
+        let mut film = Film::new(4, 4);
+        let mut b = buffer(unit(0, 2, 2, 6, 4), 1);
+        assert!(film.add(&b).is_err());
+        b.unit = unit(0, 0, 0, 4, 2);
+        b.weight.pop();
+        assert!(film.add(&b).is_err());
+    }
+
+    #[test]
+    fn autolinear_maps_average_luminance_to_mid_grey() {
+        let radiance = vec![Vec3::splat(2.0); 4];
+        let mapped = tone_map(&radiance, &ToneMap::AutoLinear, 2.2);
+        let expected = 1.25 * (118.0f32 / 255.0).powf(2.2);
+        assert!((mapped[0].x - expected).abs() < 1e-5);
+    }
+
+    #[test]
+    fn reinhard_compresses_highlights_and_keeps_hue() {
+        let tm = ToneMap::Reinhard {
+            prescale: 1.0,
+            postscale: 1.0,
+            burn: 7.0,
+        };
+        // A uniform image sits at the key: luminance 0.1 after scaling by 0.1 / Y.
+        let grey = tone_map(&[Vec3::splat(4.0); 3], &tm, 2.2);
+        let expected = 4.0 * 0.1 / 4.0 * (1.0 + 0.1 / 49.0) / 1.1;
+        assert!((grey[0].x - expected).abs() < 1e-6, "{}", grey[0].x);
+
+        let radiance = vec![Vec3::new(0.1, 0.05, 0.02), Vec3::new(100.0, 50.0, 20.0)];
+        let mapped = tone_map(&radiance, &tm, 2.2);
+        let ratio_out = mapped[1].x / mapped[0].x;
+        assert!(ratio_out < 1000.0 / 3.0, "{ratio_out}");
+        assert!((mapped[1].x / mapped[1].y - 2.0).abs() < 1e-4);
     }
 }

@@ -39,7 +39,13 @@ pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeEr
     );
     let rgb = img.to_rgb32f();
     let (width, height) = rgb.dimensions();
-    let linearise = |v: f32| if is_float || gamma == 1.0 { v } else { v.max(0.0).powf(gamma) };
+    let linearise = |v: f32| {
+        if is_float || gamma == 1.0 {
+            v
+        } else {
+            v.max(0.0).powf(gamma)
+        }
+    };
     let pixels = rgb
         .pixels()
         .map(|p| Vec3::new(linearise(p[0]), linearise(p[1]), linearise(p[2])))

@@ -10,6 +10,7 @@ pub mod assets;
 pub mod camera;
 pub mod desc;
 pub mod film;
+pub mod filter;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;

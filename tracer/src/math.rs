@@ -35,7 +35,11 @@ impl Frame {
         let len2 = s.length_squared();
         if len2 > 1e-12 && len2.is_finite() {
             let s = s / len2.sqrt();
-            Self { s, t: n.cross(s), n }
+            Self {
+                s,
+                t: n.cross(s),
+                n,
+            }
         } else {
             Self::from_normal(n)
         }

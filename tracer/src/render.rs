@@ -1,9 +1,19 @@
 //! The render API every node uses: settings, the unit plan, the built scene and rendering one
 //! unit into a sample buffer.
 
+use glam::{Vec2, Vec3};
+
 use crate::assets::AssetSource;
+use crate::camera::Camera;
 use crate::desc::{LatLongConvention, SceneDesc};
 use crate::film::SampleBuffer;
+use crate::filter::FilterSampler;
+use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::integrator::trace_path;
+use crate::lights::Lights;
+use crate::material::{Bsdf, Materials};
+use crate::sampler::PixelSampler;
+use crate::texture::Textures;
 
 /// Everything besides the scene that decides the image. Identical settings and scene give
 /// bit-identical images whatever renders them.
@@ -136,28 +146,98 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
 }
 
 /// The scene ready to render: world-space geometry and BVH, textures, materials, lights.
-pub struct RenderScene {}
+pub struct RenderScene {
+    desc: SceneDesc,
+    settings: RenderSettings,
+    camera: Camera,
+    filter: FilterSampler,
+    geometry: SceneGeometry,
+    textures: Textures,
+    materials: Materials,
+    lights: Lights,
+}
 
 impl RenderScene {
     pub fn build(
-        _desc: &SceneDesc,
-        _source: &dyn AssetSource,
-        _settings: &RenderSettings,
+        desc: &SceneDesc,
+        source: &dyn AssetSource,
+        settings: &RenderSettings,
     ) -> Result<Self, BuildError> {
-        todo!("renderer")
+        let geometry = SceneGeometry::build(desc);
+        let lights = Lights::build(desc, &geometry, source, settings.latlong)?;
+        Ok(Self {
+            camera: Camera::new(&desc.camera, settings.width, settings.height),
+            filter: FilterSampler::new(&desc.filter),
+            textures: Textures::build(desc, source)?,
+            materials: Materials::build(desc),
+            geometry,
+            lights,
+            desc: desc.clone(),
+            settings: settings.clone(),
+        })
+    }
+
+    pub fn desc(&self) -> &SceneDesc {
+        &self.desc
     }
 
     pub fn settings(&self) -> &RenderSettings {
-        todo!("renderer")
+        &self.settings
+    }
+
+    pub fn geometry(&self) -> &SceneGeometry {
+        &self.geometry
+    }
+
+    pub fn lights(&self) -> &Lights {
+        &self.lights
     }
 
     pub fn triangle_count(&self) -> usize {
-        todo!("renderer")
+        self.geometry.triangle_count()
+    }
+
+    /// The BSDF at a hit; `u_mix` resolves mix materials.
+    pub fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
+        let material = self.desc.shapes[hit.shape as usize].material;
+        self.materials.bsdf(material, hit, &self.textures, u_mix)
     }
 
     /// Renders one unit on the calling thread. Deterministic: the same unit gives the same
     /// buffer bytes on any machine and thread.
-    pub fn render_unit(&self, _unit: &WorkUnit) -> (SampleBuffer, UnitStats) {
-        todo!("renderer")
+    pub fn render_unit(&self, unit: &WorkUnit) -> (SampleBuffer, UnitStats) {
+        let mut buffer = SampleBuffer::new(*unit);
+        let mut stats = UnitStats::default();
+        let tile_width = unit.x1 - unit.x0;
+        for y in unit.y0..unit.y1 {
+            for x in unit.x0..unit.x1 {
+                let i = ((y - unit.y0) * tile_width + (x - unit.x0)) as usize;
+                let mut rgb = Vec3::ZERO;
+                let mut weight = 0.0f32;
+                for index in unit.sample_start..unit.sample_end {
+                    let mut sampler =
+                        PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed);
+                    let (offset, w) = self.filter.sample(sampler.get_2d());
+                    let lens = sampler.get_2d();
+                    let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                    stats.samples += 1;
+                    let Some(ray) = self.camera.generate_ray(film, lens) else {
+                        weight += w;
+                        continue;
+                    };
+                    let path = trace_path(self, ray, &mut sampler);
+                    stats.rays += u64::from(path.rays);
+                    if path.radiance.is_finite() {
+                        rgb += path.radiance * w;
+                        weight += w;
+                    } else {
+                        stats.dropped += 1;
+                    }
+                }
+                buffer.rgb[i] = rgb.to_array();
+                buffer.weight[i] = weight;
+            }
+        }
+        (buffer, stats)
     }
 }
