@@ -115,8 +115,8 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         writeln!(stdout, "listening on {local}")?;
         stdout.flush()?;
         drop(stdout);
-        eprintln!(
-            "yat worker: {threads} thread(s){}{}",
+        tracing::info!(
+            "{threads} thread(s){}{}",
             if tls.is_some() { ", TLS" } else { "" },
             if args.token.is_some() {
                 ", token required"
@@ -151,7 +151,7 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
 fn exit_when_stdin_closes() {
     std::thread::spawn(|| {
         let _ = std::io::copy(&mut std::io::stdin().lock(), &mut std::io::sink());
-        eprintln!("yat worker: standard input closed, exiting");
+        tracing::info!("standard input closed, exiting");
         std::process::exit(0);
     });
 }

@@ -1,0 +1,71 @@
+//! The scene as workers receive it: the main file and every file it references, read once on
+//! the coordinator and named by content hash.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::Context;
+use prost::bytes::Bytes;
+use yat_proto::hash::sha256_hex;
+use yat_proto::pb;
+use yat_tracer::assets::{AssetError, AssetSource, FsSource};
+use yat_tracer::desc::SceneDesc;
+use yat_tracer::render::RenderSettings;
+
+pub struct SceneManifest {
+    pub main: pb::SceneFile,
+    pub assets: Vec<pb::SceneFile>,
+    /// File contents by hash (files with the same content are sent once).
+    pub blobs: HashMap<String, Bytes>,
+}
+
+impl SceneManifest {
+    /// Reads the main file and the assets the parse listed, as the in-process render would. A
+    /// referenced file that does not exist is left out: the worker then misses it exactly as an
+    /// in-process render does.
+    pub fn read(main_file: &Path, desc: &SceneDesc) -> anyhow::Result<Self> {
+        let source = FsSource::for_main_file(main_file);
+        let main_name = main_file
+            .file_name()
+            .and_then(|n| n.to_str())
+            .with_context(|| format!("not a scene file path: {}", main_file.display()))?;
+        let mut blobs = HashMap::new();
+        let mut add = |written: &str| -> anyhow::Result<Option<pb::SceneFile>> {
+            let bytes = match source.read(written) {
+                Ok(bytes) => bytes,
+                Err(AssetError::NotFound { .. }) => return Ok(None),
+                Err(e) => return Err(e.into()),
+            };
+            let sha256 = sha256_hex(&bytes);
+            blobs
+                .entry(sha256.clone())
+                .or_insert_with(|| Bytes::from_owner(bytes));
+            Ok(Some(pb::SceneFile {
+                path: written.to_string(),
+                sha256,
+            }))
+        };
+        let main =
+            add(main_name)?.with_context(|| format!("{} has vanished", main_file.display()))?;
+        let mut assets = Vec::with_capacity(desc.assets.len());
+        for asset in &desc.assets {
+            match add(&asset.path)? {
+                Some(file) => assets.push(file),
+                None => tracing::warn!("{}: not found, not sent to workers", asset.path),
+            }
+        }
+        Ok(Self {
+            main,
+            assets,
+            blobs,
+        })
+    }
+
+    pub fn load_request(&self, settings: &RenderSettings) -> pb::LoadSceneRequest {
+        pb::LoadSceneRequest {
+            main: Some(self.main.clone()),
+            assets: self.assets.clone(),
+            settings: Some(settings.into()),
+        }
+    }
+}

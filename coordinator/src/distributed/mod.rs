@@ -1,0 +1,316 @@
+//! Rendering over gRPC workers: the coordinator ships the scene's files to every worker, hands
+//! out the units of the fixed plan pull-style, re-queues what a failing worker held, and merges
+//! each unit's result once. The plan and the exact film sums make the image bit-identical to an
+//! in-process render whatever the workers do.
+
+mod local;
+mod manifest;
+mod node;
+mod report;
+mod schedule;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context};
+use tokio::sync::mpsc;
+use tokio::task::JoinSet;
+use tonic::transport::{Certificate, ClientTlsConfig};
+use yat_tracer::film::Film;
+use yat_tracer::render::{plan_units, UnitStats};
+
+use crate::render_cmd::{RenderJob, RenderOutcome};
+use local::LocalWorker;
+use manifest::SceneManifest;
+use node::{run_node, Event, Node, NodeConfig, Shared};
+use report::{process_cpu_time, DistributedReport, Preview, Progress};
+use schedule::{Schedule, UnitDeadline};
+
+/// Command-line options of a distributed render (flattened into `yat render`).
+#[derive(clap::Args, Debug, Default)]
+pub struct DistributedArgs {
+    /// Render on these workers, HOST:PORT[,HOST:PORT...] (each started with `yat worker`).
+    #[arg(long, value_delimiter = ',', value_name = "HOST:PORT,...")]
+    pub workers: Vec<String>,
+    /// Start N workers on this machine, sharing its cores, and render on them too.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub local_workers: usize,
+    /// The token the workers were started with.
+    #[arg(long, env = "YAT_TOKEN", hide_env_values = true)]
+    pub token: Option<String>,
+    /// Connect to the workers over TLS, trusting this PEM CA certificate.
+    #[arg(long, value_name = "PEM")]
+    pub tls_ca: Option<PathBuf>,
+    /// The name the workers' certificates are issued to [default: the host of each address].
+    #[arg(long, requires = "tls_ca")]
+    pub tls_domain: Option<String>,
+    /// Give up when no worker has been connected for this many seconds [default: wait].
+    #[arg(long, value_name = "SECONDS")]
+    pub timeout: Option<f64>,
+    /// Rewrite `<output>.preview.png` this often during the render; 0 disables [default: 10].
+    #[arg(long, value_name = "SECONDS")]
+    pub preview_every: Option<f64>,
+    /// Write each worker's figures (units, failures, bytes) and the coordinator's CPU time as
+    /// JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    pub workers_json: Option<PathBuf>,
+    /// Testing aid: presume a unit lost after this many seconds instead of
+    /// max(30 s, 4 x the slowest unit seen).
+    #[arg(long, hide = true, env = "YAT_UNIT_DEADLINE")]
+    pub unit_deadline: Option<f64>,
+}
+
+impl DistributedArgs {
+    /// True when the render should go to workers instead of in-process.
+    pub fn is_active(&self) -> bool {
+        !self.workers.is_empty() || self.local_workers > 0
+    }
+}
+
+const DEFAULT_PREVIEW_EVERY: f64 = 10.0;
+/// How long the render waits without any worker before saying so (and again after each such
+/// period).
+const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
+
+fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
+    Duration::try_from_secs_f64(value)
+        .with_context(|| format!("--{name} must be a non-negative number of seconds"))
+}
+
+pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderOutcome> {
+    let cpu_start = process_cpu_time();
+    let started = Instant::now();
+    let timeout = args.timeout.map(|t| seconds("timeout", t)).transpose()?;
+    let preview_every = seconds(
+        "preview-every",
+        args.preview_every.unwrap_or(DEFAULT_PREVIEW_EVERY),
+    )?;
+    let unit_deadline = args
+        .unit_deadline
+        .map(|t| seconds("unit-deadline", t))
+        .transpose()?;
+
+    let manifest = SceneManifest::read(&job.main_file, &job.desc)?;
+    let tls = args
+        .tls_ca
+        .as_ref()
+        .map(|ca| {
+            let pem = std::fs::read(ca).with_context(|| format!("cannot read {}", ca.display()))?;
+            let mut tls = ClientTlsConfig::new().ca_certificate(Certificate::from_pem(pem));
+            if let Some(domain) = &args.tls_domain {
+                tls = tls.domain_name(domain.clone());
+            }
+            anyhow::Ok(tls)
+        })
+        .transpose()?;
+    let mut configs: Vec<NodeConfig> = args
+        .workers
+        .iter()
+        .map(|address| NodeConfig {
+            address: address.trim().to_string(),
+            token: args.token.clone(),
+            tls: tls.clone(),
+            local: None,
+        })
+        .collect();
+    for config in &configs {
+        config.validate()?;
+    }
+    if args.local_workers > 0 {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        for worker in LocalWorker::spawn_all(args.local_workers, cores)? {
+            configs.push(NodeConfig {
+                address: worker.address.clone(),
+                token: Some(worker.token.clone()),
+                tls: None,
+                local: Some(Arc::new(worker)),
+            });
+        }
+    }
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .thread_name("yat-net")
+        .enable_all()
+        .build()
+        .context("cannot start the network runtime")?;
+    let (events, event_rx) = mpsc::unbounded_channel();
+    let shared = Arc::new(Shared {
+        schedule: Schedule::new(plan_units(&job.settings)),
+        deadline: UnitDeadline::new(unit_deadline),
+        load_request: manifest.load_request(&job.settings),
+        manifest,
+        events,
+    });
+    let nodes: Vec<Arc<Node>> = configs
+        .into_iter()
+        .map(|c| Arc::new(Node::new(c)))
+        .collect();
+    let render_loop = RenderLoop {
+        job,
+        nodes: &nodes,
+        shared: &shared,
+        timeout,
+        preview: Preview::new(
+            &job.output_png,
+            (!preview_every.is_zero()).then_some(preview_every),
+        ),
+    };
+    let outcome = runtime.block_on(render_loop.run(event_rx));
+    // Ends the node loops and closes connections; then `nodes` drops the local workers.
+    drop(runtime);
+
+    let report = DistributedReport::new(
+        started.elapsed(),
+        process_cpu_time().saturating_sub(cpu_start),
+        shared.schedule.len(),
+        outcome.as_ref().map_or(0, |o| o.stats.samples),
+        nodes
+            .iter()
+            .map(|n| n.report.lock().unwrap().clone())
+            .collect(),
+    );
+    if let Some(path) = &args.workers_json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let outcome = outcome?;
+    if !job.quiet {
+        report.print();
+    }
+    Ok(outcome)
+}
+
+struct RenderLoop<'a> {
+    job: &'a RenderJob,
+    nodes: &'a [Arc<Node>],
+    shared: &'a Arc<Shared>,
+    timeout: Option<Duration>,
+    preview: Preview,
+}
+
+impl RenderLoop<'_> {
+    /// Merges results as they come until every unit is in, watching that some worker is
+    /// there to render.
+    async fn run(
+        mut self,
+        mut events: mpsc::UnboundedReceiver<Event>,
+    ) -> anyhow::Result<RenderOutcome> {
+        let settings = &self.job.settings;
+        let quiet = self.job.quiet;
+        let total_units = self.shared.schedule.len();
+        let total_samples = plan_units(settings).iter().map(|u| u.sample_count()).sum();
+        let progress = Progress::new(total_samples, total_units, quiet);
+        let mut tasks = JoinSet::new();
+        for node in self.nodes {
+            tasks.spawn(run_node(node.clone(), self.shared.clone()));
+        }
+        let mut film = Film::new(settings.width, settings.height);
+        let mut stats = UnitStats::default();
+        let mut merged = 0;
+        let mut alone_since = Some(Instant::now());
+        let mut waiting_noticed = Instant::now();
+        let mut tick = tokio::time::interval(Duration::from_millis(250));
+        let result = loop {
+            if merged == total_units {
+                break Ok(());
+            }
+            tokio::select! {
+                event = events.recv() => match event.expect("the shared state holds a sender") {
+                    Event::Result { buffer, stats: unit_stats } => {
+                        film.add(&buffer)?;
+                        stats += unit_stats;
+                        merged += 1;
+                        progress.update(unit_stats.samples, merged, self.alive(), self.nodes.len());
+                    }
+                    Event::Notice(line) => progress.say(quiet, &line),
+                    Event::Fatal(e) => break Err(e),
+                },
+                _ = tick.tick() => {
+                    progress.update(0, merged, self.alive(), self.nodes.len());
+                    if let Err(e) = self.preview.maybe_write(&film, &self.job.desc.film) {
+                        progress.say(quiet, &format!("{e:#}"));
+                    }
+                    if self.alive() > 0 {
+                        alone_since = None;
+                        continue;
+                    }
+                    let since = *alone_since.get_or_insert_with(Instant::now);
+                    if let Err(e) = self.check_workers_remain(since) {
+                        break Err(e);
+                    }
+                    if since.elapsed() >= WAITING_NOTICE_EVERY
+                        && waiting_noticed.elapsed() >= WAITING_NOTICE_EVERY
+                    {
+                        waiting_noticed = Instant::now();
+                        progress.say(quiet, &format!(
+                            "waiting for workers: none connected for {:.0} s ({}){}",
+                            since.elapsed().as_secs_f64(),
+                            self.last_errors(),
+                            self.timeout.map_or(String::new(), |t| format!(
+                                "; giving up after {:.0} s", t.as_secs_f64()))
+                        ));
+                    }
+                }
+            }
+        };
+        tasks.abort_all();
+        progress.finish();
+        result?;
+        self.preview.remove();
+        Ok(RenderOutcome { film, stats })
+    }
+
+    fn alive(&self) -> usize {
+        self.nodes
+            .iter()
+            .filter(|n| n.report.lock().unwrap().connected)
+            .count()
+    }
+
+    /// Fails when no worker can come back, or when the wait has exceeded --timeout.
+    fn check_workers_remain(&self, alone_since: Instant) -> anyhow::Result<()> {
+        let reports: Vec<_> = self
+            .nodes
+            .iter()
+            .map(|n| n.report.lock().unwrap().clone())
+            .collect();
+        if reports.iter().all(|r| r.gone.is_some()) {
+            let reasons: Vec<_> = reports
+                .iter()
+                .map(|r| format!("{}: {}", r.address, r.gone.as_deref().unwrap_or_default()))
+                .collect();
+            bail!(
+                "no worker can render this scene:\n  {}",
+                reasons.join("\n  ")
+            );
+        }
+        if let Some(timeout) = self.timeout {
+            if alone_since.elapsed() >= timeout {
+                bail!(
+                    "no worker connected for {:.0} s (--timeout); last errors: {}",
+                    timeout.as_secs_f64(),
+                    self.last_errors()
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn last_errors(&self) -> String {
+        self.nodes
+            .iter()
+            .map(|n| {
+                let r = n.report.lock().unwrap();
+                let why = r
+                    .gone
+                    .as_deref()
+                    .or(r.last_error.as_deref())
+                    .unwrap_or("connecting");
+                format!("{}: {why}", r.address)
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
