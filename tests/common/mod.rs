@@ -1,0 +1,233 @@
+//! Helpers for end-to-end tests: a small scene written to a folder, `yat worker` processes on
+//! loopback ports, and `yat render` runs.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdout, Command, Output, Stdio};
+
+pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
+
+/// A closed box lit by an area light, with a glossy sphere, its materials in an Include'd file
+/// and a poster textured with a PNG image map. Returns the main file.
+pub fn write_scene(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir.join("textures")).unwrap();
+    let checks = image::RgbImage::from_fn(8, 8, |x, y| {
+        if (x + y) % 2 == 0 {
+            image::Rgb([230, 200, 40])
+        } else {
+            image::Rgb([20, 60, 200])
+        }
+    });
+    checks.save(dir.join("textures/checks.png")).unwrap();
+    std::fs::write(
+        dir.join("materials.lxo"),
+        r#"Texture "checks" "color" "imagemap" "string filename" ["textures/checks.png"]
+  "float gamma" [2.2]
+MakeNamedMaterial "white" "string type" "matte" "color Kd" [0.7 0.7 0.7]
+MakeNamedMaterial "red" "string type" "matte" "color Kd" [0.6 0.07 0.05]
+MakeNamedMaterial "green" "string type" "matte" "color Kd" [0.12 0.45 0.09]
+MakeNamedMaterial "poster" "string type" "matte" "texture Kd" "checks"
+MakeNamedMaterial "shiny" "string type" "glossy" "color Kd" [0.2 0.3 0.6]
+  "float uroughness" [0.05] "float vroughness" [0.05]
+MakeNamedMaterial "lamp" "string type" "null"
+"#,
+    )
+    .unwrap();
+    let scene = dir.join("box.lxs");
+    std::fs::write(
+        &scene,
+        r#"# A closed box with an area light, a glossy sphere and a textured poster.
+Film "fleximage" "integer xresolution" [128] "integer yresolution" [96]
+  "string filename" ["box"]
+PixelFilter "blackmanharris" "float xwidth" 2 "float ywidth" 2
+SurfaceIntegrator "path" "integer maxdepth" [5]
+LookAt 0 -0.9 1  0 0 1  0 0 1
+Camera "perspective" "float fov" [70]
+WorldBegin
+Include "materials.lxo"
+AttributeBegin
+  NamedMaterial "white"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 2  -1 1 2  1 1 2  1 -1 2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 1 0  1 1 0  1 1 2  -1 1 2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 0  -1 -1 2  1 -1 2  1 -1 0]
+AttributeEnd
+AttributeBegin
+  NamedMaterial "red"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 0  -1 1 0  -1 1 2  -1 -1 2]
+AttributeEnd
+AttributeBegin
+  NamedMaterial "green"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [1 -1 0  1 -1 2  1 1 2  1 1 0]
+AttributeEnd
+AttributeBegin
+  NamedMaterial "poster"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-0.5 0.99 0.6  0.5 0.99 0.6  0.5 0.99 1.4  -0.5 0.99 1.4]
+    "float uv" [0 0  1 0  1 1  0 1]
+AttributeEnd
+AttributeBegin
+  Translate 0.35 0.2 0.35
+  NamedMaterial "shiny"
+  Shape "sphere" "float radius" 0.35
+AttributeEnd
+AttributeBegin
+  NamedMaterial "lamp"
+  AreaLightSource "area" "color L" [1 0.9 0.7] "float power" 40 "float efficacy" 17
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-0.3 -0.3 1.99  -0.3 0.3 1.99  0.3 0.3 1.99  0.3 -0.3 1.99]
+AttributeEnd
+WorldEnd
+"#,
+    )
+    .unwrap();
+    scene
+}
+
+/// The scene's files and their total size, as a coordinator must upload them.
+pub fn scene_bytes(dir: &Path) -> u64 {
+    ["box.lxs", "materials.lxo", "textures/checks.png"]
+        .iter()
+        .map(|f| std::fs::metadata(dir.join(f)).unwrap().len())
+        .sum()
+}
+
+/// Render settings every test uses: 4 tiles x 8 passes = 32 units.
+pub const SETTINGS: [&str; 4] = ["--spp", "16", "--resolution", "128x96"];
+
+/// A `yat worker` process on a loopback port; killed when dropped.
+pub struct Worker {
+    pub address: String,
+    child: Child,
+    _stdout: BufReader<ChildStdout>,
+}
+
+impl Worker {
+    /// Starts a worker with one render thread and these extra arguments.
+    pub fn start(extra: &[&str]) -> Self {
+        Self::start_on("127.0.0.1:0", extra)
+    }
+
+    pub fn start_on(listen: &str, extra: &[&str]) -> Self {
+        let mut child = Command::new(YAT)
+            .args(["worker", "--listen", listen, "--threads", "1"])
+            .args(extra)
+            .env_remove("YAT_TOKEN")
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("start yat worker");
+        let mut stdout = BufReader::new(child.stdout.take().unwrap());
+        let mut line = String::new();
+        stdout.read_line(&mut line).unwrap();
+        let address = line
+            .trim()
+            .strip_prefix("listening on ")
+            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
+            .to_string();
+        Self {
+            address,
+            child,
+            _stdout: stdout,
+        }
+    }
+
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// SIGKILL.
+    pub fn kill(&mut self) {
+        self.child.kill().unwrap();
+        self.child.wait().unwrap();
+    }
+
+    /// Sends a signal with the `kill` command (STOP, CONT).
+    pub fn signal(&self, name: &str) {
+        let status = Command::new("kill")
+            .args([&format!("-{name}"), &self.pid().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success(), "kill -{name} failed");
+    }
+
+    /// The worker's counters, over its Stats RPC.
+    pub fn stats(&self, token: Option<&str>) -> yat_proto::pb::StatsReply {
+        let address = format!("http://{}", self.address);
+        let token = yat_proto::auth::AttachToken::new(token).unwrap();
+        tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap()
+            .block_on(async move {
+                let channel = tonic::transport::Endpoint::from_shared(address)
+                    .unwrap()
+                    .connect()
+                    .await
+                    .unwrap();
+                yat_proto::RenderNodeClient::with_interceptor(channel, token)
+                    .stats(yat_proto::pb::StatsRequest {})
+                    .await
+                    .unwrap()
+                    .into_inner()
+            })
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        let _ = Command::new("kill")
+            .args(["-CONT", &self.pid().to_string()])
+            .stderr(Stdio::null())
+            .status();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// `yat render SCENE -o OUT --exr` with the test settings and `extra` arguments.
+pub fn render_command(scene: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut command = Command::new(YAT);
+    command
+        .arg("render")
+        .arg(scene)
+        .arg("-o")
+        .arg(out)
+        .arg("--exr")
+        .args(SETTINGS)
+        .args(extra)
+        .env_remove("YAT_TOKEN")
+        .env_remove("YAT_UNIT_DEADLINE");
+    command
+}
+
+pub fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    render_command(scene, out, extra)
+        .output()
+        .expect("run yat render")
+}
+
+/// Panics with the command's output unless it succeeded.
+pub fn assert_success(output: &Output) {
+    assert!(
+        output.status.success(),
+        "yat failed ({})\nstdout:\n{}\nstderr:\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// The PNG and EXR bytes of a render written to `out`.
+pub fn image_bytes(out: &Path) -> (Vec<u8>, Vec<u8>) {
+    (
+        std::fs::read(out).unwrap(),
+        std::fs::read(out.with_extension("exr")).unwrap(),
+    )
+}
+
+/// The `--workers-json` report.
+pub fn workers_report(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
