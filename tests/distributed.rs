@@ -314,3 +314,54 @@ fn with_no_worker_the_render_stops_after_its_timeout() {
         "{took:?}"
     );
 }
+
+/// A CA and a worker certificate for "localhost" signed by it, as PEM files in `dir`:
+/// (ca.pem, worker.pem, worker.key).
+fn write_tls_files(dir: &Path) -> [std::path::PathBuf; 3] {
+    use rcgen::{BasicConstraints, CertificateParams, CertifiedIssuer, IsCa, KeyPair};
+    let mut ca_params = CertificateParams::new(Vec::new()).unwrap();
+    ca_params.is_ca = IsCa::Ca(BasicConstraints::Unconstrained);
+    let ca = CertifiedIssuer::self_signed(ca_params, KeyPair::generate().unwrap()).unwrap();
+    let key = KeyPair::generate().unwrap();
+    let cert = CertificateParams::new(vec!["localhost".to_string()])
+        .unwrap()
+        .signed_by(&key, &ca)
+        .unwrap();
+    let paths = ["ca.pem", "worker.pem", "worker.key"].map(|f| dir.join(f));
+    std::fs::write(&paths[0], ca.pem()).unwrap();
+    std::fs::write(&paths[1], cert.pem()).unwrap();
+    std::fs::write(&paths[2], key.serialize_pem()).unwrap();
+    paths
+}
+
+#[test]
+fn tls_workers_render_for_a_coordinator_that_trusts_their_ca() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let expected = reference(dir.path(), &scene);
+    let [ca, cert, key] = write_tls_files(dir.path());
+    let worker = Worker::start(&[
+        "--tls-cert",
+        cert.to_str().unwrap(),
+        "--tls-key",
+        key.to_str().unwrap(),
+    ]);
+    let out = dir.path().join("tls.png");
+    let tls = [
+        "--workers",
+        &worker.address,
+        "--tls-ca",
+        ca.to_str().unwrap(),
+        "--tls-domain",
+        "localhost",
+    ];
+    assert_success(&render(&scene, &out, &tls));
+    assert_same_image(&out, &expected);
+
+    let plain = render(
+        &scene,
+        &dir.path().join("plain.png"),
+        &["--workers", &worker.address, "--timeout", "2"],
+    );
+    assert!(!plain.status.success(), "a plaintext client is not served");
+}
