@@ -365,3 +365,72 @@ fn tls_workers_render_for_a_coordinator_that_trusts_their_ca() {
     );
     assert!(!plain.status.success(), "a plaintext client is not served");
 }
+
+/// The processes whose parent is `pid`.
+fn children(pid: u32) -> Vec<u32> {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return Vec::new();
+    };
+    tasks
+        .flatten()
+        .filter_map(|t| std::fs::read_to_string(t.path().join("children")).ok())
+        .flat_map(|s| {
+            s.split_whitespace()
+                .filter_map(|p| p.parse().ok())
+                .collect::<Vec<u32>>()
+        })
+        .collect()
+}
+
+/// True while `pid` exists and is not a zombie.
+fn is_running(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .map(|stat| {
+            let state = stat.rsplit(')').next().unwrap_or("").trim_start();
+            !state.starts_with('Z') && !state.starts_with('X')
+        })
+        .unwrap_or(false)
+}
+
+#[test]
+fn local_workers_do_not_outlive_a_killed_coordinator() {
+    if !Path::new("/proc/self/task").exists() {
+        println!("no /proc: skipping");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    // Long enough to be killed mid-way: thousands of samples per pixel.
+    let mut coordinator = std::process::Command::new(YAT)
+        .arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path().join("long.png"))
+        .args(["--local-workers", "2", "--spp", "8192", "--quiet"])
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let workers = loop {
+        let workers = children(coordinator.id());
+        if workers.len() == 2 {
+            break workers;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "no local workers"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(workers.iter().all(|&w| is_running(w)));
+    coordinator.kill().unwrap();
+    coordinator.wait().unwrap();
+    let killed = Instant::now();
+    while workers.iter().any(|&w| is_running(w)) {
+        assert!(
+            killed.elapsed() < Duration::from_secs(10),
+            "local workers outlived their coordinator"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
