@@ -200,8 +200,7 @@ impl RenderLoop<'_> {
         let settings = &self.job.settings;
         let quiet = self.job.quiet;
         let total_units = self.shared.schedule.len();
-        let total_samples = plan_units(settings).iter().map(|u| u.sample_count()).sum();
-        let progress = Progress::new(total_samples, total_units, quiet);
+        let progress = Progress::new(self.shared.schedule.sample_count(), total_units, quiet);
         let mut tasks = JoinSet::new();
         for node in self.nodes {
             tasks.spawn(run_node(node.clone(), self.shared.clone()));

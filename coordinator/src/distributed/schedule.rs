@@ -41,6 +41,11 @@ impl Schedule {
         self.units.len()
     }
 
+    /// Camera samples of the whole plan.
+    pub fn sample_count(&self) -> u64 {
+        self.units.iter().map(WorkUnit::sample_count).sum()
+    }
+
     pub fn is_finished(&self) -> bool {
         let state = self.state.lock().unwrap();
         state.done_count == self.units.len()
