@@ -345,3 +345,130 @@ impl pb::render_node_server::RenderNode for RenderNodeService {
         }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tonic::transport::server::TcpIncoming;
+    use tonic::Code;
+    use yat_proto::{RenderNodeClient, RenderNodeServer};
+
+    /// A worker on a loopback port, with a 1000-byte blob limit, and a client to it.
+    async fn worker() -> RenderNodeClient<tonic::transport::Channel> {
+        let capabilities = Capabilities {
+            threads: 1,
+            max_message_bytes: 1 << 20,
+            max_blob_bytes: 1000,
+            features: Vec::new(),
+        };
+        let blobs = BlobStore::new(1 << 20, None).unwrap();
+        let service = RenderNodeService::new(capabilities, blobs, Duration::ZERO).unwrap();
+        let incoming = TcpIncoming::bind("127.0.0.1:0".parse().unwrap()).unwrap();
+        let address = incoming.local_addr().unwrap();
+        tokio::spawn(
+            tonic::transport::Server::builder()
+                .add_service(RenderNodeServer::new(service))
+                .serve_with_incoming(incoming),
+        );
+        RenderNodeClient::connect(format!("http://{address}"))
+            .await
+            .unwrap()
+    }
+
+    fn chunks(hash: &str, size: u64, parts: &[&'static [u8]]) -> Vec<pb::BlobChunk> {
+        parts
+            .iter()
+            .enumerate()
+            .map(|(i, data)| pb::BlobChunk {
+                sha256: if i == 0 {
+                    hash.to_string()
+                } else {
+                    String::new()
+                },
+                size: if i == 0 { size } else { 0 },
+                data: prost::bytes::Bytes::from_static(data),
+            })
+            .collect()
+    }
+
+    #[tokio::test]
+    async fn blobs_are_verified_before_they_are_stored() {
+        let mut client = worker().await;
+        let good = sha256_hex(b"hello world");
+        let uploader = client.clone();
+        let put = |c: Vec<pb::BlobChunk>| {
+            let mut client = uploader.clone();
+            async move { client.put_blob(tokio_stream::iter(c)).await }
+        };
+        let wrong_hash = sha256_hex(b"something else");
+        let refused = [
+            (
+                chunks(&wrong_hash, 11, &[b"hello ", b"world"]),
+                Code::InvalidArgument,
+            ),
+            (
+                chunks(&good, 5, &[b"hello ", b"world"]),
+                Code::InvalidArgument,
+            ),
+            (
+                chunks(&good, 12, &[b"hello ", b"world"]),
+                Code::InvalidArgument,
+            ),
+            (
+                chunks("../etc/passwd", 11, &[b"hello world"]),
+                Code::InvalidArgument,
+            ),
+            (
+                chunks(&good, 5000, &[b"hello world"]),
+                Code::ResourceExhausted,
+            ),
+        ];
+        for (stream, code) in refused {
+            assert_eq!(put(stream).await.unwrap_err().code(), code);
+        }
+        let query = pb::HasBlobsRequest {
+            sha256: vec![good.clone(), wrong_hash.clone()],
+        };
+        let missing = client.has_blobs(query.clone()).await.unwrap().into_inner();
+        assert_eq!(missing.missing, vec![good.clone(), wrong_hash.clone()]);
+
+        let stored = put(chunks(&good, 11, &[b"hello ", b"world"]))
+            .await
+            .unwrap();
+        assert_eq!(stored.into_inner().stored_bytes, 11);
+        let missing = client.has_blobs(query).await.unwrap().into_inner();
+        assert_eq!(missing.missing, vec![wrong_hash]);
+        let stats = client
+            .stats(pb::StatsRequest {})
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!((stats.blob_bytes_received, stats.blobs_cached), (11, 1));
+    }
+
+    #[tokio::test]
+    async fn other_protocol_versions_and_unknown_scenes_are_refused() {
+        let mut client = worker().await;
+        let hello = |protocol_version| pb::HandshakeRequest {
+            protocol_version,
+            client: "test".into(),
+        };
+        let reply = client.handshake(hello(PROTOCOL_VERSION)).await.unwrap();
+        assert_eq!(reply.into_inner().threads, 1);
+        let refused = client
+            .handshake(hello(PROTOCOL_VERSION + 1))
+            .await
+            .unwrap_err();
+        assert_eq!(refused.code(), Code::FailedPrecondition);
+        assert!(refused.message().contains(&format!(
+            "version {PROTOCOL_VERSION}, the client (test) version {}",
+            PROTOCOL_VERSION + 1
+        )));
+        let unit = pb::RenderUnitRequest {
+            scene_id: "nothing".into(),
+            unit: None,
+        };
+        let status = client.render_unit(unit).await.unwrap_err();
+        assert_eq!(status.code(), Code::NotFound);
+    }
+}
