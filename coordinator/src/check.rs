@@ -1,6 +1,16 @@
 //! `yat check`: parse a scene and print a summary. OWNER: parser helper.
 
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use yat_tracer::assets::FsSource;
+use yat_tracer::desc::{
+    AssetKind, CameraKind, FilterKind, Geometry, LightDesc, MaterialDesc, SceneDesc, ToneMap,
+};
+use yat_tracer::parse::parse_scene;
 
 #[derive(clap::Args)]
 pub struct CheckArgs {
@@ -9,5 +19,199 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: CheckArgs) -> anyhow::Result<()> {
-    anyhow::bail!("check {} is not implemented yet", args.scene.display())
+    let main = args
+        .scene
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("\"{}\" is not a scene file path", args.scene.display()))?;
+    let source = FsSource::for_main_file(&args.scene);
+    let start = Instant::now();
+    let desc = parse_scene(main, &source)
+        .with_context(|| format!("cannot load scene {}", args.scene.display()))?;
+    let elapsed = start.elapsed();
+    print!(
+        "{}",
+        summary(
+            &args.scene.display().to_string(),
+            &desc,
+            elapsed.as_secs_f64()
+        )
+    );
+    Ok(())
+}
+
+/// Numbers as a person reads them: LuxRender's "infinite" 1e30 stays short.
+fn short(v: f32) -> String {
+    if v.abs() >= 1e6 {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+fn counts<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let mut m = BTreeMap::new();
+    for n in names {
+        *m.entry(n).or_insert(0usize) += 1;
+    }
+    if m.is_empty() {
+        return "none".into();
+    }
+    m.iter()
+        .map(|(k, v)| format!("{v} {k}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
+    let mut s = String::new();
+    let c = &d.camera;
+    let f = &d.film;
+    let _ = writeln!(s, "scene        {path}");
+    let _ = writeln!(s, "resolution   {}x{}", f.xresolution, f.yresolution);
+    let camera = match c.kind {
+        CameraKind::Perspective { fov } => format!("perspective fov {fov}"),
+        CameraKind::Orthographic => "orthographic".to_string(),
+        CameraKind::Fisheye { fov } => format!("fisheye fov {fov}"),
+    };
+    let sw = c.screen_window;
+    let _ = writeln!(
+        s,
+        "camera       {camera}, lensradius {}, focaldistance {}, screenwindow [{} {} {} {}]",
+        c.lens_radius,
+        short(c.focal_distance),
+        sw[0],
+        sw[1],
+        sw[2],
+        sw[3]
+    );
+    let eye = c.camera_to_world.transform_point3(glam::Vec3::ZERO);
+    let dir = c
+        .camera_to_world
+        .transform_vector3(glam::Vec3::Z)
+        .normalize();
+    let _ = writeln!(
+        s,
+        "             at ({:.3}, {:.3}, {:.3}) looking along ({:.3}, {:.3}, {:.3})",
+        eye.x, eye.y, eye.z, dir.x, dir.y, dir.z
+    );
+    let tonemap = match f.tonemap {
+        ToneMap::AutoLinear => "autolinear".to_string(),
+        ToneMap::Linear {
+            sensitivity,
+            exposure,
+            fstop,
+        } => {
+            format!("linear (sensitivity {sensitivity}, exposure {exposure}, fstop {fstop})")
+        }
+        ToneMap::Reinhard {
+            prescale,
+            postscale,
+            burn,
+        } => {
+            format!("reinhard (prescale {prescale}, postscale {postscale}, burn {burn})")
+        }
+        ToneMap::Contrast { ywa } => format!("contrast (ywa {ywa})"),
+    };
+    let halt = match (f.haltspp, f.halttime) {
+        (Some(n), _) => format!(", haltspp {n}"),
+        (None, Some(t)) => format!(", halttime {t} s"),
+        (None, None) => String::new(),
+    };
+    let _ = writeln!(
+        s,
+        "film         gamma {}, tonemap {tonemap}, output \"{}\"{halt}",
+        f.gamma, f.filename
+    );
+    let filter = match d.filter.kind {
+        FilterKind::Box => "box".to_string(),
+        FilterKind::Triangle => "triangle".to_string(),
+        FilterKind::Gaussian { alpha } => format!("gaussian (alpha {alpha})"),
+        FilterKind::Mitchell { b, c } => format!("mitchell (B {b:.3}, C {c:.3})"),
+        FilterKind::BlackmanHarris => "blackmanharris".to_string(),
+        FilterKind::Sinc { tau } => format!("sinc (tau {tau})"),
+    };
+    let _ = writeln!(
+        s,
+        "filter       {filter}, width {} x {}",
+        d.filter.xwidth, d.filter.ywidth
+    );
+    let i = &d.integrator;
+    let _ = writeln!(
+        s,
+        "integrator   path, max depth {} (file asks for \"{}\"), rr {:?} {}",
+        i.max_depth, i.requested, i.rr_strategy, i.rr_continue_prob
+    );
+    let spp = d
+        .sampler
+        .pixel_samples
+        .map_or("not given".to_string(), |n| n.to_string());
+    let _ = writeln!(
+        s,
+        "sampler      \"{}\", pixelsamples {spp}",
+        d.sampler.requested
+    );
+
+    let triangles: usize = d
+        .shapes
+        .iter()
+        .map(|sh| match &sh.geometry {
+            Geometry::Mesh(m) => m.indices.len(),
+            _ => 0,
+        })
+        .sum();
+    let shape_kinds = counts(d.shapes.iter().map(|sh| match sh.geometry {
+        Geometry::Mesh(_) => "mesh",
+        Geometry::Sphere { .. } => "sphere",
+        Geometry::Disk { .. } => "disk",
+        Geometry::Cylinder { .. } => "cylinder",
+        Geometry::Plane { .. } => "plane",
+    }));
+    let _ = writeln!(
+        s,
+        "shapes       {} ({shape_kinds}), {triangles} triangles",
+        d.shapes.len()
+    );
+    let emitters = d.shapes.iter().filter(|sh| sh.area_light.is_some()).count();
+    let lights = counts(
+        d.lights
+            .iter()
+            .map(|l| match l {
+                LightDesc::Point { .. } => "point",
+                LightDesc::Spot { .. } => "spot",
+                LightDesc::Distant { .. } => "distant",
+                LightDesc::Infinite { map: Some(_), .. } => "infinite (map)",
+                LightDesc::Infinite { map: None, .. } => "infinite",
+            })
+            .chain(std::iter::repeat_n("area (shapes)", emitters)),
+    );
+    let _ = writeln!(s, "lights       {lights}");
+    let materials = counts(d.materials.iter().map(|m| match m {
+        MaterialDesc::Matte { .. } => "matte",
+        MaterialDesc::Glossy { .. } => "glossy",
+        MaterialDesc::Mirror { .. } => "mirror",
+        MaterialDesc::Glass { .. } => "glass",
+        MaterialDesc::Metal { .. } => "metal",
+        MaterialDesc::MatteTranslucent { .. } => "mattetranslucent",
+        MaterialDesc::Null => "null",
+        MaterialDesc::Mix { .. } => "mix",
+    }));
+    let _ = writeln!(s, "materials    {} ({materials})", d.materials.len());
+    let _ = writeln!(s, "textures     {}", d.textures.len());
+    let assets = counts(d.assets.iter().map(|a| match a.kind {
+        AssetKind::Include => "include",
+        AssetKind::Ply => "ply",
+        AssetKind::Image => "image",
+    }));
+    let _ = writeln!(s, "assets       {} ({assets})", d.assets.len());
+    let _ = writeln!(s, "parse time   {:.1} ms", seconds * 1e3);
+    if d.warnings.is_empty() {
+        let _ = writeln!(s, "warnings     none");
+    } else {
+        let _ = writeln!(s, "warnings     {}", d.warnings.len());
+        for w in &d.warnings {
+            let _ = writeln!(s, "  {w}");
+        }
+    }
+    s
 }

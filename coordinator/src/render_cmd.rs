@@ -54,6 +54,9 @@ pub struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Write the render's figures (times, samples/s, rays/s, memory) as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
     #[command(flatten)]
     pub distributed: DistributedArgs,
 }
@@ -149,15 +152,31 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let render_time = started.elapsed() - parse_time - build_time.unwrap_or_default();
 
     write_outputs(&job, &outcome.film, args.exr)?;
+    let render_secs = render_time.as_secs_f64().max(1e-9);
+    let report = RenderReport {
+        scene: args.scene.display().to_string(),
+        width: job.settings.width,
+        height: job.settings.height,
+        spp: job.settings.spp,
+        max_depth: job.settings.max_depth,
+        triangles,
+        parse_seconds: parse_time.as_secs_f64(),
+        build_seconds: build_time.map(|b| b.as_secs_f64()),
+        render_seconds: render_secs,
+        samples: outcome.stats.samples,
+        rays: outcome.stats.rays,
+        dropped_samples: outcome.stats.dropped,
+        samples_per_second: outcome.stats.samples as f64 / render_secs,
+        rays_per_second: outcome.stats.rays as f64 / render_secs,
+        peak_memory_bytes: peak_memory_bytes(),
+    };
+    if let Some(path) = &args.stats_json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     if !args.quiet {
-        print_summary(
-            &job,
-            &outcome.stats,
-            parse_time,
-            build_time,
-            render_time,
-            triangles,
-        );
+        println!("wrote {}", job.output_png.display());
+        report.print();
     }
     Ok(())
 }
@@ -231,42 +250,63 @@ pub fn write_outputs(job: &RenderJob, film: &Film, exr: bool) -> anyhow::Result<
     Ok(())
 }
 
-fn print_summary(
-    job: &RenderJob,
-    stats: &UnitStats,
-    parse: Duration,
-    build: Option<Duration>,
-    render: Duration,
-    triangles: Option<usize>,
-) {
-    let s = &job.settings;
-    let secs = render.as_secs_f64().max(1e-9);
-    println!("wrote {}", job.output_png.display());
-    println!(
-        "{}x{} at {} spp, depth {}{}",
-        s.width,
-        s.height,
-        s.spp,
-        s.max_depth,
-        triangles.map_or(String::new(), |t| format!(", {t} triangles"))
-    );
-    println!(
-        "parse {:.3} s{}, render {:.3} s",
-        parse.as_secs_f64(),
-        build.map_or(String::new(), |b| format!(
-            ", build {:.3} s",
-            b.as_secs_f64()
-        )),
-        secs
-    );
-    println!(
-        "{:.3} M samples/s, {:.3} M rays/s{}",
-        stats.samples as f64 / secs / 1e6,
-        stats.rays as f64 / secs / 1e6,
-        if stats.dropped > 0 {
-            format!(", {} NaN/Inf samples dropped", stats.dropped)
-        } else {
-            String::new()
-        }
-    );
+/// The figures of one render, printed at the end and written by `--stats-json`.
+#[derive(serde::Serialize)]
+pub struct RenderReport {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub triangles: Option<usize>,
+    pub parse_seconds: f64,
+    pub build_seconds: Option<f64>,
+    pub render_seconds: f64,
+    pub samples: u64,
+    pub rays: u64,
+    pub dropped_samples: u64,
+    pub samples_per_second: f64,
+    pub rays_per_second: f64,
+    pub peak_memory_bytes: Option<u64>,
+}
+
+impl RenderReport {
+    fn print(&self) {
+        println!(
+            "{}x{} at {} spp, depth {}{}",
+            self.width,
+            self.height,
+            self.spp,
+            self.max_depth,
+            self.triangles
+                .map_or(String::new(), |t| format!(", {t} triangles"))
+        );
+        println!(
+            "parse {:.3} s{}, render {:.3} s",
+            self.parse_seconds,
+            self.build_seconds
+                .map_or(String::new(), |b| format!(", build {b:.3} s")),
+            self.render_seconds
+        );
+        println!(
+            "{:.3} M samples/s, {:.3} M rays/s{}{}",
+            self.samples_per_second / 1e6,
+            self.rays_per_second / 1e6,
+            self.peak_memory_bytes
+                .map_or(String::new(), |m| format!(", peak memory {} MB", m >> 20)),
+            if self.dropped_samples > 0 {
+                format!(", {} NaN/Inf samples dropped", self.dropped_samples)
+            } else {
+                String::new()
+            }
+        );
+    }
+}
+
+/// The process's peak resident set size, where the OS reports it (Linux).
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

@@ -195,18 +195,17 @@ pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
             } else {
                 1.0
             };
-            // Reinhard et al. 2002 with key 0.18 and burn as the white point (in key units).
-            let key = 0.18 / y_wa;
-            let inv_white2 = if burn > 0.0 { 1.0 / (burn * burn) } else { 0.0 };
+            // LuxRender's global Reinhard (2002, equation 4) with key 0.1 over the log-average
+            // luminance; burn is the white point, prescale divides the compressed luminance.
+            let key = 0.1 / y_wa;
+            let pre = key / prescale;
+            let post = key * postscale;
+            let inv_burn2 = if burn > 0.0 { 1.0 / (burn * burn) } else { 1e5 };
             radiance
                 .iter()
                 .map(|&c| {
-                    let y = luminance(c) * key * prescale;
-                    if y <= 0.0 {
-                        return Vec3::ZERO;
-                    }
-                    let mapped = y * (1.0 + y * inv_white2) / (1.0 + y);
-                    c * key * prescale * (mapped / y) * postscale
+                    let y = luminance(c) * pre;
+                    c * (post * (1.0 + y * inv_burn2) / (1.0 + y))
                 })
                 .collect()
         }
@@ -279,16 +278,20 @@ mod tests {
 
     #[test]
     fn reinhard_compresses_highlights_and_keeps_hue() {
-        let radiance = vec![Vec3::new(0.1, 0.05, 0.02), Vec3::new(100.0, 50.0, 20.0)];
         let tm = ToneMap::Reinhard {
             prescale: 1.0,
             postscale: 1.0,
-            burn: 6.0,
+            burn: 7.0,
         };
+        // A uniform image sits at the key: luminance 0.1 after scaling by 0.1 / Y.
+        let grey = tone_map(&[Vec3::splat(4.0); 3], &tm, 2.2);
+        let expected = 4.0 * 0.1 / 4.0 * (1.0 + 0.1 / 49.0) / 1.1;
+        assert!((grey[0].x - expected).abs() < 1e-6, "{}", grey[0].x);
+
+        let radiance = vec![Vec3::new(0.1, 0.05, 0.02), Vec3::new(100.0, 50.0, 20.0)];
         let mapped = tone_map(&radiance, &tm, 2.2);
-        let ratio_in = radiance[1].x / radiance[0].x;
         let ratio_out = mapped[1].x / mapped[0].x;
-        assert!(ratio_out < ratio_in / 5.0, "{ratio_out}");
+        assert!(ratio_out < 1000.0 / 3.0, "{ratio_out}");
         assert!((mapped[1].x / mapped[1].y - 2.0).abs() < 1e-4);
     }
 }

@@ -1,20 +1,114 @@
-//! The LuxRender 1.x scene parser: `.lxs` text -> directives with positions -> [`SceneDesc`]
+//! The LuxRender 1.x scene parser: `.lxs` text -> statements with positions -> [`SceneDesc`]
 //! with LuxRender's defaults applied.
 //!
 //! OWNER: parser helper. Interface used by the renderer and the `yat check` command; keep the
 //! signatures.
+//!
+//! Module map: [`lexer`] (bytes -> tokens), [`reader`] (tokens -> statement arguments and
+//! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
+//! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
+//! described: [`options`] (camera, film, filter, integrator, sampler), [`textures`],
+//! [`materials`], [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
+//!
+//! Choices where LuxRender leaves room (each is pinned by a test):
+//! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
+//!   warning; it renders an empty (black) scene.
+//! - `AttributeEnd`/`TransformEnd` without a matching begin is a warning and is ignored (pbrt's
+//!   and LuxRender's behaviour); blocks still open at the end of the file are a warning.
+//! - References to undefined names (`NamedMaterial`, textures, `ObjectInstance`) are warnings,
+//!   as in LuxRender; the statement falls back to the default.
+//! - `Camera "environment"` and `"realistic"` give a warning and render as perspective.
+//! - Statements after `WorldEnd` are ignored with one warning.
 
-use crate::assets::AssetSource;
-use crate::desc::SceneDesc;
+mod builder;
+mod lexer;
+mod lights;
+mod materials;
+mod options;
+mod params;
+mod ply;
+mod reader;
+mod shapes;
+mod spectra;
+mod textures;
+
+use crate::assets::{AssetError, AssetSource};
+use crate::desc::{SceneDesc, SourcePos};
+
+pub use spectra::{blackbody_rgb, metal_preset};
+
+/// Include files may nest this deep (the main file is depth 0).
+pub const MAX_INCLUDE_DEPTH: usize = 32;
+
+pub(crate) type Pos = SourcePos;
+
+impl SourcePos {
+    pub(crate) fn new(file: &str, line: u32, column: u32) -> Self {
+        Self {
+            file: file.to_string(),
+            line,
+            column,
+        }
+    }
+}
 
 #[derive(Debug, thiserror::Error)]
 pub enum ParseError {
-    #[error("{0}")]
-    Todo(String),
+    /// The text is not a well-formed statement sequence.
+    #[error("{pos}: syntax error: {message}")]
+    Syntax { pos: SourcePos, message: String },
+    /// A parameter has the wrong type, count or value.
+    #[error("{pos}: {statement}: parameter \"{param}\": {message}")]
+    Parameter {
+        pos: SourcePos,
+        statement: String,
+        param: String,
+        message: String,
+    },
+    /// Well-formed but unusable input: bad mesh data, include cycles, a missing required value.
+    #[error("{pos}: {message}")]
+    Invalid { pos: SourcePos, message: String },
+    /// A referenced file (Include, PLY, image) cannot be read.
+    #[error("{pos}: {error}")]
+    Asset { pos: SourcePos, error: AssetError },
+    /// A referenced image exists but its header does not decode.
+    #[error("{pos}: image \"{path}\" does not decode: {message}")]
+    Image {
+        pos: SourcePos,
+        path: String,
+        message: String,
+    },
+    /// A PLY file is malformed.
+    #[error("{pos}: PLY file \"{path}\": {message}")]
+    Ply {
+        pos: SourcePos,
+        path: String,
+        message: String,
+    },
+}
+
+impl ParseError {
+    /// Where in the scene files the problem is.
+    pub fn pos(&self) -> &SourcePos {
+        match self {
+            ParseError::Syntax { pos, .. }
+            | ParseError::Parameter { pos, .. }
+            | ParseError::Invalid { pos, .. }
+            | ParseError::Asset { pos, .. }
+            | ParseError::Image { pos, .. }
+            | ParseError::Ply { pos, .. } => pos,
+        }
+    }
 }
 
 /// Parses the main scene file `main` (its name as given to `source`) and every file it
 /// includes, and builds the scene description. Warnings go into `SceneDesc::warnings`.
-pub fn parse_scene(_main: &str, _source: &dyn AssetSource) -> Result<SceneDesc, ParseError> {
-    todo!("parser helper")
+pub fn parse_scene(main: &str, source: &dyn AssetSource) -> Result<SceneDesc, ParseError> {
+    let bytes = source.read(main).map_err(|error| ParseError::Asset {
+        pos: SourcePos::new(main, 0, 0),
+        error,
+    })?;
+    let mut b = builder::Builder::new(source);
+    b.run_file(main, &bytes)?;
+    b.finish()
 }

@@ -1,0 +1,207 @@
+//! Area lights: a shape whose front side emits constant radiance. Points are sampled uniformly
+//! by area over the whole shape (triangles chosen by an area table), except whole spheres,
+//! which are sampled inside the cone they subtend (only their visible cap).
+
+use std::f32::consts::{PI, TAU};
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::{AnalyticShape, ShapeSurface, SurfaceSample, TriangleSurface};
+use crate::math::{luminance, Frame};
+
+use super::distribution::Distribution1D;
+
+/// Below this sin^2 of the cone's half-angle (about 1.5 degrees) the cone is sampled through
+/// Taylor expansions: 1 - cos(theta_max) would cancel catastrophically (pbrt-v4).
+const SMALL_CONE_SIN2: f32 = 0.000_685_23;
+
+pub(super) struct AreaLight {
+    radiance: Vec3,
+    emitter: Emitter,
+}
+
+enum Emitter {
+    Triangles {
+        triangles: Vec<TriangleSurface>,
+        by_area: Distribution1D,
+        area: f32,
+    },
+    /// A whole sphere under a similarity transform.
+    Sphere {
+        centre: Vec3,
+        radius: f32,
+        shape: Box<AnalyticShape>,
+    },
+    Quadric(Box<AnalyticShape>),
+}
+
+/// A point on the light as seen from a shading point.
+pub(super) struct EmitterSample {
+    pub wi: Vec3,
+    pub dist: f32,
+    /// Solid-angle density.
+    pub pdf: f32,
+}
+
+impl AreaLight {
+    pub fn new(radiance: Vec3, surface: ShapeSurface) -> Self {
+        let emitter = match surface {
+            ShapeSurface::Triangles(triangles) => {
+                let areas: Vec<f32> = triangles.iter().map(TriangleSurface::area).collect();
+                let area = areas.iter().map(|&a| f64::from(a)).sum::<f64>() as f32;
+                Emitter::Triangles {
+                    triangles,
+                    by_area: Distribution1D::new(areas),
+                    area,
+                }
+            }
+            ShapeSurface::Analytic(shape) => match shape.whole_sphere() {
+                Some((centre, radius)) => Emitter::Sphere {
+                    centre,
+                    radius,
+                    shape,
+                },
+                None => Emitter::Quadric(shape),
+            },
+        };
+        Self { radiance, emitter }
+    }
+
+    pub fn radiance(&self) -> Vec3 {
+        self.radiance
+    }
+
+    pub fn area(&self) -> f32 {
+        match &self.emitter {
+            Emitter::Triangles { area, .. } => *area,
+            Emitter::Sphere { shape, .. } | Emitter::Quadric(shape) => shape.area(),
+        }
+    }
+
+    /// Radiant flux of a one-sided Lambertian emitter.
+    pub fn power(&self) -> f32 {
+        luminance(self.radiance) * self.area() * PI
+    }
+
+    /// A point on the light seen from `from`; None when it shows its back (or nothing).
+    pub fn sample(&self, from: Vec3, u: Vec2) -> Option<EmitterSample> {
+        let point = match &self.emitter {
+            Emitter::Triangles {
+                triangles,
+                by_area,
+                area,
+            } => {
+                let (i, _, u0) = by_area.sample_discrete(u.x)?;
+                let s = triangles[i].sample(Vec2::new(u0, u.y));
+                SurfaceSample {
+                    pdf_area: 1.0 / area,
+                    ..s
+                }
+            }
+            Emitter::Quadric(shape) => shape.sample(u),
+            Emitter::Sphere {
+                centre,
+                radius,
+                shape,
+            } => {
+                if from.distance_squared(*centre) <= radius * radius {
+                    shape.sample(u)
+                } else {
+                    return sample_sphere_cone(from, *centre, *radius, shape.orientation(), u);
+                }
+            }
+        };
+        let to_light = point.p - from;
+        let dist2 = to_light.length_squared();
+        let dist = dist2.sqrt();
+        let wi = to_light / dist;
+        let cos_light = -point.n.dot(wi);
+        let pdf = point.pdf_area * dist2 / cos_light;
+        (cos_light > 0.0 && pdf.is_finite()).then_some(EmitterSample { wi, dist, pdf })
+    }
+
+    /// The solid-angle density of [`Self::sample`] from `from` at the light point `p` with
+    /// front normal `n`.
+    pub fn pdf(&self, from: Vec3, p: Vec3, n: Vec3) -> f32 {
+        let to_from = from - p;
+        let dist2 = to_from.length_squared();
+        let cos_light = n.dot(to_from) / dist2.sqrt();
+        if cos_light.is_nan() || cos_light <= 0.0 {
+            return 0.0;
+        }
+        let pdf_area = match &self.emitter {
+            Emitter::Triangles { area, .. } => 1.0 / area,
+            Emitter::Quadric(shape) => shape.pdf_area(n),
+            Emitter::Sphere {
+                centre,
+                radius,
+                shape,
+            } => {
+                let dc2 = from.distance_squared(*centre);
+                if dc2 <= radius * radius {
+                    shape.pdf_area(n)
+                } else {
+                    return 1.0 / (TAU * one_minus_cos_max(radius * radius / dc2));
+                }
+            }
+        };
+        let pdf = pdf_area * dist2 / cos_light;
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
+}
+
+fn one_minus_cos_max(sin2_max: f32) -> f32 {
+    if sin2_max < SMALL_CONE_SIN2 {
+        sin2_max / 2.0
+    } else {
+        1.0 - (1.0 - sin2_max).max(0.0).sqrt()
+    }
+}
+
+/// pbrt-v4's sphere sampling from outside: a direction uniform in the cone of the sphere's
+/// silhouette, turned into the point where it meets the sphere.
+fn sample_sphere_cone(
+    from: Vec3,
+    centre: Vec3,
+    radius: f32,
+    orientation: f32,
+    u: Vec2,
+) -> Option<EmitterSample> {
+    let dc2 = from.distance_squared(centre);
+    let sin2_max = radius * radius / dc2;
+    let sin_max = sin2_max.sqrt();
+    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+    let (cos_theta, sin2_theta) = if sin2_max < SMALL_CONE_SIN2 {
+        let sin2_theta = sin2_max * u.x;
+        ((1.0 - sin2_theta).sqrt(), sin2_theta)
+    } else {
+        let cos_theta = (cos_max - 1.0) * u.x + 1.0;
+        (cos_theta, 1.0 - cos_theta * cos_theta)
+    };
+    // The angle at the centre between the direction back to `from` and the sampled point.
+    let cos_alpha =
+        sin2_theta / sin_max + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
+    let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+    let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
+    let frame = Frame::from_normal((centre - from).normalize());
+    let outward = frame.to_world(-Vec3::new(
+        sin_alpha * cos_phi,
+        sin_alpha * sin_phi,
+        cos_alpha,
+    ));
+    let p = centre + radius * outward;
+    let to_light = p - from;
+    let dist = to_light.length();
+    let wi = to_light / dist;
+    let pdf = 1.0 / (TAU * one_minus_cos_max(sin2_max));
+    // Under ReverseOrientation the visible cap shows its back.
+    (orientation * outward.dot(wi) < 0.0 && pdf.is_finite()).then_some(EmitterSample {
+        wi,
+        dist,
+        pdf,
+    })
+}

@@ -1,0 +1,220 @@
+//! The infinite light: constant radiance, or radiance times a LatLong environment map that is
+//! importance-sampled by luminance.
+
+use std::f32::consts::{PI, TAU};
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+
+use crate::desc::LatLongConvention;
+use crate::image_io::RgbImage;
+use crate::math::luminance;
+
+use super::distribution::Distribution2D;
+
+pub(super) struct InfiniteLight {
+    radiance: Vec3,
+    map: Option<LatLongMap>,
+    world_to_light: Mat3,
+    light_to_world: Mat3,
+    /// |det world_to_light|: with the renormalisation of directions, part of the solid-angle
+    /// Jacobian between light and world space (1 for rotations).
+    abs_det: f32,
+}
+
+impl InfiniteLight {
+    /// A singular `light_to_world` is replaced by the identity (reported by the caller).
+    pub fn new(
+        radiance: Vec3,
+        map: Option<RgbImage>,
+        light_to_world: &Mat4,
+        convention: LatLongConvention,
+    ) -> Self {
+        let linear = Mat3::from_mat4(*light_to_world);
+        let det = linear.determinant();
+        let linear = if det != 0.0 && det.is_finite() {
+            linear
+        } else {
+            Mat3::IDENTITY
+        };
+        let world_to_light = linear.inverse();
+        Self {
+            radiance,
+            map: map.map(|image| LatLongMap::new(image, convention)),
+            world_to_light,
+            light_to_world: linear,
+            abs_det: world_to_light.determinant().abs(),
+        }
+    }
+
+    /// Whether the transform had to be replaced.
+    pub fn is_singular(light_to_world: &Mat4) -> bool {
+        let det = Mat3::from_mat4(*light_to_world).determinant();
+        det == 0.0 || !det.is_finite()
+    }
+
+    /// Radiance arriving from world direction `dir` (unit).
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        match &self.map {
+            None => self.radiance,
+            Some(map) => {
+                let d = (self.world_to_light * dir).normalize_or_zero();
+                self.radiance * map.lookup(map.uv(d))
+            }
+        }
+    }
+
+    /// A world direction and its solid-angle density.
+    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        match &self.map {
+            None => {
+                let z = 1.0 - 2.0 * u.x;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let (sin, cos) = (TAU * u.y).sin_cos();
+                Some((Vec3::new(r * cos, r * sin, z), 1.0 / (4.0 * PI)))
+            }
+            Some(map) => {
+                let (uv, pdf_uv) = map.distribution.sample(u)?;
+                let (d_light, sin_theta) = map.direction(uv);
+                if pdf_uv <= 0.0 || sin_theta <= 0.0 {
+                    return None;
+                }
+                let dir = (self.light_to_world * d_light).normalize_or_zero();
+                let pdf = pdf_uv / (2.0 * PI * PI * sin_theta) * self.jacobian(dir);
+                (dir != Vec3::ZERO && pdf.is_finite()).then_some((dir, pdf))
+            }
+        }
+    }
+
+    /// The solid-angle density of [`Self::sample`] for world direction `dir`.
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        match &self.map {
+            None => 1.0 / (4.0 * PI),
+            Some(map) => {
+                let d = (self.world_to_light * dir).normalize_or_zero();
+                // Not sqrt(1 - z^2), which rounds to 0 near the poles.
+                let sin_theta = d.truncate().length();
+                if sin_theta <= 0.0 {
+                    return 0.0;
+                }
+                map.distribution.pdf(map.uv(d)) / (2.0 * PI * PI * sin_theta) * self.jacobian(dir)
+            }
+        }
+    }
+
+    /// d omega_light / d omega_world at world direction `dir` for the map d -> A d / |A d|.
+    fn jacobian(&self, dir: Vec3) -> f32 {
+        self.abs_det / (self.world_to_light * dir).length().powi(3)
+    }
+
+    /// pi R^2 times the luminance of the mean radiance: what a disk of the scene's size
+    /// facing the light would receive.
+    pub fn power(&self, scene_radius: f32) -> f32 {
+        let mean = self.map.as_ref().map_or(Vec3::ONE, LatLongMap::mean);
+        PI * scene_radius * scene_radius * luminance(self.radiance * mean)
+    }
+}
+
+/// An equirectangular map in light space (z up): t = theta / pi with row 0 straight up, and s
+/// by `convention`.
+struct LatLongMap {
+    image: RgbImage,
+    convention: LatLongConvention,
+    /// Over texels, by luminance x sin(theta).
+    distribution: Distribution2D,
+}
+
+impl LatLongMap {
+    fn new(mut image: RgbImage, convention: LatLongConvention) -> Self {
+        for p in &mut image.pixels {
+            *p = if p.is_finite() {
+                p.max(Vec3::ZERO)
+            } else {
+                Vec3::ZERO
+            };
+        }
+        let (w, h) = (image.width as usize, image.height as usize);
+        let lum: Vec<f32> = image.pixels.iter().map(|&p| luminance(p)).collect();
+        // The map is looked up bilinearly, so a texel's cell also shows 1/4 of each
+        // neighbour on its half: over the cell that averages to 3/4 own + 1/8 per side, per
+        // axis. Sampling that blur keeps the density positive wherever the lookup is.
+        let mut func = vec![0.0f32; w * h];
+        for y in 0..h {
+            let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
+            for x in 0..w {
+                let mut sum = 0.0;
+                for (dy, wy) in [(-1i64, 0.125f32), (0, 0.75), (1, 0.125)] {
+                    let yy = (y as i64 + dy).clamp(0, h as i64 - 1) as usize;
+                    for (dx, wx) in [(-1i64, 0.125f32), (0, 0.75), (1, 0.125)] {
+                        let xx = (x as i64 + dx).rem_euclid(w as i64) as usize;
+                        sum += wy * wx * lum[yy * w + xx];
+                    }
+                }
+                func[y * w + x] = sum * sin_theta;
+            }
+        }
+        Self {
+            distribution: Distribution2D::new(&func, w, h),
+            image,
+            convention,
+        }
+    }
+
+    /// Map coordinates of a unit light-space direction.
+    fn uv(&self, d: Vec3) -> Vec2 {
+        let theta = d.truncate().length().atan2(d.z);
+        let phi = d.y.atan2(d.x);
+        let s = match self.convention {
+            LatLongConvention::Seed => (PI + phi) / TAU,
+            LatLongConvention::LuxRender => {
+                if phi < 0.0 {
+                    (phi + TAU) / TAU
+                } else {
+                    phi / TAU
+                }
+            }
+        };
+        Vec2::new(s, theta / PI)
+    }
+
+    /// The light-space direction at map coordinates `uv`, and sin(theta) there.
+    fn direction(&self, uv: Vec2) -> (Vec3, f32) {
+        let (sin_theta, cos_theta) = (uv.y * PI).sin_cos();
+        let phi = match self.convention {
+            LatLongConvention::Seed => uv.x * TAU - PI,
+            LatLongConvention::LuxRender => uv.x * TAU,
+        };
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        (
+            Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta),
+            sin_theta,
+        )
+    }
+
+    /// Bilinear between texel centres, wrapping around in s and clamped in t.
+    fn lookup(&self, uv: Vec2) -> Vec3 {
+        let (w, h) = (self.image.width as i64, self.image.height as i64);
+        let x = uv.x * w as f32 - 0.5;
+        let y = uv.y * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let xi = [(x0 as i64).rem_euclid(w), (x0 as i64 + 1).rem_euclid(w)];
+        let yi = [(y0 as i64).clamp(0, h - 1), (y0 as i64 + 1).clamp(0, h - 1)];
+        let texel = |xx: i64, yy: i64| self.image.pixels[(yy * w + xx) as usize];
+        let top = texel(xi[0], yi[0]) * (1.0 - fx) + texel(xi[1], yi[0]) * fx;
+        let bottom = texel(xi[0], yi[1]) * (1.0 - fx) + texel(xi[1], yi[1]) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// Mean radiance over the sphere: texels weighted by their solid angle.
+    fn mean(&self) -> Vec3 {
+        let (w, h) = (self.image.width as usize, self.image.height as usize);
+        let mut sum = Vec3::ZERO;
+        for y in 0..h {
+            let (t0, t1) = (y as f32 / h as f32 * PI, (y + 1) as f32 / h as f32 * PI);
+            let solid_angle = TAU / w as f32 * (t0.cos() - t1.cos());
+            let row: Vec3 = self.image.pixels[y * w..(y + 1) * w].iter().sum();
+            sum += row * solid_angle;
+        }
+        sum / (4.0 * PI)
+    }
+}

@@ -1,0 +1,574 @@
+use std::f32::consts::PI;
+use std::io::Cursor;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use super::*;
+use crate::assets::MemorySource;
+use crate::desc::{AreaLightDesc, EnvMapDesc, Geometry, ShapeDesc};
+use crate::geometry::tests::{mesh, scene_desc, shape, sphere};
+use crate::math::{luminance, Ray};
+
+fn build_with(
+    shapes: Vec<ShapeDesc>,
+    lights: Vec<LightDesc>,
+    source: &MemorySource,
+    latlong: LatLongConvention,
+) -> (SceneGeometry, Lights) {
+    let desc = scene_desc(shapes, lights);
+    let geometry = SceneGeometry::build(&desc);
+    let lights = Lights::build(&desc, &geometry, source, latlong).unwrap();
+    (geometry, lights)
+}
+
+fn build(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> (SceneGeometry, Lights) {
+    build_with(
+        shapes,
+        lights,
+        &MemorySource::new(),
+        LatLongConvention::Seed,
+    )
+}
+
+fn emitter(geometry: Geometry, m: Mat4, radiance: Vec3) -> ShapeDesc {
+    ShapeDesc {
+        area_light: Some(AreaLightDesc { radiance }),
+        ..shape(geometry, m)
+    }
+}
+
+/// A square of side `side` centred at the origin in the z = 0 plane, facing -z.
+fn square_facing_down(side: f32) -> Geometry {
+    let h = side / 2.0;
+    Geometry::Mesh(Arc::new(mesh(
+        vec![
+            Vec3::new(-h, -h, 0.0),
+            Vec3::new(h, -h, 0.0),
+            Vec3::new(h, h, 0.0),
+            Vec3::new(-h, h, 0.0),
+        ],
+        vec![[0, 2, 1], [0, 3, 2]],
+    )))
+}
+
+fn disk(radius: f32) -> Geometry {
+    Geometry::Disk {
+        height: 0.0,
+        radius,
+        inner_radius: 0.0,
+        phimax: 360.0,
+    }
+}
+
+fn point(position: Vec3, intensity: f32) -> LightDesc {
+    LightDesc::Point {
+        position,
+        intensity: Vec3::splat(intensity),
+    }
+}
+
+/// Monte Carlo estimate of the irradiance at `p` on a surface facing `n`, by light sampling.
+fn irradiance(lights: &Lights, p: Vec3, n: Vec3, samples: u32, seed: u64) -> Vec3 {
+    let mut rng = fastrand::Rng::with_seed(seed);
+    let mut sum = glam::DVec3::ZERO;
+    for _ in 0..samples {
+        let u = Vec2::new(rng.f32(), rng.f32());
+        if let Some(s) = lights.sample(p, rng.f32(), u) {
+            let cos = s.wi.dot(n).max(0.0);
+            sum += (s.li * cos / s.pdf).as_dvec3();
+        }
+    }
+    (sum / f64::from(samples)).as_vec3()
+}
+
+fn rel_err(got: f32, want: f32) -> f32 {
+    (got / want - 1.0).abs()
+}
+
+#[test]
+fn square_emitter_irradiance_matches_the_form_factor() {
+    let radiance = Vec3::new(2.0, 1.0, 0.5);
+    let (side, h) = (1.0, 1.5);
+    let m = Mat4::from_translation(Vec3::new(0.0, 0.0, h));
+    let (_, lights) = build(vec![emitter(square_facing_down(side), m, radiance)], vec![]);
+    let e = irradiance(&lights, Vec3::ZERO, Vec3::Z, 400_000, 1);
+    // Point under the corner of an a x b rectangle parallel to it at height h:
+    // F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))].
+    let x = side / 2.0 / h;
+    let s = (1.0 + x * x).sqrt();
+    let corner = (2.0 * x / s * (x / s).atan()) / (2.0 * PI);
+    let expected = radiance * PI * 4.0 * corner;
+    for c in 0..3 {
+        assert!(
+            rel_err(e[c], expected[c]) < 0.01,
+            "E = {e}, expected {expected}"
+        );
+    }
+
+    // Small and far: E ~ L A cos / d^2, seen 30 degrees off the emitter's axis.
+    let (side, d) = (0.2, 10.0);
+    let (_, lights) = build(
+        vec![emitter(square_facing_down(side), Mat4::IDENTITY, Vec3::ONE)],
+        vec![],
+    );
+    let p = Vec3::new(0.0, d * 0.5, -d * 0.75f32.sqrt());
+    let to_light = -p.normalize();
+    let e = irradiance(&lights, p, to_light, 100_000, 2);
+    let expected = side * side * (30f32).to_radians().cos() / (d * d);
+    assert!(
+        rel_err(e.x, expected) < 0.02,
+        "E = {}, expected {expected}",
+        e.x
+    );
+}
+
+#[test]
+fn sphere_and_disk_emitters_give_exact_irradiance() {
+    // A sphere of radius r seen from distance d: E = pi L (r/d)^2 on a surface facing it,
+    // sampled through the cone it subtends.
+    let (r, d) = (0.5, 3.0);
+    let (_, lights) = build(vec![emitter(sphere(r), Mat4::IDENTITY, Vec3::ONE)], vec![]);
+    let p = Vec3::new(0.0, -d, 0.0);
+    let e = irradiance(&lights, p, Vec3::Y, 200_000, 3);
+    assert!(rel_err(e.x, PI * (r / d) * (r / d)) < 0.005, "E = {}", e.x);
+    // Tiny and far: the small-angle branch of the cone sampling.
+    let (r, d) = (0.01, 20.0);
+    let (_, lights) = build(vec![emitter(sphere(r), Mat4::IDENTITY, Vec3::ONE)], vec![]);
+    let e = irradiance(&lights, Vec3::new(d, 0.0, 0.0), -Vec3::X, 20_000, 4);
+    assert!(rel_err(e.x, PI * (r / d) * (r / d)) < 0.005, "E = {}", e.x);
+
+    // A disk of radius R at height h above the point, facing it (the disk faces +z, so turn
+    // it over): E = pi L R^2 / (h^2 + R^2). Uniform area sampling.
+    let (radius, h) = (1.0, 2.0);
+    let m = Mat4::from_translation(Vec3::new(0.0, 0.0, h)) * Mat4::from_rotation_x(PI);
+    let (_, lights) = build(vec![emitter(disk(radius), m, Vec3::ONE)], vec![]);
+    let e = irradiance(&lights, Vec3::ZERO, Vec3::Z, 400_000, 5);
+    let expected = PI * radius * radius / (h * h + radius * radius);
+    assert!(
+        rel_err(e.x, expected) < 0.01,
+        "E = {}, expected {expected}",
+        e.x
+    );
+}
+
+#[test]
+fn pdf_hit_agrees_with_sample_at_the_sampled_point() {
+    let shapes = vec![
+        emitter(
+            square_facing_down(1.0),
+            Mat4::from_translation(Vec3::new(0.0, 0.0, 3.0)),
+            Vec3::ONE,
+        ),
+        emitter(
+            sphere(0.5),
+            Mat4::from_translation(Vec3::new(3.0, 0.0, 1.0)),
+            Vec3::splat(4.0),
+        ),
+        // A partial sphere and a stretched disk take the uniform-area path.
+        emitter(
+            Geometry::Sphere {
+                radius: 0.7,
+                zmin: -0.7,
+                zmax: 0.3,
+                phimax: 270.0,
+            },
+            Mat4::from_translation(Vec3::new(-3.0, 0.0, 1.0)),
+            Vec3::splat(2.0),
+        ),
+        emitter(
+            disk(0.5),
+            Mat4::from_translation(Vec3::new(0.0, 3.0, 1.0))
+                * Mat4::from_rotation_x(1.2)
+                * Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0)),
+            Vec3::splat(3.0),
+        ),
+    ];
+    let (geometry, lights) = build(shapes, vec![point(Vec3::new(0.0, 0.0, 5.0), 1.0)]);
+    let mut rng = fastrand::Rng::with_seed(11);
+    let mut checked = [0usize; 4];
+    for _ in 0..40_000 {
+        let p = Vec3::new(
+            rng.f32() * 4.0 - 2.0,
+            rng.f32() * 4.0 - 2.0,
+            rng.f32() * 0.5 - 1.0,
+        );
+        let Some(s) = lights.sample(p, rng.f32(), Vec2::new(rng.f32(), rng.f32())) else {
+            continue;
+        };
+        if s.delta {
+            continue;
+        }
+        let hit = geometry
+            .intersect(&Ray::new(p, s.wi), s.dist * 1.001)
+            .expect("a sampled light point is on the light's surface");
+        assert!(
+            (hit.t - s.dist).abs() < 1e-3 * s.dist,
+            "t {} vs dist {}",
+            hit.t,
+            s.dist
+        );
+        // At grazing angles cos at the light, and so the pdf, is ill-conditioned in f32.
+        if hit.ng.dot(-s.wi) < 0.05 {
+            continue;
+        }
+        let pdf = lights.pdf_hit(p, &hit);
+        assert!(
+            rel_err(pdf, s.pdf) < 1e-3,
+            "pdf_hit {pdf} vs sample {}",
+            s.pdf
+        );
+        assert_eq!(lights.emitted(&hit, -s.wi), s.li);
+        checked[hit.shape as usize] += 1;
+    }
+    assert!(
+        checked.iter().all(|&n| n > 500),
+        "samples per emitter {checked:?}"
+    );
+}
+
+#[test]
+fn area_lights_emit_from_the_front_only() {
+    let m = Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0));
+    let (geometry, lights) = build(vec![emitter(square_facing_down(1.0), m, Vec3::ONE)], vec![]);
+    let above = Vec3::new(0.1, 0.1, 4.0);
+    assert!((0..100).all(|i| lights
+        .sample(above, 0.5, Vec2::new(i as f32 / 100.0, 0.3))
+        .is_none()));
+    let hit = geometry
+        .intersect(&Ray::new(above, -Vec3::Z), f32::INFINITY)
+        .unwrap();
+    assert_eq!(lights.emitted(&hit, Vec3::Z), Vec3::ZERO);
+    assert_eq!(lights.pdf_hit(above, &hit), 0.0);
+    let below = Vec3::new(0.1, 0.1, 0.0);
+    let hit = geometry
+        .intersect(&Ray::new(below, Vec3::Z), f32::INFINITY)
+        .unwrap();
+    assert_eq!(lights.emitted(&hit, -Vec3::Z), Vec3::ONE);
+    assert!(lights.pdf_hit(below, &hit) > 0.0);
+
+    // ReverseOrientation turns a sphere light inwards: nothing reaches the outside.
+    let mut inward = emitter(sphere(1.0), Mat4::IDENTITY, Vec3::ONE);
+    inward.reverse_orientation = true;
+    let (_, lights) = build(vec![inward], vec![]);
+    assert!((0..100).all(|i| lights
+        .sample(Vec3::X * 3.0, 0.5, Vec2::new(i as f32 / 100.0, 0.7))
+        .is_none()));
+    assert!(lights
+        .sample(Vec3::X * 0.3, 0.5, Vec2::new(0.2, 0.7))
+        .is_some());
+}
+
+#[test]
+fn delta_lights_follow_their_definitions() {
+    let spot = LightDesc::Spot {
+        position: Vec3::ZERO,
+        direction: -Vec3::Z,
+        intensity: Vec3::splat(8.0),
+        cone_angle: 30.0,
+        cone_delta_angle: 10.0,
+    };
+    let (_, lights) = build(vec![], vec![spot]);
+    let at_angle = |deg: f32| {
+        let p = Vec3::new(deg.to_radians().sin(), 0.0, -deg.to_radians().cos()) * 2.0;
+        lights.sample(p, 0.5, Vec2::ZERO).map_or(0.0, |s| s.li.x)
+    };
+    assert!((at_angle(0.0) - 2.0).abs() < 1e-5, "I / d^2 on the axis");
+    assert!(
+        (at_angle(19.0) - 2.0).abs() < 1e-5,
+        "full inside coneangle - conedeltaangle"
+    );
+    assert_eq!(at_angle(31.0), 0.0);
+    // Halfway in cosine between cos 30 and cos 20 the smoothstep is 1/2.
+    let mid = (0.5 * (30f32.to_radians().cos() + 20f32.to_radians().cos()))
+        .acos()
+        .to_degrees();
+    assert!((at_angle(mid) - 1.0).abs() < 1e-3, "{}", at_angle(mid));
+
+    let distant = LightDesc::Distant {
+        to_light: Vec3::new(0.0, 1.0, 1.0).normalize(),
+        radiance: Vec3::new(1.0, 2.0, 3.0),
+    };
+    let lights_d = vec![
+        point(Vec3::new(0.0, 0.0, 4.0), 1.0),
+        point(Vec3::new(0.0, 0.0, -4.0), 3.0),
+        distant,
+    ];
+    let (_, lights) = build(vec![], lights_d);
+    // Powers 4 pi x 1, 4 pi x 3 and pi R^2 Y(L) with R = 1 (no geometry).
+    let powers = [
+        4.0 * PI,
+        12.0 * PI,
+        PI * luminance(Vec3::new(1.0, 2.0, 3.0)),
+    ];
+    let total: f32 = powers.iter().sum();
+    let mut seen = [false; 3];
+    for i in 0..1000 {
+        let s = lights
+            .sample(Vec3::ZERO, (i as f32 + 0.5) / 1000.0, Vec2::ZERO)
+            .unwrap();
+        assert!(s.delta);
+        let which = if s.dist.is_infinite() {
+            assert_eq!(s.li, Vec3::new(1.0, 2.0, 3.0));
+            assert!((s.wi - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-6);
+            2
+        } else {
+            assert!((s.dist - 4.0).abs() < 1e-6);
+            let k = if s.wi.z > 0.0 { 0 } else { 1 };
+            assert!((s.li.x - [1.0, 3.0][k] / 16.0).abs() < 1e-6);
+            k
+        };
+        assert!(rel_err(s.pdf, powers[which] / total) < 1e-5);
+        seen[which] = true;
+    }
+    assert!(seen.iter().all(|&s| s));
+}
+
+/// An 8-bit PNG in memory.
+fn png(width: u32, height: u32, texel: impl Fn(u32, u32) -> [u8; 3]) -> Arc<[u8]> {
+    let img = image::RgbImage::from_fn(width, height, |x, y| image::Rgb(texel(x, y)));
+    let mut bytes = Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner().into()
+}
+
+fn env_light(filename: &str, light_to_world: Mat4) -> LightDesc {
+    LightDesc::Infinite {
+        radiance: Vec3::ONE,
+        map: Some(EnvMapDesc {
+            filename: filename.into(),
+            gamma: 1.0,
+        }),
+        light_to_world,
+    }
+}
+
+fn env_lights(source: &MemorySource, light: LightDesc, convention: LatLongConvention) -> Lights {
+    build_with(vec![], vec![light], source, convention).1
+}
+
+fn spherical(theta: f32, phi: f32) -> Vec3 {
+    Vec3::new(
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    )
+}
+
+#[test]
+fn latlong_marker_shows_in_the_direction_each_convention_puts_it() {
+    // 8 x 4 map, black but for a red texel at column 6, row 1: its centre is u = 0.8125,
+    // v = 0.375, so theta = 0.375 pi.
+    let mut source = MemorySource::new();
+    source.insert(
+        "env.png",
+        png(8, 4, |x, y| {
+            if (x, y) == (6, 1) {
+                [255, 0, 0]
+            } else {
+                [0, 0, 0]
+            }
+        }),
+    );
+    let theta = 0.375 * PI;
+    // Seed: u = (pi + phi) / 2 pi -> phi = 2 pi u - pi = 0.625 pi.
+    // LuxRender: s = phi / 2 pi with phi in [0, 2 pi) -> phi = 1.625 pi.
+    for (convention, phi) in [
+        (LatLongConvention::Seed, 0.625 * PI),
+        (LatLongConvention::LuxRender, 1.625 * PI),
+    ] {
+        let lights = env_lights(&source, env_light("env.png", Mat4::IDENTITY), convention);
+        let marker = spherical(theta, phi);
+        assert!(
+            (lights.environment(marker) - Vec3::X).length() < 1e-4,
+            "{convention:?}: {}",
+            lights.environment(marker)
+        );
+        // Half a turn away is black.
+        assert_eq!(lights.environment(spherical(theta, phi + PI)), Vec3::ZERO);
+        // Importance sampling finds the marker: samples land in the 3 x 3 texels the
+        // bilinear lookup spreads it over, most of them (0.75^2 x the sin(theta) share of the
+        // middle row, about 0.6) in the marker's own texel.
+        let mut rng = fastrand::Rng::with_seed(9);
+        let mut in_marker = 0;
+        for _ in 0..1000 {
+            let s = lights
+                .sample(Vec3::ZERO, 0.5, Vec2::new(rng.f32(), rng.f32()))
+                .unwrap();
+            let phi = s.wi.y.atan2(s.wi.x);
+            let u = match convention {
+                LatLongConvention::Seed => (PI + phi) / (2.0 * PI),
+                LatLongConvention::LuxRender => phi.rem_euclid(2.0 * PI) / (2.0 * PI),
+            };
+            let (column, row) = ((u * 8.0) as u32, (s.wi.z.acos() / PI * 4.0) as u32);
+            assert!(
+                (5..=7).contains(&column) && row <= 2,
+                "{convention:?}: {}",
+                s.wi
+            );
+            in_marker += u32::from((column, row) == (6, 1));
+        }
+        assert!(
+            in_marker > 550 && in_marker < 650,
+            "{convention:?}: {in_marker}"
+        );
+
+        // Rotated light space (z up -> world y up): the marker turns with it.
+        let rotation = Mat4::from_rotation_x(-PI / 2.0);
+        let lights = env_lights(&source, env_light("env.png", rotation), convention);
+        let world = rotation.transform_vector3(marker);
+        assert!((lights.environment(world) - Vec3::X).length() < 1e-4);
+    }
+
+    // Pinned formulas on a 4 x 1 map with one colour per column: with Seed, -x has u = 1
+    // (wrapping onto the seam between the last and first columns) and +x has u = 0.5 (the
+    // seam between columns 1 and 2); LuxRender puts +x at s = 0 and +y at s = 0.25.
+    let colours = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 0]];
+    let c = |i: usize| Vec3::from_array(colours[i].map(|v| f32::from(v) / 255.0));
+    source.insert("columns.png", png(4, 1, |x, _| colours[x as usize]));
+    let seed = env_lights(
+        &source,
+        env_light("columns.png", Mat4::IDENTITY),
+        LatLongConvention::Seed,
+    );
+    let lux = env_lights(
+        &source,
+        env_light("columns.png", Mat4::IDENTITY),
+        LatLongConvention::LuxRender,
+    );
+    let near = |a: Vec3, b: Vec3| (a - b).length() < 1e-4;
+    assert!(near(seed.environment(-Vec3::X), (c(3) + c(0)) / 2.0));
+    assert!(near(seed.environment(Vec3::X), (c(1) + c(2)) / 2.0));
+    assert!(
+        near(seed.environment(Vec3::Y), (c(2) + c(3)) / 2.0),
+        "+y: u = 0.75"
+    );
+    assert!(near(lux.environment(Vec3::X), (c(3) + c(0)) / 2.0));
+    assert!(near(lux.environment(-Vec3::X), (c(1) + c(2)) / 2.0));
+    assert!(
+        near(lux.environment(Vec3::Y), (c(0) + c(1)) / 2.0),
+        "+y: s = 0.25"
+    );
+}
+
+#[test]
+fn env_map_sampling_estimates_the_map_integral() {
+    let (w, h) = (64u32, 32u32);
+    let texel = |x: u32, y: u32| {
+        let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
+        let base = 40.0 + 30.0 * (fx * 2.0 * PI).sin() * (fy * PI).cos();
+        let spot = if (20..23).contains(&x) && (8..10).contains(&y) {
+            200.0
+        } else {
+            0.0
+        };
+        [
+            (base + spot) as u8,
+            (base * 0.5) as u8,
+            (spot * 0.9) as u8 + 10,
+        ]
+    };
+    let mut source = MemorySource::new();
+    source.insert("env.png", png(w, h, texel));
+    // Sum of radiance x texel solid angle.
+    let mut integral = glam::DVec3::ZERO;
+    for y in 0..h {
+        let (t0, t1) = (
+            y as f64 / h as f64 * std::f64::consts::PI,
+            (y + 1) as f64 / h as f64 * std::f64::consts::PI,
+        );
+        let solid_angle = std::f64::consts::TAU / w as f64 * (t0.cos() - t1.cos());
+        for x in 0..w {
+            let t = texel(x, y).map(|v| f64::from(v) / 255.0);
+            integral += glam::DVec3::from_array(t) * solid_angle;
+        }
+    }
+    let rotation = Mat4::from_rotation_y(0.4) * Mat4::from_rotation_z(1.0);
+    for convention in [LatLongConvention::Seed, LatLongConvention::LuxRender] {
+        let lights = env_lights(&source, env_light("env.png", rotation), convention);
+        let mut rng = fastrand::Rng::with_seed(21);
+        let n = 400_000;
+        let mut sum = glam::DVec3::ZERO;
+        for _ in 0..n {
+            let u = Vec2::new(rng.f32(), rng.f32());
+            let s = lights
+                .sample(Vec3::ZERO, rng.f32(), u)
+                .unwrap_or_else(|| panic!("{u}"));
+            let pdf = lights.pdf_environment(s.wi);
+            assert!(
+                rel_err(pdf, s.pdf) < 1e-3,
+                "pdf_environment {pdf} vs sample {}",
+                s.pdf
+            );
+            assert_eq!(lights.environment(s.wi), s.li);
+            sum += (s.li / s.pdf).as_dvec3();
+        }
+        let estimate = sum / f64::from(n);
+        for c in 0..3 {
+            let err = (estimate[c] / integral[c] - 1.0).abs();
+            assert!(
+                err < 0.01,
+                "{convention:?}: estimate {estimate}, integral {integral}"
+            );
+        }
+    }
+}
+
+#[test]
+fn constant_infinite_light_is_uniform_and_shares_with_other_lights() {
+    let sky = LightDesc::Infinite {
+        radiance: Vec3::splat(0.5),
+        map: None,
+        light_to_world: Mat4::IDENTITY,
+    };
+    let (_, lights) = build(vec![], vec![sky.clone()]);
+    assert_eq!(
+        lights.environment(Vec3::new(0.3, -0.2, 0.9).normalize()),
+        Vec3::splat(0.5)
+    );
+    assert!(rel_err(lights.pdf_environment(Vec3::Z), 1.0 / (4.0 * PI)) < 1e-6);
+    // Irradiance on a surface under a uniform sky: pi L.
+    let e = irradiance(&lights, Vec3::ZERO, Vec3::Z, 200_000, 8);
+    assert!(rel_err(e.x, PI * 0.5) < 0.01, "E = {}", e.x);
+
+    // Beside a far brighter point light the sky still gets the floor's share.
+    let (_, lights) = build(vec![], vec![sky, point(Vec3::Z, 1e6)]);
+    let p_sky = lights.pdf_environment(Vec3::Z) * 4.0 * PI;
+    assert!(
+        rel_err(p_sky, 0.1 / 1.1) < 1e-4,
+        "sky selection probability {p_sky}"
+    );
+}
+
+#[test]
+fn a_missing_env_map_is_an_error_naming_the_file() {
+    let desc = scene_desc(vec![], vec![env_light("maps/sky.hdr", Mat4::IDENTITY)]);
+    let geometry = SceneGeometry::build(&desc);
+    let err = Lights::build(
+        &desc,
+        &geometry,
+        &MemorySource::new(),
+        LatLongConvention::Seed,
+    )
+    .err()
+    .expect("missing file");
+    assert!(err.to_string().contains("maps/sky.hdr"), "{err}");
+
+    let mut source = MemorySource::new();
+    source.insert("maps/sky.hdr", Arc::from(&b"not an image"[..]));
+    let err = Lights::build(&desc, &geometry, &source, LatLongConvention::Seed)
+        .err()
+        .expect("undecodable file");
+    assert!(matches!(err, LightError::Decode(_)) && err.to_string().contains("maps/sky.hdr"));
+}
+
+#[test]
+fn no_lights_means_no_samples() {
+    let (_, lights) = build(vec![shape(sphere(1.0), Mat4::IDENTITY)], vec![]);
+    assert!(lights.is_empty());
+    assert!(lights
+        .sample(Vec3::X * 3.0, 0.5, Vec2::splat(0.5))
+        .is_none());
+    assert_eq!(lights.environment(Vec3::Z), Vec3::ZERO);
+    assert_eq!(lights.pdf_environment(Vec3::Z), 0.0);
+}

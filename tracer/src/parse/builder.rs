@@ -1,0 +1,756 @@
+//! The graphics state machine: walks statements in file order (following Includes), keeps
+//! the current transform, attribute stack, named textures, materials and objects, and collects
+//! the scene description.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+
+use super::options::OptionsState;
+use super::params::ParamList;
+use super::reader::Reader;
+use super::{ParseError, Pos, MAX_INCLUDE_DEPTH};
+use crate::assets::AssetSource;
+use crate::desc::{
+    AssetKind, AssetRef, Fresnel, LightDesc, MaterialDesc, MaterialId, SceneDesc, ShapeDesc, Tex,
+    TextureDesc, TextureId, TriangleMesh, Warning,
+};
+
+/// Area light parameters kept in the graphics state; the radiance is known only once the
+/// world-space area of each shape is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLightParams {
+    pub l: Vec3,
+    pub gain: f32,
+    pub power: f32,
+    pub efficacy: f32,
+}
+
+#[derive(Clone, Debug, Default)]
+struct GraphicsState {
+    material: Option<MaterialId>,
+    area_light: Option<AreaLightParams>,
+    reverse_orientation: bool,
+}
+
+/// What a named texture resolves to. Fresnel textures are folded into the metal2 material.
+#[derive(Clone, Debug)]
+pub enum TexBinding {
+    Texture(TextureId),
+    Fresnel(Fresnel),
+}
+
+#[derive(Clone, Debug)]
+struct NamedTexture {
+    name: String,
+    is_color: bool,
+    binding: TexBinding,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FrameKind {
+    Attribute,
+    Transform,
+    Object,
+}
+
+impl FrameKind {
+    fn begin(self) -> &'static str {
+        match self {
+            FrameKind::Attribute => "AttributeBegin",
+            FrameKind::Transform => "TransformBegin",
+            FrameKind::Object => "ObjectBegin",
+        }
+    }
+}
+
+struct Frame {
+    kind: FrameKind,
+    pos: Pos,
+    ctm: Mat4,
+    /// Saved graphics state and texture scope (attribute and object blocks only).
+    saved: Option<(GraphicsState, usize)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Block {
+    Options,
+    World,
+    Ended,
+}
+
+/// A shape as defined, before instancing and area-light normalisation.
+#[derive(Clone, Debug)]
+pub struct PendingShape {
+    pub desc: ShapeDesc,
+    pub emitter: Option<AreaLightParams>,
+}
+
+pub struct Builder<'s> {
+    pub(super) source: &'s dyn AssetSource,
+    /// The main file's name, for diagnostics about the scene as a whole.
+    main: String,
+    include_stack: Vec<String>,
+    pub(super) ctm: Mat4,
+    named_coords: HashMap<String, Mat4>,
+    gs: GraphicsState,
+    stack: Vec<Frame>,
+    block: Block,
+    /// Inside MotionBegin/End: whether the block's first transform was applied already.
+    motion: Option<bool>,
+    pub(super) options: OptionsState,
+    textures_in_scope: Vec<NamedTexture>,
+    named_materials: HashMap<String, MaterialId>,
+    default_material: Option<MaterialId>,
+    objects: HashMap<String, Vec<PendingShape>>,
+    /// PLY meshes by file name, shared by every shape that loads the same file.
+    pub(super) ply_meshes: HashMap<String, Arc<TriangleMesh>>,
+    current_object: Option<(String, Vec<PendingShape>)>,
+    pub(super) textures: Vec<TextureDesc>,
+    pub(super) materials: Vec<MaterialDesc>,
+    shapes: Vec<ShapeDesc>,
+    pub(super) lights: Vec<LightDesc>,
+    warnings: Vec<Warning>,
+    warned: HashSet<String>,
+    assets: Vec<AssetRef>,
+    asset_set: HashSet<AssetRef>,
+}
+
+/// Exporter parameters the seed scenes (LuxBlend) write everywhere and that change nothing
+/// this renderer does; they are accepted silently.
+fn is_exporter_param(name: &str) -> bool {
+    name.starts_with("write_")
+        || name.starts_with("colorspace_")
+        || matches!(
+            name,
+            "restart_resume_flm"
+                | "ldr_clamp_method"
+                | "displayinterval"
+                | "writeinterval"
+                | "flmwriteinterval"
+                | "outlierrejection_k"
+                | "tilecount"
+                | "premultiplyalpha"
+                | "importance"
+                | "nsamples"
+                | "flipz"
+                | "generatetangents"
+                | "discardmipmaps"
+                | "maxanisotropy"
+                | "filtertype"
+                | "shutteropen"
+                | "shutterclose"
+                | "shutterdistribution"
+                | "separable"
+                | "filmindex"
+        )
+}
+
+impl<'s> Builder<'s> {
+    pub fn new(source: &'s dyn AssetSource) -> Self {
+        Self {
+            source,
+            main: String::new(),
+            include_stack: Vec::new(),
+            ctm: Mat4::IDENTITY,
+            named_coords: HashMap::new(),
+            gs: GraphicsState::default(),
+            stack: Vec::new(),
+            block: Block::Options,
+            motion: None,
+            options: OptionsState::default(),
+            textures_in_scope: Vec::new(),
+            named_materials: HashMap::new(),
+            default_material: None,
+            objects: HashMap::new(),
+            ply_meshes: HashMap::new(),
+            current_object: None,
+            textures: Vec::new(),
+            materials: Vec::new(),
+            shapes: Vec::new(),
+            lights: Vec::new(),
+            warnings: Vec::new(),
+            warned: HashSet::new(),
+            assets: Vec::new(),
+            asset_set: HashSet::new(),
+        }
+    }
+
+    // -----------------------------------------------------------------------------------------
+    // Diagnostics and assets
+
+    pub(super) fn warn(&mut self, pos: &Pos, message: impl Into<String>) {
+        self.warnings.push(Warning {
+            pos: pos.clone(),
+            message: message.into(),
+        });
+    }
+
+    /// A warning given once per `key` for the whole scene.
+    pub(super) fn warn_once(&mut self, key: String, pos: &Pos, message: impl Into<String>) {
+        if self.warned.insert(key) {
+            self.warn(pos, message);
+        }
+    }
+
+    /// Warns once per statement type and parameter about parameters nothing read.
+    pub(super) fn warn_unused(&mut self, params: &ParamList) {
+        let unused: Vec<(String, Pos)> = params
+            .unused()
+            .filter(|p| !is_exporter_param(&p.name))
+            .map(|p| (p.decl(), p.pos.clone()))
+            .collect();
+        for (decl, pos) in unused {
+            self.warn_once(
+                format!("param|{}|{decl}", params.statement),
+                &pos,
+                format!("{}: unknown parameter \"{decl}\" ignored", params.statement),
+            );
+        }
+    }
+
+    /// Reads a referenced file through the source and records it as an asset.
+    pub(super) fn read_asset(
+        &mut self,
+        path: &str,
+        kind: AssetKind,
+        pos: &Pos,
+    ) -> Result<Arc<[u8]>, ParseError> {
+        let bytes = self.source.read(path).map_err(|error| ParseError::Asset {
+            pos: pos.clone(),
+            error,
+        })?;
+        let r = AssetRef {
+            path: path.to_string(),
+            kind,
+        };
+        if self.asset_set.insert(r.clone()) {
+            self.assets.push(r);
+        }
+        Ok(bytes)
+    }
+
+    /// Checks that an image file exists and its header decodes.
+    pub(super) fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
+        let already = self.asset_set.contains(&AssetRef {
+            path: path.to_string(),
+            kind: AssetKind::Image,
+        });
+        let bytes = self.read_asset(path, AssetKind::Image, pos)?;
+        if already {
+            return Ok(());
+        }
+        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| e.to_string())
+            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+            .map(|_| ())
+            .map_err(|message| ParseError::Image {
+                pos: pos.clone(),
+                path: path.to_string(),
+                message,
+            })
+    }
+
+    // -----------------------------------------------------------------------------------------
+    // Files and statements
+
+    pub fn run_file(&mut self, name: &str, text: &[u8]) -> Result<(), ParseError> {
+        if self.include_stack.is_empty() {
+            self.main = name.to_string();
+        }
+        self.include_stack.push(name.to_string());
+        let mut r = Reader::new(name, text);
+        while let Some((keyword, pos)) = r.keyword()? {
+            self.statement(keyword, &pos, &mut r)?;
+        }
+        self.include_stack.pop();
+        Ok(())
+    }
+
+    fn include(&mut self, path: String, pos: &Pos) -> Result<(), ParseError> {
+        if self.include_stack.contains(&path) {
+            let mut chain = self.include_stack.join(" -> ");
+            chain.push_str(" -> ");
+            chain.push_str(&path);
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: format!("Include cycle: {chain}"),
+            });
+        }
+        if self.include_stack.len() > MAX_INCLUDE_DEPTH {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: format!(
+                    "Include \"{path}\": includes nest deeper than {MAX_INCLUDE_DEPTH} levels"
+                ),
+            });
+        }
+        let bytes = self.read_asset(&path, AssetKind::Include, pos)?;
+        self.run_file(&path, &bytes)
+    }
+
+    fn statement(&mut self, keyword: &str, pos: &Pos, r: &mut Reader) -> Result<(), ParseError> {
+        if self.block == Block::Ended {
+            r.skip_statement()?;
+            self.warn_once(
+                "after WorldEnd".into(),
+                pos,
+                format!("{keyword} after WorldEnd: statements after WorldEnd are ignored"),
+            );
+            return Ok(());
+        }
+        match keyword {
+            "Identity" => self.transform(Mat4::IDENTITY, false),
+            "Translate" => {
+                let v = r.numbers::<3>("Translate")?;
+                self.transform(Mat4::from_translation(Vec3::from_array(v)), true);
+            }
+            "Scale" => {
+                let v = r.numbers::<3>("Scale")?;
+                self.transform(Mat4::from_scale(Vec3::from_array(v)), true);
+            }
+            "Rotate" => {
+                let [angle, x, y, z] = r.numbers::<4>("Rotate")?;
+                let axis = Vec3::new(x, y, z);
+                if axis.length_squared() == 0.0 || !axis.length_squared().is_finite() {
+                    return Err(ParseError::Invalid {
+                        pos: pos.clone(),
+                        message: "Rotate: the axis must be a non-zero vector".into(),
+                    });
+                }
+                let m = Mat4::from_axis_angle(axis.normalize(), angle.to_radians());
+                self.transform(m, true);
+            }
+            "LookAt" => {
+                let v = r.numbers::<9>("LookAt")?;
+                let m = look_at(
+                    Vec3::new(v[0], v[1], v[2]),
+                    Vec3::new(v[3], v[4], v[5]),
+                    Vec3::new(v[6], v[7], v[8]),
+                )
+                .ok_or_else(|| ParseError::Invalid {
+                    pos: pos.clone(),
+                    message: "LookAt: the eye and target coincide, or the up vector is parallel to the viewing direction".into(),
+                })?;
+                self.transform(m, true);
+            }
+            "Transform" | "ConcatTransform" => {
+                let v = r.numbers::<16>(keyword)?;
+                self.transform(Mat4::from_cols_array(&v), keyword == "ConcatTransform");
+            }
+            "CoordinateSystem" => {
+                let name = r.string("a coordinate system name")?;
+                self.named_coords.insert(name, self.ctm);
+            }
+            "CoordSysTransform" => {
+                let name = r.string("a coordinate system name")?;
+                match self.named_coords.get(&name) {
+                    Some(m) => self.ctm = *m,
+                    None => self.warn(
+                        pos,
+                        format!("CoordSysTransform: no coordinate system named \"{name}\""),
+                    ),
+                }
+            }
+            "MotionBegin" => {
+                r.number_array("MotionBegin")?;
+                self.motion = Some(false);
+                self.warn_once(
+                    "motion".into(),
+                    pos,
+                    "MotionBegin: motion blur is not rendered; each motion block uses its first transform",
+                );
+            }
+            "MotionEnd" => self.motion = None,
+            "AttributeBegin" => self.push(FrameKind::Attribute, pos),
+            "TransformBegin" => self.push(FrameKind::Transform, pos),
+            "AttributeEnd" => self.pop(FrameKind::Attribute, pos),
+            "TransformEnd" => self.pop(FrameKind::Transform, pos),
+            "WorldBegin" => {
+                if self.block == Block::World {
+                    self.warn(pos, "WorldBegin inside the world block ignored");
+                } else {
+                    self.block = Block::World;
+                    self.ctm = Mat4::IDENTITY;
+                    self.named_coords.insert("world".into(), Mat4::IDENTITY);
+                }
+            }
+            "WorldEnd" => {
+                for f in std::mem::take(&mut self.stack) {
+                    self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
+                }
+                self.block = Block::Ended;
+            }
+            "Include" => {
+                let path = r.string("the file to include")?;
+                self.include(path, pos)?;
+            }
+            "Camera" | "Film" | "PixelFilter" | "Sampler" | "SurfaceIntegrator" => {
+                let ty = r.string(&format!("the {keyword} type"))?;
+                let params = r.params(format!("{keyword} \"{ty}\""))?;
+                if self.block == Block::World {
+                    self.warn(pos, format!("{keyword} inside the world block is ignored (it belongs before WorldBegin)"));
+                    return Ok(());
+                }
+                if keyword == "Camera" {
+                    self.named_coords
+                        .insert("camera".into(), self.ctm.inverse());
+                }
+                self.option(keyword, ty, params, pos)?;
+            }
+            "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath"
+            | "PortalShape" => r.skip_statement()?,
+            "Volume" | "MakeNamedVolume" | "Exterior" | "Interior" => {
+                r.skip_statement()?;
+                self.warn_once(
+                    "volumes".into(),
+                    pos,
+                    format!("{keyword}: participating media are not rendered; volume statements are ignored"),
+                );
+            }
+            "Texture" | "Material" | "MakeNamedMaterial" | "NamedMaterial" | "LightSource"
+            | "AreaLightSource" | "Shape" | "ReverseOrientation" | "ObjectBegin" | "ObjectEnd"
+            | "ObjectInstance" => {
+                if self.block == Block::Options {
+                    r.skip_statement()?;
+                    self.warn(pos, format!("{keyword} before WorldBegin is ignored"));
+                    return Ok(());
+                }
+                self.world_statement(keyword, pos, r)?;
+            }
+            _ => {
+                r.skip_statement()?;
+                self.warn_once(
+                    format!("statement|{keyword}"),
+                    pos,
+                    format!("unknown statement `{keyword}` ignored"),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn world_statement(
+        &mut self,
+        keyword: &str,
+        pos: &Pos,
+        r: &mut Reader,
+    ) -> Result<(), ParseError> {
+        match keyword {
+            "Texture" => {
+                let name = r.string("the texture name")?;
+                let kind = r.string("the texture kind (\"float\" or \"color\")")?;
+                let class = r.string("the texture type")?;
+                let params = r.params(format!("Texture \"{class}\""))?;
+                self.texture(name, &kind, &class, &params, pos)?;
+                self.warn_unused(&params);
+            }
+            "Material" => {
+                let ty = r.string("the material type")?;
+                let params = r.params(format!("Material \"{ty}\""))?;
+                let ty = if ty.is_empty() {
+                    params.string_or("type", "matte")?
+                } else {
+                    ty
+                };
+                let id = self.material(&ty, &params, pos)?;
+                self.gs.material = Some(id);
+            }
+            "MakeNamedMaterial" => {
+                let name = r.string("the material name")?;
+                let params = r.params("MakeNamedMaterial".into())?;
+                let ty = params.string_or("type", "matte")?;
+                let params = ParamList::new(format!("Material \"{ty}\""), params.params);
+                let id = self.material(&ty, &params, pos)?;
+                self.named_materials.insert(name, id);
+            }
+            "NamedMaterial" => {
+                let name = r.string("the material name")?;
+                match self.named_materials.get(&name) {
+                    Some(&id) => self.gs.material = Some(id),
+                    None => self.warn(pos, format!("NamedMaterial: no material named \"{name}\"; the current material stays")),
+                }
+            }
+            "LightSource" => {
+                let ty = r.string("the light type")?;
+                let params = r.params(format!("LightSource \"{ty}\""))?;
+                if self.current_object.is_some() {
+                    self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined");
+                }
+                self.light(&ty, &params, pos)?;
+                self.warn_unused(&params);
+            }
+            "AreaLightSource" => {
+                let ty = r.string("the area light type")?;
+                let params = r.params(format!("AreaLightSource \"{ty}\""))?;
+                if ty != "area" {
+                    self.warn(
+                        pos,
+                        format!("AreaLightSource \"{ty}\" is treated as \"area\""),
+                    );
+                }
+                self.gs.area_light = Some(AreaLightParams {
+                    l: params.color("L", Vec3::ONE)?,
+                    gain: params.float("gain", 1.0)?,
+                    power: params.float("power", 100.0)?,
+                    efficacy: params.float("efficacy", 17.0)?,
+                });
+                self.warn_unused(&params);
+            }
+            "Shape" => {
+                let ty = r.string("the shape type")?;
+                let params = r.params(format!("Shape \"{ty}\""))?;
+                self.shape_statement(&ty, &params, pos)?;
+                self.warn_unused(&params);
+            }
+            "ReverseOrientation" => self.gs.reverse_orientation = !self.gs.reverse_orientation,
+            "ObjectBegin" => {
+                let name = r.string("the object name")?;
+                if let Some((open, _)) = &self.current_object {
+                    return Err(ParseError::Invalid {
+                        pos: pos.clone(),
+                        message: format!(
+                            "ObjectBegin \"{name}\" inside object \"{open}\": objects cannot nest"
+                        ),
+                    });
+                }
+                self.push(FrameKind::Object, pos);
+                self.current_object = Some((name, Vec::new()));
+            }
+            "ObjectEnd" => {
+                if self.current_object.is_none() {
+                    self.warn(pos, "ObjectEnd without ObjectBegin ignored");
+                } else {
+                    self.pop(FrameKind::Object, pos);
+                }
+            }
+            "ObjectInstance" => {
+                let name = r.string("the object name")?;
+                match self.objects.get(&name) {
+                    Some(shapes) => {
+                        let shapes = shapes.clone();
+                        for s in shapes {
+                            self.emit_shape(s, self.ctm);
+                        }
+                    }
+                    None => self.warn(pos, format!("ObjectInstance: no object named \"{name}\"")),
+                }
+            }
+            _ => unreachable!("dispatched world statements only"),
+        }
+        Ok(())
+    }
+
+    // -----------------------------------------------------------------------------------------
+    // Transforms and blocks
+
+    /// Applies a transform statement: post-multiplies (`concat`) or replaces the current
+    /// matrix. Inside a motion block only the first transform counts.
+    fn transform(&mut self, m: Mat4, concat: bool) {
+        if let Some(applied) = self.motion {
+            if applied {
+                return;
+            }
+            self.motion = Some(true);
+        }
+        self.ctm = if concat { self.ctm * m } else { m };
+    }
+
+    fn push(&mut self, kind: FrameKind, pos: &Pos) {
+        let saved =
+            (kind != FrameKind::Transform).then(|| (self.gs.clone(), self.textures_in_scope.len()));
+        self.stack.push(Frame {
+            kind,
+            pos: pos.clone(),
+            ctm: self.ctm,
+            saved,
+        });
+    }
+
+    fn pop(&mut self, kind: FrameKind, pos: &Pos) {
+        let end = match kind {
+            FrameKind::Attribute => "AttributeEnd",
+            FrameKind::Transform => "TransformEnd",
+            FrameKind::Object => "ObjectEnd",
+        };
+        let Some(frame) = self.stack.pop() else {
+            self.warn(pos, format!("{end} without a matching begin ignored"));
+            return;
+        };
+        if frame.kind != kind {
+            self.warn(
+                pos,
+                format!("{end} closes the {} at {}", frame.kind.begin(), frame.pos),
+            );
+        }
+        self.ctm = frame.ctm;
+        if let Some((gs, textures_len)) = frame.saved {
+            self.gs = gs;
+            self.textures_in_scope.truncate(textures_len);
+        }
+        if frame.kind == FrameKind::Object {
+            if let Some((name, shapes)) = self.current_object.take() {
+                self.objects.insert(name, shapes);
+            }
+        }
+    }
+
+    // -----------------------------------------------------------------------------------------
+    // Names
+
+    pub(super) fn bind_texture(&mut self, name: String, is_color: bool, binding: TexBinding) {
+        self.textures_in_scope.push(NamedTexture {
+            name,
+            is_color,
+            binding,
+        });
+    }
+
+    /// The texture named `name`, preferring one of the requested kind (a float texture used
+    /// as a colour is splatted).
+    pub(super) fn find_texture(&self, name: &str, want_color: bool) -> Option<&TexBinding> {
+        let mut any = None;
+        for t in self
+            .textures_in_scope
+            .iter()
+            .rev()
+            .filter(|t| t.name == name)
+        {
+            if t.is_color == want_color {
+                return Some(&t.binding);
+            }
+            any.get_or_insert(&t.binding);
+        }
+        any
+    }
+
+    pub(super) fn add_texture(&mut self, t: TextureDesc) -> TextureId {
+        self.textures.push(t);
+        TextureId(self.textures.len() as u32 - 1)
+    }
+
+    pub(super) fn add_material(&mut self, m: MaterialDesc) -> MaterialId {
+        self.materials.push(m);
+        MaterialId(self.materials.len() as u32 - 1)
+    }
+
+    pub(super) fn named_material(&mut self, name: &str, pos: &Pos) -> MaterialId {
+        match self.named_materials.get(name) {
+            Some(&id) => id,
+            None => {
+                self.warn(
+                    pos,
+                    format!("no material named \"{name}\"; using the default matte"),
+                );
+                self.default_material()
+            }
+        }
+    }
+
+    /// LuxRender's default material: matte, Kd 0.9.
+    pub(super) fn default_material(&mut self) -> MaterialId {
+        if let Some(id) = self.default_material {
+            return id;
+        }
+        let id = self.add_material(MaterialDesc::Matte {
+            kd: Tex::color(Vec3::splat(0.9)),
+            sigma: Tex::float(0.0),
+        });
+        self.default_material = Some(id);
+        id
+    }
+
+    // -----------------------------------------------------------------------------------------
+    // Shapes
+
+    fn shape_statement(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<(), ParseError> {
+        let Some(geometry) = self.geometry(ty, params, pos)? else {
+            return Ok(());
+        };
+        let material = match self.gs.material {
+            Some(id) => id,
+            None => self.default_material(),
+        };
+        let shape = PendingShape {
+            desc: ShapeDesc {
+                name: params.string("name")?.unwrap_or_default(),
+                geometry,
+                object_to_world: self.ctm,
+                reverse_orientation: self.gs.reverse_orientation,
+                material,
+                area_light: None,
+            },
+            emitter: self.gs.area_light.clone(),
+        };
+        match &mut self.current_object {
+            Some((_, shapes)) => shapes.push(shape),
+            None => self.emit_shape(shape, Mat4::IDENTITY),
+        }
+        Ok(())
+    }
+
+    /// Places a shape in the world (`instance` is the ObjectInstance transform) and sets its
+    /// area light's radiance from its world-space area.
+    fn emit_shape(&mut self, shape: PendingShape, instance: Mat4) {
+        let mut desc = shape.desc;
+        desc.object_to_world = instance * desc.object_to_world;
+        desc.area_light = shape
+            .emitter
+            .map(|e| super::lights::area_light(&e, super::shapes::world_area(&desc)));
+        self.shapes.push(desc);
+    }
+
+    // -----------------------------------------------------------------------------------------
+
+    pub fn finish(mut self) -> Result<SceneDesc, ParseError> {
+        let end = Pos::new(&self.main, 0, 0);
+        for f in std::mem::take(&mut self.stack) {
+            self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
+        }
+        if self.block == Block::Options {
+            self.warn(&end, "no WorldBegin: the scene is empty");
+        }
+        let options = std::mem::take(&mut self.options);
+        let (camera, film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
+        Ok(SceneDesc {
+            camera,
+            film,
+            filter,
+            integrator,
+            sampler,
+            textures: self.textures,
+            materials: self.materials,
+            shapes: self.shapes,
+            lights: self.lights,
+            warnings: self.warnings,
+            assets: self.assets,
+        })
+    }
+}
+
+/// LuxRender's LookAt (world-to-camera): right = normalize(cross(dir, up)),
+/// up' = cross(right, dir); camera space has +x right, +y up, +z along the view.
+pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
+    let dir = (target - eye).try_normalize()?;
+    let right = dir.cross(up.try_normalize()?).try_normalize()?;
+    let new_up = right.cross(dir);
+    let camera_to_world = Mat4::from_cols(
+        right.extend(0.0),
+        new_up.extend(0.0),
+        dir.extend(0.0),
+        eye.extend(1.0),
+    );
+    let world_to_camera = camera_to_world.inverse();
+    world_to_camera
+        .to_cols_array()
+        .iter()
+        .all(|v| v.is_finite())
+        .then_some(world_to_camera)
+}

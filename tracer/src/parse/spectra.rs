@@ -1,0 +1,112 @@
+//! Spectral data reduced to RGB: LuxRender's built-in metal presets (complex index of
+//! refraction per channel) and blackbody colours.
+
+use glam::Vec3;
+
+use crate::math::luminance;
+
+/// Complex index of refraction (eta, k) of LuxRender's named metals, sampled at 650, 550 and
+/// 450 nm for the R, G and B channels. Aluminium: Rakic 1995; gold, silver, copper: Johnson
+/// and Christy 1972; amorphous carbon: the Sopra a-C data LuxRender ships (approximate).
+pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
+    let (eta, k) = match name {
+        "aluminium" | "aluminum" => ([1.49, 0.96, 0.62], [7.82, 6.69, 5.47]),
+        "gold" => ([0.17, 0.43, 1.38], [3.15, 2.46, 1.91]),
+        "silver" => ([0.14, 0.12, 0.13], [4.15, 3.35, 2.60]),
+        "copper" => ([0.21, 1.02, 1.24], [3.67, 2.58, 2.40]),
+        "amorphous carbon" => ([1.97, 1.88, 1.78], [0.78, 0.78, 0.79]),
+        _ => return None,
+    };
+    Some((Vec3::from_array(eta), Vec3::from_array(k)))
+}
+
+/// Linear sRGB colour of a blackbody at `kelvin`, scaled to luminance 1 (a blackbody texture
+/// sets a hue; the light's gain sets the brightness).
+pub fn blackbody_rgb(kelvin: f32) -> Vec3 {
+    let t = f64::from(kelvin.max(100.0));
+    let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+    let mut lambda = 380.0f64;
+    while lambda <= 780.0 {
+        let b = planck(lambda, t);
+        let (cx, cy, cz) = cie_1931(lambda);
+        x += b * cx;
+        y += b * cy;
+        z += b * cz;
+        lambda += 5.0;
+    }
+    // XYZ -> linear sRGB (D65).
+    let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
+    let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
+    let bl = 0.0557 * x - 0.2040 * y + 1.0570 * z;
+    let rgb = Vec3::new(r as f32, g as f32, bl as f32).max(Vec3::ZERO);
+    let yl = luminance(rgb);
+    if yl > 0.0 {
+        rgb / yl
+    } else {
+        Vec3::ONE
+    }
+}
+
+/// Planck's law, spectral radiance up to a constant factor (normalised away by the caller).
+fn planck(lambda_nm: f64, t: f64) -> f64 {
+    const C2: f64 = 1.438_776_9e-2; // hc/k in m K
+    let l = lambda_nm * 1e-9;
+    1.0 / (l.powi(5) * ((C2 / (l * t)).exp() - 1.0))
+}
+
+/// The CIE 1931 2-degree colour matching functions, multi-lobe Gaussian fit of Wyman, Sloan
+/// and Shirley 2013 ("Simple Analytic Approximations to the CIE XYZ Color Matching Functions").
+fn cie_1931(l: f64) -> (f64, f64, f64) {
+    let g = |x: f64, mu: f64, s1: f64, s2: f64| {
+        let t = (x - mu) / if x < mu { s1 } else { s2 };
+        (-0.5 * t * t).exp()
+    };
+    let x = 1.056 * g(l, 599.8, 37.9, 31.0) + 0.362 * g(l, 442.0, 16.0, 26.7)
+        - 0.065 * g(l, 501.1, 20.4, 26.2);
+    let y = 0.821 * g(l, 568.8, 46.9, 40.5) + 0.286 * g(l, 530.9, 16.3, 31.1);
+    let z = 1.217 * g(l, 437.0, 11.8, 36.0) + 0.681 * g(l, 459.0, 26.0, 13.8);
+    (x, y, z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Normal-incidence reflectance of a conductor.
+    fn f0(eta: Vec3, k: Vec3) -> Vec3 {
+        ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k)
+    }
+
+    #[test]
+    fn metal_presets_have_the_expected_colours() {
+        let (e, k) = metal_preset("gold").unwrap();
+        let gold = f0(e, k);
+        assert!(
+            gold.x > 0.9 && gold.x > gold.y && gold.y > gold.z && gold.z < 0.5,
+            "{gold}"
+        );
+        let (e, k) = metal_preset("aluminium").unwrap();
+        let al = f0(e, k);
+        assert!(al.min_element() > 0.85, "{al}");
+        let (e, k) = metal_preset("copper").unwrap();
+        let cu = f0(e, k);
+        assert!(cu.x > 0.9 && cu.y < 0.7, "{cu}");
+        let (e, k) = metal_preset("amorphous carbon").unwrap();
+        assert!(f0(e, k).max_element() < 0.25);
+        assert!(metal_preset("unobtainium").is_none());
+    }
+
+    #[test]
+    fn blackbody_hue_follows_temperature() {
+        let warm = blackbody_rgb(2700.0);
+        let d65ish = blackbody_rgb(6504.0);
+        let cool = blackbody_rgb(12000.0);
+        for c in [warm, d65ish, cool] {
+            assert!((luminance(c) - 1.0).abs() < 1e-4);
+        }
+        assert!(warm.x > warm.y && warm.y > warm.z, "{warm}");
+        assert!(cool.z > cool.x, "{cool}");
+        // Near 6500 K a blackbody is close to white in sRGB.
+        assert!((d65ish.x / d65ish.z - 1.0).abs() < 0.2, "{d65ish}");
+    }
+}

@@ -1,0 +1,743 @@
+//! The parser's LuxRender conventions and defaults, on synthetic scenes held in memory.
+
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+use yat_tracer::assets::MemorySource;
+use yat_tracer::desc::*;
+use yat_tracer::math::luminance;
+use yat_tracer::parse::{metal_preset, parse_scene};
+
+fn source(files: &[(&str, &[u8])]) -> MemorySource {
+    let mut s = MemorySource::new();
+    for (name, bytes) in files {
+        s.insert(*name, Arc::from(*bytes));
+    }
+    s
+}
+
+fn parse(text: &str) -> SceneDesc {
+    parse_with(text, &[])
+}
+
+fn parse_with(text: &str, files: &[(&str, &[u8])]) -> SceneDesc {
+    let mut all = vec![("main.lxs", text.as_bytes())];
+    all.extend_from_slice(files);
+    parse_scene("main.lxs", &source(&all)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn world(body: &str) -> SceneDesc {
+    parse(&format!(
+        "Camera \"perspective\"\nWorldBegin\n{body}\nWorldEnd\n"
+    ))
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
+fn png(width: u32, height: u32) -> Vec<u8> {
+    let img = image::RgbImage::from_pixel(width, height, image::Rgb([200, 100, 50]));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+#[test]
+fn look_at_gives_luxrender_camera_basis() {
+    let d = parse("LookAt 0 -5 0  0 0 0  0 0 1\nCamera \"perspective\"\nWorldBegin\nWorldEnd");
+    let m = d.camera.camera_to_world;
+    assert!(close(
+        m.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, -5.0, 0.0)
+    ));
+    assert!(close(m.transform_vector3(Vec3::Z), Vec3::Y), "forward");
+    assert!(close(m.transform_vector3(Vec3::X), Vec3::X), "right");
+    assert!(close(m.transform_vector3(Vec3::Y), Vec3::Z), "up");
+}
+
+#[test]
+fn camera_transform_is_the_one_current_at_camera_and_world_begin_resets_it() {
+    let d = parse(
+        "Translate 0 0 -3\nCamera \"perspective\"\nTranslate 100 0 0\nWorldBegin\nShape \"sphere\"\nWorldEnd",
+    );
+    // World-to-camera translates by -3 in z: the camera sits at z = +3.
+    assert!(close(
+        d.camera.camera_to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 0.0, 3.0)
+    ));
+    assert_eq!(d.shapes[0].object_to_world, Mat4::IDENTITY);
+}
+
+#[test]
+fn transform_is_column_major_and_transforms_post_multiply() {
+    let d = world(
+        "AttributeBegin\nTransform [0 1 0 0  -1 0 0 0  0 0 1 0  1 2 3 1]\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nTranslate 1 0 0\nScale 2 2 2\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nRotate 90 0 0 1\nConcatTransform [1 0 0 0 0 1 0 0 0 0 1 0 5 0 0 1]\nShape \"sphere\"\nAttributeEnd",
+    );
+    let m = d.shapes[0].object_to_world;
+    assert!(
+        close(m.transform_point3(Vec3::ZERO), Vec3::new(1.0, 2.0, 3.0)),
+        "translation in 12-14"
+    );
+    assert!(
+        close(m.transform_vector3(Vec3::X), Vec3::Y),
+        "first column is the image of x"
+    );
+    let m = d.shapes[1].object_to_world;
+    // current = translate x scale: scale applies to the object first.
+    assert!(close(m.transform_point3(Vec3::X), Vec3::new(3.0, 0.0, 0.0)));
+    let m = d.shapes[2].object_to_world;
+    // Rotating +90 degrees about z (right-handed) takes the translated x axis to +y.
+    assert!(close(
+        m.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 5.0, 0.0)
+    ));
+}
+
+#[test]
+fn nested_attribute_blocks_restore_state() {
+    let d = world(
+        "Texture \"t\" \"color\" \"constant\" \"color value\" [0.1 0.2 0.3]\n\
+         Material \"mirror\"\n\
+         AttributeBegin\n\
+           Translate 1 0 0\n ReverseOrientation\n Material \"null\"\n\
+           Texture \"t\" \"color\" \"constant\" \"color value\" [0.9 0.9 0.9]\n\
+           AreaLightSource \"area\" \"float power\" [0]\n\
+           TransformBegin\n Translate 0 1 0\n Shape \"sphere\"\n TransformEnd\n\
+           Shape \"sphere\"\n\
+         AttributeEnd\n\
+         Material \"matte\" \"texture Kd\" \"t\"\n\
+         Shape \"sphere\"",
+    );
+    let [inner, middle, outer] = &d.shapes[..] else {
+        panic!("3 shapes expected, got {}", d.shapes.len())
+    };
+    assert!(close(
+        inner.object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(1.0, 1.0, 0.0)
+    ));
+    assert!(close(
+        middle.object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::X
+    ));
+    assert!(inner.reverse_orientation && middle.reverse_orientation && inner.area_light.is_some());
+    assert_eq!(d.materials[inner.material.0 as usize], MaterialDesc::Null);
+    assert_eq!(outer.object_to_world, Mat4::IDENTITY);
+    assert!(!outer.reverse_orientation && outer.area_light.is_none());
+    // The texture defined inside the block went out of scope with it.
+    let MaterialDesc::Matte {
+        kd: Tex::Texture(id),
+        ..
+    } = d.materials[outer.material.0 as usize]
+    else {
+        panic!("matte with a texture expected")
+    };
+    assert_eq!(
+        d.textures[id.0 as usize].kind,
+        TextureKind::Constant(Vec3::new(0.1, 0.2, 0.3))
+    );
+}
+
+#[test]
+fn default_screen_window_follows_the_aspect() {
+    let wide = parse("Film \"fleximage\" \"integer xresolution\" [400] \"integer yresolution\" [200]\nCamera \"perspective\"\nWorldBegin\nWorldEnd");
+    assert_eq!(wide.camera.screen_window, [-2.0, 2.0, -1.0, 1.0]);
+    let tall = parse("Film \"fleximage\" \"integer xresolution\" [200] \"integer yresolution\" [400]\nCamera \"perspective\"\nWorldBegin\nWorldEnd");
+    assert_eq!(tall.camera.screen_window, [-1.0, 1.0, -2.0, 2.0]);
+    let given = parse(
+        "Camera \"perspective\" \"float screenwindow\" [-1 1 -0.25 0.25]\nWorldBegin\nWorldEnd",
+    );
+    assert_eq!(given.camera.screen_window, [-1.0, 1.0, -0.25, 0.25]);
+}
+
+#[test]
+fn options_have_luxrender_defaults() {
+    let d = parse("Camera \"perspective\"\nWorldBegin\nWorldEnd");
+    assert_eq!(d.camera.kind, CameraKind::Perspective { fov: 90.0 });
+    assert_eq!((d.camera.lens_radius, d.camera.focal_distance), (0.0, 1e30));
+    assert_eq!((d.camera.hither, d.camera.yon), (1e-3, 1e30));
+    assert_eq!(
+        (d.film.xresolution, d.film.yresolution, d.film.gamma),
+        (800, 600, 2.2)
+    );
+    assert_eq!(d.film.tonemap, ToneMap::AutoLinear);
+    assert_eq!(
+        (d.film.filename.as_str(), d.film.haltspp, d.film.halttime),
+        ("luxout", None, None)
+    );
+    assert_eq!(
+        d.filter.kind,
+        FilterKind::Mitchell {
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0
+        }
+    );
+    assert_eq!((d.filter.xwidth, d.filter.ywidth), (2.0, 2.0));
+    let i = &d.integrator;
+    assert_eq!(
+        (
+            i.max_depth,
+            i.rr_strategy,
+            i.rr_continue_prob,
+            i.include_environment
+        ),
+        (16, RussianRoulette::Efficiency, 0.65, true)
+    );
+    assert_eq!(d.sampler.pixel_samples, None);
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+}
+
+#[test]
+fn options_read_their_parameters() {
+    let d = parse(
+        "Film \"fleximage\" \"string tonemapkernel\" \"reinhard\" \"float reinhard_burn\" 3 \"integer haltspp\" 64 \"float halttime\" 30\n\
+         PixelFilter \"gaussian\" \"float alpha\" 1.5 \"float xwidth\" 1\n\
+         Sampler \"sobol\" \"integer pixelsamples\" [32]\n\
+         SurfaceIntegrator \"path\" \"integer maxdepth\" 5 \"string rrstrategy\" \"none\" \"bool includeenvironment\" \"false\"\n\
+         Camera \"fisheye\" \"float fov\" 55 \"float lensradius\" 0.1 \"float focaldistance\" 4\n\
+         WorldBegin\nWorldEnd",
+    );
+    assert_eq!(
+        d.film.tonemap,
+        ToneMap::Reinhard {
+            prescale: 1.0,
+            postscale: 1.0,
+            burn: 3.0
+        }
+    );
+    assert_eq!((d.film.haltspp, d.film.halttime), (Some(64), Some(30.0)));
+    assert_eq!(d.filter.kind, FilterKind::Gaussian { alpha: 1.5 });
+    assert_eq!((d.filter.xwidth, d.filter.ywidth), (1.0, 2.0));
+    assert_eq!(d.sampler.pixel_samples, Some(32));
+    assert_eq!(
+        (
+            d.integrator.max_depth,
+            d.integrator.rr_strategy,
+            d.integrator.include_environment
+        ),
+        (5, RussianRoulette::None, false)
+    );
+    assert_eq!(d.camera.kind, CameraKind::Fisheye { fov: 55.0 });
+    assert_eq!((d.camera.lens_radius, d.camera.focal_distance), (0.1, 4.0));
+}
+
+#[test]
+fn bidirectional_renders_as_path_at_eyedepth_with_one_warning() {
+    let d = parse("SurfaceIntegrator \"bidirectional\" \"integer eyedepth\" [8] \"integer lightdepth\" [8]\nWorldBegin\nWorldEnd");
+    assert_eq!(
+        (d.integrator.max_depth, d.integrator.requested.as_str()),
+        (8, "bidirectional")
+    );
+    let w: Vec<_> = d
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("bidirectional"))
+        .collect();
+    assert_eq!(w.len(), 1);
+    assert_eq!(
+        (w[0].pos.file.as_str(), w[0].pos.line, w[0].pos.column),
+        ("main.lxs", 1, 1)
+    );
+}
+
+#[test]
+fn material_defaults_and_rules() {
+    let d = world(
+        "Material \"matte\"\nShape \"sphere\"\n\
+         Material \"glossy\" \"float index\" [1.5] \"color Kd\" [2 0.5 -1]\nShape \"sphere\"\n\
+         Material \"glossy\" \"float Ks\" [0.4]\nShape \"sphere\"\n\
+         Material \"roughglass\"\nShape \"sphere\"\n\
+         MakeNamedMaterial \"a\" \"string type\" \"mirror\"\nMakeNamedMaterial \"b\"\n\
+         MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string namedmaterial1\" \"a\" \"string namedmaterial2\" \"b\" \"float amount\" 0.25\n\
+         NamedMaterial \"m\"\nShape \"sphere\"\n\
+         Shape \"sphere\"",
+    );
+    let mat = |i: usize| &d.materials[d.shapes[i].material.0 as usize];
+    assert_eq!(
+        *mat(0),
+        MaterialDesc::Matte {
+            kd: Tex::color(Vec3::splat(0.9)),
+            sigma: Tex::float(0.0)
+        }
+    );
+    let MaterialDesc::Glossy {
+        kd,
+        ks,
+        ka,
+        depth,
+        uroughness,
+        multibounce,
+        ..
+    } = mat(1)
+    else {
+        panic!()
+    };
+    assert_eq!(
+        *kd,
+        Tex::color(Vec3::new(1.0, 0.5, 0.0)),
+        "Kd clamped to [0, 1]"
+    );
+    let Tex::Const(ks) = ks else { panic!() };
+    assert!(
+        close(*ks, Vec3::splat(0.04)),
+        "Ks x ((1.5-1)/(1.5+1))^2: {ks}"
+    );
+    assert_eq!(
+        (*ka, *depth, *uroughness, *multibounce),
+        (Tex::float(0.0), Tex::float(0.0), Tex::float(0.1), false)
+    );
+    let MaterialDesc::Glossy { ks, kd, .. } = mat(2) else {
+        panic!()
+    };
+    assert_eq!(
+        (*ks, *kd),
+        (Tex::float(0.4), Tex::float(1.0)),
+        "\"float Ks\" is a grey colour"
+    );
+    let MaterialDesc::Glass {
+        kr,
+        kt,
+        index,
+        architectural,
+        uroughness,
+        ..
+    } = mat(3)
+    else {
+        panic!()
+    };
+    assert_eq!(
+        (*kr, *kt, *index, *architectural, *uroughness),
+        (
+            Tex::float(1.0),
+            Tex::float(1.0),
+            Tex::float(1.5),
+            false,
+            Tex::float(0.001)
+        )
+    );
+    let MaterialDesc::Mix { a, b, amount } = mat(4) else {
+        panic!()
+    };
+    assert_eq!(
+        d.materials[a.0 as usize],
+        MaterialDesc::Mirror {
+            kr: Tex::float(1.0)
+        }
+    );
+    assert!(matches!(
+        d.materials[b.0 as usize],
+        MaterialDesc::Matte { .. }
+    ));
+    assert_eq!(*amount, Tex::float(0.25));
+    // NamedMaterial stays current for later shapes.
+    assert_eq!(d.shapes[5].material, d.shapes[4].material);
+}
+
+#[test]
+fn shape_without_material_is_default_matte() {
+    let d = world("Shape \"sphere\"");
+    assert_eq!(
+        d.materials[d.shapes[0].material.0 as usize],
+        MaterialDesc::Matte {
+            kd: Tex::color(Vec3::splat(0.9)),
+            sigma: Tex::float(0.0)
+        }
+    );
+}
+
+#[test]
+fn metals_and_fresnel_textures() {
+    let d = world(
+        "Material \"metal\"\nShape \"sphere\"\n\
+         Material \"metal\" \"string name\" \"gold\"\nShape \"sphere\"\n\
+         Material \"metal\" \"string filename\" \"Au.nk\"\nShape \"sphere\"\n\
+         Material \"metal2\"\nShape \"sphere\"\n\
+         Material \"metal2\" \"float fresnel\" [2.5]\nShape \"sphere\"\n\
+         Material \"metal2\" \"color fresnel\" [0.4 0.4 0.4]\nShape \"sphere\"\n\
+         Material \"metal2\" \"color Kr\" [0.8 0.8 0.2]\nShape \"sphere\"\n\
+         Texture \"fc\" \"color\" \"fresnelcolor\" \"color Kr\" [0.9 0.6 0.2]\n\
+         Material \"metal2\" \"texture fresnel\" \"fc\"\nShape \"sphere\"\n\
+         Texture \"fn\" \"fresnel\" \"fresnelname\" \"string name\" \"copper\"\n\
+         Material \"metal2\" \"texture fresnel\" \"fn\"\nShape \"sphere\"",
+    );
+    let fresnel = |i: usize| match &d.materials[d.shapes[i].material.0 as usize] {
+        MaterialDesc::Metal {
+            fresnel,
+            uroughness,
+            ..
+        } => {
+            assert_eq!(*uroughness, Tex::float(0.1));
+            fresnel.clone()
+        }
+        other => panic!("metal expected, got {other:?}"),
+    };
+    let conductor = |name| {
+        let (eta, k) = metal_preset(name).unwrap();
+        Fresnel::Conductor { eta, k }
+    };
+    assert_eq!(fresnel(0), conductor("aluminium"));
+    assert_eq!(fresnel(1), conductor("gold"));
+    assert_eq!(
+        fresnel(2),
+        conductor("aluminium"),
+        ".nk files fall back to aluminium"
+    );
+    assert!(d.warnings.iter().any(|w| w.message.contains("Au.nk")));
+    assert_eq!(fresnel(3), Fresnel::Index(Tex::float(5.0)));
+    assert_eq!(fresnel(4), Fresnel::Index(Tex::float(2.5)));
+    assert_eq!(fresnel(5), Fresnel::Reflectance(Tex::float(0.4)));
+    assert_eq!(
+        fresnel(6),
+        Fresnel::Reflectance(Tex::color(Vec3::new(0.8, 0.8, 0.2)))
+    );
+    assert_eq!(
+        fresnel(7),
+        Fresnel::Reflectance(Tex::color(Vec3::new(0.9, 0.6, 0.2)))
+    );
+    assert_eq!(fresnel(8), conductor("copper"));
+    assert!(
+        d.textures.is_empty(),
+        "fresnel textures fold into the material"
+    );
+}
+
+#[test]
+fn textures_map_to_descriptions() {
+    let img = png(4, 2);
+    let d = parse_with(
+        "Camera \"perspective\"\nWorldBegin\nTranslate 0 0 2\n\
+         Texture \"im\" \"color\" \"imagemap\" \"string filename\" \"tex/a.png\" \"float gamma\" 2.2 \"string wrap\" \"clamp\" \"float vscale\" -1 \"float vdelta\" 1\n\
+         Texture \"pl\" \"float\" \"imagemap\" \"string filename\" \"tex/a.png\" \"string mapping\" \"planar\" \"float uscale\" 3\n\
+         Texture \"ck\" \"float\" \"checkerboard\" \"integer dimension\" 3 \"float tex2\" \"pl\"\n\
+         Texture \"mx\" \"color\" \"mix\" \"texture tex1\" \"im\" \"float amount\" 0.3\n\
+         Texture \"bb\" \"color\" \"blackbody\" \"float temperature\" 3000\n\
+         Material \"matte\" \"texture Kd\" \"mx\" \"float sigma\" \"ck\"\nShape \"sphere\"\nWorldEnd",
+        &[("tex/a.png", &img)],
+    );
+    let t = |n: usize| &d.textures[n].kind;
+    let inv = Mat4::from_translation(Vec3::new(0.0, 0.0, -2.0));
+    assert_eq!(
+        *t(0),
+        TextureKind::ImageMap {
+            filename: "tex/a.png".into(),
+            gamma: 2.2,
+            gain: 1.0,
+            wrap: Wrap::Clamp,
+            mapping: Mapping2D::Uv {
+                uscale: 1.0,
+                vscale: -1.0,
+                udelta: 0.0,
+                vdelta: 1.0
+            },
+        }
+    );
+    let TextureKind::ImageMap {
+        mapping:
+            Mapping2D::Planar {
+                world_to_texture,
+                v1,
+                v2,
+                ..
+            },
+        ..
+    } = t(1)
+    else {
+        panic!("{:?}", t(1))
+    };
+    assert!(world_to_texture.abs_diff_eq(inv, 1e-6) && *v1 == Vec3::X && *v2 == Vec3::Y);
+    assert!(!d.textures[1].is_color && d.textures[0].is_color);
+    assert_eq!(
+        *t(2),
+        TextureKind::Checkerboard3D {
+            tex1: Tex::float(1.0),
+            tex2: Tex::Texture(TextureId(1)),
+            world_to_texture: inv
+        }
+    );
+    assert_eq!(
+        *t(3),
+        TextureKind::Mix {
+            tex1: Tex::Texture(TextureId(0)),
+            tex2: Tex::float(1.0),
+            amount: Tex::float(0.3)
+        }
+    );
+    let TextureKind::Constant(c) = t(4) else {
+        panic!()
+    };
+    assert!((luminance(*c) - 1.0).abs() < 1e-4 && c.x > c.z);
+    assert_eq!(
+        d.assets,
+        vec![AssetRef {
+            path: "tex/a.png".into(),
+            kind: AssetKind::Image
+        }],
+        "one entry per file"
+    );
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+}
+
+#[test]
+fn area_light_gain_uses_world_area_power_and_efficacy() {
+    let d = world(
+        "AttributeBegin\nScale 2 2 2\n\
+         AreaLightSource \"area\" \"color L\" [1 0.5 0.25] \"float gain\" [3]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n\
+         Shape \"sphere\" \"float radius\" 0.5\n\
+         AttributeEnd\n\
+         AttributeBegin\nAreaLightSource \"area\" \"color L\" [1 1 1] \"float power\" [0] \"float gain\" 5\nShape \"sphere\"\nAttributeEnd",
+    );
+    let l = Vec3::new(1.0, 0.5, 0.25);
+    for (shape, area) in [(&d.shapes[0], 4.0), (&d.shapes[1], 4.0 * PI)] {
+        let gain = 3.0 * 100.0 * 17.0 / (area * PI * luminance(l));
+        let r = shape.area_light.as_ref().unwrap().radiance;
+        assert!(
+            ((r - l * gain) / (l * gain)).abs().max_element() < 1e-4,
+            "{r} vs {}",
+            l * gain
+        );
+    }
+    assert_eq!(
+        d.shapes[2].area_light,
+        Some(AreaLightDesc {
+            radiance: Vec3::splat(5.0)
+        })
+    );
+}
+
+#[test]
+fn lights_follow_luxrender_rules() {
+    let d = world(
+        "TransformBegin\nTranslate 1 2 3\n\
+         LightSource \"point\" \"color L\" [1 1 1] \"float power\" [10] \"float efficacy\" [2] \"point from\" [0 0 1]\n\
+         LightSource \"spot\" \"point from\" [0 0 0] \"point to\" [0 0 -1] \"float power\" 1 \"float efficacy\" 1\n\
+         LightSource \"distant\" \"point from\" [0 0 1] \"point to\" [0 0 0] \"color L\" [2 2 2]\n\
+         Scale -1 1 1\nLightSource \"infinite\" \"color L\" [0.5 0.5 0.5] \"float gain\" 2\n\
+         TransformEnd\nLightSource \"sunsky\"\nLightSource \"sky\"",
+    );
+    let LightDesc::Point {
+        position,
+        intensity,
+    } = &d.lights[0]
+    else {
+        panic!()
+    };
+    assert!(close(*position, Vec3::new(1.0, 2.0, 4.0)));
+    assert!(close(*intensity, Vec3::splat(20.0 / (4.0 * PI))));
+    let LightDesc::Spot {
+        position,
+        direction,
+        intensity,
+        cone_angle,
+        cone_delta_angle,
+    } = &d.lights[1]
+    else {
+        panic!()
+    };
+    assert!(close(*position, Vec3::new(1.0, 2.0, 3.0)) && close(*direction, -Vec3::Z));
+    assert_eq!((*cone_angle, *cone_delta_angle), (30.0, 5.0));
+    let solid = 2.0 * PI * (1.0 - 0.5 * (25f32.to_radians().cos() + 30f32.to_radians().cos()));
+    assert!(close(*intensity, Vec3::splat(1.0 / solid)));
+    let LightDesc::Distant { to_light, radiance } = &d.lights[2] else {
+        panic!()
+    };
+    assert!(close(*to_light, Vec3::Z) && *radiance == Vec3::splat(2.0));
+    let LightDesc::Infinite {
+        radiance,
+        map,
+        light_to_world,
+    } = &d.lights[3]
+    else {
+        panic!()
+    };
+    assert_eq!((*radiance, map.clone()), (Vec3::ONE, None));
+    assert!(close(light_to_world.transform_vector3(Vec3::X), -Vec3::X));
+    assert_eq!(d.lights.len(), 4);
+    let skipped = d
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("not supported"))
+        .count();
+    assert_eq!(
+        skipped, 2,
+        "one warning per unsupported light type: {:?}",
+        d.warnings
+    );
+}
+
+#[test]
+fn object_instances_share_meshes_and_compose_transforms() {
+    let d = world(
+        "ObjectBegin \"tri\"\nTranslate 0 0 1\nShape \"trianglemesh\" \"point P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\nObjectEnd\n\
+         AttributeBegin\nTranslate 5 0 0\nObjectInstance \"tri\"\nAttributeEnd\n\
+         AttributeBegin\nTranslate -5 0 0\nObjectInstance \"tri\"\nAttributeEnd\nObjectInstance \"missing\"",
+    );
+    assert_eq!(d.shapes.len(), 2, "definitions are not shapes themselves");
+    assert!(close(
+        d.shapes[0].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(5.0, 0.0, 1.0)
+    ));
+    assert!(close(
+        d.shapes[1].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(-5.0, 0.0, 1.0)
+    ));
+    let (Geometry::Mesh(a), Geometry::Mesh(b)) = (&d.shapes[0].geometry, &d.shapes[1].geometry)
+    else {
+        panic!()
+    };
+    assert!(Arc::ptr_eq(a, b));
+    assert!(d.warnings.iter().any(|w| w.message.contains("\"missing\"")));
+}
+
+#[test]
+fn meshes_quads_uvs_and_planes() {
+    let d = world(
+        "Shape \"mesh\" \"point P\" [0 0 0 1 0 0 1 1 0 0 1 0] \"integer quadindices\" [0 1 2 3] \"float uv\" [0 0 1 0 1 1 0 1] \"normal N\" [0 0 1 0 0 1 0 0 1 0 0 1] \"string name\" \"quad\"\n\
+         Shape \"plane\" \"normal n\" [0 0 2]\nShape \"plane\"",
+    );
+    let Geometry::Mesh(m) = &d.shapes[0].geometry else {
+        panic!()
+    };
+    assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(m.uvs.as_ref().unwrap()[2], [1.0, 1.0]);
+    assert_eq!(m.normals.as_ref().unwrap().len(), 4);
+    assert_eq!(d.shapes[0].name, "quad");
+    assert_eq!(d.shapes[1].geometry, Geometry::Plane { normal: Vec3::Z });
+    assert_eq!(d.shapes[2].geometry, Geometry::Plane { normal: Vec3::Z });
+}
+
+#[test]
+fn plymesh_is_read_through_the_source() {
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let d = parse_with(
+        "WorldBegin\nShape \"plymesh\" \"string filename\" \"m/a.ply\"\nShape \"plymesh\" \"string filename\" \"m/a.ply\"\nWorldEnd",
+        &[("m/a.ply", ply.as_bytes())],
+    );
+    let (Geometry::Mesh(a), Geometry::Mesh(b)) = (&d.shapes[0].geometry, &d.shapes[1].geometry)
+    else {
+        panic!()
+    };
+    assert_eq!(a.indices, vec![[0, 1, 2]]);
+    assert!(Arc::ptr_eq(a, b), "one file, one mesh");
+    assert_eq!(
+        d.assets,
+        vec![AssetRef {
+            path: "m/a.ply".into(),
+            kind: AssetKind::Ply
+        }]
+    );
+}
+
+#[test]
+fn includes_are_relative_to_the_main_folder_and_listed_once() {
+    let d = parse_with(
+        "WorldBegin\nInclude \"sub/a.lxo\"\nInclude \"sub/b.lxo\"\nInclude \"sub/a.lxo\"\nWorldEnd",
+        &[
+            ("sub/a.lxo", b"Shape \"sphere\"\n"),
+            ("sub/b.lxo", b"# paths stay relative to the main file\nInclude \"sub/a.lxo\"\nShape \"disk\" \"float bogus\" 1\n"),
+        ],
+    );
+    assert_eq!(d.shapes.len(), 4);
+    let paths: Vec<_> = d.assets.iter().map(|a| (a.path.as_str(), a.kind)).collect();
+    assert_eq!(
+        paths,
+        vec![
+            ("sub/a.lxo", AssetKind::Include),
+            ("sub/b.lxo", AssetKind::Include)
+        ]
+    );
+    let w = &d.warnings[0];
+    assert_eq!(
+        (w.pos.file.as_str(), w.pos.line, w.pos.column),
+        ("sub/b.lxo", 3, 14),
+        "{w}"
+    );
+}
+
+#[test]
+fn unknown_statements_and_parameters_warn_once_each() {
+    let d = parse(
+        "Frobnicate 1 2 \"x\"\nFrobnicate [3]\nCamera \"perspective\" \"float shutteropen\" 0 \"bool autofocus\" \"false\"\n\
+         Film \"fleximage\" \"bool write_png\" \"true\" \"float colorspace_white\" [0.3 0.3] \"integer displayinterval\" 10\n\
+         WorldBegin\nLightGroup \"default\"\nAccelerator \"qbvh\"\n\
+         Shape \"sphere\" \"float wobble\" 1 \"bool generatetangents\" \"false\" \"string name\" \"a\"\n\
+         Shape \"sphere\" \"float wobble\" 2\nShape \"disk\" \"float wobble\" 2\nWorldEnd",
+    );
+    let messages: Vec<_> = d.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(messages.len(), 3, "{messages:#?}");
+    assert!(messages[0].starts_with("main.lxs:1:1:") && messages[0].contains("Frobnicate"));
+    assert!(messages[1].contains("Shape \"sphere\"") && messages[1].contains("float wobble"));
+    assert!(messages[2].contains("Shape \"disk\""));
+}
+
+#[test]
+fn motion_blocks_use_the_first_transform_with_one_warning() {
+    let d = world(
+        "AttributeBegin\nMotionBegin [0 1]\nTranslate 1 0 0\nTranslate 9 0 0\nMotionEnd\nShape \"sphere\"\nAttributeEnd\n\
+         MotionBegin [0 1]\nTranslate 0 1 0\nTranslate 0 9 0\nMotionEnd\nShape \"sphere\"",
+    );
+    assert!(close(
+        d.shapes[0].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::X
+    ));
+    assert!(close(
+        d.shapes[1].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::Y
+    ));
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+}
+
+#[test]
+fn coordinate_systems_are_named_and_restored() {
+    let d = parse(
+        "LookAt 0 -5 0 0 0 0 0 0 1\nCamera \"perspective\"\nWorldBegin\nTranslate 1 0 0\nCoordinateSystem \"mine\"\nIdentity\n\
+         CoordSysTransform \"camera\"\nShape \"sphere\"\nCoordSysTransform \"mine\"\nShape \"sphere\"\nWorldEnd",
+    );
+    assert!(close(
+        d.shapes[0].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, -5.0, 0.0)
+    ));
+    assert!(close(
+        d.shapes[1].object_to_world.transform_point3(Vec3::ZERO),
+        Vec3::X
+    ));
+}
+
+#[test]
+fn free_form_layout_and_optional_brackets() {
+    let d = parse(
+        "Film \"fleximage\"\n\"integer xresolution\"\n 320 \"integer yresolution\" [\n240\n] # comment [ ] \"\nCamera\n\"perspective\" \"float fov\" 30 WorldBegin Shape \"sphere\" \"float radius\" [ 2 ] WorldEnd",
+    );
+    assert_eq!((d.film.xresolution, d.film.yresolution), (320, 240));
+    assert_eq!(d.camera.kind, CameraKind::Perspective { fov: 30.0 });
+    assert!(
+        matches!(d.shapes[0].geometry, Geometry::Sphere { radius, zmin, zmax, phimax } if (radius, zmin, zmax, phimax) == (2.0, -2.0, 2.0, 360.0))
+    );
+}
+
+#[test]
+fn empty_file_loads_defaults_with_warnings() {
+    let d = parse("");
+    assert!(d.shapes.is_empty() && d.lights.is_empty());
+    assert_eq!((d.film.xresolution, d.film.yresolution), (800, 600));
+    assert_eq!(d.camera.camera_to_world, Mat4::IDENTITY);
+    assert!(d
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("no WorldBegin")));
+    assert!(d.warnings.iter().any(|w| w.message.contains("no Camera")));
+}
+
+#[test]
+fn unbalanced_blocks_are_warnings() {
+    let d = world("AttributeEnd\nTransformBegin\nAttributeEnd\nAttributeBegin\nShape \"sphere\"");
+    let m: Vec<_> = d.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(m.len(), 3, "{m:?}");
+    assert!(m[0].contains("AttributeEnd without a matching begin"));
+    assert!(m[1].contains("closes the TransformBegin"));
+    assert!(m[2].contains("AttributeBegin is never closed"));
+    assert_eq!(d.shapes.len(), 1);
+}
