@@ -270,7 +270,7 @@ impl<'s> Builder<'s> {
     }
 
     fn include(&mut self, path: String, pos: &Pos) -> Result<(), ParseError> {
-        if self.include_stack.iter().any(|f| *f == path) {
+        if self.include_stack.contains(&path) {
             let mut chain = self.include_stack.join(" -> ");
             chain.push_str(" -> ");
             chain.push_str(&path);

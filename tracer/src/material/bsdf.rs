@@ -1,0 +1,95 @@
+//! The BSDF at a surface point in world space: a local scattering function in the shading
+//! frame, guarded by the geometric normal against light leaks.
+
+use glam::{Vec2, Vec3};
+
+use super::bxdf::{Bxdf, LocalSample};
+use crate::math::Frame;
+
+/// A sampled scattering direction.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// Unit world-space direction away from the surface.
+    pub wi: Vec3,
+    /// BSDF value for (wo, wi), not multiplied by the cosine.
+    pub f: Vec3,
+    /// Solid-angle density; for specular lobes the discrete probability of the lobe.
+    pub pdf: f32,
+    pub specular: bool,
+}
+
+/// The BSDF at one surface point, in world space. Plain data: building one allocates nothing.
+///
+/// Shading normals make the shading frame disagree with the true surface near silhouettes. A
+/// pair of directions counts as a reflection only when both the shading normal and the
+/// geometric normal see them on the same side (and as a transmission only when both see them
+/// on opposite sides); otherwise the BSDF is zero, so light never leaks through a surface and
+/// a reflection never comes from below it.
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    frame: Frame,
+    ng: Vec3,
+    bxdf: Bxdf,
+}
+
+impl Bsdf {
+    /// `frame.n` is the shading normal; `ng` the geometric normal (either orientation).
+    pub(crate) fn new(frame: Frame, ng: Vec3, bxdf: Bxdf) -> Self {
+        Self { frame, ng, bxdf }
+    }
+
+    /// True when the material is `null`: the ray continues straight through.
+    pub fn is_pass_through(&self) -> bool {
+        matches!(self.bxdf, Bxdf::PassThrough)
+    }
+
+    /// True when every lobe is specular (light sampling is useless here).
+    pub fn is_specular(&self) -> bool {
+        self.bxdf.is_specular()
+    }
+
+    /// Whether the geometric and shading normals agree on which side `wi` is on relative
+    /// to `wo`.
+    fn sides_agree(&self, wo: Vec3, wi: Vec3, wo_local: Vec3, wi_local: Vec3) -> bool {
+        let geometric = wo.dot(self.ng) * wi.dot(self.ng);
+        let shading = wo_local.z * wi_local.z;
+        (geometric > 0.0 && shading > 0.0) || (geometric < 0.0 && shading < 0.0)
+    }
+
+    /// f(wo, wi) for the non-specular lobes; wo and wi are unit world directions away from
+    /// the surface.
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let (wo_local, wi_local) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if !self.sides_agree(wo, wi, wo_local, wi_local) {
+            return Vec3::ZERO;
+        }
+        self.bxdf.f(wo_local, wi_local)
+    }
+
+    /// Density with which `sample` picks wi (non-specular lobes only).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.bxdf
+            .pdf(self.frame.to_local(wo), self.frame.to_local(wi))
+    }
+
+    /// Samples wi given wo; `u_lobe` picks a lobe, `u` the direction.
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let wo_local = self.frame.to_local(wo);
+        let LocalSample {
+            wi: wi_local,
+            f,
+            pdf,
+            specular,
+        } = self.bxdf.sample(wo_local, u_lobe, u)?;
+        let wi = self.frame.to_world(wi_local).normalize();
+        if !self.sides_agree(wo, wi, wo_local, wi_local) || f == Vec3::ZERO {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f,
+            pdf,
+            specular,
+        })
+    }
+}

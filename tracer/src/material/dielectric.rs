@@ -1,0 +1,199 @@
+//! Dielectric interfaces: smooth glass (specular reflection and refraction), rough glass
+//! (Walter et al. 2007 microfacet reflection and transmission) and architectural glass (a thin
+//! pane: no bend, internal reflections summed).
+//!
+//! Transmitted radiance is not scaled by 1/eta^2. Cameras and lights sit outside glass in the
+//! scenes YAT renders, so on a closed object the factors of entering and leaving cancel; and
+//! without them an open glass surface (a single-sided windshield) does not darken what is
+//! behind it. It also makes every dielectric's directional albedo at most 1.
+
+use glam::{Vec2, Vec3};
+
+use super::bxdf::LocalSample;
+use super::fresnel;
+use super::local::{reflect, refract, same_hemisphere};
+use super::microfacet::TrowbridgeReitz;
+
+#[derive(Clone, Copy, Debug)]
+pub enum Surface {
+    Smooth,
+    Rough(TrowbridgeReitz),
+    /// Architectural glass: a thin pane, smooth.
+    Thin,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Dielectric {
+    /// Tints of the reflected and transmitted light.
+    pub kr: Vec3,
+    pub kt: Vec3,
+    /// Index of the inside relative to the outside (the side the normal points to).
+    pub eta: f32,
+    pub surface: Surface,
+}
+
+impl Dielectric {
+    pub fn is_specular(&self) -> bool {
+        !matches!(self.surface, Surface::Rough(_)) || self.eta == 1.0
+    }
+
+    /// Probability of choosing reflection given Fresnel reflectance `r`: in proportion to the
+    /// reflected and transmitted energy, so a black tint is never sampled.
+    fn reflect_probability(&self, r: f32) -> f32 {
+        let pr = r * self.kr.max_element();
+        let pt = (1.0 - r) * self.kt.max_element();
+        if pr + pt > 0.0 {
+            pr / (pr + pt)
+        } else {
+            0.0
+        }
+    }
+
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).0,
+            _ => Vec3::ZERO,
+        }
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).1,
+            _ => 0.0,
+        }
+    }
+
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.sample_rough(distrib, wo, u_lobe, u),
+            Surface::Thin => self.sample_thin(wo, u_lobe),
+            _ => self.sample_smooth(wo, u_lobe),
+        }
+    }
+
+    fn sample_smooth(&self, wo: Vec3, u_lobe: f32) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let r = fresnel::dielectric(wo.z, self.eta);
+        let p_reflect = self.reflect_probability(r);
+        if u_lobe < p_reflect {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            LocalSample::specular(wi, self.kr * (r / wi.z.abs()), p_reflect)
+        } else {
+            let (wi, _) = refract(wo, Vec3::Z, self.eta)?;
+            if wi.z == 0.0 {
+                return None;
+            }
+            LocalSample::specular(wi, self.kt * ((1.0 - r) / wi.z.abs()), 1.0 - p_reflect)
+        }
+    }
+
+    fn sample_thin(&self, wo: Vec3, u_lobe: f32) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        // Light bounces between the two faces of the pane: sum the geometric series of the
+        // internal reflections (pbrt-v4's ThinDielectricBxDF).
+        let mut r = fresnel::dielectric(wo.z.abs(), self.eta);
+        if r < 1.0 {
+            r += (1.0 - r) * (1.0 - r) * r / (1.0 - r * r);
+        }
+        let p_reflect = self.reflect_probability(r);
+        if u_lobe < p_reflect {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            LocalSample::specular(wi, self.kr * (r / wi.z.abs()), p_reflect)
+        } else {
+            let wi = -wo;
+            LocalSample::specular(wi, self.kt * ((1.0 - r) / wi.z.abs()), 1.0 - p_reflect)
+        }
+    }
+
+    /// The generalized half vector of a reflection or refraction pair, facing up; None for
+    /// configurations no microfacet can produce.
+    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+        let (cos_o, cos_i) = (wo.z, wi.z);
+        if cos_o == 0.0 || cos_i == 0.0 {
+            return None;
+        }
+        let reflect = cos_o * cos_i > 0.0;
+        let etap = if reflect {
+            1.0
+        } else if cos_o > 0.0 {
+            self.eta
+        } else {
+            1.0 / self.eta
+        };
+        let wm = wi * etap + wo;
+        if wm.length_squared() == 0.0 {
+            return None;
+        }
+        let mut wm = wm.normalize();
+        if wm.z < 0.0 {
+            wm = -wm;
+        }
+        // Microfacets seen from behind scatter nothing.
+        if wm.dot(wi) * cos_i < 0.0 || wm.dot(wo) * cos_o < 0.0 {
+            return None;
+        }
+        Some((wm, etap))
+    }
+
+    /// f and pdf of rough glass together (they share the half vector and Fresnel term).
+    fn rough_f_pdf(&self, distrib: TrowbridgeReitz, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let Some((wm, etap)) = self.half_vector(wo, wi) else {
+            return (Vec3::ZERO, 0.0);
+        };
+        let r = fresnel::dielectric(wo.dot(wm), self.eta);
+        let p_reflect = self.reflect_probability(r);
+        let (cos_o, cos_i) = (wo.z, wi.z);
+        if same_hemisphere(wo, wi) {
+            let f = self.kr * (distrib.d(wm) * distrib.g(wo, wi) * r / (4.0 * cos_i * cos_o).abs());
+            let pdf = distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs()) * p_reflect;
+            (f, pdf)
+        } else {
+            let denom = wi.dot(wm) + wo.dot(wm) / etap;
+            let denom2 = denom * denom;
+            if denom2 == 0.0 {
+                return (Vec3::ZERO, 0.0);
+            }
+            let f = self.kt
+                * (distrib.d(wm)
+                    * distrib.g(wo, wi)
+                    * (1.0 - r)
+                    * (wi.dot(wm) * wo.dot(wm) / (cos_i * cos_o * denom2)).abs());
+            let dwm_dwi = wi.dot(wm).abs() / denom2;
+            let pdf = distrib.d_visible(wo, wm) * dwm_dwi * (1.0 - p_reflect);
+            (f, pdf)
+        }
+    }
+
+    fn sample_rough(
+        &self,
+        distrib: TrowbridgeReitz,
+        wo: Vec3,
+        u_lobe: f32,
+        u: Vec2,
+    ) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let wm = distrib.sample_wm(wo, u);
+        let r = fresnel::dielectric(wo.dot(wm), self.eta);
+        let wi = if u_lobe < self.reflect_probability(r) {
+            let wi = reflect(wo, wm);
+            if !same_hemisphere(wo, wi) {
+                return None;
+            }
+            wi
+        } else {
+            let (wi, _) = refract(wo, wm, self.eta)?;
+            if same_hemisphere(wo, wi) || wi.z == 0.0 {
+                return None;
+            }
+            wi
+        };
+        let (f, pdf) = self.rough_f_pdf(distrib, wo, wi);
+        LocalSample::non_specular(wi, f, pdf)
+    }
+}

@@ -1,0 +1,131 @@
+//! Diffuse lobes: Lambert or Oren-Nayar reflection (matte), and diffuse reflection plus
+//! diffuse transmission (mattetranslucent). Both are two-sided.
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::{Vec2, Vec3};
+
+use super::bxdf::LocalSample;
+use super::local::{cosine_hemisphere_pdf, flip_z, same_hemisphere, sample_cosine_hemisphere};
+
+/// The Oren-Nayar roughness terms (pbrt's qualitative model); A = 1, B = 0 is Lambert.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrenNayar {
+    a: f32,
+    b: f32,
+}
+
+impl OrenNayar {
+    /// `sigma_degrees`: standard deviation of the facet slope angle, clamped to [0, 90].
+    pub fn new(sigma_degrees: f32) -> Self {
+        let sigma = sigma_degrees.clamp(0.0, 90.0).to_radians();
+        let s2 = sigma * sigma;
+        Self {
+            a: 1.0 - s2 / (2.0 * (s2 + 0.33)),
+            b: 0.45 * s2 / (s2 + 0.09),
+        }
+    }
+
+    /// The factor multiplying R/pi for two directions in the same (upper) hemisphere.
+    fn factor(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.b == 0.0 {
+            return self.a;
+        }
+        let sin_i = (1.0 - wi.z * wi.z).max(0.0).sqrt();
+        let sin_o = (1.0 - wo.z * wo.z).max(0.0).sqrt();
+        // cos(phi_i - phi_o) from the projections onto the tangent plane.
+        let max_cos = if sin_i > 1e-4 && sin_o > 1e-4 {
+            ((wi.x * wo.x + wi.y * wo.y) / (sin_i * sin_o)).max(0.0)
+        } else {
+            0.0
+        };
+        let (cos_i, cos_o) = (wi.z.abs(), wo.z.abs());
+        let (sin_alpha, tan_beta) = if cos_i > cos_o {
+            (sin_o, sin_i / cos_i)
+        } else {
+            (sin_i, sin_o / cos_o)
+        };
+        self.a + self.b * max_cos * sin_alpha * tan_beta
+    }
+}
+
+/// matte: diffuse reflection.
+#[derive(Clone, Copy, Debug)]
+pub struct DiffuseReflection {
+    pub r: Vec3,
+    pub roughness: OrenNayar,
+}
+
+impl DiffuseReflection {
+    /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if !same_hemisphere(wo, wi) {
+            return Vec3::ZERO;
+        }
+        self.r * (FRAC_1_PI * self.roughness.factor(wo, wi))
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !same_hemisphere(wo, wi) {
+            return 0.0;
+        }
+        cosine_hemisphere_pdf(wi.z.abs())
+    }
+
+    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+        let wi = sample_cosine_hemisphere(u);
+        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
+    }
+}
+
+/// mattetranslucent: diffuse reflection `r` on the side of `wo`, diffuse transmission `t` to
+/// the other side, each with the same Oren-Nayar roughness.
+#[derive(Clone, Copy, Debug)]
+pub struct DiffuseTranslucent {
+    pub r: Vec3,
+    pub t: Vec3,
+    pub roughness: OrenNayar,
+}
+
+impl DiffuseTranslucent {
+    /// Probability of sampling the reflection lobe, by albedo.
+    fn reflect_probability(&self) -> f32 {
+        let (r, t) = (self.r.element_sum(), self.t.element_sum());
+        if r + t > 0.0 {
+            r / (r + t)
+        } else {
+            0.5
+        }
+    }
+
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wi.z == 0.0 {
+            return Vec3::ZERO;
+        }
+        if same_hemisphere(wo, wi) {
+            self.r * (FRAC_1_PI * self.roughness.factor(wo, wi))
+        } else {
+            self.t * (FRAC_1_PI * self.roughness.factor(wo, flip_z(wi)))
+        }
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let p_r = self.reflect_probability();
+        let lobe = if same_hemisphere(wo, wi) {
+            p_r
+        } else {
+            1.0 - p_r
+        };
+        lobe * cosine_hemisphere_pdf(wi.z.abs())
+    }
+
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        let up = sample_cosine_hemisphere(u);
+        let wi = if u_lobe < self.reflect_probability() {
+            up
+        } else {
+            flip_z(up)
+        };
+        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
+    }
+}

@@ -1,0 +1,132 @@
+//! LuxRender's Glossy2: a diffuse base under a glossy coat.
+//!
+//! - Coat: GGX microfacet reflection with Schlick's Fresnel, R0 = Ks (a specular reflection
+//!   when the roughness is zero).
+//! - Base: Lambert Kd, attenuated by the light the coat reflects on the way in and on the way
+//!   out, (1 - F(cos_i)) (1 - F(cos_o)), and by absorption in the coat,
+//!   exp(-Ka d (1/cos_i + 1/cos_o)) (LuxRender's CoatingAbsorption). LuxRender weights the base
+//!   by 1 - F at the half vector instead, which reflects more than it receives at grazing
+//!   angles; the product of the two macro-surface Fresnel terms keeps the sum within 1.
+//! - multibounce: the energy the coat's masking and shadowing remove is returned as a diffuse
+//!   lobe coloured by the coat's average Fresnel (Kulla and Conty 2017), where LuxRender adds
+//!   an ad-hoc (1 - G) term.
+//!
+//! Unlike LuxRender, whose coat vanishes on back faces, the coat is two-sided, so meshes with
+//! inconsistent winding do not show matte patches.
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::{Vec2, Vec3};
+
+use super::bxdf::LocalSample;
+use super::fresnel;
+use super::ggx_albedo;
+use super::local::{cosine_hemisphere_pdf, reflect, same_hemisphere, sample_cosine_hemisphere};
+use super::microfacet::TrowbridgeReitz;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Glossy {
+    pub kd: Vec3,
+    /// The coat's normal-incidence reflectance.
+    pub ks: Vec3,
+    /// Absorption coefficient of the coat and its thickness.
+    pub ka: Vec3,
+    pub depth: f32,
+    /// None: a smooth, specular coat.
+    pub distrib: Option<TrowbridgeReitz>,
+    /// Isotropic roughness for the multibounce term; None when multibounce is off.
+    pub multibounce_alpha: Option<f32>,
+}
+
+impl Glossy {
+    fn absorption(&self, cos_o: f32, cos_i: f32) -> Vec3 {
+        if self.depth > 0.0 && self.ka != Vec3::ZERO {
+            let path = self.depth * (cos_i + cos_o) / (cos_i * cos_o);
+            (-self.ka * path).exp()
+        } else {
+            Vec3::ONE
+        }
+    }
+
+    /// Probability of sampling the coat, by each lobe's approximate albedo seen from `wo`.
+    fn coat_probability(&self, cos_o: f32) -> f32 {
+        let f = fresnel::schlick(cos_o, self.ks);
+        let coat = f.element_sum();
+        let base = (self.kd * (Vec3::ONE - f) * self.absorption(cos_o, 1.0)).element_sum();
+        if coat + base > 0.0 {
+            coat / (coat + base)
+        } else {
+            0.0
+        }
+    }
+
+    fn base_f(&self, cos_o: f32, cos_i: f32) -> Vec3 {
+        let in_out = (Vec3::ONE - fresnel::schlick(cos_o, self.ks))
+            * (Vec3::ONE - fresnel::schlick(cos_i, self.ks));
+        self.kd * in_out * self.absorption(cos_o, cos_i) * FRAC_1_PI
+    }
+
+    fn multibounce_f(&self, alpha: f32, cos_o: f32, cos_i: f32) -> Vec3 {
+        let e_avg = ggx_albedo::average_albedo(alpha);
+        if e_avg >= 1.0 {
+            return Vec3::ZERO;
+        }
+        let lost =
+            (1.0 - ggx_albedo::albedo(alpha, cos_o)) * (1.0 - ggx_albedo::albedo(alpha, cos_i));
+        // Average Schlick reflectance over the hemisphere, and the colour after many bounces.
+        let f_avg = self.ks + (Vec3::ONE - self.ks) / 21.0;
+        let f_ms = f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
+        f_ms * (lost * FRAC_1_PI / (1.0 - e_avg))
+    }
+
+    /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if !same_hemisphere(wo, wi) {
+            return Vec3::ZERO;
+        }
+        let (cos_o, cos_i) = (wo.z.abs(), wi.z.abs());
+        let mut f = self.base_f(cos_o, cos_i);
+        if let Some(distrib) = self.distrib {
+            let wm = (wo + wi).normalize();
+            let s = fresnel::schlick(wo.dot(wm), self.ks);
+            f += s * (distrib.d(wm) * distrib.g(wo, wi) / (4.0 * cos_o * cos_i));
+        }
+        if let Some(alpha) = self.multibounce_alpha {
+            f += self.multibounce_f(alpha, cos_o, cos_i);
+        }
+        f
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !same_hemisphere(wo, wi) {
+            return 0.0;
+        }
+        let p_coat = self.coat_probability(wo.z.abs());
+        let coat = match self.distrib {
+            Some(distrib) => {
+                let wm = (wo + wi).normalize();
+                distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
+            }
+            None => 0.0,
+        };
+        p_coat * coat + (1.0 - p_coat) * cosine_hemisphere_pdf(wi.z.abs())
+    }
+
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let p_coat = self.coat_probability(wo.z);
+        let wi = if u_lobe < p_coat {
+            let Some(distrib) = self.distrib else {
+                let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+                let f = fresnel::schlick(wo.z, self.ks) / wi.z;
+                return LocalSample::specular(wi, f, p_coat);
+            };
+            reflect(wo, distrib.sample_wm(wo, u))
+        } else {
+            sample_cosine_hemisphere(u)
+        };
+        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
+    }
+}
