@@ -513,7 +513,7 @@ fn brute_force(geometry: &SceneGeometry, ray: &Ray, tmax: f32) -> Option<(f32, u
     for (slot, prim) in geometry.prims.iter().enumerate() {
         let t_best = best.map_or(tmax, |b| b.0);
         let t = match *prim {
-            Prim::Triangle(tri) => tri.intersect(o, d, t_best).map(|h| h.0),
+            Prim::Triangle { edges, .. } => edges.intersect(o, d, t_best).map(|h| h.0),
             Prim::Analytic(a) => geometry.analytic[a as usize]
                 .intersect(o, d, t_best)
                 .map(|h| h.t),
@@ -674,8 +674,8 @@ fn bvh_throughput() {
             .prims
             .iter()
             .filter_map(|p| match *p {
-                Prim::Triangle(t) => {
-                    let [v0, v1, v2] = t.vertices();
+                Prim::Triangle { edges, .. } => {
+                    let [v0, v1, v2] = edges.vertices();
                     Some(obvhs::triangle::Triangle { v0, v1, v2 })
                 }
                 Prim::Analytic(_) => None,
