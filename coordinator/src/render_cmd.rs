@@ -144,7 +144,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         let build_time = build_start.elapsed();
         let triangles = scene.triangle_count();
         (
-            render_in_process(&scene, args.threads, args.quiet)?,
+            render_in_process(&scene, args.threads, job.quiet)?,
             Some(build_time),
             Some(triangles),
         )
@@ -154,7 +154,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     write_outputs(&job, &outcome.film, args.exr)?;
     let render_secs = render_time.as_secs_f64().max(1e-9);
     let report = RenderReport {
-        scene: args.scene.display().to_string(),
+        scene: job.main_file.display().to_string(),
         width: job.settings.width,
         height: job.settings.height,
         spp: job.settings.spp,

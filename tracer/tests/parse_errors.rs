@@ -56,7 +56,7 @@ fn truncated_files_are_errors() {
     let full = "Camera \"perspective\" \"float fov\" [45]\nWorldBegin\nShape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0]\nWorldEnd\n";
     let mut failures = 0;
     for cut in 1..full.len() {
-        if let Err(e) = parse_files(&[("main.lxs", full[..cut].as_bytes())]) {
+        if let Err(e) = parse_files(&[("main.lxs", &full.as_bytes()[..cut])]) {
             failures += 1;
             assert!(e.to_string().starts_with("main.lxs:"), "{e}");
         }
@@ -173,9 +173,9 @@ fn invalid_mesh_data_names_the_parameter_and_position() {
     assert!(e.contains("\"float uv\""), "{e}");
     let e = world_error("Shape \"trianglemesh\" \"integer indices\" [0 1 2]");
     assert!(e.contains("missing \"point P\""), "{e}");
-    let e = world_error(&format!(
-        "Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1e40 0]"
-    ));
+    let e = world_error(
+        "Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1e40 0]",
+    );
     assert!(
         e.contains("\"point P\"") && e.contains("out of range"),
         "{e}"

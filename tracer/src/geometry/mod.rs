@@ -62,20 +62,21 @@ pub struct SurfaceSample {
     pub pdf_area: f32,
 }
 
-/// The part of a BVH primitive the traversal reads.
+/// A BVH primitive: what the traversal reads, and where its shading data lives.
 #[derive(Clone, Copy, Debug)]
 enum Prim {
-    Triangle(TriangleEdges),
+    Triangle {
+        edges: TriangleEdges,
+        /// Index into `SceneGeometry::meshes`, and the triangle within that mesh.
+        mesh: u32,
+        tri: u32,
+    },
     /// Index into `SceneGeometry::analytic`.
     Analytic(u32),
 }
 
-/// Where a primitive's shading data lives.
-#[derive(Clone, Copy, Debug)]
-enum PrimSource {
-    Triangle { mesh: u32, tri: u32 },
-    Analytic(u32),
-}
+// One cache line per primitive: the indices fit in the padding the 16-byte aligned edges leave.
+const _: () = assert!(std::mem::size_of::<Prim>() == 64);
 
 /// The surface of one shape, owned, for sampling points on emitters.
 #[derive(Clone, Debug)]
@@ -86,11 +87,9 @@ pub enum ShapeSurface {
 
 pub struct SceneGeometry {
     bvh: CwBvh,
-    /// BVH primitives in leaf order.
-    prims: Vec<Prim>,
-    /// One per BVH primitive in leaf order. `SurfaceHit::prim` is the leaf-order index, or
+    /// BVH primitives in leaf order. `SurfaceHit::prim` is the leaf-order index, or
     /// `prims.len()` + the index of a plane.
-    sources: Vec<PrimSource>,
+    prims: Vec<Prim>,
     meshes: Vec<WorldMesh>,
     analytic: Vec<AnalyticShape>,
     planes: Vec<InfinitePlane>,
@@ -104,8 +103,19 @@ pub struct SceneGeometry {
 #[derive(Clone, Copy)]
 enum Closest {
     None,
-    Triangle { slot: u32, b1: f32, b2: f32 },
-    Analytic { slot: u32, hit: QuadricHit },
+    Triangle {
+        slot: u32,
+        edges: TriangleEdges,
+        mesh: u32,
+        tri: u32,
+        b1: f32,
+        b2: f32,
+    },
+    Analytic {
+        slot: u32,
+        shape: u32,
+        hit: QuadricHit,
+    },
     Plane(u32),
 }
 
@@ -117,7 +127,6 @@ impl SceneGeometry {
         let mut planes = Vec::new();
         let mut aabbs = Vec::new();
         let mut prims = Vec::new();
-        let mut sources = Vec::new();
         for (index, shape) in desc.shapes.iter().enumerate() {
             let index = index as u32;
             let m = &shape.object_to_world;
@@ -139,8 +148,8 @@ impl SceneGeometry {
                     for tri in 0..world.triangle_count() as u32 {
                         let vertices = world.vertices(tri);
                         aabbs.push(Aabb::from_points(&vertices.map(Vec3A::from)));
-                        prims.push(Prim::Triangle(TriangleEdges::new(vertices)));
-                        sources.push(PrimSource::Triangle {
+                        prims.push(Prim::Triangle {
+                            edges: TriangleEdges::new(vertices),
                             mesh: mesh_index,
                             tri,
                         });
@@ -156,7 +165,6 @@ impl SceneGeometry {
                         let a = analytic.len() as u32;
                         aabbs.push(s.world_bounds());
                         prims.push(Prim::Analytic(a));
-                        sources.push(PrimSource::Analytic(a));
                         analytic.push(s);
                     }
                     None => tracing::warn!("shape \"{}\": degenerate shape skipped", shape.name),
@@ -176,16 +184,10 @@ impl SceneGeometry {
             .iter()
             .map(|&i| prims[i as usize])
             .collect();
-        let sources = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| sources[i as usize])
-            .collect();
         let triangle_count = meshes.iter().map(WorldMesh::triangle_count).sum();
         Self {
             bvh,
             prims,
-            sources,
             meshes,
             analytic,
             planes,
@@ -233,10 +235,13 @@ impl SceneGeometry {
         // accepted hit.
         self.bvh.ray_traverse(bvh_ray, &mut bvh_hit, |r, slot| {
             match self.prims[slot] {
-                Prim::Triangle(tri) => {
-                    if let Some((t, b1, b2)) = tri.intersect(r.origin, r.direction, r.tmax) {
+                Prim::Triangle { edges, mesh, tri } => {
+                    if let Some((t, b1, b2)) = edges.intersect(r.origin, r.direction, r.tmax) {
                         closest = Closest::Triangle {
                             slot: slot as u32,
+                            edges,
+                            mesh,
+                            tri,
                             b1,
                             b2,
                         };
@@ -248,6 +253,7 @@ impl SceneGeometry {
                     if let Some(hit) = shape.intersect(r.origin, r.direction, r.tmax) {
                         closest = Closest::Analytic {
                             slot: slot as u32,
+                            shape: a,
                             hit,
                         };
                         return hit.t;
@@ -262,20 +268,16 @@ impl SceneGeometry {
 
         match closest {
             Closest::None => None,
-            Closest::Triangle { slot, b1, b2 } => {
-                let PrimSource::Triangle { mesh, tri } = self.sources[slot as usize] else {
-                    unreachable!("triangle slots have triangle sources")
-                };
-                let Prim::Triangle(edges) = &self.prims[slot as usize] else {
-                    unreachable!("triangle slots hold triangles")
-                };
-                Some(self.meshes[mesh as usize].hit(tri, edges, t_closest, b1, b2, slot))
-            }
-            Closest::Analytic { slot, hit } => {
-                let PrimSource::Analytic(a) = self.sources[slot as usize] else {
-                    unreachable!("analytic slots have analytic sources")
-                };
-                Some(self.analytic[a as usize].hit(hit, slot))
+            Closest::Triangle {
+                slot,
+                edges,
+                mesh,
+                tri,
+                b1,
+                b2,
+            } => Some(self.meshes[mesh as usize].hit(tri, &edges, t_closest, b1, b2, slot)),
+            Closest::Analytic { slot, shape, hit } => {
+                Some(self.analytic[shape as usize].hit(hit, slot))
             }
             Closest::Plane(i) => {
                 let prim = (self.prims.len() + i as usize) as u32;
@@ -300,7 +302,7 @@ impl SceneGeometry {
         let bvh_ray = obvhs::ray::Ray::new(origin, dir, 0.0, tmax);
         !self.bvh.ray_traverse_miss(bvh_ray, |r, slot| {
             let t = match self.prims[slot] {
-                Prim::Triangle(tri) => tri
+                Prim::Triangle { edges, .. } => edges
                     .intersect(r.origin, r.direction, r.tmax)
                     .map(|(t, _, _)| t),
                 Prim::Analytic(a) => self.analytic[a as usize]

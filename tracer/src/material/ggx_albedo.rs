@@ -70,6 +70,12 @@ fn table() -> &'static Table {
     })
 }
 
+/// Builds the table now rather than at the first lookup (which would stall a render thread
+/// and the threads waiting on it).
+pub fn prepare() {
+    table();
+}
+
 fn lerp_index(x: f32, steps: usize) -> (usize, usize, f32) {
     let f = x.clamp(0.0, 1.0) * (steps - 1) as f32;
     let i0 = (f as usize).min(steps - 2);

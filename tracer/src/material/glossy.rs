@@ -2,11 +2,12 @@
 //!
 //! - Coat: GGX microfacet reflection with Schlick's Fresnel, R0 = Ks (a specular reflection
 //!   when the roughness is zero).
-//! - Base: Lambert Kd, attenuated by the light the coat reflects on the way in and on the way
-//!   out, (1 - F(cos_i)) (1 - F(cos_o)), and by absorption in the coat,
-//!   exp(-Ka d (1/cos_i + 1/cos_o)) (LuxRender's CoatingAbsorption). LuxRender weights the base
-//!   by 1 - F at the half vector instead, which reflects more than it receives at grazing
-//!   angles; the product of the two macro-surface Fresnel terms keeps the sum within 1.
+//! - Base: Lambert Kd, shaped by the light the coat reflects on the way in and on the way out,
+//!   (1 - F(cos_i)) (1 - F(cos_o)) / (1 - F_avg), so that it reflects Kd (1 - F(cos_o)) in all,
+//!   and attenuated by absorption in the coat, exp(-Ka d (1/cos_i + 1/cos_o)) (LuxRender's
+//!   CoatingAbsorption). LuxRender weights the base by 1 - F at the half vector instead, which
+//!   brightens grazing views beyond what the surface receives (albedo up to about 1.5); this
+//!   form matches it at normal incidence, stays reciprocal and keeps the sum within 1.
 //! - multibounce: the energy the coat's masking and shadowing remove is returned as a diffuse
 //!   lobe coloured by the coat's average Fresnel (Kulla and Conty 2017), where LuxRender adds
 //!   an ad-hoc (1 - G) term.
@@ -23,6 +24,11 @@ use super::fresnel;
 use super::ggx_albedo;
 use super::local::{cosine_hemisphere_pdf, reflect, same_hemisphere, sample_cosine_hemisphere};
 use super::microfacet::TrowbridgeReitz;
+
+/// Cosine-weighted hemispherical average of Schlick's Fresnel: 2 * integral F(mu) mu dmu.
+fn schlick_average(r0: Vec3) -> Vec3 {
+    r0 + (Vec3::ONE - r0) / 21.0
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct Glossy {
@@ -63,7 +69,15 @@ impl Glossy {
     fn base_f(&self, cos_o: f32, cos_i: f32) -> Vec3 {
         let in_out = (Vec3::ONE - fresnel::schlick(cos_o, self.ks))
             * (Vec3::ONE - fresnel::schlick(cos_i, self.ks));
-        self.kd * in_out * self.absorption(cos_o, cos_i) * FRAC_1_PI
+        // Dividing by the hemispherical average of 1 - F makes the base reflect Kd (1 - F(cos_o))
+        // in all: the coat takes its share once, as in LuxRender, not once on each crossing.
+        let transmitted_avg = Vec3::ONE - schlick_average(self.ks);
+        let normalised = Vec3::select(
+            transmitted_avg.cmpgt(Vec3::splat(1e-6)),
+            in_out / transmitted_avg,
+            Vec3::ZERO,
+        );
+        self.kd * normalised * self.absorption(cos_o, cos_i) * FRAC_1_PI
     }
 
     fn multibounce_f(&self, alpha: f32, cos_o: f32, cos_i: f32) -> Vec3 {
@@ -74,7 +88,7 @@ impl Glossy {
         let lost =
             (1.0 - ggx_albedo::albedo(alpha, cos_o)) * (1.0 - ggx_albedo::albedo(alpha, cos_i));
         // Average Schlick reflectance over the hemisphere, and the colour after many bounces.
-        let f_avg = self.ks + (Vec3::ONE - self.ks) / 21.0;
+        let f_avg = schlick_average(self.ks);
         let f_ms = f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
         f_ms * (lost * FRAC_1_PI / (1.0 - e_avg))
     }

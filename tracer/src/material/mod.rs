@@ -54,6 +54,18 @@ impl Materials {
 
     /// The materials indexed by [`MaterialId`].
     pub fn new(materials: Vec<MaterialDesc>) -> Self {
+        let multibounce = materials.iter().any(|m| {
+            matches!(
+                m,
+                MaterialDesc::Glossy {
+                    multibounce: true,
+                    ..
+                }
+            )
+        });
+        if multibounce {
+            ggx_albedo::prepare();
+        }
         Self { materials }
     }
 

@@ -446,7 +446,11 @@ mod tests {
         let l = list(vec![
             (ParamType::String, "fov", Values::Strings(vec!["x".into()])),
             (ParamType::Color, "Kd", Values::Numbers(vec![1.0, 2.0])),
-            (ParamType::Float, "big", Values::Numbers(vec![1e999])),
+            (
+                ParamType::Float,
+                "big",
+                Values::Numbers(vec![f64::INFINITY]),
+            ),
             (ParamType::Integer, "i", Values::Numbers(vec![1e12])),
             (ParamType::Integer, "f", Values::Numbers(vec![1.5])),
         ]);

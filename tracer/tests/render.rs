@@ -1,0 +1,317 @@
+//! Whole-renderer tests on scenes built in code: analytic values (white furnace), camera
+//! properties, environment-map orientation and determinism.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3, Vec4};
+use yat_tracer::assets::MemorySource;
+use yat_tracer::desc::*;
+use yat_tracer::film::Film;
+use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
+
+/// A camera at `eye` looking along +y with z up (camera x = world x, camera y = world z).
+fn camera(kind: CameraKind, eye: Vec3, lens_radius: f32, focal_distance: f32) -> CameraDesc {
+    CameraDesc {
+        kind,
+        camera_to_world: Mat4::from_cols(
+            Vec3::X.extend(0.0),
+            Vec3::Z.extend(0.0),
+            Vec3::Y.extend(0.0),
+            eye.extend(1.0),
+        ),
+        screen_window: [-1.0, 1.0, -1.0, 1.0],
+        lens_radius,
+        focal_distance,
+        hither: 1e-3,
+        yon: 1e30,
+    }
+}
+
+fn scene(camera: CameraDesc, size: u32) -> SceneDesc {
+    SceneDesc {
+        camera,
+        film: FilmDesc {
+            xresolution: size,
+            yresolution: size,
+            gamma: 2.2,
+            tonemap: ToneMap::AutoLinear,
+            filename: "test".into(),
+            haltspp: None,
+            halttime: None,
+        },
+        filter: FilterDesc {
+            kind: FilterKind::Box,
+            xwidth: 0.5,
+            ywidth: 0.5,
+        },
+        integrator: IntegratorDesc {
+            max_depth: 16,
+            rr_strategy: RussianRoulette::Efficiency,
+            rr_continue_prob: 0.65,
+            include_environment: true,
+            requested: "path".into(),
+        },
+        sampler: SamplerDesc {
+            pixel_samples: None,
+            requested: "sobol".into(),
+        },
+        textures: vec![],
+        materials: vec![],
+        shapes: vec![],
+        lights: vec![],
+        warnings: vec![],
+        assets: vec![],
+    }
+}
+
+fn add_sphere(desc: &mut SceneDesc, centre: Vec3, radius: f32, material: MaterialDesc) {
+    desc.materials.push(material);
+    desc.shapes.push(ShapeDesc {
+        name: "sphere".into(),
+        geometry: Geometry::Sphere {
+            radius,
+            zmin: -radius,
+            zmax: radius,
+            phimax: 360.0,
+        },
+        object_to_world: Mat4::from_translation(centre),
+        reverse_orientation: false,
+        material: MaterialId(desc.materials.len() as u32 - 1),
+        area_light: None,
+    });
+}
+
+fn constant_sky(desc: &mut SceneDesc, radiance: Vec3) {
+    desc.lights.push(LightDesc::Infinite {
+        radiance,
+        map: None,
+        light_to_world: Mat4::IDENTITY,
+    });
+}
+
+fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
+    RenderSettings {
+        width: desc.film.xresolution,
+        height: desc.film.yresolution,
+        spp,
+        max_depth: desc.integrator.max_depth,
+        seed: 1,
+        latlong: LatLongConvention::Seed,
+    }
+}
+
+fn render(desc: &SceneDesc, source: &MemorySource, spp: u32) -> Film {
+    let settings = settings(desc, spp);
+    let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
+    let mut film = Film::new(settings.width, settings.height);
+    for unit in plan_units(&settings) {
+        film.add(&scene.render_unit(&unit).0).unwrap();
+    }
+    film
+}
+
+fn mean(film: &Film, pixels: impl Iterator<Item = (u32, u32)>) -> Vec3 {
+    let (sum, n) = pixels.fold((Vec3::ZERO, 0), |(s, n), (x, y)| {
+        (s + film.pixel(x, y), n + 1)
+    });
+    sum / n as f32
+}
+
+/// A convex white Lambertian object under a uniform sky of radiance L reflects exactly L; with
+/// albedo 0.5 it reflects L / 2. Every pixel sees either the sky or the sphere.
+#[test]
+fn white_furnace_converges_to_the_sky_radiance() {
+    for (albedo, expected) in [(1.0, 0.5), (0.5, 0.25)] {
+        let mut desc = scene(
+            camera(
+                CameraKind::Perspective { fov: 30.0 },
+                Vec3::new(0.0, -4.0, 0.0),
+                0.0,
+                1e30,
+            ),
+            16,
+        );
+        add_sphere(
+            &mut desc,
+            Vec3::ZERO,
+            1.0,
+            MaterialDesc::Matte {
+                kd: Tex::float(albedo),
+                sigma: Tex::float(0.0),
+            },
+        );
+        constant_sky(&mut desc, Vec3::splat(0.5));
+        let film = render(&desc, &MemorySource::new(), 64);
+        // The centre pixels see the sphere only.
+        let centre = mean(&film, (6..10).flat_map(|y| (6..10).map(move |x| (x, y))));
+        for c in centre.to_array() {
+            assert!(
+                (c - expected).abs() < 0.01 * expected.max(0.5),
+                "albedo {albedo}: {centre}"
+            );
+        }
+    }
+}
+
+#[test]
+fn zero_lens_radius_gives_exactly_the_pinhole_image() {
+    let build = |focal_distance| {
+        let mut desc = scene(
+            camera(
+                CameraKind::Perspective { fov: 40.0 },
+                Vec3::new(0.0, -4.0, 0.0),
+                0.0,
+                focal_distance,
+            ),
+            16,
+        );
+        add_sphere(
+            &mut desc,
+            Vec3::ZERO,
+            1.0,
+            MaterialDesc::Matte {
+                kd: Tex::float(0.7),
+                sigma: Tex::float(0.0),
+            },
+        );
+        constant_sky(&mut desc, Vec3::ONE);
+        render(&desc, &MemorySource::new(), 8).radiance()
+    };
+    assert_eq!(build(1e30), build(2.5));
+}
+
+/// A thin lens blurs what is off the focal plane: the sphere's edge spreads over more pixels.
+#[test]
+fn thin_lens_blurs_out_of_focus_objects() {
+    let edge_width = |lens_radius: f32| {
+        let mut desc = scene(
+            camera(
+                CameraKind::Perspective { fov: 30.0 },
+                Vec3::new(0.0, -4.0, 0.0),
+                lens_radius,
+                12.0,
+            ),
+            32,
+        );
+        add_sphere(
+            &mut desc,
+            Vec3::ZERO,
+            1.0,
+            MaterialDesc::Matte {
+                kd: Tex::float(0.0),
+                sigma: Tex::float(0.0),
+            },
+        );
+        constant_sky(&mut desc, Vec3::ONE);
+        let film = render(&desc, &MemorySource::new(), 32);
+        // Pixels of the middle row that are neither sky (1) nor sphere (0).
+        (0..32)
+            .filter(|&x| (0.05..0.95).contains(&film.pixel(x, 16).x))
+            .count()
+    };
+    let sharp = edge_width(0.0);
+    let blurred = edge_width(0.3);
+    assert!(sharp <= 2, "pinhole edge spans {sharp} pixels");
+    assert!(blurred >= sharp + 4, "lens 0.3 edge spans {blurred} pixels");
+}
+
+#[test]
+fn fisheye_corners_are_black_and_centre_is_not() {
+    let mut desc = scene(
+        camera(CameraKind::Fisheye { fov: 90.0 }, Vec3::ZERO, 0.0, 1e30),
+        32,
+    );
+    constant_sky(&mut desc, Vec3::splat(0.8));
+    let film = render(&desc, &MemorySource::new(), 4);
+    for (x, y) in [(0, 0), (31, 0), (0, 31), (31, 31)] {
+        assert_eq!(film.pixel(x, y), Vec3::ZERO);
+    }
+    assert!((film.pixel(16, 16) - Vec3::splat(0.8)).length() < 1e-4);
+}
+
+/// A LatLong map whose only red texel sits at u = 0.75, v = 0.5: with the seed convention
+/// (u = (pi + phi) / 2pi) that is phi = pi / 2, the +y horizon; with LuxRender's (u = phi / 2pi)
+/// it is phi = 3pi / 2, the -y horizon.
+#[test]
+fn environment_marker_shows_up_in_the_convention_direction() {
+    let (w, h) = (64u32, 32u32);
+    let mut img = image::RgbImage::from_pixel(w, h, image::Rgb([0, 0, 40]));
+    for y in h / 2 - 2..h / 2 + 2 {
+        for x in 3 * w / 4 - 2..3 * w / 4 + 2 {
+            img.put_pixel(x, y, image::Rgb([255, 0, 0]));
+        }
+    }
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let mut source = MemorySource::new();
+    source.insert("marker.png", Arc::from(png.into_boxed_slice()));
+
+    let red_towards = |convention: LatLongConvention, forward: Vec3| {
+        let mut cam = camera(CameraKind::Perspective { fov: 10.0 }, Vec3::ZERO, 0.0, 1e30);
+        let right = forward.cross(Vec3::Z);
+        cam.camera_to_world = Mat4::from_cols(
+            right.extend(0.0),
+            Vec3::Z.extend(0.0),
+            forward.extend(0.0),
+            Vec4::W,
+        );
+        let mut desc = scene(cam, 8);
+        desc.lights.push(LightDesc::Infinite {
+            radiance: Vec3::ONE,
+            map: Some(EnvMapDesc {
+                filename: "marker.png".into(),
+                gamma: 1.0,
+            }),
+            light_to_world: Mat4::IDENTITY,
+        });
+        let mut settings = settings(&desc, 4);
+        settings.latlong = convention;
+        let scene = RenderScene::build(&desc, &source, &settings).unwrap();
+        let mut film = Film::new(8, 8);
+        for unit in plan_units(&settings) {
+            film.add(&scene.render_unit(&unit).0).unwrap();
+        }
+        let c = film.pixel(4, 4);
+        c.x > 0.5 && c.z < 0.1
+    };
+    assert!(red_towards(LatLongConvention::Seed, Vec3::Y));
+    assert!(!red_towards(LatLongConvention::Seed, -Vec3::Y));
+    assert!(red_towards(LatLongConvention::LuxRender, -Vec3::Y));
+    assert!(!red_towards(LatLongConvention::LuxRender, Vec3::Y));
+}
+
+/// The same unit gives the same bytes, and merging the plan in any order gives the same film.
+#[test]
+fn rendering_is_deterministic_in_any_order() {
+    let mut desc = scene(
+        camera(
+            CameraKind::Perspective { fov: 40.0 },
+            Vec3::new(0.0, -4.0, 0.5),
+            0.2,
+            4.0,
+        ),
+        24,
+    );
+    add_sphere(
+        &mut desc,
+        Vec3::ZERO,
+        1.0,
+        MaterialDesc::Matte {
+            kd: Tex::float(0.8),
+            sigma: Tex::float(0.0),
+        },
+    );
+    constant_sky(&mut desc, Vec3::new(0.3, 0.5, 0.9));
+    let settings = settings(&desc, 8);
+    let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).unwrap();
+    let units = plan_units(&settings);
+    let buffers: Vec<_> = units.iter().map(|u| scene.render_unit(u).0).collect();
+    assert_eq!(buffers[0], scene.render_unit(&units[0]).0);
+    let mut forward = Film::new(24, 24);
+    let mut backward = Film::new(24, 24);
+    buffers.iter().for_each(|b| forward.add(b).unwrap());
+    buffers.iter().rev().for_each(|b| backward.add(b).unwrap());
+    assert_eq!(forward.radiance(), backward.radiance());
+    assert!(forward.radiance().iter().any(|c| c.x != c.z));
+}
