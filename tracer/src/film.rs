@@ -33,8 +33,10 @@ impl SampleBuffer {
 const FIXED_ONE: f64 = (1u64 << 24) as f64;
 
 fn to_fixed(v: f32) -> i64 {
-    // `as` saturates and maps NaN to 0, so a hostile buffer cannot wrap the sums.
-    (f64::from(v) * FIXED_ONE).round() as i64
+    // Truncation is as deterministic as rounding and compiles to one instruction (rounding calls
+    // libm, which dominated the coordinator's merge time). `as` saturates and maps NaN to 0, so
+    // a hostile buffer cannot wrap the sums.
+    (f64::from(v) * FIXED_ONE) as i64
 }
 
 /// The accumulated image. Sums are integers, so adding buffers is associative and commutative:
@@ -90,14 +92,16 @@ impl Film {
             });
         }
         let tile_width = (u.x1 - u.x0) as usize;
-        for (row, y) in (u.y0..u.y1).enumerate() {
-            let film_row = y as usize * self.width as usize + u.x0 as usize;
-            let tile_row = row * tile_width;
-            for i in 0..tile_width {
-                let [r, g, b] = buffer.rgb[tile_row + i];
-                let s = &mut self.sums[film_row + i];
-                for (sum, v) in s.iter_mut().zip([r, g, b, buffer.weight[tile_row + i]]) {
-                    *sum = sum.saturating_add(to_fixed(v));
+        let rows = buffer
+            .rgb
+            .chunks_exact(tile_width)
+            .zip(buffer.weight.chunks_exact(tile_width));
+        for ((rgb, weight), y) in rows.zip(u.y0..u.y1) {
+            let start = y as usize * self.width as usize + u.x0 as usize;
+            let film_row = &mut self.sums[start..start + tile_width];
+            for ((sum, &[r, g, b]), &w) in film_row.iter_mut().zip(rgb).zip(weight) {
+                for (s, v) in sum.iter_mut().zip([r, g, b, w]) {
+                    *s = s.saturating_add(to_fixed(v));
                 }
             }
         }
