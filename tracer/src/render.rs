@@ -155,6 +155,8 @@ pub struct RenderScene {
     textures: Textures,
     materials: Materials,
     lights: Lights,
+    /// Per shape, for the object-space positions 3D texture mappings use.
+    world_to_object: Vec<glam::Affine3A>,
 }
 
 impl RenderScene {
@@ -172,6 +174,11 @@ impl RenderScene {
             materials: Materials::build(desc),
             geometry,
             lights,
+            world_to_object: desc
+                .shapes
+                .iter()
+                .map(|s| glam::Affine3A::from_mat4(s.object_to_world).inverse())
+                .collect(),
             desc: desc.clone(),
             settings: settings.clone(),
         })
@@ -199,8 +206,15 @@ impl RenderScene {
 
     /// The BSDF at a hit; `u_mix` resolves mix materials.
     pub fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
-        let material = self.desc.shapes[hit.shape as usize].material;
-        self.materials.bsdf(material, hit, &self.textures, u_mix)
+        let shape = hit.shape as usize;
+        let p_object = self.world_to_object[shape].transform_point3(hit.p);
+        self.materials.bsdf(
+            self.desc.shapes[shape].material,
+            hit,
+            p_object,
+            &self.textures,
+            u_mix,
+        )
     }
 
     /// Renders one unit on the calling thread. Deterministic: the same unit gives the same

@@ -315,3 +315,65 @@ fn rendering_is_deterministic_in_any_order() {
     assert_eq!(forward.radiance(), backward.radiance());
     assert!(forward.radiance().iter().any(|c| c.x != c.z));
 }
+
+/// 3D texture mappings see the shape's object space (the seed scenes' rule): a planar-mapped
+/// checkerboard on a unit quad scaled by 5 has checks 5 world units wide, not 1.
+#[test]
+fn planar_mapping_follows_the_object_space() {
+    let mut cam = camera(
+        CameraKind::Perspective { fov: 90.0 },
+        Vec3::new(0.0, 0.0, 10.0),
+        0.0,
+        1e30,
+    );
+    cam.camera_to_world = Mat4::from_cols(
+        Vec3::X.extend(0.0),
+        Vec3::Y.extend(0.0),
+        (-Vec3::Z).extend(0.0),
+        Vec3::new(0.0, 0.0, 10.0).extend(1.0),
+    );
+    let mut desc = scene(cam, 40);
+    desc.textures.push(TextureDesc {
+        name: "checks".into(),
+        is_color: true,
+        kind: TextureKind::Checkerboard2D {
+            tex1: Tex::float(1.0),
+            tex2: Tex::float(0.0),
+            mapping: Mapping2D::Planar {
+                world_to_texture: Mat4::IDENTITY,
+                v1: Vec3::X,
+                v2: Vec3::Y,
+                udelta: 0.0,
+                vdelta: 0.0,
+            },
+        },
+    });
+    desc.materials.push(MaterialDesc::Matte {
+        kd: Tex::Texture(TextureId(0)),
+        sigma: Tex::float(0.0),
+    });
+    desc.shapes.push(ShapeDesc {
+        name: "quad".into(),
+        geometry: Geometry::Mesh(Arc::new(TriangleMesh {
+            positions: vec![
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(-1.0, 1.0, 0.0),
+            ],
+            normals: None,
+            uvs: None,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        })),
+        object_to_world: Mat4::from_scale(Vec3::new(5.0, 5.0, 1.0)),
+        reverse_orientation: false,
+        material: MaterialId(0),
+        area_light: None,
+    });
+    constant_sky(&mut desc, Vec3::ONE);
+    let film = render(&desc, &MemorySource::new(), 4);
+    // World (1.5, 0.5) is object (0.3, 0.1): check (0, 0), white; world-space mapping would
+    // put it in check (1, 0), black. World (-1.5, 0.5) is object (-0.3, 0.1): black.
+    assert!(film.pixel(23, 19).x > 0.9, "{}", film.pixel(23, 19));
+    assert!(film.pixel(17, 19).x < 0.1, "{}", film.pixel(17, 19));
+}

@@ -100,10 +100,19 @@ impl Materials {
         Some(material)
     }
 
-    /// The BSDF of material `id` at `hit`. `u_mix` resolves `mix` materials stochastically.
-    pub fn bsdf(&self, id: MaterialId, hit: &SurfaceHit, textures: &Textures, u_mix: f32) -> Bsdf {
+    /// The BSDF of material `id` at `hit`, whose position in its shape's object space is
+    /// `p_object` (what 3D texture mappings see). `u_mix` resolves `mix` materials
+    /// stochastically.
+    pub fn bsdf(
+        &self,
+        id: MaterialId,
+        hit: &SurfaceHit,
+        p_object: Vec3,
+        textures: &Textures,
+        u_mix: f32,
+    ) -> Bsdf {
         let at = TexturePoint {
-            p: hit.p,
+            p: p_object,
             uv: hit.uv,
         };
         let color = |t: Tex| unit(textures.eval(t, &at));

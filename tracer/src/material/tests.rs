@@ -30,6 +30,7 @@ fn bsdf_of(material: MaterialDesc) -> Bsdf {
     Materials::new(vec![material]).bsdf(
         MaterialId(0),
         &hit_with(Vec3::Z, Vec3::Z),
+        Vec3::ZERO,
         &Textures::default(),
         0.5,
     )
@@ -472,8 +473,13 @@ fn shading_normals_do_not_leak_light() {
     // The shading normal leans 30 degrees away from the geometric one.
     let ns = Vec3::new(0.5, 0.0, 0.75f32.sqrt());
     let hit = hit_with(Vec3::Z, ns);
-    let bsdf =
-        Materials::new(vec![matte(1.0, 0.0)]).bsdf(MaterialId(0), &hit, &Textures::default(), 0.0);
+    let bsdf = Materials::new(vec![matte(1.0, 0.0)]).bsdf(
+        MaterialId(0),
+        &hit,
+        hit.p,
+        &Textures::default(),
+        0.0,
+    );
     let wo = Vec3::new(0.0, 0.6, 0.8);
     // Above the shading plane but below the geometric surface: no reflection.
     let below_surface = Vec3::new(0.8, 0.0, -0.2).normalize();
@@ -514,7 +520,7 @@ fn mix_chooses_each_side_in_proportion_to_amount() {
         for i in 0..n {
             let u = (i as f32 + 0.5) / n as f32;
             let kd = materials
-                .bsdf(MaterialId(id), &hit, &textures, u)
+                .bsdf(MaterialId(id), &hit, hit.p, &textures, u)
                 .eval(Vec3::Z, Vec3::Z)
                 .x
                 * PI;
@@ -548,7 +554,7 @@ fn null_passes_through_and_bad_ids_fall_back_to_matte() {
     }]);
     let hit = hit_with(Vec3::Z, Vec3::Z);
     for id in [0, 7] {
-        let bsdf = materials.bsdf(MaterialId(id), &hit, &Textures::default(), 0.3);
+        let bsdf = materials.bsdf(MaterialId(id), &hit, hit.p, &Textures::default(), 0.3);
         assert!((bsdf.eval(Vec3::Z, Vec3::Z).x * PI - 0.9).abs() < 1e-5);
     }
 }

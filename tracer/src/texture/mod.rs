@@ -23,6 +23,10 @@ use mapping::Mapping;
 /// What a texture lookup needs to know about the surface point.
 #[derive(Clone, Copy, Debug)]
 pub struct TexturePoint {
+    /// Position in the shaded shape's object space: planar, spherical, cylindrical and 3D
+    /// checkerboard mappings project it (then apply the Texture's own transform). The seed
+    /// scenes are composed this way: their planar-mapped walls are scaled unit quads that show
+    /// the image once per unit of object space, whatever their size in the world.
     pub p: Vec3,
     pub uv: Vec2,
 }
