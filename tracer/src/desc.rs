@@ -218,11 +218,21 @@ pub enum Mapping2D {
         udelta: f32,
         vdelta: f32,
     },
+    /// s = uscale x phi / 2pi + udelta, t = vscale x theta / pi + vdelta.
     Spherical {
         world_to_texture: Mat4,
+        uscale: f32,
+        vscale: f32,
+        udelta: f32,
+        vdelta: f32,
     },
+    /// s = uscale x phi / 2pi + udelta, t = vscale x (1 - z) / 2 + vdelta.
     Cylindrical {
         world_to_texture: Mat4,
+        uscale: f32,
+        vscale: f32,
+        udelta: f32,
+        vdelta: f32,
     },
     /// s = dot(p, v1) + udelta, t = dot(p, v2) + vdelta with p in texture space.
     Planar {

@@ -199,26 +199,27 @@ impl Builder<'_> {
         let mapping = params.string_or("mapping", "uv")?;
         Ok(match mapping.as_str() {
             "spherical" | "cylindrical" => {
-                for (name, default) in [
-                    ("uscale", 1.0),
-                    ("vscale", 1.0),
-                    ("udelta", 0.0),
-                    ("vdelta", 0.0),
-                ] {
-                    let v = params.float(name, default)?;
-                    if v != default {
-                        self.warn_once(
-                            format!("mapping|{mapping}|{name}"),
-                            pos,
-                            format!("{mapping} mapping: \"float {name}\" {v} is not supported; using {default}"),
-                        );
-                    }
-                }
                 let world_to_texture = self.ctm.inverse();
+                let uscale = params.float("uscale", 1.0)?;
+                let vscale = params.float("vscale", 1.0)?;
+                let udelta = params.float("udelta", 0.0)?;
+                let vdelta = params.float("vdelta", 0.0)?;
                 if mapping == "spherical" {
-                    Mapping2D::Spherical { world_to_texture }
+                    Mapping2D::Spherical {
+                        world_to_texture,
+                        uscale,
+                        vscale,
+                        udelta,
+                        vdelta,
+                    }
                 } else {
-                    Mapping2D::Cylindrical { world_to_texture }
+                    Mapping2D::Cylindrical {
+                        world_to_texture,
+                        uscale,
+                        vscale,
+                        udelta,
+                        vdelta,
+                    }
                 }
             }
             "planar" => {

@@ -27,10 +27,14 @@ pub enum Mapping {
     /// s = phi / 2pi, t = theta / pi of the direction from the texture-space origin.
     Spherical {
         world_to_texture: Mat4,
+        scale: Vec2,
+        delta: Vec2,
     },
     /// s = phi / 2pi around the texture-space z axis, t = (1 - z) / 2.
     Cylindrical {
         world_to_texture: Mat4,
+        scale: Vec2,
+        delta: Vec2,
     },
     /// s = dot(p, v1) + udelta, t = dot(p, v2) + vdelta with p in texture space.
     Planar {
@@ -53,10 +57,28 @@ impl Mapping {
                 scale: Vec2::new(uscale, vscale),
                 delta: Vec2::new(udelta, vdelta),
             },
-            Mapping2D::Spherical { world_to_texture } => Mapping::Spherical { world_to_texture },
-            Mapping2D::Cylindrical { world_to_texture } => {
-                Mapping::Cylindrical { world_to_texture }
-            }
+            Mapping2D::Spherical {
+                world_to_texture,
+                uscale,
+                vscale,
+                udelta,
+                vdelta,
+            } => Mapping::Spherical {
+                world_to_texture,
+                scale: Vec2::new(uscale, vscale),
+                delta: Vec2::new(udelta, vdelta),
+            },
+            Mapping2D::Cylindrical {
+                world_to_texture,
+                uscale,
+                vscale,
+                udelta,
+                vdelta,
+            } => Mapping::Cylindrical {
+                world_to_texture,
+                scale: Vec2::new(uscale, vscale),
+                delta: Vec2::new(udelta, vdelta),
+            },
             Mapping2D::Planar {
                 world_to_texture,
                 v1,
@@ -76,14 +98,22 @@ impl Mapping {
     pub fn map(&self, at: &TexturePoint) -> Vec2 {
         match self {
             Mapping::Uv { scale, delta } => *scale * at.uv + *delta,
-            Mapping::Spherical { world_to_texture } => {
+            Mapping::Spherical {
+                world_to_texture,
+                scale,
+                delta,
+            } => {
                 let p = world_to_texture.transform_point3(at.p).normalize_or_zero();
                 let theta = p.z.clamp(-1.0, 1.0).acos();
-                Vec2::new(spherical_phi(p) / TAU, theta / PI)
+                *scale * Vec2::new(spherical_phi(p) / TAU, theta / PI) + *delta
             }
-            Mapping::Cylindrical { world_to_texture } => {
+            Mapping::Cylindrical {
+                world_to_texture,
+                scale,
+                delta,
+            } => {
                 let p = world_to_texture.transform_point3(at.p);
-                Vec2::new(spherical_phi(p) / TAU, 0.5 - 0.5 * p.z)
+                *scale * Vec2::new(spherical_phi(p) / TAU, 0.5 - 0.5 * p.z) + *delta
             }
             Mapping::Planar {
                 world_to_texture,
@@ -121,21 +151,36 @@ mod tests {
 
     #[test]
     fn spherical_mapping_angles() {
-        let m = Mapping::new(&Mapping2D::Spherical {
-            world_to_texture: Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-        });
+        let spherical = |vscale: f32, vdelta: f32| {
+            Mapping::new(&Mapping2D::Spherical {
+                world_to_texture: Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+                uscale: 1.0,
+                vscale,
+                udelta: 0.0,
+                vdelta,
+            })
+        };
+        let m = spherical(1.0, 0.0);
         // A point above the texture-space origin is at theta 0; one on -y at phi 3pi/2.
         let top = m.map(&at(Vec3::new(0.0, 0.0, 3.0), Vec2::ZERO));
         assert!(top.y.abs() < 1e-6, "{top}");
         let side = m.map(&at(Vec3::new(0.0, -2.0, 1.0), Vec2::ZERO));
         assert!((side - Vec2::new(0.75, 0.5)).length() < 1e-6, "{side}");
+        // Blender's vscale -1, vdelta 1 turns the map upside down: the top reads t = 1.
+        let flipped = spherical(-1.0, 1.0).map(&at(Vec3::new(0.0, 0.0, 3.0), Vec2::ZERO));
+        assert!((flipped.y - 1.0).abs() < 1e-6, "{flipped}");
     }
 
     #[test]
     fn cylindrical_mapping_angles_and_height() {
         let m = Mapping::new(&Mapping2D::Cylindrical {
             world_to_texture: Mat4::IDENTITY,
+            uscale: 2.0,
+            vscale: 1.0,
+            udelta: -0.5,
+            vdelta: 0.0,
         });
+        // phi = pi gives s = 2 x 0.5 - 0.5.
         let st = m.map(&at(Vec3::new(-1.0, 0.0, 0.5), Vec2::ZERO));
         assert!((st - Vec2::new(0.5, 0.25)).length() < 1e-6, "{st}");
     }
