@@ -1,7 +1,8 @@
-//! The `yat` command: render (in-process or over workers), worker, check.
+//! The `yat` command: render (in-process or over workers), worker, check, export-luxcore.
 
 mod check;
 mod distributed;
+mod export_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Worker(yat_worker::WorkerArgs),
     /// Parse a scene and report what it contains, without rendering.
     Check(check::CheckArgs),
+    /// Write a scene as LuxCoreRender SDL and PLY meshes (for side-by-side benchmarks).
+    ExportLuxcore(export_cmd::ExportArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -39,5 +42,6 @@ fn main() -> anyhow::Result<()> {
         Command::Render(args) => render_cmd::run(args),
         Command::Worker(args) => yat_worker::run(args),
         Command::Check(args) => check::run(args),
+        Command::ExportLuxcore(args) => export_cmd::run(args),
     }
 }

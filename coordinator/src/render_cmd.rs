@@ -23,6 +23,15 @@ pub enum LatLongArg {
     Luxrender,
 }
 
+impl From<LatLongArg> for LatLongConvention {
+    fn from(arg: LatLongArg) -> Self {
+        match arg {
+            LatLongArg::Seed => LatLongConvention::Seed,
+            LatLongArg::Luxrender => LatLongConvention::LuxRender,
+        }
+    }
+}
+
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// The main .lxs file.
@@ -113,10 +122,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         max_depth: args.maxdepth,
         seed: Some(args.seed),
         resolution: args.resolution,
-        latlong: match args.latlong {
-            LatLongArg::Seed => LatLongConvention::Seed,
-            LatLongArg::Luxrender => LatLongConvention::LuxRender,
-        },
+        latlong: args.latlong.into(),
     };
     let settings = RenderSettings::resolve(&desc, &overrides);
     let output_png = args

@@ -15,6 +15,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod lights;
+pub mod luxcore;
 pub mod material;
 pub mod math;
 pub mod parse;

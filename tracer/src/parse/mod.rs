@@ -26,7 +26,7 @@ mod lights;
 mod materials;
 mod options;
 mod params;
-mod ply;
+pub(crate) mod ply;
 mod reader;
 mod shapes;
 mod spectra;

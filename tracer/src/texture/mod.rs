@@ -18,7 +18,7 @@ use glam::{Mat4, Vec2, Vec3};
 use crate::assets::AssetSource;
 use crate::desc::{SceneDesc, Tex, TextureDesc, TextureId, TextureKind, Wrap};
 use crate::image_io::{self, RgbImage};
-use mapping::Mapping;
+pub use mapping::Mapping;
 
 /// What a texture lookup needs to know about the surface point.
 #[derive(Clone, Copy, Debug)]
