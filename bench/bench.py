@@ -1,20 +1,27 @@
 #!/usr/bin/env python3
 """YAT's benchmark: renders a fixed list of scenes at a fixed spp and depth with the release
 binary and prints, per scene, resolution, spp, parse/build time, render time, samples/s, rays/s,
-peak memory and core-seconds per sample, then sets our time for the seed scenes (scaled to
-1000 spp) beside the original tracer's published table.
+peak memory and core-seconds per sample; sets our time for the seed scenes (scaled to 1000 spp)
+beside the original tracer's published table; and renders the compared seed scenes with
+LuxCoreRender too (same machine, threads, spp and depth), reporting samples/s and Monte Carlo
+efficiency 1 / (MSE against the renderer's own converged reference x render seconds).
 
-    python3 bench/bench.py            # full list, writes bench/RESULTS.md
-    python3 bench/bench.py --quick    # fewer samples, prints only
+    python3 bench/bench.py               # everything, writes bench/RESULTS.md
+    python3 bench/bench.py --quick       # fewer samples, no LuxCore, prints only
+    python3 bench/bench.py --no-luxcore  # our scenes and the seed table only
 
-Speed lives here, never in timed tests.
+The script makes its own virtualenv (bench/.venv: pyluxcore, numpy, OpenEXR) and re-runs itself
+in it. Converged references are cached in bench/out/refs (YAT's keyed by the binary, LuxCore's by
+the exported scene). Speed lives here, never in timed tests.
 """
 
 import argparse
 import datetime
+import hashlib
 import json
 import os
 import platform
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -23,6 +30,20 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SEED = Path(os.environ.get("YAT_SEED_SCENES", ROOT.parent / "shared/seed-project/scenes"))
 YAT = ROOT / "target/release/yat"
+VENV = ROOT / "bench/.venv"
+VENV_PYTHON = VENV / "bin/python"
+REQUIREMENTS = ["pyluxcore==2.11.2", "numpy>=1.26", "OpenEXR>=3.2"]
+REFS = ROOT / "bench/out/refs"
+
+# Seed scenes rendered by both YAT and LuxCore: (scene, short-render spp, reference spp). The
+# fisheye scenes are left out (LuxCore has no such camera). CaptainFalcon has 4x the pixels.
+LUXCORE_SCENES = [
+    ("DepthOfField/depth-of-field-high.lxs", 16, 256),
+    ("CornellBox/cornell-box.lxs", 16, 256),
+    ("MetalMario/metal-mario-bg1.lxs", 16, 256),
+    ("CaptainFalcon/captainfalcon.lxs", 4, 64),
+]
+SHORT_SEED, REFERENCE_SEED = 1, 7
 
 # (scene relative to its root, the original tracer's published time at 1000 spp on 8 cores in
 # seconds, or None when it published none). From the seed project's README.
@@ -65,25 +86,167 @@ def build():
         )
 
 
-def render(scene, spp, depth, threads, out_dir):
-    """Runs one render; returns its --stats-json figures plus wall time and child peak RSS."""
-    stats = out_dir / "stats.json"
-    cmd = [
-        str(YAT), "render", str(scene), "--quiet", "--spp", str(spp), "--maxdepth", str(depth),
-        "--threads", str(threads), "--stats-json", str(stats), "-o", str(out_dir / "out.png"),
-    ]
+def ensure_venv():
+    """Re-runs this script inside bench/.venv, creating it and installing REQUIREMENTS first."""
+    if Path(sys.prefix).resolve() == VENV.resolve():
+        return
+    if not VENV_PYTHON.exists():
+        print(f"creating {VENV} ...", file=sys.stderr, flush=True)
+        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
+    subprocess.run(
+        [str(VENV_PYTHON), "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
+         *REQUIREMENTS],
+        check=True,
+    )
+    os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), __file__, *sys.argv[1:]])
+
+
+def run_measured(cmd, what, stats):
+    """Runs a render process; returns its JSON figures plus wall time and child peak RSS."""
     start = datetime.datetime.now()
-    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    # wait4 gives this child's own rusage (peak RSS), not the sum over all children.
     _, status, usage = os.wait4(proc.pid, 0)
     wall = (datetime.datetime.now() - start).total_seconds()
     err = proc.stderr.read().decode(errors="replace")
     if status != 0:
-        raise RuntimeError(f"{scene}: yat failed ({status}): {err.strip()[-500:]}")
-    figures = json.loads(stats.read_text())
+        raise RuntimeError(f"{what} failed ({status}): {err.strip()[-500:]}")
+    figures = json.loads(Path(stats).read_text())
     figures["wall_seconds"] = wall
     figures["cpu_seconds"] = usage.ru_utime + usage.ru_stime
     figures["peak_rss_mb"] = usage.ru_maxrss / 1024
     return figures
+
+
+def render(scene, spp, depth, threads, out_dir, seed=0):
+    """One YAT render in-process on `threads` threads; writes out_dir/out.png and out.exr."""
+    stats = out_dir / "stats.json"
+    cmd = [
+        str(YAT), "render", str(scene), "--quiet", "--spp", str(spp), "--maxdepth", str(depth),
+        "--threads", str(threads), "--seed", str(seed), "--stats-json", str(stats),
+        "-o", str(out_dir / "out.png"), "--exr",
+    ]
+    return run_measured(cmd, f"yat on {scene}", stats)
+
+
+def render_luxcore(export_dir, spp, depth, threads, out_dir, seed):
+    """One LuxCore render of an exported scene; writes out_dir/lux.exr."""
+    stats = out_dir / "lux.json"
+    cmd = [
+        str(VENV_PYTHON), str(ROOT / "bench/luxcore.py"), str(export_dir), "--spp", str(spp),
+        "--depth", str(depth), "--threads", str(threads), "--seed", str(seed),
+        "--out", str(out_dir / "lux.exr"), "--stats", str(stats),
+    ]
+    return run_measured(cmd, f"LuxCore on {export_dir}", stats)
+
+
+def read_exr(path):
+    import numpy as np
+    import OpenEXR
+
+    with OpenEXR.File(str(path)) as f:
+        channels = f.channels()
+        if "RGB" in channels:
+            return np.asarray(channels["RGB"].pixels, dtype=np.float64)[..., :3]
+        return np.stack([np.asarray(channels[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+
+
+def file_digest(*paths):
+    h = hashlib.sha256()
+    for p in paths:
+        h.update(Path(p).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def reference(kind, key, make):
+    """A converged reference image, cached in REFS under `key`; `make(dir)` renders it into
+    dir/ref.exr."""
+    path = REFS / f"{kind}-{key}.exr"
+    if not path.exists():
+        REFS.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory() as tmp:
+            make(Path(tmp))
+            shutil.move(Path(tmp) / "ref.exr", path)
+    return read_exr(path)
+
+
+def block_correlation(a, b, block=16):
+    """Correlation of block-mean luminance: the same picture, whatever the noise."""
+    import numpy as np
+
+    def blocks(x):
+        h, w = x.shape[0] // block * block, x.shape[1] // block * block
+        y = x[:h, :w].mean(-1).reshape(h // block, block, w // block, block).mean((1, 3))
+        return y.ravel()
+
+    return float(np.corrcoef(blocks(a), blocks(b))[0, 1])
+
+
+def luxcore_comparison(args):
+    """YAT and LuxCore side by side on LUXCORE_SCENES; returns the Markdown table and the
+    export notes."""
+    import numpy as np
+
+    yat_key = file_digest(YAT)
+    rows, notes = [], []
+    for rel, spp, ref_spp in LUXCORE_SCENES:
+        if args.only and args.only not in rel:
+            continue
+        scene = SEED / rel
+        name = scene.name
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            export = tmp / "export"
+            proc = subprocess.run(
+                [str(YAT), "export-luxcore", str(scene), str(export)],
+                capture_output=True, text=True,
+            )
+            if proc.returncode != 0:
+                notes.append(f"{name}: not compared: {proc.stderr.strip().splitlines()[-1]}")
+                continue
+            notes += [f"{name}: {line[6:]}" for line in proc.stderr.splitlines()
+                      if line.startswith("note: ")]
+            lux_key = file_digest(export / "scene.scn", ROOT / "bench/luxcore.py")
+
+            def yat_ref(d):
+                print(f"  YAT reference {name} at {ref_spp} spp ...", file=sys.stderr, flush=True)
+                render(scene, ref_spp, args.depth, args.threads, d, REFERENCE_SEED)
+                (d / "out.exr").rename(d / "ref.exr")
+
+            def lux_ref(d):
+                print(f"  LuxCore reference {name} at {ref_spp} spp ...", file=sys.stderr,
+                      flush=True)
+                render_luxcore(export, ref_spp, args.depth, args.threads, d, REFERENCE_SEED)
+                (d / "lux.exr").rename(d / "ref.exr")
+
+            depth_key = f"{name}-{ref_spp}spp-d{args.depth}"
+            y_ref = reference("yat", f"{depth_key}-{yat_key}", yat_ref)
+            l_ref = reference("luxcore", f"{depth_key}-{lux_key}", lux_ref)
+
+            print(f"comparing {name} at {spp} spp ...", file=sys.stderr, flush=True)
+            y = render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED)
+            l = render_luxcore(export, spp, args.depth, args.threads, tmp, SHORT_SEED)
+            y_mse = float(np.mean((read_exr(tmp / "out.exr") - y_ref) ** 2))
+            l_mse = float(np.mean((read_exr(tmp / "lux.exr") - l_ref) ** 2))
+            y_eff = 1 / (y_mse * y["render_seconds"])
+            l_eff = 1 / (l_mse * l["render_seconds"])
+            rows.append([
+                name, f"{y['width']}x{y['height']}", f"{spp} / {ref_spp}",
+                f"{y['render_seconds']:.2f}", f"{l['render_seconds']:.2f}",
+                f"{y['samples_per_second'] / 1e6:.3f}", f"{l['samples_per_second'] / 1e6:.3f}",
+                f"{y['samples_per_second'] / l['samples_per_second']:.2f}x",
+                f"{y['rays_per_second'] / 1e6:.2f}", f"{l['rays_per_second'] / 1e6:.2f}",
+                f"{y_mse:.3g}", f"{l_mse:.3g}", f"{y_eff:.3g}", f"{l_eff:.3g}",
+                f"{y_eff / l_eff:.2f}x",
+                f"{y_ref.mean() / l_ref.mean():.3f}", f"{block_correlation(y_ref, l_ref):.4f}",
+            ])
+    header = [
+        "scene", "resolution", "spp / ref spp", "YAT s", "LuxCore s", "YAT M samples/s",
+        "LuxCore M samples/s", "samples/s ratio", "YAT M rays/s", "LuxCore M rays/s", "YAT MSE",
+        "LuxCore MSE", "YAT efficiency", "LuxCore efficiency", "efficiency ratio",
+        "mean ratio (refs)", "block corr (refs)",
+    ]
+    return table(header, rows), notes
 
 
 def fmt_row(cols, widths):
@@ -104,8 +267,14 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count(), help="render threads")
     ap.add_argument("--quick", action="store_true", help="4 spp, and do not write RESULTS.md")
     ap.add_argument("--only", help="render only scenes whose path contains this text")
+    ap.add_argument("--no-luxcore", action="store_true", help="skip the LuxCore side by side")
+    ap.add_argument("--luxcore-only", action="store_true",
+                    help="only the LuxCore side by side (prints, does not write RESULTS.md)")
     args = ap.parse_args()
     spp = 4 if args.quick else args.spp
+    with_luxcore = not (args.quick or args.no_luxcore) and SEED.exists()
+    if with_luxcore:
+        ensure_venv()
 
     build()
     scenes = [("seed", SEED / s, t) for s, t in SEED_TABLE] + [
@@ -116,6 +285,8 @@ def main():
     if not SEED.exists():
         print(f"seed scenes not found at {SEED}: benchmarking our own scenes only", file=sys.stderr)
         scenes = [s for s in scenes if s[0] == "own"]
+    if args.luxcore_only:
+        scenes = []
 
     rows, seed_rows = [], []
     with tempfile.TemporaryDirectory() as tmp:
@@ -150,6 +321,28 @@ def main():
          "core-s ratio"],
         seed_rows,
     )
+    luxcore_section = ""
+    if with_luxcore:
+        lux_table, lux_notes = luxcore_comparison(args)
+        notes = "\n".join(f"- {n}" for n in lux_notes)
+        luxcore_section = f"""
+## Side by side with LuxCoreRender
+
+Each scene as YAT parsed it, written out by `yat export-luxcore` (LuxCore's own .lxs importer
+drops the spheres and the planar mapping, refuses metal2's fresnel colour and loses the named
+materials and the camera), rendered by pyluxcore {REQUIREMENTS[0].split("==")[1]} with PATHCPU and
+its default sampler (SOBOL, adaptive strength 0.95), same threads and path depth. Each renderer
+renders a converged reference of its own (ref spp, another seed) and a short render (spp);
+MSE is per channel over all pixels of the linear images, efficiency = 1 / (MSE x render s), and
+the efficiency ratio is YAT's over LuxCore's. "mean ratio" and "block corr" compare the two
+references (mean radiance, and correlation of 16x16-pixel block luminance): the two renderers
+rendered the same picture.
+
+{lux_table}
+
+Export notes:
+{notes}
+"""
     cpu = platform.processor() or platform.machine()
     try:
         cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if "model name" in l)
@@ -174,9 +367,9 @@ Our time at {spp} spp scaled linearly to 1000 spp; the original's published time
 depth 10 on an 8-core AMD FX-8150 (OpenJDK 8), converted to core-seconds (x 8).
 
 {seed_table}
-"""
+{luxcore_section}"""
     print(report)
-    if not args.quick and not args.only:
+    if not (args.quick or args.only or args.luxcore_only or args.no_luxcore):
         (ROOT / "bench/RESULTS.md").write_text(report)
         print("wrote bench/RESULTS.md", file=sys.stderr)
 

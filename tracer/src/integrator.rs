@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use crate::desc::RussianRoulette;
 use crate::geometry::SurfaceHit;
-use crate::math::{luminance, offset_origin, Ray};
+use crate::math::{offset_origin, Ray};
 use crate::render::RenderScene;
 use crate::sampler::PixelSampler;
 
@@ -119,7 +119,10 @@ pub fn trace_path(scene: &RenderScene, mut ray: Ray, sampler: &mut PixelSampler)
             let continue_prob = match integrator.rr_strategy {
                 RussianRoulette::None => 1.0,
                 RussianRoulette::Probability => integrator.rr_continue_prob,
-                RussianRoulette::Efficiency => luminance(throughput).clamp(0.05, 1.0),
+                // The largest channel, not luminance: a path along a saturated red wall
+                // has a small luminance but a large red throughput, and dividing that by a
+                // small survival probability is what makes coloured fireflies.
+                RussianRoulette::Efficiency => throughput.max_element().clamp(0.05, 1.0),
             };
             if u_rr >= continue_prob {
                 break;

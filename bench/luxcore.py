@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+"""Renders a scene exported by `yat export-luxcore` with LuxCoreRender's CPU path tracer
+(pyluxcore, PATHCPU) and writes linear RGB as EXR plus its figures as JSON. bench.py runs it
+in the benchmark's virtualenv, one process per render (as it runs yat).
+
+    luxcore.py EXPORT_DIR --spp N --depth D --threads T --out rgb.exr --stats stats.json
+
+Timing starts when RenderSession.Start() returns (scene and BVH ready) and stops when the
+halt condition is met, like yat's render_seconds.
+"""
+
+import argparse
+import json
+import os
+import time
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("export_dir")
+    ap.add_argument("--spp", type=int, required=True)
+    ap.add_argument("--depth", type=int, required=True)
+    ap.add_argument("--threads", type=int, required=True)
+    ap.add_argument("--sampler", default="SOBOL", help="SOBOL (LuxCore's default) or RANDOM")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--out", required=True, help="linear RGB EXR")
+    ap.add_argument("--stats", required=True, help="JSON figures")
+    args = ap.parse_args()
+    out = os.path.abspath(args.out)
+    stats_path = os.path.abspath(args.stats)
+
+    import pyluxcore
+
+    pyluxcore.Init(lambda _msg: None)
+    # The export's paths are relative to its folder; LuxCore resolves them from the cwd.
+    os.chdir(args.export_dir)
+    cfg = pyluxcore.Properties("render.cfg")
+    props = {
+        "renderengine.type": "PATHCPU",
+        "renderengine.seed": args.seed,
+        "native.threads.count": args.threads,
+        "sampler.type": args.sampler,
+        "path.pathdepth.total": args.depth,
+        "path.pathdepth.diffuse": args.depth,
+        "path.pathdepth.glossy": args.depth,
+        "path.pathdepth.specular": args.depth,
+        "batch.haltspp": args.spp,
+        "film.outputs.0.type": "RGB",
+        "film.outputs.0.filename": out,
+    }
+    for key, value in props.items():
+        cfg.Set(pyluxcore.Property(key, value))
+
+    loading = time.perf_counter()
+    scene = pyluxcore.Scene(cfg.Get("scene.file").GetString())
+    config = pyluxcore.RenderConfig(cfg, scene)
+    session = pyluxcore.RenderSession(config)
+    session.Start()
+    started = time.perf_counter()
+    while True:
+        session.UpdateStats()
+        if session.HasDone():
+            break
+        time.sleep(0.02)
+    seconds = time.perf_counter() - started
+    stats = session.GetStats()
+    session.Stop()
+    film = session.GetFilm()
+    width, height = film.GetWidth(), film.GetHeight()
+    passes = stats.Get("stats.renderengine.pass").GetInt()
+    figures = {
+        "width": width,
+        "height": height,
+        "spp": passes,
+        "load_seconds": started - loading,
+        "render_seconds": seconds,
+        "samples_per_second": width * height * passes / seconds,
+        "luxcore_samples_per_second": stats.Get("stats.renderengine.total.samplesec").GetFloat(),
+        "rays_per_second": stats.Get("stats.renderengine.total.raysec").GetFloat(),
+        "sampler": args.sampler,
+        "pyluxcore": pyluxcore.Version(),
+    }
+    film.SaveOutputs()
+    with open(stats_path, "w") as f:
+        json.dump(figures, f)
+    # pyluxcore 2.11 crashes in interpreter shutdown after a render; everything is written.
+    os._exit(0)
+
+
+if __name__ == "__main__":
+    main()
