@@ -153,6 +153,50 @@ fn white_furnace_converges_to_the_sky_radiance() {
     }
 }
 
+/// Inside a closed sphere that emits Le and reflects with albedo a, every path bounces until
+/// the depth limit: L = Le (1 + a + ... + a^depth) per channel. A saturated red (0.9, 0.05,
+/// 0.05) is where Russian roulette on luminance goes wrong: the red throughput stays high
+/// while luminance is small, and the few surviving paths carry fireflies. The mean must hold
+/// and the red channel must stay quiet.
+#[test]
+fn saturated_interreflection_converges_without_fireflies() {
+    let albedo = Vec3::new(0.9, 0.05, 0.05);
+    let le = Vec3::splat(0.1);
+    let mut desc = scene(
+        camera(CameraKind::Perspective { fov: 60.0 }, Vec3::ZERO, 0.0, 1e30),
+        16,
+    );
+    desc.integrator.max_depth = 10;
+    add_sphere(
+        &mut desc,
+        Vec3::ZERO,
+        2.0,
+        MaterialDesc::Matte {
+            kd: Tex::color(albedo),
+            sigma: Tex::float(0.0),
+        },
+    );
+    let shape = desc.shapes.last_mut().unwrap();
+    shape.reverse_orientation = true;
+    shape.area_light = Some(AreaLightDesc { radiance: le });
+    let film = render(&desc, &MemorySource::new(), 16);
+    let depth = desc.integrator.max_depth as i32;
+    let expected = le * (Vec3::ONE - albedo.powf((depth + 1) as f32)) / (Vec3::ONE - albedo);
+    let pixels: Vec<Vec3> = (0..16)
+        .flat_map(|y| (0..16).map(move |x| (x, y)))
+        .map(|(x, y)| film.pixel(x, y))
+        .collect();
+    let mean = pixels.iter().sum::<Vec3>() / pixels.len() as f32;
+    assert!(
+        ((mean - expected) / expected).abs().max_element() < 0.03,
+        "mean {mean}, expected {expected}"
+    );
+    let red_var = pixels.iter().map(|p| (p.x - mean.x).powi(2)).sum::<f32>() / pixels.len() as f32;
+    let red_rel_std = red_var.sqrt() / mean.x;
+    // Measured: 0.05 with roulette on the largest channel, 0.19 with it on luminance.
+    assert!(red_rel_std < 0.1, "red relative std {red_rel_std}");
+}
+
 #[test]
 fn zero_lens_radius_gives_exactly_the_pinhole_image() {
     let build = |focal_distance| {

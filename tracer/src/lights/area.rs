@@ -11,6 +11,12 @@ use crate::math::{luminance, Frame};
 
 use super::distribution::Distribution1D;
 
+/// Points this close to a sphere light (squared distance to its centre over radius^2) sample
+/// it by area, not by cone: a point on the sphere itself (an emitting sphere seen from
+/// inside) lies inside or outside by rounding only, and the cone from a point on the surface
+/// is degenerate. Area sampling is valid everywhere, so the margin costs nothing in bias.
+const ON_SPHERE: f32 = 1.0 + 1e-3;
+
 /// Below this sin^2 of the cone's half-angle (about 1.5 degrees) the cone is sampled through
 /// Taylor expansions: 1 - cos(theta_max) would cancel catastrophically (pbrt-v4).
 const SMALL_CONE_SIN2: f32 = 0.000_685_23;
@@ -104,7 +110,7 @@ impl AreaLight {
                 radius,
                 shape,
             } => {
-                if from.distance_squared(*centre) <= radius * radius {
+                if from.distance_squared(*centre) <= radius * radius * ON_SPHERE {
                     shape.sample(u)
                 } else {
                     return sample_sphere_cone(from, *centre, *radius, shape.orientation(), u);
@@ -138,7 +144,7 @@ impl AreaLight {
                 shape,
             } => {
                 let dc2 = from.distance_squared(*centre);
-                if dc2 <= radius * radius {
+                if dc2 <= radius * radius * ON_SPHERE {
                     shape.pdf_area(n)
                 } else {
                     return 1.0 / (TAU * one_minus_cos_max(radius * radius / dc2));
