@@ -58,15 +58,13 @@ pub fn trace_path(scene: &RenderScene, mut ray: Ray, sampler: &mut PixelSampler)
         rays += 1;
         let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else {
             if depth > 0 || integrator.include_environment {
-                let le = lights.environment(ray.dir);
-                if le != Vec3::ZERO {
-                    let weight = if prev.specular {
-                        1.0
-                    } else {
-                        power_heuristic(prev.pdf, lights.pdf_environment(ray.dir))
-                    };
-                    radiance += throughput * le * weight;
-                }
+                let (le, weight) = if prev.specular {
+                    (lights.environment(ray.dir), 1.0)
+                } else {
+                    let (le, pdf) = lights.environment_and_pdf(ray.dir);
+                    (le, power_heuristic(prev.pdf, pdf))
+                };
+                radiance += throughput * le * weight;
             }
             break;
         };

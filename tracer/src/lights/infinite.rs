@@ -56,21 +56,38 @@ impl InfiniteLight {
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         match &self.map {
             None => self.radiance,
+            Some(map) => self.radiance * map.lookup(map.uv(self.to_light(dir))),
+        }
+    }
+
+    /// Radiance from `dir` and the solid-angle density of [`Self::sample`] there, with one
+    /// conversion to map coordinates for both.
+    pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+        match &self.map {
+            None => (self.radiance, 1.0 / (4.0 * PI)),
             Some(map) => {
-                let d = (self.world_to_light * dir).normalize_or_zero();
-                self.radiance * map.lookup(map.uv(d))
+                let d = self.to_light(dir);
+                let uv = map.uv(d);
+                (
+                    self.radiance * map.lookup(uv),
+                    self.map_pdf(map, d, uv, dir),
+                )
             }
         }
     }
 
-    /// A world direction and its solid-angle density.
-    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+    /// A world direction, its solid-angle density and the radiance from it.
+    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
         match &self.map {
             None => {
                 let z = 1.0 - 2.0 * u.x;
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let (sin, cos) = (TAU * u.y).sin_cos();
-                Some((Vec3::new(r * cos, r * sin, z), 1.0 / (4.0 * PI)))
+                Some((
+                    Vec3::new(r * cos, r * sin, z),
+                    1.0 / (4.0 * PI),
+                    self.radiance,
+                ))
             }
             Some(map) => {
                 let (uv, pdf_uv) = map.distribution.sample(u)?;
@@ -80,7 +97,8 @@ impl InfiniteLight {
                 }
                 let dir = (self.light_to_world * d_light).normalize_or_zero();
                 let pdf = pdf_uv / (2.0 * PI * PI * sin_theta) * self.jacobian(dir);
-                (dir != Vec3::ZERO && pdf.is_finite()).then_some((dir, pdf))
+                let radiance = self.radiance * map.lookup(uv);
+                (dir != Vec3::ZERO && pdf.is_finite()).then_some((dir, pdf, radiance))
             }
         }
     }
@@ -90,15 +108,24 @@ impl InfiniteLight {
         match &self.map {
             None => 1.0 / (4.0 * PI),
             Some(map) => {
-                let d = (self.world_to_light * dir).normalize_or_zero();
-                // Not sqrt(1 - z^2), which rounds to 0 near the poles.
-                let sin_theta = d.truncate().length();
-                if sin_theta <= 0.0 {
-                    return 0.0;
-                }
-                map.distribution.pdf(map.uv(d)) / (2.0 * PI * PI * sin_theta) * self.jacobian(dir)
+                let d = self.to_light(dir);
+                self.map_pdf(map, d, map.uv(d), dir)
             }
         }
+    }
+
+    fn to_light(&self, dir: Vec3) -> Vec3 {
+        (self.world_to_light * dir).normalize_or_zero()
+    }
+
+    /// Density at light-space direction `d` (map coordinates `uv`, world direction `dir`).
+    fn map_pdf(&self, map: &LatLongMap, d: Vec3, uv: Vec2, dir: Vec3) -> f32 {
+        // Not sqrt(1 - z^2), which rounds to 0 near the poles.
+        let sin_theta = d.truncate().length();
+        if sin_theta <= 0.0 {
+            return 0.0;
+        }
+        map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta) * self.jacobian(dir)
     }
 
     /// d omega_light / d omega_world at world direction `dir` for the map d -> A d / |A d|.

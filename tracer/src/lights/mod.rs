@@ -233,11 +233,17 @@ impl Lights {
             Light::Spot(light) => light.sample(p).map(delta),
             Light::Distant(light) => Some(delta(light.sample())),
             Light::Infinite(light) => {
-                let (wi, _) = light.sample(u)?;
-                let pdf = self.pdf_environment(wi);
-                (pdf > 0.0).then(|| LightSample {
+                let (wi, pdf, li) = light.sample(u)?;
+                // A lone infinite light is the whole mixture: its own density and radiance
+                // serve, without looking the direction up again.
+                let (li, pdf) = if self.infinite.len() == 1 {
+                    (li, pmf * pdf)
+                } else {
+                    self.environment_and_pdf(wi)
+                };
+                (pdf > 0.0).then_some(LightSample {
                     wi,
-                    li: self.environment(wi),
+                    li,
                     pdf,
                     dist: f32::INFINITY,
                     delta: false,
@@ -283,6 +289,17 @@ impl Lights {
         self.infinite_lights()
             .map(|(index, light)| self.selection.pmf(index) * light.pdf(dir))
             .sum()
+    }
+
+    /// [`Self::environment`] and [`Self::pdf_environment`] together, for an escaping ray that
+    /// needs its MIS weight.
+    pub fn environment_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+        self.infinite_lights()
+            .map(|(index, light)| {
+                let (radiance, pdf) = light.radiance_and_pdf(dir);
+                (radiance, self.selection.pmf(index) * pdf)
+            })
+            .fold((Vec3::ZERO, 0.0), |(r, p), (ri, pi)| (r + ri, p + pi))
     }
 
     fn infinite_lights(&self) -> impl Iterator<Item = (usize, &InfiniteLight)> {
