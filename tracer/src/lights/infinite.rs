@@ -151,16 +151,9 @@ struct LatLongMap {
 }
 
 impl LatLongMap {
-    fn new(mut image: RgbImage, convention: LatLongConvention) -> Self {
-        for p in &mut image.pixels {
-            *p = if p.is_finite() {
-                p.max(Vec3::ZERO)
-            } else {
-                Vec3::ZERO
-            };
-        }
+    fn new(image: RgbImage, convention: LatLongConvention) -> Self {
         let (w, h) = (image.width as usize, image.height as usize);
-        let lum: Vec<f32> = image.pixels.iter().map(|&p| luminance(p)).collect();
+        let lum: Vec<f32> = image.texels().map(luminance).collect();
         // The map is looked up bilinearly, so a texel's cell also shows 1/4 of each
         // neighbour on its half: over the cell that averages to 3/4 own + 1/8 per side, per
         // axis. Sampling that blur keeps the density positive wherever the lookup is.
@@ -226,7 +219,7 @@ impl LatLongMap {
         let (fx, fy) = (x - x0, y - y0);
         let xi = [(x0 as i64).rem_euclid(w), (x0 as i64 + 1).rem_euclid(w)];
         let yi = [(y0 as i64).clamp(0, h - 1), (y0 as i64 + 1).clamp(0, h - 1)];
-        let texel = |xx: i64, yy: i64| self.image.pixels[(yy * w + xx) as usize];
+        let texel = |xx: i64, yy: i64| self.image.texel((yy * w + xx) as usize);
         let top = texel(xi[0], yi[0]) * (1.0 - fx) + texel(xi[1], yi[0]) * fx;
         let bottom = texel(xi[0], yi[1]) * (1.0 - fx) + texel(xi[1], yi[1]) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -239,7 +232,7 @@ impl LatLongMap {
         for y in 0..h {
             let (t0, t1) = (y as f32 / h as f32 * PI, (y + 1) as f32 / h as f32 * PI);
             let solid_angle = TAU / w as f32 * (t0.cos() - t1.cos());
-            let row: Vec3 = self.image.pixels[y * w..(y + 1) * w].iter().sum();
+            let row: Vec3 = (y * w..(y + 1) * w).map(|i| self.image.texel(i)).sum();
             sum += row * solid_angle;
         }
         sum / (4.0 * PI)

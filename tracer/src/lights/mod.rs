@@ -320,12 +320,8 @@ fn emits(c: Vec3) -> bool {
 fn load_map(source: &dyn AssetSource, filename: &str, gamma: f32) -> Result<RgbImage, LightError> {
     let bytes = source.read(filename)?;
     let image = image_io::decode(&bytes, filename, gamma)?;
-    Ok(if image.pixels.is_empty() {
-        RgbImage {
-            width: 1,
-            height: 1,
-            pixels: vec![Vec3::ZERO],
-        }
+    Ok(if image.is_empty() {
+        RgbImage::from_linear(1, 1, vec![Vec3::ZERO])
     } else {
         image
     })

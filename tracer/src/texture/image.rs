@@ -27,14 +27,14 @@ fn texel(image: &RgbImage, x: i64, y: i64, wrap: Wrap, gain: f32) -> Vec3 {
         Wrap::White if !inside => return Vec3::ONE,
         Wrap::Black | Wrap::White => (x, y),
     };
-    image.pixels[(y * w + x) as usize] * gain
+    image.texel((y * w + x) as usize) * gain
 }
 
 /// Bilinear interpolation of the four texels around (s, t), with texel centres at half
 /// integers.
 pub fn lookup(image: &RgbImage, st: Vec2, wrap: Wrap, gain: f32) -> Vec3 {
     let texels = image.width as usize * image.height as usize;
-    if texels == 0 || image.pixels.len() < texels || !st.is_finite() {
+    if texels == 0 || image.len() < texels || !st.is_finite() {
         return Vec3::ZERO;
     }
     let x = (st.x * image.width as f32 - 0.5).clamp(-MAX_COORD, MAX_COORD);
