@@ -158,15 +158,19 @@ def file_digest(*paths):
     return h.hexdigest()[:16]
 
 
-def reference(kind, key, make):
-    """A converged reference image, cached in REFS under `key`; `make(dir)` renders it into
-    dir/ref.exr."""
-    path = REFS / f"{kind}-{key}.exr"
+def reference(kind, setting, digest, make):
+    """A converged reference image, cached in REFS per renderer, scene setting and input digest;
+    `make(dir)` renders it into dir/ref.exr. A new digest replaces the setting's older references,
+    which no binary can reproduce any more."""
+    path = REFS / f"{kind}-{setting}-{digest}.exr"
     if not path.exists():
         REFS.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory() as tmp:
             make(Path(tmp))
             shutil.move(Path(tmp) / "ref.exr", path)
+        for stale in REFS.glob(f"{kind}-{setting}-*.exr"):
+            if stale != path:
+                stale.unlink()
     return read_exr(path)
 
 
@@ -219,9 +223,9 @@ def luxcore_comparison(args):
                 render_luxcore(export, ref_spp, args.depth, args.threads, d, REFERENCE_SEED)
                 (d / "lux.exr").rename(d / "ref.exr")
 
-            depth_key = f"{name}-{ref_spp}spp-d{args.depth}"
-            y_ref = reference("yat", f"{depth_key}-{yat_key}", yat_ref)
-            l_ref = reference("luxcore", f"{depth_key}-{lux_key}", lux_ref)
+            setting = f"{name}-{ref_spp}spp-d{args.depth}"
+            y_ref = reference("yat", setting, yat_key, yat_ref)
+            l_ref = reference("luxcore", setting, lux_key, lux_ref)
 
             print(f"comparing {name} at {spp} spp ...", file=sys.stderr, flush=True)
             y = render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED)
