@@ -1,6 +1,21 @@
 //! Decoding the image files a scene references (textures, environment maps) into linear RGB.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+
+/// Texel coordinates beyond this are clamped before conversion to integers (far outside any
+/// image, and small enough that neighbours never overflow).
+const MAX_COORD: f32 = 1.0e9;
+
+/// Where a texel coordinate beyond the image's edge reads from, along one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    /// The image tiles the plane.
+    Repeat,
+    /// The nearest edge texel.
+    Clamp,
+    /// Nothing: the weight of such texels is returned for the caller's border colour.
+    Outside,
+}
 
 /// A decoded image in linear RGB, rows top to bottom.
 #[derive(Clone, Debug)]
@@ -63,10 +78,55 @@ impl RgbImage {
         self.texel((y * self.width + x) as usize)
     }
 
+    /// Bilinear interpolation at `st` (0..1 across the image, texel centres at half-integer
+    /// texel coordinates). Returns the weighted sum of the texels inside the image and the total
+    /// weight that fell outside it under `Edge::Outside`, for the caller's border colour.
+    pub fn bilinear(&self, st: Vec2, edge_s: Edge, edge_t: Edge) -> (Vec3, f32) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        if w == 0 || h == 0 || self.len() < w * h || !st.is_finite() {
+            return (Vec3::ZERO, 0.0);
+        }
+        let (xs, fx) = axis_neighbours(st.x, self.width, edge_s);
+        let (ys, fy) = axis_neighbours(st.y, self.height, edge_t);
+        let mut inside = Vec3::ZERO;
+        let mut outside = 0.0;
+        for (y, wy) in ys.into_iter().zip([1.0 - fy, fy]) {
+            for (x, wx) in xs.into_iter().zip([1.0 - fx, fx]) {
+                match (x, y) {
+                    (Some(x), Some(y)) => inside += self.texel(y * w + x) * (wx * wy),
+                    _ => outside += wx * wy,
+                }
+            }
+        }
+        (inside, outside)
+    }
+
     /// Every texel, row-major.
     pub fn texels(&self) -> impl Iterator<Item = Vec3> + '_ {
         (0..self.len()).map(|i| self.texel(i))
     }
+}
+
+/// The two texels along one axis of length `n` that bracket coordinate `c` (0..1 across the
+/// axis), after `edge`, and the weight of the second.
+fn axis_neighbours(c: f32, n: u32, edge: Edge) -> ([Option<usize>; 2], f32) {
+    let x = (c * n as f32 - 0.5).clamp(-MAX_COORD, MAX_COORD);
+    let x0 = x.floor();
+    let (i, n) = (x0 as i64, i64::from(n));
+    let pair = match edge {
+        Edge::Repeat => {
+            // Lookups land inside the image nearly always: the division only when they do not.
+            let a = if (0..n).contains(&i) {
+                i
+            } else {
+                i.rem_euclid(n)
+            };
+            [a, if a + 1 == n { 0 } else { a + 1 }].map(Some)
+        }
+        Edge::Clamp => [i.clamp(0, n - 1), (i + 1).clamp(0, n - 1)].map(Some),
+        Edge::Outside => [i, i + 1].map(|j| (0..n).contains(&j).then_some(j)),
+    };
+    (pair.map(|j| j.map(|j| j as usize)), x - x0)
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -138,6 +198,38 @@ mod tests {
         let mut bytes = std::io::Cursor::new(Vec::new());
         img.write_to(&mut bytes, format).unwrap();
         bytes.into_inner()
+    }
+
+    /// Halfway between the last texel of a row and the first, each edge rule reads what it
+    /// says: both (repeat), the last twice (clamp), or the last and the border (outside).
+    #[test]
+    fn bilinear_across_the_edge_follows_the_edge_rule() {
+        let row = [
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.0, 4.0),
+        ];
+        let image = RgbImage::from_linear(3, 2, [row, row].concat());
+        let at_right_edge = Vec2::new(1.0, 0.25);
+        let cases = [
+            (Edge::Repeat, Vec3::new(0.5, 0.0, 2.0), 0.0),
+            (Edge::Clamp, Vec3::new(0.0, 0.0, 4.0), 0.0),
+            (Edge::Outside, Vec3::new(0.0, 0.0, 2.0), 0.5),
+        ];
+        for (edge, inside, outside) in cases {
+            let got = image.bilinear(at_right_edge, edge, Edge::Clamp);
+            assert!(
+                got.0.abs_diff_eq(inside, 1e-6) && (got.1 - outside).abs() < 1e-6,
+                "{edge:?}: {got:?}"
+            );
+        }
+        let third_of_the_way =
+            image.bilinear(Vec2::new(1.0 / 3.0, 0.25), Edge::Repeat, Edge::Clamp);
+        assert!(third_of_the_way
+            .0
+            .abs_diff_eq(Vec3::new(0.5, 0.0, 0.0), 1e-6));
+        let nowhere = image.bilinear(Vec2::new(f32::NAN, 0.5), Edge::Repeat, Edge::Repeat);
+        assert_eq!(nowhere, (Vec3::ZERO, 0.0));
     }
 
     #[test]

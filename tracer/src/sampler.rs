@@ -73,19 +73,18 @@ fn van_der_corput(index: u32) -> u32 {
     index.reverse_bits()
 }
 
-/// Sobol dimension 1 (primitive polynomial x + 1): direction numbers v1 = 1/2,
-/// v(k+1) = v(k) xor v(k)/2.
-fn sobol_dimension_1(mut index: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut result = 0;
-    while index != 0 {
-        if index & 1 != 0 {
-            result ^= v;
-        }
-        index >>= 1;
-        v ^= v >> 1;
-    }
-    result
+/// Sobol dimension 1 (primitive polynomial x + 1), as a 0.32 fixed-point fraction. Its
+/// generator matrix is Pascal's triangle mod 2: fraction bit k is the parity of the index bits
+/// i with C(i, k) odd, which by Lucas' theorem are the i whose bits include k's. That sum over
+/// supersets takes five masked shifts, one per bit of a bit position, and no branches.
+fn sobol_dimension_1(index: u32) -> u32 {
+    let mut x = index;
+    x ^= (x >> 1) & 0x5555_5555;
+    x ^= (x >> 2) & 0x3333_3333;
+    x ^= (x >> 4) & 0x0f0f_0f0f;
+    x ^= (x >> 8) & 0x00ff_00ff;
+    x ^= (x >> 16) & 0x0000_ffff;
+    x.reverse_bits()
 }
 
 /// Hash-based nested uniform (Owen) scrambling of a 0.32 fraction (Burley 2020, "Practical
@@ -135,7 +134,12 @@ fn permutation_element(mut i: u32, len: u32, p: u32) -> u32 {
             break;
         }
     }
-    (i.wrapping_add(p)) % len
+    // The common power-of-two sample counts need no division.
+    if len.is_power_of_two() {
+        i.wrapping_add(p) & (len - 1)
+    } else {
+        i.wrapping_add(p) % len
+    }
 }
 
 #[cfg(test)]
@@ -153,6 +157,35 @@ mod tests {
                     seen[j] = true;
                 }
             }
+        }
+    }
+
+    /// The branch-free form equals the definition by direction numbers: v1 = 1/2,
+    /// v(k+1) = v(k) xor v(k)/2, the value the xor of the v(k) of the index's set bits.
+    #[test]
+    fn sobol_dimension_1_matches_its_direction_numbers() {
+        let by_direction_numbers = |index: u32| {
+            let mut v = 1u32 << 31;
+            let mut result = 0;
+            for bit in 0..32 {
+                if index >> bit & 1 != 0 {
+                    result ^= v;
+                }
+                v ^= v >> 1;
+            }
+            result
+        };
+        let mut state = 1u64;
+        let indices = (0..4096u32).chain((0..4096).map(|_| {
+            state = mix64(state);
+            state as u32
+        }));
+        for index in indices.chain([u32::MAX]) {
+            assert_eq!(
+                sobol_dimension_1(index),
+                by_direction_numbers(index),
+                "index {index:#x}"
+            );
         }
     }
 

@@ -6,7 +6,7 @@ use std::f32::consts::{PI, TAU};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::desc::LatLongConvention;
-use crate::image_io::RgbImage;
+use crate::image_io::{Edge, RgbImage};
 use crate::math::luminance;
 
 use super::distribution::Distribution2D;
@@ -212,17 +212,7 @@ impl LatLongMap {
 
     /// Bilinear between texel centres, wrapping around in s and clamped in t.
     fn lookup(&self, uv: Vec2) -> Vec3 {
-        let (w, h) = (self.image.width as i64, self.image.height as i64);
-        let x = uv.x * w as f32 - 0.5;
-        let y = uv.y * h as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let xi = [(x0 as i64).rem_euclid(w), (x0 as i64 + 1).rem_euclid(w)];
-        let yi = [(y0 as i64).clamp(0, h - 1), (y0 as i64 + 1).clamp(0, h - 1)];
-        let texel = |xx: i64, yy: i64| self.image.texel((yy * w + xx) as usize);
-        let top = texel(xi[0], yi[0]) * (1.0 - fx) + texel(xi[1], yi[0]) * fx;
-        let bottom = texel(xi[0], yi[1]) * (1.0 - fx) + texel(xi[1], yi[1]) * fx;
-        top * (1.0 - fy) + bottom * fy
+        self.image.bilinear(uv, Edge::Repeat, Edge::Clamp).0
     }
 
     /// Mean radiance over the sphere: texels weighted by their solid angle.
