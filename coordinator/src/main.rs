@@ -1,8 +1,10 @@
 //! The `yat` command: render (in-process or over workers), worker, check, export-luxcore.
 
 mod check;
+mod checkpoint;
 mod distributed;
 mod export_cmd;
+mod manifest;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -30,7 +32,7 @@ enum Command {
     ExportLuxcore(export_cmd::ExportArgs),
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_env("YAT_LOG")
@@ -38,10 +40,22 @@ fn main() -> anyhow::Result<()> {
         )
         .with_writer(std::io::stderr)
         .init();
-    match Cli::parse().command {
+    let result = match Cli::parse().command {
         Command::Render(args) => render_cmd::run(args),
         Command::Worker(args) => yat_worker::run(args),
         Command::Check(args) => check::run(args),
         Command::ExportLuxcore(args) => export_cmd::run(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("Error: {e:?}");
+            let interrupted = e.is::<checkpoint::Interrupted>();
+            std::process::ExitCode::from(if interrupted {
+                checkpoint::INTERRUPTED_EXIT_CODE as u8
+            } else {
+                1
+            })
+        }
     }
 }

@@ -11,9 +11,13 @@ use rayon::prelude::*;
 use yat_tracer::assets::FsSource;
 use yat_tracer::desc::{LatLongConvention, SceneDesc};
 use yat_tracer::film::Film;
-use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings, UnitStats};
+use yat_tracer::render::{
+    plan_units, RenderOverrides, RenderScene, RenderSettings, UnitStats, WorkUnit,
+};
 
+use crate::checkpoint::{Checkpoint, CheckpointFile, Interrupt, Interrupted, RenderIdentity};
 use crate::distributed::DistributedArgs;
+use crate::manifest::SceneManifest;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum LatLongArg {
@@ -66,6 +70,10 @@ pub struct RenderArgs {
     /// Write the render's figures (times, samples/s, rays/s, memory) as JSON to this file.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
+    /// Save the render so far to `<output>.resume` this often (and on Ctrl-C), so that running
+    /// the same command again resumes it; 0 disables checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    pub checkpoint_every: f64,
     #[command(flatten)]
     pub distributed: DistributedArgs,
 }
@@ -89,9 +97,66 @@ pub struct RenderJob {
     pub main_file: PathBuf,
     pub desc: SceneDesc,
     pub settings: RenderSettings,
-    /// The PNG the render will write; previews go next to it.
+    /// The PNG the render will write; previews and the checkpoint go next to it.
     pub output_png: PathBuf,
     pub quiet: bool,
+    /// Where the render is kept as it goes (None with `--checkpoint-every 0`).
+    pub checkpoint: Option<CheckpointFile>,
+    /// Set by Ctrl-C or SIGTERM when checkpoints are on: the render stops, saved.
+    pub interrupt: Interrupt,
+}
+
+impl RenderJob {
+    /// The render to start from: the checkpoint a previous run of this render left, or nothing.
+    pub fn resume(&self, units: &[WorkUnit]) -> Checkpoint {
+        match &self.checkpoint {
+            Some(file) => file.resume(&self.settings, units, self.quiet),
+            None => Checkpoint::new(&self.settings, units.len()),
+        }
+    }
+
+    /// The error of a render that stopped short, after saving what it merged and saying how to
+    /// resume it.
+    pub fn stopped(
+        &self,
+        checkpoint: &Checkpoint,
+        units: &[WorkUnit],
+        why: anyhow::Error,
+    ) -> anyhow::Error {
+        let kept = match &self.checkpoint {
+            Some(file) if checkpoint.done_count() > 0 => Some(match file.save(checkpoint) {
+                Ok(()) => format!(
+                    "{:.1}% of the samples are kept in {}; the same command resumes the render",
+                    100.0 * checkpoint.done_samples(units) as f64
+                        / units.iter().map(WorkUnit::sample_count).sum::<u64>().max(1) as f64,
+                    file.path().display()
+                ),
+                Err(e) => format!("{e:#}"),
+            }),
+            _ => None,
+        };
+        match (self.interrupt.is_set(), kept) {
+            (true, kept) => Interrupted {
+                kept: kept.unwrap_or_else(|| "nothing had been rendered yet".into()),
+            }
+            .into(),
+            (false, Some(kept)) => anyhow::anyhow!("{why:#}\n{kept}"),
+            (false, None) => why,
+        }
+    }
+
+    /// Whether a periodic checkpoint last saved at `saved` is due again.
+    pub fn checkpoint_due(&self, saved: Instant) -> bool {
+        self.checkpoint
+            .as_ref()
+            .is_some_and(|file| saved.elapsed() >= file.every())
+    }
+}
+
+/// A duration option given in seconds.
+pub fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
+    Duration::try_from_secs_f64(value)
+        .with_context(|| format!("--{name} must be a non-negative number of seconds"))
 }
 
 /// The merged result of a render.
@@ -129,35 +194,61 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.png", desc.film.filename)));
+    let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
+    // The files by content: what workers receive, and what names the render for its checkpoint.
+    let manifest = if args.distributed.is_active() || !checkpoint_every.is_zero() {
+        Some(SceneManifest::read(&args.scene, &desc)?)
+    } else {
+        None
+    };
+    let checkpoint = manifest
+        .as_ref()
+        .filter(|_| !checkpoint_every.is_zero())
+        .map(|m| {
+            let identity = RenderIdentity::of(&m.load_request(&settings));
+            CheckpointFile::beside(&output_png, identity, checkpoint_every)
+        });
+    let interrupt = if checkpoint.is_some() {
+        Interrupt::install()?
+    } else {
+        Interrupt::default()
+    };
     let job = RenderJob {
         main_file: args.scene.clone(),
         desc,
         settings,
         output_png,
         quiet: args.quiet,
+        checkpoint,
+        interrupt,
     };
 
-    let (outcome, build_time, triangles) = if args.distributed.is_active() {
-        (
-            crate::distributed::render(&args.distributed, &job)?,
+    let (outcome, build_time, triangles) = match manifest {
+        Some(manifest) if args.distributed.is_active() => (
+            crate::distributed::render(&args.distributed, &job, manifest)?,
             None,
             None,
-        )
-    } else {
-        let build_start = Instant::now();
-        let scene = RenderScene::build(&job.desc, &source, &job.settings)
-            .with_context(|| format!("cannot build {}", args.scene.display()))?;
-        let build_time = build_start.elapsed();
-        let triangles = scene.triangle_count();
-        (
-            render_in_process(&scene, args.threads, job.quiet)?,
-            Some(build_time),
-            Some(triangles),
-        )
+        ),
+        _ => {
+            drop(manifest);
+            let build_start = Instant::now();
+            let scene = RenderScene::build(&job.desc, &source, &job.settings)
+                .with_context(|| format!("cannot build {}", args.scene.display()))?;
+            let build_time = build_start.elapsed();
+            let triangles = scene.triangle_count();
+            (
+                render_in_process(&scene, args.threads, &job)?,
+                Some(build_time),
+                Some(triangles),
+            )
+        }
     };
     let render_time = started.elapsed() - parse_time - build_time.unwrap_or_default();
 
     write_outputs(&job, &outcome.film, args.exr)?;
+    if let Some(file) = &job.checkpoint {
+        file.remove();
+    }
     let render_secs = render_time.as_secs_f64().max(1e-9);
     let report = RenderReport {
         scene: job.main_file.display().to_string(),
@@ -187,55 +278,95 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Renders every unit of the plan on a rayon pool, merging as units finish.
+/// The render so far, as the in-process render threads share it.
+struct InProcessState {
+    checkpoint: Checkpoint,
+    stats: UnitStats,
+    saved: Instant,
+}
+
+/// Renders every unit of the plan not yet in the job's checkpoint on a rayon pool, merging as
+/// units finish and saving the checkpoint as often as the job asks.
 pub fn render_in_process(
     scene: &RenderScene,
     threads: Option<usize>,
-    quiet: bool,
+    job: &RenderJob,
 ) -> anyhow::Result<RenderOutcome> {
-    let settings = scene.settings();
-    let units = plan_units(settings);
-    let total_samples: u64 = units.iter().map(|u| u.sample_count()).sum();
-    let progress = progress_bar(total_samples, quiet);
-    let film = Mutex::new(Film::new(settings.width, settings.height));
-    let stats = Mutex::new(UnitStats::default());
+    let units = plan_units(scene.settings());
+    let start = job.resume(&units);
+    let todo: Vec<WorkUnit> = units
+        .iter()
+        .filter(|u| !start.is_done(u))
+        .copied()
+        .collect();
+    let progress = progress_bar(
+        units.iter().map(WorkUnit::sample_count).sum(),
+        start.done_samples(&units),
+        job.quiet,
+    );
+    let state = Mutex::new(InProcessState {
+        checkpoint: start,
+        stats: UnitStats::default(),
+        saved: Instant::now(),
+    });
+    // One save at a time; a thread finding another saving leaves it to that one.
+    let saving = Mutex::new(());
+    let poisoned = || anyhow::anyhow!("a render thread panicked");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
         .context("cannot start the render threads")?;
-    pool.install(|| {
-        units.par_iter().try_for_each(|unit| {
+    let result = pool.install(|| {
+        todo.par_iter().try_for_each(|unit| {
+            if job.interrupt.is_set() {
+                anyhow::bail!("interrupted");
+            }
             let (buffer, unit_stats) = scene.render_unit(unit);
-            film.lock()
-                .map_err(|_| anyhow::anyhow!("a render thread panicked"))?
-                .add(&buffer)?;
-            *stats
-                .lock()
-                .map_err(|_| anyhow::anyhow!("a render thread panicked"))? += unit_stats;
+            let snapshot = {
+                let mut state = state.lock().map_err(|_| poisoned())?;
+                state.checkpoint.add(&buffer)?;
+                state.stats += unit_stats;
+                match saving.try_lock() {
+                    Ok(guard) if job.checkpoint_due(state.saved) => {
+                        state.saved = Instant::now();
+                        Some((guard, state.checkpoint.clone()))
+                    }
+                    _ => None,
+                }
+            };
             progress.inc(unit_stats.samples);
+            if let (Some((_guard, snapshot)), Some(file)) = (snapshot, &job.checkpoint) {
+                if let Err(e) = file.save(&snapshot) {
+                    progress.println(format!("{e:#}"));
+                }
+            }
             anyhow::Ok(())
         })
-    })?;
+    });
     progress.finish_and_clear();
+    let state = state.into_inner().map_err(|_| poisoned())?;
+    if let Err(why) = result {
+        return Err(job.stopped(&state.checkpoint, &units, why));
+    }
     Ok(RenderOutcome {
-        film: film
-            .into_inner()
-            .map_err(|_| anyhow::anyhow!("a render thread panicked"))?,
-        stats: stats
-            .into_inner()
-            .map_err(|_| anyhow::anyhow!("a render thread panicked"))?,
+        film: state.checkpoint.into_film(),
+        stats: state.stats,
     })
 }
 
-/// A progress bar over samples (hidden when quiet).
-pub fn progress_bar(total_samples: u64, quiet: bool) -> ProgressBar {
+/// A progress bar over samples (hidden when quiet), starting at those a checkpoint holds; its
+/// message, if any, follows the ETA.
+pub fn progress_bar(total_samples: u64, done_samples: u64, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::new(total_samples);
+    let bar = ProgressBar::new(total_samples).with_position(done_samples);
+    // Records the resumed position, then forgets it, so samples/s and the ETA count this run.
+    bar.tick();
+    bar.reset_eta();
     bar.set_style(
         ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta}",
+            "{elapsed_precise} [{bar:30}] {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta} {msg}",
         )
         .expect("static template")
         .progress_chars("=> "),

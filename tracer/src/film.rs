@@ -74,6 +74,21 @@ impl Film {
         self.height
     }
 
+    /// Per pixel (rows top to bottom): the R, G, B and weight sums in fixed point, exactly as
+    /// merged; with [`Film::from_sums`] this is how a render is kept and resumed losslessly.
+    pub fn sums(&self) -> &[[i64; 4]] {
+        &self.sums
+    }
+
+    /// A film holding these sums; None unless there are width x height of them.
+    pub fn from_sums(width: u32, height: u32, sums: Vec<[i64; 4]>) -> Option<Self> {
+        (sums.len() == width as usize * height as usize).then_some(Self {
+            width,
+            height,
+            sums,
+        })
+    }
+
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
     /// gives the same bits. A buffer that does not fit (wrong tile or length) is refused.
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {

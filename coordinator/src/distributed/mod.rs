@@ -4,7 +4,6 @@
 //! in-process render whatever the workers do.
 
 mod local;
-mod manifest;
 mod node;
 mod report;
 mod schedule;
@@ -17,12 +16,12 @@ use anyhow::{bail, Context};
 use tokio::sync::mpsc;
 use tokio::task::JoinSet;
 use tonic::transport::{Certificate, ClientTlsConfig};
-use yat_tracer::film::Film;
-use yat_tracer::render::{plan_units, UnitStats};
+use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
 
-use crate::render_cmd::{RenderJob, RenderOutcome};
+use crate::checkpoint::Checkpoint;
+use crate::manifest::SceneManifest;
+use crate::render_cmd::{seconds, RenderJob, RenderOutcome};
 use local::LocalWorker;
-use manifest::SceneManifest;
 use node::{run_node, Event, Node, NodeConfig, Shared};
 use report::{process_cpu_time, DistributedReport, Preview, Progress};
 use schedule::{Schedule, UnitDeadline};
@@ -73,12 +72,11 @@ const DEFAULT_PREVIEW_EVERY: f64 = 10.0;
 /// period).
 const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
 
-fn seconds(name: &str, value: f64) -> anyhow::Result<Duration> {
-    Duration::try_from_secs_f64(value)
-        .with_context(|| format!("--{name} must be a non-negative number of seconds"))
-}
-
-pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderOutcome> {
+pub fn render(
+    args: &DistributedArgs,
+    job: &RenderJob,
+    manifest: SceneManifest,
+) -> anyhow::Result<RenderOutcome> {
     let cpu_start = process_cpu_time();
     let started = Instant::now();
     let timeout = args.timeout.map(|t| seconds("timeout", t)).transpose()?;
@@ -91,7 +89,6 @@ pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderO
         .map(|t| seconds("unit-deadline", t))
         .transpose()?;
 
-    let manifest = SceneManifest::read(&job.main_file, &job.desc)?;
     let tls = args
         .tls_ca
         .as_ref()
@@ -135,9 +132,11 @@ pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderO
         .enable_all()
         .build()
         .context("cannot start the network runtime")?;
+    let units = plan_units(&job.settings);
+    let start = job.resume(&units);
     let (events, event_rx) = mpsc::unbounded_channel();
     let shared = Arc::new(Shared {
-        schedule: Schedule::new(plan_units(&job.settings)),
+        schedule: Schedule::new(units.clone(), |u| start.is_done(u)),
         deadline: UnitDeadline::new(unit_deadline),
         load_request: manifest.load_request(&job.settings),
         manifest,
@@ -149,6 +148,7 @@ pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderO
         .collect();
     let render_loop = RenderLoop {
         job,
+        units: &units,
         nodes: &nodes,
         shared: &shared,
         timeout,
@@ -157,7 +157,7 @@ pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderO
             (!preview_every.is_zero()).then_some(preview_every),
         ),
     };
-    let outcome = runtime.block_on(render_loop.run(event_rx));
+    let outcome = runtime.block_on(render_loop.run(start, event_rx));
     // Ends the node loops and closes connections; then `nodes` drops the local workers.
     drop(runtime);
 
@@ -184,6 +184,7 @@ pub fn render(args: &DistributedArgs, job: &RenderJob) -> anyhow::Result<RenderO
 
 struct RenderLoop<'a> {
     job: &'a RenderJob,
+    units: &'a [WorkUnit],
     nodes: &'a [Arc<Node>],
     shared: &'a Arc<Shared>,
     timeout: Option<Duration>,
@@ -191,45 +192,64 @@ struct RenderLoop<'a> {
 }
 
 impl RenderLoop<'_> {
-    /// Merges results as they come until every unit is in, watching that some worker is
-    /// there to render.
+    /// Merges results into `checkpoint` as they come until every unit is in, watching that
+    /// some worker is there to render and saving the checkpoint as often as the job asks.
     async fn run(
         mut self,
+        mut checkpoint: Checkpoint,
         mut events: mpsc::UnboundedReceiver<Event>,
     ) -> anyhow::Result<RenderOutcome> {
-        let settings = &self.job.settings;
         let quiet = self.job.quiet;
-        let total_units = self.shared.schedule.len();
-        let progress = Progress::new(self.shared.schedule.sample_count(), total_units, quiet);
+        let progress = Progress::new(
+            self.shared.schedule.sample_count(),
+            checkpoint.done_samples(self.units),
+            self.units.len(),
+            quiet,
+        );
         let mut tasks = JoinSet::new();
         for node in self.nodes {
             tasks.spawn(run_node(node.clone(), self.shared.clone()));
         }
-        let mut film = Film::new(settings.width, settings.height);
         let mut stats = UnitStats::default();
-        let mut merged = 0;
+        let mut saved = Instant::now();
         let mut alone_since = Some(Instant::now());
         let mut waiting_noticed = Instant::now();
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         let result = loop {
-            if merged == total_units {
+            if checkpoint.is_complete() {
                 break Ok(());
             }
             tokio::select! {
                 event = events.recv() => match event.expect("the shared state holds a sender") {
                     Event::Result { buffer, stats: unit_stats } => {
-                        film.add(&buffer)?;
+                        if let Err(e) = checkpoint.add(&buffer) {
+                            break Err(e.into());
+                        }
                         stats += unit_stats;
-                        merged += 1;
-                        progress.update(unit_stats.samples, merged, self.alive(), self.nodes.len());
+                        progress.update(
+                            unit_stats.samples,
+                            checkpoint.done_count(),
+                            self.alive(),
+                            self.nodes.len(),
+                        );
                     }
                     Event::Notice(line) => progress.say(quiet, &line),
                     Event::Fatal(e) => break Err(e),
                 },
                 _ = tick.tick() => {
-                    progress.update(0, merged, self.alive(), self.nodes.len());
-                    if let Err(e) = self.preview.maybe_write(&film, &self.job.desc.film) {
+                    if self.job.interrupt.is_set() {
+                        break Err(anyhow::anyhow!("interrupted"));
+                    }
+                    progress.update(0, checkpoint.done_count(), self.alive(), self.nodes.len());
+                    if let Err(e) = self.preview.maybe_write(checkpoint.film(), &self.job.desc.film) {
                         progress.say(quiet, &format!("{e:#}"));
+                    }
+                    if let (true, Some(file)) = (self.job.checkpoint_due(saved), &self.job.checkpoint) {
+                        saved = Instant::now();
+                        // Lets the runtime's other thread serve the workers meanwhile.
+                        if let Err(e) = tokio::task::block_in_place(|| file.save(&checkpoint)) {
+                            progress.say(quiet, &format!("{e:#}"));
+                        }
                     }
                     if self.alive() > 0 {
                         alone_since = None;
@@ -256,9 +276,14 @@ impl RenderLoop<'_> {
         };
         tasks.abort_all();
         progress.finish();
-        result?;
+        if let Err(why) = result {
+            return Err(self.job.stopped(&checkpoint, self.units, why));
+        }
         self.preview.remove();
-        Ok(RenderOutcome { film, stats })
+        Ok(RenderOutcome {
+            film: checkpoint.into_film(),
+            stats,
+        })
     }
 
     fn alive(&self) -> usize {

@@ -22,8 +22,8 @@ use yat_tracer::film::SampleBuffer;
 use yat_tracer::render::{UnitStats, WorkUnit};
 
 use super::local::LocalWorker;
-use super::manifest::SceneManifest;
 use super::schedule::{Schedule, UnitDeadline};
+use crate::manifest::SceneManifest;
 
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 /// Deadline of the small calls (handshake, blob queries, stats).

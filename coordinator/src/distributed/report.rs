@@ -4,11 +4,12 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use yat_tracer::desc::FilmDesc;
 use yat_tracer::film::Film;
 
 use super::node::NodeReport;
+use crate::render_cmd::progress_bar;
 
 /// Progress over samples, with units and live workers in the message.
 pub struct Progress {
@@ -17,29 +18,17 @@ pub struct Progress {
 }
 
 impl Progress {
-    pub fn new(total_samples: u64, units_total: usize, quiet: bool) -> Self {
-        let bar = if quiet {
-            ProgressBar::hidden()
-        } else {
-            let bar = ProgressBar::new(total_samples);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{elapsed_precise} [{bar:30}] {percent:>3}% {human_pos}/{human_len} samples, \
-                     {per_sec}, ETA {eta} | {msg}",
-                )
-                .expect("static template")
-                .progress_chars("=> "),
-            );
-            bar.enable_steady_tick(Duration::from_millis(200));
-            bar
-        };
-        Self { bar, units_total }
+    pub fn new(total_samples: u64, done_samples: u64, units_total: usize, quiet: bool) -> Self {
+        Self {
+            bar: progress_bar(total_samples, done_samples, quiet),
+            units_total,
+        }
     }
 
     pub fn update(&self, samples: u64, units_done: usize, alive: usize, workers: usize) {
         self.bar.inc(samples);
         self.bar.set_message(format!(
-            "units {units_done}/{}, workers {alive}/{workers}",
+            "| units {units_done}/{}, workers {alive}/{workers}",
             self.units_total
         ));
     }

@@ -24,11 +24,15 @@ struct QueueState {
 }
 
 impl Schedule {
-    pub fn new(units: Vec<WorkUnit>) -> Self {
+    /// The plan's units, less those `already_done` (by a render this one resumes).
+    pub fn new(units: Vec<WorkUnit>, already_done: impl Fn(&WorkUnit) -> bool) -> Self {
+        let done: Vec<bool> = units.iter().map(already_done).collect();
         let state = QueueState {
-            pending: (0..units.len() as u32).collect(),
-            done: vec![false; units.len()],
-            done_count: 0,
+            pending: (0..units.len() as u32)
+                .filter(|&i| !done[i as usize])
+                .collect(),
+            done_count: done.iter().filter(|&&d| d).count(),
+            done,
         };
         Self {
             units,
@@ -130,15 +134,38 @@ mod tests {
     use yat_tracer::desc::LatLongConvention;
     use yat_tracer::render::{plan_units, RenderSettings};
 
-    fn schedule() -> Schedule {
-        Schedule::new(plan_units(&RenderSettings {
+    fn plan() -> Vec<WorkUnit> {
+        plan_units(&RenderSettings {
             width: 130,
             height: 70,
             spp: 16,
             max_depth: 4,
             seed: 0,
             latlong: LatLongConvention::Seed,
-        }))
+        })
+    }
+
+    fn schedule() -> Schedule {
+        Schedule::new(plan(), |_| false)
+    }
+
+    #[test]
+    fn a_resumed_schedule_hands_out_only_what_is_missing() {
+        let s = Schedule::new(plan(), |u| u.index % 4 != 1);
+        let taken: Vec<u32> = std::iter::from_fn(|| s.take()).map(|u| u.index).collect();
+        assert_eq!(
+            taken,
+            (0..s.len() as u32)
+                .filter(|i| i % 4 == 1)
+                .collect::<Vec<_>>()
+        );
+        for index in taken {
+            assert!(!s.is_finished());
+            assert!(s.complete(&plan()[index as usize]));
+        }
+        assert!(s.is_finished());
+        let all_done = Schedule::new(plan(), |_| true);
+        assert!(all_done.is_finished() && all_done.take().is_none());
     }
 
     #[test]

@@ -1,0 +1,453 @@
+//! Checkpoints: a render's merged film and the units it holds, kept on disk every so often so
+//! that a render stopped by a crash, a reboot, a lost coordinator machine or Ctrl-C resumes
+//! where it was. The film's sums are exact integers, so a resumed render is bit-identical to
+//! one never stopped, whichever way (in-process or on workers) each part was rendered.
+//!
+//! File layout (little-endian): magic, format version, render identity (64 hex bytes), width,
+//! height, unit count, a bit per unit of the plan, the film's four i64 sums per pixel, and the
+//! SHA-256 of everything before it.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::Context;
+use prost::Message;
+use yat_proto::hash::Sha256Stream;
+use yat_proto::pb;
+use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
+use yat_tracer::render::{RenderSettings, WorkUnit};
+
+const MAGIC: &[u8; 8] = b"YATRESUM";
+const FORMAT_VERSION: u32 = 1;
+const IDENTITY_LEN: usize = 64;
+const DIGEST_LEN: usize = 64;
+const HEADER_LEN: usize = MAGIC.len() + 4 + IDENTITY_LEN + 3 * 4;
+
+/// What a checkpoint belongs to: the SHA-256 of the renderer's version and of the scene as a
+/// worker is asked to load it (every file by content hash, and the settings). Anything that
+/// changes the image changes it; threads, workers and output paths do not.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderIdentity(String);
+
+impl RenderIdentity {
+    pub fn of(load_request: &pb::LoadSceneRequest) -> Self {
+        let mut digest = Sha256Stream::default();
+        digest.update(b"yat render ");
+        digest.update(env!("CARGO_PKG_VERSION").as_bytes());
+        digest.update(&load_request.encode_to_vec());
+        Self(digest.finish_hex())
+    }
+}
+
+/// The render so far: the merged film and which units of the plan it holds.
+#[derive(Clone)]
+pub struct Checkpoint {
+    film: Film,
+    done: Vec<bool>,
+    done_count: usize,
+}
+
+impl Checkpoint {
+    /// Nothing rendered yet.
+    pub fn new(settings: &RenderSettings, unit_count: usize) -> Self {
+        Self {
+            film: Film::new(settings.width, settings.height),
+            done: vec![false; unit_count],
+            done_count: 0,
+        }
+    }
+
+    /// Merges a unit's result. A unit already merged is not added again (false); a buffer that
+    /// fits neither the film nor the plan is refused.
+    pub fn add(&mut self, buffer: &SampleBuffer) -> Result<bool, BufferMismatch> {
+        let index = buffer.unit.index as usize;
+        let Some(done) = self.done.get_mut(index) else {
+            return Err(BufferMismatch {
+                index: buffer.unit.index,
+                width: self.film.width(),
+                height: self.film.height(),
+            });
+        };
+        if *done {
+            return Ok(false);
+        }
+        self.film.add(buffer)?;
+        *done = true;
+        self.done_count += 1;
+        Ok(true)
+    }
+
+    pub fn is_done(&self, unit: &WorkUnit) -> bool {
+        self.done.get(unit.index as usize) == Some(&true)
+    }
+
+    pub fn done_count(&self) -> usize {
+        self.done_count
+    }
+
+    pub fn is_complete(&self) -> bool {
+        self.done_count == self.done.len()
+    }
+
+    /// Camera samples of the units merged, out of `units` (the plan).
+    pub fn done_samples(&self, units: &[WorkUnit]) -> u64 {
+        units
+            .iter()
+            .filter(|u| self.is_done(u))
+            .map(WorkUnit::sample_count)
+            .sum()
+    }
+
+    pub fn film(&self) -> &Film {
+        &self.film
+    }
+
+    pub fn into_film(self) -> Film {
+        self.film
+    }
+
+    fn encode(&self, identity: &RenderIdentity) -> Vec<u8> {
+        let sums = self.film.sums();
+        let mut bytes =
+            Vec::with_capacity(HEADER_LEN + self.done.len().div_ceil(8) + sums.len() * 32 + 64);
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        bytes.extend_from_slice(identity.0.as_bytes());
+        for v in [
+            self.film.width(),
+            self.film.height(),
+            self.done.len() as u32,
+        ] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        bytes.extend(self.done.chunks(8).map(|bits| {
+            bits.iter()
+                .enumerate()
+                .fold(0u8, |byte, (i, &done)| byte | (u8::from(done) << i))
+        }));
+        for sum in sums {
+            for v in sum {
+                bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let mut digest = Sha256Stream::default();
+        digest.update(&bytes);
+        bytes.extend_from_slice(digest.finish_hex().as_bytes());
+        bytes
+    }
+
+    /// Reads a checkpoint of the render `identity` with these settings and this many units.
+    fn decode(
+        bytes: &[u8],
+        identity: &RenderIdentity,
+        settings: &RenderSettings,
+        unit_count: usize,
+    ) -> Result<Self, CheckpointError> {
+        if bytes.len() < HEADER_LEN + DIGEST_LEN || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(CheckpointError::NotACheckpoint);
+        }
+        let (body, digest) = bytes.split_at(bytes.len() - DIGEST_LEN);
+        let mut check = Sha256Stream::default();
+        check.update(body);
+        if check.finish_hex().as_bytes() != digest {
+            return Err(CheckpointError::Corrupt);
+        }
+        let u32_at = |at: usize| u32::from_le_bytes(body[at..at + 4].try_into().expect("4 bytes"));
+        let version = u32_at(MAGIC.len());
+        if version != FORMAT_VERSION {
+            return Err(CheckpointError::OtherFormat(version));
+        }
+        let stored_identity = &body[MAGIC.len() + 4..MAGIC.len() + 4 + IDENTITY_LEN];
+        let dims_at = MAGIC.len() + 4 + IDENTITY_LEN;
+        let (width, height, units) = (u32_at(dims_at), u32_at(dims_at + 4), u32_at(dims_at + 8));
+        if stored_identity != identity.0.as_bytes()
+            || (width, height) != (settings.width, settings.height)
+            || units as usize != unit_count
+        {
+            return Err(CheckpointError::OtherRender);
+        }
+        let bitmap_len = unit_count.div_ceil(8);
+        let pixels = width as usize * height as usize;
+        let rest = &body[HEADER_LEN..];
+        if rest.len() != bitmap_len + pixels * 32 {
+            return Err(CheckpointError::Corrupt);
+        }
+        let (bitmap, sum_bytes) = rest.split_at(bitmap_len);
+        let done: Vec<bool> = (0..unit_count)
+            .map(|i| bitmap[i / 8] >> (i % 8) & 1 == 1)
+            .collect();
+        let sums = sum_bytes
+            .chunks_exact(32)
+            .map(|pixel| {
+                std::array::from_fn(|c| {
+                    i64::from_le_bytes(pixel[c * 8..c * 8 + 8].try_into().expect("8 bytes"))
+                })
+            })
+            .collect();
+        let film = Film::from_sums(width, height, sums).ok_or(CheckpointError::Corrupt)?;
+        Ok(Self {
+            film,
+            done_count: done.iter().filter(|&&d| d).count(),
+            done,
+        })
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("not a YAT checkpoint")]
+    NotACheckpoint,
+    #[error("damaged (its checksum does not match)")]
+    Corrupt,
+    #[error("written in checkpoint format {0}, this yat reads format {FORMAT_VERSION}")]
+    OtherFormat(u32),
+    #[error("of another render (the scene's files, the settings or the yat version differ)")]
+    OtherRender,
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
+/// Where and how often a render keeps its checkpoint: `<output stem>.resume` beside the image.
+pub struct CheckpointFile {
+    path: PathBuf,
+    identity: RenderIdentity,
+    every: Duration,
+}
+
+impl CheckpointFile {
+    pub fn beside(output_png: &Path, identity: RenderIdentity, every: Duration) -> Self {
+        Self {
+            path: output_png.with_extension("resume"),
+            identity,
+            every,
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    pub fn every(&self) -> Duration {
+        self.every
+    }
+
+    /// The checkpoint this render left, if there is one.
+    pub fn load(
+        &self,
+        settings: &RenderSettings,
+        unit_count: usize,
+    ) -> Result<Option<Checkpoint>, CheckpointError> {
+        let bytes = match std::fs::read(&self.path) {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(e.into()),
+        };
+        Checkpoint::decode(&bytes, &self.identity, settings, unit_count).map(Some)
+    }
+
+    /// The checkpoint to start from: the one on disk when it belongs to this render, else an
+    /// empty one (saying why a file there is not used; it is overwritten by the next save).
+    pub fn resume(&self, settings: &RenderSettings, units: &[WorkUnit], quiet: bool) -> Checkpoint {
+        match self.load(settings, units.len()) {
+            Ok(Some(checkpoint)) => {
+                if !quiet {
+                    eprintln!(
+                        "resuming from {}: {} of {} units ({:.1}% of the samples) already rendered",
+                        self.path.display(),
+                        checkpoint.done_count(),
+                        units.len(),
+                        100.0 * checkpoint.done_samples(units) as f64
+                            / units.iter().map(WorkUnit::sample_count).sum::<u64>().max(1) as f64
+                    );
+                }
+                checkpoint
+            }
+            Ok(None) => Checkpoint::new(settings, units.len()),
+            Err(e) => {
+                eprintln!(
+                    "not resuming from {}: it is {e}; starting afresh",
+                    self.path.display()
+                );
+                Checkpoint::new(settings, units.len())
+            }
+        }
+    }
+
+    /// Writes the checkpoint atomically: a crash while saving leaves the previous one whole.
+    pub fn save(&self, checkpoint: &Checkpoint) -> anyhow::Result<()> {
+        let bytes = checkpoint.encode(&self.identity);
+        let temporary = self.path.with_extension("resume.partial");
+        let write = || -> std::io::Result<()> {
+            let mut file = std::fs::File::create(&temporary)?;
+            file.write_all(&bytes)?;
+            file.sync_all()?;
+            std::fs::rename(&temporary, &self.path)
+        };
+        write().with_context(|| format!("cannot save the checkpoint {}", self.path.display()))
+    }
+
+    /// Removes the checkpoint once the final image is written.
+    pub fn remove(&self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render with
+/// its checkpoint saved, a second one ends the process at once.
+#[derive(Clone, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+/// Exit status of a render stopped by a signal (128 + SIGINT, as shells report it).
+pub const INTERRUPTED_EXIT_CODE: i32 = 130;
+
+impl Interrupt {
+    pub fn install() -> anyhow::Result<Self> {
+        let flag = Arc::new(AtomicBool::new(false));
+        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            // Registered first, so it sees the flag as the previous signal left it.
+            signal_hook::flag::register_conditional_shutdown(
+                signal,
+                INTERRUPTED_EXIT_CODE,
+                flag.clone(),
+            )
+            .context("cannot watch for Ctrl-C")?;
+            signal_hook::flag::register(signal, flag.clone()).context("cannot watch for Ctrl-C")?;
+        }
+        Ok(Self(flag))
+    }
+
+    pub fn is_set(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// The error of a render stopped by Ctrl-C or SIGTERM; `main` exits with
+/// [`INTERRUPTED_EXIT_CODE`] on it.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted: {kept}")]
+pub struct Interrupted {
+    pub kept: String,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use yat_tracer::desc::LatLongConvention;
+    use yat_tracer::render::plan_units;
+
+    fn settings() -> RenderSettings {
+        RenderSettings {
+            width: 70,
+            height: 40,
+            spp: 8,
+            max_depth: 3,
+            seed: 0,
+            latlong: LatLongConvention::Seed,
+        }
+    }
+
+    fn identity(name: &str) -> RenderIdentity {
+        RenderIdentity::of(&pb::LoadSceneRequest {
+            main: Some(pb::SceneFile {
+                path: name.into(),
+                sha256: "0".repeat(64),
+            }),
+            assets: vec![],
+            settings: Some((&settings()).into()),
+        })
+    }
+
+    /// A checkpoint holding every third unit of the plan, with distinct sums per unit.
+    fn partial() -> (Checkpoint, Vec<WorkUnit>) {
+        let units = plan_units(&settings());
+        let mut checkpoint = Checkpoint::new(&settings(), units.len());
+        for unit in units.iter().step_by(3) {
+            let mut buffer = SampleBuffer::new(*unit);
+            for (i, (rgb, w)) in buffer.rgb.iter_mut().zip(&mut buffer.weight).enumerate() {
+                *rgb = [i as f32 * 0.25, unit.index as f32, -1.5];
+                *w = 0.75;
+            }
+            assert!(checkpoint.add(&buffer).unwrap());
+            assert!(!checkpoint.add(&buffer).unwrap(), "merged once");
+        }
+        (checkpoint, units)
+    }
+
+    #[test]
+    fn a_checkpoint_reads_back_exactly() {
+        let (checkpoint, units) = partial();
+        let id = identity("a.lxs");
+        let back = Checkpoint::decode(&checkpoint.encode(&id), &id, &settings(), units.len())
+            .expect("own checkpoint");
+        assert_eq!(back.film().sums(), checkpoint.film().sums());
+        assert_eq!(back.done, checkpoint.done);
+        assert_eq!(back.done_count(), units.len().div_ceil(3));
+        assert!(back.is_done(&units[3]) && !back.is_done(&units[4]));
+        assert!(back.done_samples(&units) > 0 && !back.is_complete());
+    }
+
+    #[test]
+    fn another_render_or_a_damaged_file_is_refused() {
+        let (checkpoint, units) = partial();
+        let id = identity("a.lxs");
+        let bytes = checkpoint.encode(&id);
+        let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
+            Checkpoint::decode(bytes, id, settings, units.len()).err()
+        };
+        assert!(matches!(
+            decode(&bytes, &identity("b.lxs"), &settings()),
+            Some(CheckpointError::OtherRender)
+        ));
+        let wider = RenderSettings {
+            width: 71,
+            ..settings()
+        };
+        assert!(matches!(
+            decode(&bytes, &id, &wider),
+            Some(CheckpointError::OtherRender)
+        ));
+        for at in [9, HEADER_LEN + 1, bytes.len() / 2, bytes.len() - 1] {
+            let mut damaged = bytes.clone();
+            damaged[at] ^= 0x10;
+            assert!(
+                matches!(
+                    decode(&damaged, &id, &settings()),
+                    Some(CheckpointError::Corrupt)
+                ),
+                "byte {at}"
+            );
+        }
+        for len in [0, 5, HEADER_LEN, bytes.len() - 1] {
+            assert!(decode(&bytes[..len], &id, &settings()).is_some(), "{len}");
+        }
+        assert!(matches!(
+            decode(b"PNG and more bytes than a header has, surely enough of them to pass the length check of the header and digest", &id, &settings()),
+            Some(CheckpointError::NotACheckpoint)
+        ));
+    }
+
+    #[test]
+    fn saving_replaces_the_file_whole_and_resume_ignores_a_stranger() {
+        let dir = tempfile::tempdir().unwrap();
+        let output = dir.path().join("out.png");
+        let file = CheckpointFile::beside(&output, identity("a.lxs"), Duration::from_secs(1));
+        assert_eq!(file.path(), dir.path().join("out.resume"));
+        let units = plan_units(&settings());
+        assert!(file.load(&settings(), units.len()).unwrap().is_none());
+        let (checkpoint, _) = partial();
+        file.save(&Checkpoint::new(&settings(), units.len()))
+            .unwrap();
+        file.save(&checkpoint).unwrap();
+        let loaded = file.resume(&settings(), &units, true);
+        assert_eq!(loaded.film().sums(), checkpoint.film().sums());
+        assert!(!dir.path().join("out.resume.partial").exists());
+
+        let stranger = CheckpointFile::beside(&output, identity("b.lxs"), Duration::ZERO);
+        assert_eq!(stranger.resume(&settings(), &units, true).done_count(), 0);
+        file.remove();
+        assert!(!file.path().exists());
+    }
+}
