@@ -126,12 +126,14 @@ def run_measured(cmd, what, stats):
 
 
 def render(scene, spp, depth, threads, out_dir, seed=0):
-    """One YAT render in-process on `threads` threads; writes out_dir/out.png and out.exr."""
+    """One YAT render in-process on `threads` threads; writes out_dir/out.png and out.exr.
+    No previews or checkpoints: the figures time rendering, and LuxCore writes nothing meanwhile
+    either."""
     stats = out_dir / "stats.json"
     cmd = [
         str(YAT), "render", str(scene), "--quiet", "--spp", str(spp), "--maxdepth", str(depth),
         "--threads", str(threads), "--seed", str(seed), "--stats-json", str(stats),
-        "-o", str(out_dir / "out.png"), "--exr",
+        "-o", str(out_dir / "out.png"), "--exr", "--preview-every", "0", "--checkpoint-every", "0",
     ]
     return run_measured(cmd, f"yat on {scene}", stats)
 

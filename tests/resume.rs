@@ -96,9 +96,13 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
     let after_crash = std::fs::read(&checkpoint).unwrap();
 
     // 2. An in-process render of the same scene picks it up, and is stopped by Ctrl-C.
-    let mut render = long_render(&scene, &out, &[&every[..], &["--threads", "2"]].concat())
-        .spawn()
-        .unwrap();
+    let mut render = long_render(
+        &scene,
+        &out,
+        &[&every[..], &["--threads", "2", "--preview-every", "0.05"]].concat(),
+    )
+    .spawn()
+    .unwrap();
     wait_for_new_checkpoint(&mut render, &checkpoint, Some(&after_crash));
     signal(&render, "INT");
     let interrupted = render.wait_with_output().unwrap();
@@ -110,6 +114,13 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
         "{stderr}"
     );
     assert!(!out.exists(), "no final image from a stopped render");
+    let preview = image::open(out.with_extension("preview.png"))
+        .expect("an in-process render writes previews")
+        .to_rgb8();
+    assert!(
+        preview.pixels().any(|p| p.0 != [0, 0, 0]),
+        "the preview shows the render so far"
+    );
     let after_interrupt = std::fs::read(&checkpoint).unwrap();
     assert_ne!(after_interrupt, after_crash, "the second run added units");
 
@@ -136,6 +147,10 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
         "resumed image differs from the uninterrupted one"
     );
     assert!(!checkpoint.exists(), "the checkpoint is removed at the end");
+    assert!(
+        !out.with_extension("preview.png").exists(),
+        "and so is the preview"
+    );
 }
 
 #[test]

@@ -4,6 +4,7 @@ mod check;
 mod checkpoint;
 mod distributed;
 mod export_cmd;
+mod interim;
 mod manifest;
 mod render_cmd;
 

@@ -17,6 +17,7 @@ use yat_tracer::render::{
 
 use crate::checkpoint::{Checkpoint, CheckpointFile, Interrupt, Interrupted, RenderIdentity};
 use crate::distributed::DistributedArgs;
+use crate::interim::{InterimClock, InterimOutputs, PreviewFile};
 use crate::manifest::SceneManifest;
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -74,6 +75,9 @@ pub struct RenderArgs {
     /// the same command again resumes it; 0 disables checkpoints.
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
     pub checkpoint_every: f64,
+    /// Rewrite `<output>.preview.png` this often during the render; 0 disables.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub preview_every: f64,
     #[command(flatten)]
     pub distributed: DistributedArgs,
 }
@@ -100,8 +104,8 @@ pub struct RenderJob {
     /// The PNG the render will write; previews and the checkpoint go next to it.
     pub output_png: PathBuf,
     pub quiet: bool,
-    /// Where the render is kept as it goes (None with `--checkpoint-every 0`).
-    pub checkpoint: Option<CheckpointFile>,
+    /// The preview and the checkpoint, written as the render goes.
+    pub interim: InterimOutputs,
     /// Set by Ctrl-C or SIGTERM when checkpoints are on: the render stops, saved.
     pub interrupt: Interrupt,
 }
@@ -109,7 +113,7 @@ pub struct RenderJob {
 impl RenderJob {
     /// The render to start from: the checkpoint a previous run of this render left, or nothing.
     pub fn resume(&self, units: &[WorkUnit]) -> Checkpoint {
-        match &self.checkpoint {
+        match &self.interim.checkpoint {
             Some(file) => file.resume(&self.settings, units, self.quiet),
             None => Checkpoint::new(&self.settings, units.len()),
         }
@@ -123,7 +127,7 @@ impl RenderJob {
         units: &[WorkUnit],
         why: anyhow::Error,
     ) -> anyhow::Error {
-        let kept = match &self.checkpoint {
+        let kept = match &self.interim.checkpoint {
             Some(file) if checkpoint.done_count() > 0 => Some(match file.save(checkpoint) {
                 Ok(()) => format!(
                     "{:.1}% of the samples are kept in {}; the same command resumes the render",
@@ -143,13 +147,6 @@ impl RenderJob {
             (false, Some(kept)) => anyhow::anyhow!("{why:#}\n{kept}"),
             (false, None) => why,
         }
-    }
-
-    /// Whether a periodic checkpoint last saved at `saved` is due again.
-    pub fn checkpoint_due(&self, saved: Instant) -> bool {
-        self.checkpoint
-            .as_ref()
-            .is_some_and(|file| saved.elapsed() >= file.every())
     }
 }
 
@@ -195,6 +192,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.png", desc.film.filename)));
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
+    let preview_every = seconds("preview-every", args.preview_every)?;
     // The files by content: what workers receive, and what names the render for its checkpoint.
     let manifest = if args.distributed.is_active() || !checkpoint_every.is_zero() {
         Some(SceneManifest::read(&args.scene, &desc)?)
@@ -217,9 +215,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         main_file: args.scene.clone(),
         desc,
         settings,
+        interim: InterimOutputs {
+            preview: (!preview_every.is_zero())
+                .then(|| PreviewFile::beside(&output_png, preview_every)),
+            checkpoint,
+        },
         output_png,
         quiet: args.quiet,
-        checkpoint,
         interrupt,
     };
 
@@ -246,9 +248,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let render_time = started.elapsed() - parse_time - build_time.unwrap_or_default();
 
     write_outputs(&job, &outcome.film, args.exr)?;
-    if let Some(file) = &job.checkpoint {
-        file.remove();
-    }
+    job.interim.remove();
     let render_secs = render_time.as_secs_f64().max(1e-9);
     let report = RenderReport {
         scene: job.main_file.display().to_string(),
@@ -282,11 +282,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
 struct InProcessState {
     checkpoint: Checkpoint,
     stats: UnitStats,
-    saved: Instant,
+    clock: InterimClock,
 }
 
 /// Renders every unit of the plan not yet in the job's checkpoint on a rayon pool, merging as
-/// units finish and saving the checkpoint as often as the job asks.
+/// units finish and writing the preview and checkpoint as often as the job asks.
 pub fn render_in_process(
     scene: &RenderScene,
     threads: Option<usize>,
@@ -307,10 +307,10 @@ pub fn render_in_process(
     let state = Mutex::new(InProcessState {
         checkpoint: start,
         stats: UnitStats::default(),
-        saved: Instant::now(),
+        clock: InterimClock::default(),
     });
-    // One save at a time; a thread finding another saving leaves it to that one.
-    let saving = Mutex::new(());
+    // One thread writes at a time; one finding another writing leaves it to that one.
+    let writing = Mutex::new(());
     let poisoned = || anyhow::anyhow!("a render thread panicked");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
@@ -326,17 +326,16 @@ pub fn render_in_process(
                 let mut state = state.lock().map_err(|_| poisoned())?;
                 state.checkpoint.add(&buffer)?;
                 state.stats += unit_stats;
-                match saving.try_lock() {
-                    Ok(guard) if job.checkpoint_due(state.saved) => {
-                        state.saved = Instant::now();
-                        Some((guard, state.checkpoint.clone()))
-                    }
-                    _ => None,
-                }
+                let guard = writing.try_lock().ok();
+                let due = match guard {
+                    Some(_) => job.interim.due(&mut state.clock),
+                    None => Default::default(),
+                };
+                due.any().then(|| (guard, due, state.checkpoint.clone()))
             };
             progress.inc(unit_stats.samples);
-            if let (Some((_guard, snapshot)), Some(file)) = (snapshot, &job.checkpoint) {
-                if let Err(e) = file.save(&snapshot) {
+            if let Some((_guard, due, snapshot)) = snapshot {
+                for e in job.interim.write(due, &snapshot, &job.desc.film) {
                     progress.println(format!("{e:#}"));
                 }
             }

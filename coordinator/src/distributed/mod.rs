@@ -19,11 +19,12 @@ use tonic::transport::{Certificate, ClientTlsConfig};
 use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
 
 use crate::checkpoint::Checkpoint;
+use crate::interim::InterimClock;
 use crate::manifest::SceneManifest;
 use crate::render_cmd::{seconds, RenderJob, RenderOutcome};
 use local::LocalWorker;
 use node::{run_node, Event, Node, NodeConfig, Shared};
-use report::{process_cpu_time, DistributedReport, Preview, Progress};
+use report::{process_cpu_time, DistributedReport, Progress};
 use schedule::{Schedule, UnitDeadline};
 
 /// Command-line options of a distributed render (flattened into `yat render`).
@@ -47,9 +48,6 @@ pub struct DistributedArgs {
     /// Give up when no worker has been connected for this many seconds [default: wait].
     #[arg(long, value_name = "SECONDS")]
     pub timeout: Option<f64>,
-    /// Rewrite `<output>.preview.png` this often during the render; 0 disables [default: 10].
-    #[arg(long, value_name = "SECONDS")]
-    pub preview_every: Option<f64>,
     /// Write each worker's figures (units, failures, bytes) and the coordinator's CPU time as
     /// JSON to this file.
     #[arg(long, value_name = "FILE")]
@@ -67,7 +65,6 @@ impl DistributedArgs {
     }
 }
 
-const DEFAULT_PREVIEW_EVERY: f64 = 10.0;
 /// How long the render waits without any worker before saying so (and again after each such
 /// period).
 const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
@@ -80,10 +77,6 @@ pub fn render(
     let cpu_start = process_cpu_time();
     let started = Instant::now();
     let timeout = args.timeout.map(|t| seconds("timeout", t)).transpose()?;
-    let preview_every = seconds(
-        "preview-every",
-        args.preview_every.unwrap_or(DEFAULT_PREVIEW_EVERY),
-    )?;
     let unit_deadline = args
         .unit_deadline
         .map(|t| seconds("unit-deadline", t))
@@ -152,10 +145,6 @@ pub fn render(
         nodes: &nodes,
         shared: &shared,
         timeout,
-        preview: Preview::new(
-            &job.output_png,
-            (!preview_every.is_zero()).then_some(preview_every),
-        ),
     };
     let outcome = runtime.block_on(render_loop.run(start, event_rx));
     // Ends the node loops and closes connections; then `nodes` drops the local workers.
@@ -188,14 +177,13 @@ struct RenderLoop<'a> {
     nodes: &'a [Arc<Node>],
     shared: &'a Arc<Shared>,
     timeout: Option<Duration>,
-    preview: Preview,
 }
 
 impl RenderLoop<'_> {
     /// Merges results into `checkpoint` as they come until every unit is in, watching that
     /// some worker is there to render and saving the checkpoint as often as the job asks.
     async fn run(
-        mut self,
+        self,
         mut checkpoint: Checkpoint,
         mut events: mpsc::UnboundedReceiver<Event>,
     ) -> anyhow::Result<RenderOutcome> {
@@ -211,7 +199,7 @@ impl RenderLoop<'_> {
             tasks.spawn(run_node(node.clone(), self.shared.clone()));
         }
         let mut stats = UnitStats::default();
-        let mut saved = Instant::now();
+        let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
         let mut waiting_noticed = Instant::now();
         let mut tick = tokio::time::interval(Duration::from_millis(250));
@@ -241,13 +229,13 @@ impl RenderLoop<'_> {
                         break Err(anyhow::anyhow!("interrupted"));
                     }
                     progress.update(0, checkpoint.done_count(), self.alive(), self.nodes.len());
-                    if let Err(e) = self.preview.maybe_write(checkpoint.film(), &self.job.desc.film) {
-                        progress.say(quiet, &format!("{e:#}"));
-                    }
-                    if let (true, Some(file)) = (self.job.checkpoint_due(saved), &self.job.checkpoint) {
-                        saved = Instant::now();
+                    let due = self.job.interim.due(&mut clock);
+                    if due.any() {
                         // Lets the runtime's other thread serve the workers meanwhile.
-                        if let Err(e) = tokio::task::block_in_place(|| file.save(&checkpoint)) {
+                        let failed = tokio::task::block_in_place(|| {
+                            self.job.interim.write(due, &checkpoint, &self.job.desc.film)
+                        });
+                        for e in failed {
                             progress.say(quiet, &format!("{e:#}"));
                         }
                     }
@@ -279,7 +267,6 @@ impl RenderLoop<'_> {
         if let Err(why) = result {
             return Err(self.job.stopped(&checkpoint, self.units, why));
         }
-        self.preview.remove();
         Ok(RenderOutcome {
             film: checkpoint.into_film(),
             stats,

@@ -1,12 +1,8 @@
-//! What a distributed render shows: the progress bar, the preview image, the per-worker
-//! summary and its JSON form.
+//! What a distributed render shows: the progress bar, the per-worker summary and its JSON form.
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::ProgressBar;
-use yat_tracer::desc::FilmDesc;
-use yat_tracer::film::Film;
 
 use super::node::NodeReport;
 use crate::render_cmd::progress_bar;
@@ -47,48 +43,6 @@ impl Progress {
 
     pub fn finish(&self) {
         self.bar.finish_and_clear();
-    }
-}
-
-/// The preview image, rewritten every so often next to the output.
-pub struct Preview {
-    path: PathBuf,
-    every: Option<Duration>,
-    last: Instant,
-    written: bool,
-}
-
-impl Preview {
-    /// `<output stem>.preview.png` beside the output; no previews when `every` is None.
-    pub fn new(output_png: &Path, every: Option<Duration>) -> Self {
-        Self {
-            path: output_png.with_extension("preview.png"),
-            every,
-            last: Instant::now(),
-            written: false,
-        }
-    }
-
-    pub fn maybe_write(&mut self, film: &Film, desc: &FilmDesc) -> anyhow::Result<()> {
-        let Some(every) = self.every else {
-            return Ok(());
-        };
-        if self.last.elapsed() < every {
-            return Ok(());
-        }
-        self.last = Instant::now();
-        film.write_png(&self.path, desc).map_err(|e| {
-            anyhow::anyhow!("cannot write the preview {}: {e}", self.path.display())
-        })?;
-        self.written = true;
-        Ok(())
-    }
-
-    /// Removes the preview once the final image is written.
-    pub fn remove(&self) {
-        if self.written {
-            let _ = std::fs::remove_file(&self.path);
-        }
     }
 }
 

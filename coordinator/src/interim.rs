@@ -1,0 +1,140 @@
+//! What a render writes while it runs, each on its own period: the preview image
+//! (`<output>.preview.png`) and the checkpoint (`<output>.resume`). Both go once the final
+//! image is written.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use yat_tracer::desc::FilmDesc;
+
+use crate::checkpoint::{Checkpoint, CheckpointFile};
+
+/// The tone-mapped image so far, rewritten every so often next to the output.
+pub struct PreviewFile {
+    path: PathBuf,
+    every: Duration,
+}
+
+impl PreviewFile {
+    pub fn beside(output_png: &Path, every: Duration) -> Self {
+        Self {
+            path: output_png.with_extension("preview.png"),
+            every,
+        }
+    }
+
+    fn write(&self, checkpoint: &Checkpoint, desc: &FilmDesc) -> anyhow::Result<()> {
+        checkpoint
+            .film()
+            .write_png(&self.path, desc)
+            .map_err(|e| anyhow::anyhow!("cannot write the preview {}: {e}", self.path.display()))
+    }
+}
+
+/// The render's interim outputs; either may be off.
+pub struct InterimOutputs {
+    pub preview: Option<PreviewFile>,
+    pub checkpoint: Option<CheckpointFile>,
+}
+
+/// When each interim output was last written (or the render started).
+pub struct InterimClock {
+    preview: Instant,
+    checkpoint: Instant,
+}
+
+impl Default for InterimClock {
+    fn default() -> Self {
+        let now = Instant::now();
+        Self {
+            preview: now,
+            checkpoint: now,
+        }
+    }
+}
+
+/// Which interim outputs to write now.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Due {
+    pub preview: bool,
+    pub checkpoint: bool,
+}
+
+impl Due {
+    pub fn any(self) -> bool {
+        self.preview || self.checkpoint
+    }
+}
+
+impl InterimOutputs {
+    /// The outputs whose period has passed; their clocks restart now.
+    pub fn due(&self, clock: &mut InterimClock) -> Due {
+        let restart = |last: &mut Instant, every: Option<Duration>| {
+            let due = every.is_some_and(|every| last.elapsed() >= every);
+            if due {
+                *last = Instant::now();
+            }
+            due
+        };
+        Due {
+            preview: restart(&mut clock.preview, self.preview.as_ref().map(|p| p.every)),
+            checkpoint: restart(
+                &mut clock.checkpoint,
+                self.checkpoint.as_ref().map(CheckpointFile::every),
+            ),
+        }
+    }
+
+    /// Writes the due outputs of the render so far; what failed is returned, for the render to
+    /// report and go on.
+    pub fn write(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> Vec<anyhow::Error> {
+        let preview = self
+            .preview
+            .as_ref()
+            .filter(|_| due.preview)
+            .map(|p| p.write(checkpoint, desc));
+        let saved = self
+            .checkpoint
+            .as_ref()
+            .filter(|_| due.checkpoint)
+            .map(|c| c.save(checkpoint));
+        [preview, saved]
+            .into_iter()
+            .flatten()
+            .filter_map(Result::err)
+            .collect()
+    }
+
+    /// Removes both once the final image is written.
+    pub fn remove(&self) {
+        if let Some(preview) = &self.preview {
+            let _ = std::fs::remove_file(&preview.path);
+        }
+        if let Some(checkpoint) = &self.checkpoint {
+            checkpoint.remove();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_output_is_due_on_its_own_period() {
+        let dir = std::env::temp_dir();
+        let outputs = InterimOutputs {
+            preview: Some(PreviewFile::beside(
+                &dir.join("x.png"),
+                Duration::from_millis(200),
+            )),
+            checkpoint: None,
+        };
+        let mut clock = InterimClock::default();
+        assert_eq!(outputs.due(&mut clock), Due::default());
+        std::thread::sleep(Duration::from_millis(250));
+        let due = outputs.due(&mut clock);
+        assert!(due.preview && !due.checkpoint && due.any());
+        assert!(!outputs.due(&mut clock).any(), "the clock restarted");
+    }
+}
