@@ -109,34 +109,41 @@ impl Checkpoint {
         self.film
     }
 
-    fn encode(&self, identity: &RenderIdentity) -> Vec<u8> {
-        let sums = self.film.sums();
-        let mut bytes =
-            Vec::with_capacity(HEADER_LEN + self.done.len().div_ceil(8) + sums.len() * 32 + 64);
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-        bytes.extend_from_slice(identity.0.as_bytes());
+    /// Writes the checkpoint in the file layout, its digest computed on the way.
+    fn encode_to(&self, identity: &RenderIdentity, out: impl Write) -> std::io::Result<()> {
+        let mut out = DigestingWriter {
+            out,
+            digest: Sha256Stream::default(),
+        };
+        out.write_all(MAGIC)?;
+        out.write_all(&FORMAT_VERSION.to_le_bytes())?;
+        out.write_all(identity.0.as_bytes())?;
         for v in [
             self.film.width(),
             self.film.height(),
             self.done.len() as u32,
         ] {
-            bytes.extend_from_slice(&v.to_le_bytes());
+            out.write_all(&v.to_le_bytes())?;
         }
-        bytes.extend(self.done.chunks(8).map(|bits| {
-            bits.iter()
-                .enumerate()
-                .fold(0u8, |byte, (i, &done)| byte | (u8::from(done) << i))
-        }));
-        for sum in sums {
-            for v in sum {
-                bytes.extend_from_slice(&v.to_le_bytes());
+        let bitmap: Vec<u8> = self
+            .done
+            .chunks(8)
+            .map(|bits| {
+                bits.iter()
+                    .enumerate()
+                    .fold(0u8, |byte, (i, &done)| byte | (u8::from(done) << i))
+            })
+            .collect();
+        out.write_all(&bitmap)?;
+        for sum in self.film.sums() {
+            let mut pixel = [0u8; 32];
+            for (bytes, v) in pixel.chunks_exact_mut(8).zip(sum) {
+                bytes.copy_from_slice(&v.to_le_bytes());
             }
+            out.write_all(&pixel)?;
         }
-        let mut digest = Sha256Stream::default();
-        digest.update(&bytes);
-        bytes.extend_from_slice(digest.finish_hex().as_bytes());
-        bytes
+        let digest = out.digest.finish_hex();
+        out.out.write_all(digest.as_bytes())
     }
 
     /// Reads a checkpoint of the render `identity` with these settings and this many units.
@@ -278,20 +285,65 @@ impl CheckpointFile {
 
     /// Writes the checkpoint atomically: a crash while saving leaves the previous one whole.
     pub fn save(&self, checkpoint: &Checkpoint) -> anyhow::Result<()> {
-        let bytes = checkpoint.encode(&self.identity);
+        self.stage(checkpoint)?.commit()
+    }
+
+    /// The first half of [`CheckpointFile::save`], the one that reads the checkpoint: its bytes
+    /// written to a temporary file beside the real one (fast: they go to the page cache).
+    pub fn stage(&self, checkpoint: &Checkpoint) -> anyhow::Result<StagedCheckpoint> {
         let temporary = self.path.with_extension("resume.partial");
-        let write = || -> std::io::Result<()> {
-            let mut file = std::fs::File::create(&temporary)?;
-            file.write_all(&bytes)?;
-            file.sync_all()?;
-            std::fs::rename(&temporary, &self.path)
+        let write = || -> std::io::Result<std::fs::File> {
+            let mut out = std::io::BufWriter::new(std::fs::File::create(&temporary)?);
+            checkpoint.encode_to(&self.identity, &mut out)?;
+            out.into_inner().map_err(|e| e.into_error())
         };
-        write().with_context(|| format!("cannot save the checkpoint {}", self.path.display()))
+        let file = write()
+            .with_context(|| format!("cannot save the checkpoint {}", temporary.display()))?;
+        Ok(StagedCheckpoint {
+            file,
+            temporary,
+            path: self.path.clone(),
+        })
     }
 
     /// Removes the checkpoint once the final image is written.
     pub fn remove(&self) {
         let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// A checkpoint written but not yet in place.
+pub struct StagedCheckpoint {
+    file: std::fs::File,
+    temporary: PathBuf,
+    path: PathBuf,
+}
+
+impl StagedCheckpoint {
+    /// Syncs the new checkpoint to disk and puts it in place of the previous one.
+    pub fn commit(self) -> anyhow::Result<()> {
+        self.file
+            .sync_all()
+            .and_then(|()| std::fs::rename(&self.temporary, &self.path))
+            .with_context(|| format!("cannot save the checkpoint {}", self.path.display()))
+    }
+}
+
+/// Passes bytes on, adding them to a digest.
+struct DigestingWriter<W> {
+    out: W,
+    digest: Sha256Stream,
+}
+
+impl<W: Write> Write for DigestingWriter<W> {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let written = self.out.write(bytes)?;
+        self.digest.update(&bytes[..written]);
+        Ok(written)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
     }
 }
 
@@ -349,6 +401,12 @@ mod tests {
         }
     }
 
+    fn encode(checkpoint: &Checkpoint, identity: &RenderIdentity) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        checkpoint.encode_to(identity, &mut bytes).unwrap();
+        bytes
+    }
+
     fn identity(name: &str) -> RenderIdentity {
         RenderIdentity::of(&pb::LoadSceneRequest {
             main: Some(pb::SceneFile {
@@ -380,7 +438,7 @@ mod tests {
     fn a_checkpoint_reads_back_exactly() {
         let (checkpoint, units) = partial();
         let id = identity("a.lxs");
-        let back = Checkpoint::decode(&checkpoint.encode(&id), &id, &settings(), units.len())
+        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), units.len())
             .expect("own checkpoint");
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.done, checkpoint.done);
@@ -393,7 +451,7 @@ mod tests {
     fn another_render_or_a_damaged_file_is_refused() {
         let (checkpoint, units) = partial();
         let id = identity("a.lxs");
-        let bytes = checkpoint.encode(&id);
+        let bytes = encode(&checkpoint, &id);
         let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
             Checkpoint::decode(bytes, id, settings, units.len()).err()
         };

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use yat_tracer::desc::FilmDesc;
 
-use crate::checkpoint::{Checkpoint, CheckpointFile};
+use crate::checkpoint::{Checkpoint, CheckpointFile, StagedCheckpoint};
 
 /// The tone-mapped image so far, rewritten every so often next to the output.
 pub struct PreviewFile {
@@ -21,13 +21,6 @@ impl PreviewFile {
             path: output_png.with_extension("preview.png"),
             every,
         }
-    }
-
-    fn write(&self, checkpoint: &Checkpoint, desc: &FilmDesc) -> anyhow::Result<()> {
-        checkpoint
-            .film()
-            .write_png(&self.path, desc)
-            .map_err(|e| anyhow::anyhow!("cannot write the preview {}: {e}", self.path.display()))
     }
 }
 
@@ -85,24 +78,23 @@ impl InterimOutputs {
         }
     }
 
-    /// Writes the due outputs of the render so far; what failed is returned, for the render to
-    /// report and go on.
-    pub fn write(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> Vec<anyhow::Error> {
+    /// The part of writing the due outputs that reads the render so far, and is quick: tone
+    /// mapping the preview, writing the checkpoint's bytes. Render threads wait for it.
+    pub fn stage(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> StagedOutputs {
         let preview = self
             .preview
             .as_ref()
             .filter(|_| due.preview)
-            .map(|p| p.write(checkpoint, desc));
-        let saved = self
+            .map(|p| (p.path.clone(), checkpoint.film().to_display(desc)));
+        let checkpoint = self
             .checkpoint
             .as_ref()
             .filter(|_| due.checkpoint)
-            .map(|c| c.save(checkpoint));
-        [preview, saved]
-            .into_iter()
-            .flatten()
-            .filter_map(Result::err)
-            .collect()
+            .map(|c| c.stage(checkpoint));
+        StagedOutputs {
+            preview,
+            checkpoint,
+        }
     }
 
     /// Removes both once the final image is written.
@@ -113,6 +105,32 @@ impl InterimOutputs {
         if let Some(checkpoint) = &self.checkpoint {
             checkpoint.remove();
         }
+    }
+}
+
+/// Interim outputs staged, to be finished without holding up the render.
+pub struct StagedOutputs {
+    preview: Option<(PathBuf, image::RgbImage)>,
+    checkpoint: Option<anyhow::Result<StagedCheckpoint>>,
+}
+
+impl StagedOutputs {
+    /// Encodes the preview PNG and syncs the checkpoint to disk; what failed is returned, for the
+    /// render to report and go on.
+    pub fn finish(self) -> Vec<anyhow::Error> {
+        let preview = self.preview.map(|(path, image)| {
+            image
+                .save_with_format(&path, image::ImageFormat::Png)
+                .map_err(|e| anyhow::anyhow!("cannot write the preview {}: {e}", path.display()))
+        });
+        let checkpoint = self
+            .checkpoint
+            .map(|staged| staged.and_then(StagedCheckpoint::commit));
+        [preview, checkpoint]
+            .into_iter()
+            .flatten()
+            .filter_map(Result::err)
+            .collect()
     }
 }
 

@@ -322,7 +322,7 @@ pub fn render_in_process(
                 anyhow::bail!("interrupted");
             }
             let (buffer, unit_stats) = scene.render_unit(unit);
-            let snapshot = {
+            let staged = {
                 let mut state = state.lock().map_err(|_| poisoned())?;
                 state.checkpoint.add(&buffer)?;
                 state.stats += unit_stats;
@@ -331,11 +331,15 @@ pub fn render_in_process(
                     Some(_) => job.interim.due(&mut state.clock),
                     None => Default::default(),
                 };
-                due.any().then(|| (guard, due, state.checkpoint.clone()))
+                due.any().then(|| {
+                    let staged = job.interim.stage(due, &state.checkpoint, &job.desc.film);
+                    (guard, staged)
+                })
             };
             progress.inc(unit_stats.samples);
-            if let Some((_guard, due, snapshot)) = snapshot {
-                for e in job.interim.write(due, &snapshot, &job.desc.film) {
+            // Encoding and syncing happen with the render's lock released.
+            if let Some((_guard, staged)) = staged {
+                for e in staged.finish() {
                     progress.println(format!("{e:#}"));
                 }
             }

@@ -147,8 +147,8 @@ impl Film {
 
     /// Tone maps as the scene's film asks and applies its gamma: 8-bit RGB, rows top to bottom.
     pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
-        let radiance = self.radiance();
-        let mapped = tone_map(&radiance, &film.tonemap, film.gamma);
+        let mut mapped = self.radiance();
+        tone_map(&mut mapped, &film.tonemap, film.gamma);
         let inv_gamma = 1.0 / film.gamma.max(1e-3);
         let mut img = image::RgbImage::new(self.width, self.height);
         for (px, c) in img.pixels_mut().zip(mapped) {
@@ -176,8 +176,8 @@ impl Film {
     }
 }
 
-/// LuxRender's tone mapping kernels, giving values to be gamma encoded.
-pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
+/// LuxRender's tone mapping kernels, turning radiance in place into values to be gamma encoded.
+pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
     // The mid-grey LuxRender aims autolinear and linear exposure at.
     let middle_grey = (118.0f32 / 255.0).powf(gamma);
     match *tonemap {
@@ -189,7 +189,7 @@ pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
                 .fold((0.0f64, 0u64), |(s, n), y| (s + f64::from(y), n + 1));
             let y_avg = if n > 0 { (sum / n as f64) as f32 } else { 1.0 };
             let scale = 1.25 / y_avg * middle_grey;
-            radiance.iter().map(|&c| c * scale).collect()
+            radiance.iter_mut().for_each(|c| *c *= scale);
         }
         ToneMap::Linear {
             sensitivity,
@@ -197,7 +197,7 @@ pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
             fstop,
         } => {
             let scale = exposure / (fstop * fstop) * sensitivity * 0.65 / 10.0 * middle_grey;
-            radiance.iter().map(|&c| c * scale).collect()
+            radiance.iter_mut().for_each(|c| *c *= scale);
         }
         ToneMap::Reinhard {
             prescale,
@@ -220,19 +220,16 @@ pub fn tone_map(radiance: &[Vec3], tonemap: &ToneMap, gamma: f32) -> Vec<Vec3> {
             let pre = key / prescale;
             let post = key * postscale;
             let inv_burn2 = if burn > 0.0 { 1.0 / (burn * burn) } else { 1e5 };
-            radiance
-                .iter()
-                .map(|&c| {
-                    let y = luminance(c) * pre;
-                    c * (post * (1.0 + y * inv_burn2) / (1.0 + y))
-                })
-                .collect()
+            radiance.iter_mut().for_each(|c| {
+                let y = luminance(*c) * pre;
+                *c *= post * (1.0 + y * inv_burn2) / (1.0 + y);
+            });
         }
         ToneMap::Contrast { ywa } => {
             // Ward's contrast-based scale factor for display luminance 100 cd/m2.
             let ywa = ywa.max(1e-6);
             let scale = ((1.219 + 50f32.powf(0.4)) / (1.219 + ywa.powf(0.4))).powf(2.5) / 100.0;
-            radiance.iter().map(|&c| c * scale).collect()
+            radiance.iter_mut().for_each(|c| *c *= scale);
         }
     }
 }
@@ -289,8 +286,8 @@ mod tests {
 
     #[test]
     fn autolinear_maps_average_luminance_to_mid_grey() {
-        let radiance = vec![Vec3::splat(2.0); 4];
-        let mapped = tone_map(&radiance, &ToneMap::AutoLinear, 2.2);
+        let mut mapped = vec![Vec3::splat(2.0); 4];
+        tone_map(&mut mapped, &ToneMap::AutoLinear, 2.2);
         let expected = 1.25 * (118.0f32 / 255.0).powf(2.2);
         assert!((mapped[0].x - expected).abs() < 1e-5);
     }
@@ -303,12 +300,13 @@ mod tests {
             burn: 7.0,
         };
         // A uniform image sits at the key: luminance 0.1 after scaling by 0.1 / Y.
-        let grey = tone_map(&[Vec3::splat(4.0); 3], &tm, 2.2);
+        let mut grey = [Vec3::splat(4.0); 3];
+        tone_map(&mut grey, &tm, 2.2);
         let expected = 4.0 * 0.1 / 4.0 * (1.0 + 0.1 / 49.0) / 1.1;
         assert!((grey[0].x - expected).abs() < 1e-6, "{}", grey[0].x);
 
-        let radiance = vec![Vec3::new(0.1, 0.05, 0.02), Vec3::new(100.0, 50.0, 20.0)];
-        let mapped = tone_map(&radiance, &tm, 2.2);
+        let mut mapped = [Vec3::new(0.1, 0.05, 0.02), Vec3::new(100.0, 50.0, 20.0)];
+        tone_map(&mut mapped, &tm, 2.2);
         let ratio_out = mapped[1].x / mapped[0].x;
         assert!(ratio_out < 1000.0 / 3.0, "{ratio_out}");
         assert!((mapped[1].x / mapped[1].y - 2.0).abs() < 1e-4);

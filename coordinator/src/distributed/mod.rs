@@ -233,7 +233,7 @@ impl RenderLoop<'_> {
                     if due.any() {
                         // Lets the runtime's other thread serve the workers meanwhile.
                         let failed = tokio::task::block_in_place(|| {
-                            self.job.interim.write(due, &checkpoint, &self.job.desc.film)
+                            self.job.interim.stage(due, &checkpoint, &self.job.desc.film).finish()
                         });
                         for e in failed {
                             progress.say(quiet, &format!("{e:#}"));
