@@ -7,6 +7,22 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Why a file is referenced; tells the build step how to read it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum AssetKind {
+    Include,
+    Ply,
+    Image,
+}
+
+/// A file the scene depends on, keyed by its path as written (relative to the main file's
+/// folder). The coordinator ships exactly these files to workers.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct AssetRef {
+    pub path: String,
+    pub kind: AssetKind,
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum AssetError {
     #[error("file not found: \"{written}\" (tried {tried})")]

@@ -2,77 +2,14 @@
 //! build step. Every LuxRender default is already applied here, so nothing downstream needs to
 //! know the file format. Transforms are object-to-world; colours are linear RGB.
 
-use std::fmt;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 
-/// Index into [`SceneDesc::textures`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct TextureId(pub u32);
-
-/// Index into [`SceneDesc::materials`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MaterialId(pub u32);
-
-/// A material or texture parameter: a constant or a reference to a texture. Float parameters
-/// store their constant splatted over the three channels and read `.x`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Tex {
-    Const(Vec3),
-    Texture(TextureId),
-}
-
-impl Tex {
-    pub fn float(v: f32) -> Self {
-        Tex::Const(Vec3::splat(v))
-    }
-    pub fn color(c: Vec3) -> Self {
-        Tex::Const(c)
-    }
-}
-
-/// Where a diagnostic or a statement came from.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SourcePos {
-    pub file: String,
-    pub line: u32,
-    pub column: u32,
-}
-
-impl fmt::Display for SourcePos {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file, self.line, self.column)
-    }
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Warning {
-    pub pos: SourcePos,
-    pub message: String,
-}
-
-impl fmt::Display for Warning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: warning: {}", self.pos, self.message)
-    }
-}
-
-/// Why a file is referenced; tells the build step how to read it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum AssetKind {
-    Include,
-    Ply,
-    Image,
-}
-
-/// A file the scene depends on, keyed by its path as written (relative to the main file's
-/// folder). The coordinator ships exactly these files to workers.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub struct AssetRef {
-    pub path: String,
-    pub kind: AssetKind,
-}
+pub use crate::assets::{AssetKind, AssetRef};
+pub use crate::diag::{SourcePos, Warning};
+pub use crate::mesh::TriangleMesh;
+pub use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 
 #[derive(Clone, Debug)]
 pub struct SceneDesc {
@@ -100,7 +37,7 @@ pub enum CameraKind {
         fov: f32,
     },
     Orthographic,
-    /// The course's fisheye (DESIGN.md): `fov` in degrees is the angle off the axis at the
+    /// The course's fisheye (docs/architecture.md): `fov` in degrees is the angle off the axis at the
     /// circle's edge.
     Fisheye {
         fov: f32,
@@ -287,18 +224,6 @@ pub struct TextureDesc {
 // ---------------------------------------------------------------------------------------------
 // Materials
 
-/// How a metal2 material gets its Fresnel term.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Fresnel {
-    /// Normal-incidence reflectance colour (a `fresnelcolor` texture, or the course's
-    /// `color fresnel` / `color Kr` on metal2).
-    Reflectance(Tex),
-    /// A real index of refraction with no absorption (`float fresnel`).
-    Index(Tex),
-    /// Complex index of refraction per RGB channel (metal presets, `fresnelname`).
-    Conductor { eta: Vec3, k: Vec3 },
-}
-
 #[derive(Clone, Debug, PartialEq)]
 pub enum MaterialDesc {
     Matte {
@@ -353,15 +278,6 @@ pub enum MaterialDesc {
 // ---------------------------------------------------------------------------------------------
 // Shapes
 
-/// Triangle mesh data in object space. Quads are already split into triangles.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TriangleMesh {
-    pub positions: Vec<Vec3>,
-    pub normals: Option<Vec<Vec3>>,
-    pub uvs: Option<Vec<[f32; 2]>>,
-    pub indices: Vec<[u32; 3]>,
-}
-
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
     /// Shared between instances of the same object.
@@ -408,7 +324,7 @@ pub struct ShapeDesc {
 // ---------------------------------------------------------------------------------------------
 // Lights
 
-/// How a LatLong map is indexed (DESIGN.md): the seed tracer's u = (pi + phi) / 2pi, or
+/// How a LatLong map is indexed (docs/architecture.md): the seed tracer's u = (pi + phi) / 2pi, or
 /// LuxRender's s = phi / 2pi with phi in [0, 2pi). Both use t = theta / pi.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LatLongConvention {

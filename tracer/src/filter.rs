@@ -1,6 +1,6 @@
 //! Pixel reconstruction filters, used by filter importance sampling: a sample's offset from
 //! its pixel centre is drawn from |f| and carries weight sign(f), so every sample belongs to
-//! exactly one pixel and tiles need no borders (DESIGN.md).
+//! exactly one pixel and tiles need no borders (docs/architecture.md).
 
 use glam::Vec2;
 

@@ -9,6 +9,7 @@
 pub mod assets;
 pub mod camera;
 pub mod desc;
+pub mod diag;
 pub mod film;
 pub mod filter;
 pub mod geometry;
@@ -18,6 +19,8 @@ pub mod lights;
 pub mod luxcore;
 pub mod material;
 pub mod math;
+pub mod mesh;
+pub mod param;
 pub mod parse;
 pub mod render;
 pub mod sampler;

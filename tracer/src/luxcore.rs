@@ -23,10 +23,13 @@ use ply_rs_bw::ply::{
 use ply_rs_bw::writer::Writer;
 
 use crate::desc::{
-    CameraKind, FilterKind, Fresnel, Geometry, LatLongConvention, LightDesc, Mapping2D,
-    MaterialDesc, MaterialId, SceneDesc, ShapeDesc, Tex, TextureId, TextureKind, TriangleMesh,
-    Wrap,
+    CameraKind, FilterKind, Geometry, LatLongConvention, LightDesc, Mapping2D, MaterialDesc,
+    SceneDesc, ShapeDesc, TextureKind, Wrap,
 };
+
+use crate::mesh::TriangleMesh;
+
+use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 use crate::texture::{Mapping, TexturePoint};
 
 /// Half the side of the quad an infinite plane becomes (scene units).
@@ -965,8 +968,8 @@ pub fn export(
 mod tests {
     use super::*;
     use crate::assets::MemorySource;
+    use crate::mesh::ply::read_mesh;
     use crate::parse::parse_scene;
-    use crate::parse::ply::read_mesh;
 
     fn parse(world: &str, camera: &str) -> SceneDesc {
         let text = format!(

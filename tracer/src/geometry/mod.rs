@@ -1,8 +1,6 @@
 //! World-space geometry and ray queries: every shape of the scene (triangles and analytic
 //! shapes) in one obvhs BVH.
 //!
-//! OWNER: geometry helper. Interface used by the integrator and lights; keep the signatures.
-//!
 //! The BVH is one obvhs CWBVH8 built over primitive bounding boxes: each triangle of every mesh
 //! and each sphere, disk and cylinder is one primitive (`build_cwbvh` over AABBs is what
 //! `build_cwbvh_from_tris` does when spatial splits are off, as in `medium_build`). Primitive

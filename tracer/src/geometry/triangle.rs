@@ -3,8 +3,8 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec3A};
 
-use crate::desc::TriangleMesh;
 use crate::math::Frame;
+use crate::mesh::TriangleMesh;
 
 use super::{SurfaceHit, SurfaceSample};
 

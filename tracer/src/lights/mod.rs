@@ -1,8 +1,6 @@
 //! Lights: area lights on shapes, point, spot, distant and infinite (constant or LatLong map,
 //! importance-sampled by luminance), and the choice of which light to sample.
 //!
-//! OWNER: lights helper. Interface used by the integrator; keep the signatures.
-//!
 //! A light is chosen with probability proportional to an estimate of its power. The infinite
 //! lights act as one mixture: a direction sampled from any of them carries the sum of their
 //! radiance and the mixture's density, which is what `environment` and `pdf_environment`

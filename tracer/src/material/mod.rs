@@ -22,9 +22,11 @@ use glam::Vec3;
 
 pub use bsdf::{Bsdf, BsdfSample};
 
-use crate::desc::{Fresnel, MaterialDesc, MaterialId, SceneDesc, Tex};
+use crate::desc::{MaterialDesc, SceneDesc};
+
 use crate::geometry::SurfaceHit;
 use crate::math::Frame;
+use crate::param::{Fresnel, MaterialId, Tex};
 use crate::texture::{TexturePoint, Textures};
 use bxdf::Bxdf;
 use conductor::{Conductor, ConductorFresnel};

@@ -8,8 +8,9 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::*;
-use crate::desc::{Fresnel, MaterialDesc, MaterialId, Tex};
+use crate::desc::MaterialDesc;
 use crate::geometry::SurfaceHit;
+use crate::param::{Fresnel, MaterialId, Tex};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 

@@ -7,15 +7,17 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 
+use super::context::{ParseContext, TexBinding};
 use super::options::OptionsState;
 use super::params::ParamList;
 use super::reader::Reader;
 use super::{ParseError, Pos, MAX_INCLUDE_DEPTH};
 use crate::assets::AssetSource;
-use crate::desc::{
-    AssetKind, AssetRef, Fresnel, LightDesc, MaterialDesc, MaterialId, SceneDesc, ShapeDesc, Tex,
-    TextureDesc, TextureId, TriangleMesh, Warning,
-};
+use crate::assets::{AssetKind, AssetRef};
+use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
+use crate::diag::Warning;
+use crate::mesh::TriangleMesh;
+use crate::param::{MaterialId, Tex, TextureId};
 
 /// Area light parameters kept in the graphics state; the radiance is known only once the
 /// world-space area of each shape is.
@@ -32,13 +34,6 @@ struct GraphicsState {
     material: Option<MaterialId>,
     area_light: Option<AreaLightParams>,
     reverse_orientation: bool,
-}
-
-/// What a named texture resolves to. Fresnel textures are folded into the metal2 material.
-#[derive(Clone, Debug)]
-pub enum TexBinding {
-    Texture(TextureId),
-    Fresnel(Fresnel),
 }
 
 #[derive(Clone, Debug)]
@@ -177,23 +172,6 @@ impl<'s> Builder<'s> {
         }
     }
 
-    // -----------------------------------------------------------------------------------------
-    // Diagnostics and assets
-
-    pub(super) fn warn(&mut self, pos: &Pos, message: impl Into<String>) {
-        self.warnings.push(Warning {
-            pos: pos.clone(),
-            message: message.into(),
-        });
-    }
-
-    /// A warning given once per `key` for the whole scene.
-    pub(super) fn warn_once(&mut self, key: String, pos: &Pos, message: impl Into<String>) {
-        if self.warned.insert(key) {
-            self.warn(pos, message);
-        }
-    }
-
     /// Warns once per statement type and parameter about parameters nothing read.
     pub(super) fn warn_unused(&mut self, params: &ParamList) {
         let unused: Vec<(String, Pos)> = params
@@ -208,49 +186,6 @@ impl<'s> Builder<'s> {
                 format!("{}: unknown parameter \"{decl}\" ignored", params.statement),
             );
         }
-    }
-
-    /// Reads a referenced file through the source and records it as an asset.
-    pub(super) fn read_asset(
-        &mut self,
-        path: &str,
-        kind: AssetKind,
-        pos: &Pos,
-    ) -> Result<Arc<[u8]>, ParseError> {
-        let bytes = self.source.read(path).map_err(|error| ParseError::Asset {
-            pos: pos.clone(),
-            error,
-        })?;
-        let r = AssetRef {
-            path: path.to_string(),
-            kind,
-        };
-        if self.asset_set.insert(r.clone()) {
-            self.assets.push(r);
-        }
-        Ok(bytes)
-    }
-
-    /// Checks that an image file exists and its header decodes.
-    pub(super) fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
-        let already = self.asset_set.contains(&AssetRef {
-            path: path.to_string(),
-            kind: AssetKind::Image,
-        });
-        let bytes = self.read_asset(path, AssetKind::Image, pos)?;
-        if already {
-            return Ok(());
-        }
-        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-            .with_guessed_format()
-            .map_err(|e| e.to_string())
-            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
-            .map(|_| ())
-            .map_err(|message| ParseError::Image {
-                pos: pos.clone(),
-                path: path.to_string(),
-                message,
-            })
     }
 
     // -----------------------------------------------------------------------------------------
@@ -360,7 +295,7 @@ impl<'s> Builder<'s> {
                 self.warn_once(
                     "motion".into(),
                     pos,
-                    "MotionBegin: motion blur is not rendered; each motion block uses its first transform",
+                    "MotionBegin: motion blur is not rendered; each motion block uses its first transform".into()
                 );
             }
             "MotionEnd" => self.motion = None,
@@ -370,7 +305,7 @@ impl<'s> Builder<'s> {
             "TransformEnd" => self.pop(FrameKind::Transform, pos),
             "WorldBegin" => {
                 if self.block == Block::World {
-                    self.warn(pos, "WorldBegin inside the world block ignored");
+                    self.warn(pos, "WorldBegin inside the world block ignored".into());
                 } else {
                     self.block = Block::World;
                     self.ctm = Mat4::IDENTITY;
@@ -477,7 +412,7 @@ impl<'s> Builder<'s> {
                 let ty = r.string("the light type")?;
                 let params = r.params(format!("LightSource \"{ty}\""))?;
                 if self.current_object.is_some() {
-                    self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined");
+                    self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined".into());
                 }
                 self.light(&ty, &params, pos)?;
                 self.warn_unused(&params);
@@ -521,7 +456,7 @@ impl<'s> Builder<'s> {
             }
             "ObjectEnd" => {
                 if self.current_object.is_none() {
-                    self.warn(pos, "ObjectEnd without ObjectBegin ignored");
+                    self.warn(pos, "ObjectEnd without ObjectBegin ignored".into());
                 } else {
                     self.pop(FrameKind::Object, pos);
                 }
@@ -608,24 +543,6 @@ impl<'s> Builder<'s> {
         });
     }
 
-    /// The texture named `name`, preferring one of the requested kind (a float texture used
-    /// as a colour is splatted).
-    pub(super) fn find_texture(&self, name: &str, want_color: bool) -> Option<&TexBinding> {
-        let mut any = None;
-        for t in self
-            .textures_in_scope
-            .iter()
-            .rev()
-            .filter(|t| t.name == name)
-        {
-            if t.is_color == want_color {
-                return Some(&t.binding);
-            }
-            any.get_or_insert(&t.binding);
-        }
-        any
-    }
-
     pub(super) fn add_texture(&mut self, t: TextureDesc) -> TextureId {
         self.textures.push(t);
         TextureId(self.textures.len() as u32 - 1)
@@ -634,32 +551,6 @@ impl<'s> Builder<'s> {
     pub(super) fn add_material(&mut self, m: MaterialDesc) -> MaterialId {
         self.materials.push(m);
         MaterialId(self.materials.len() as u32 - 1)
-    }
-
-    pub(super) fn named_material(&mut self, name: &str, pos: &Pos) -> MaterialId {
-        match self.named_materials.get(name) {
-            Some(&id) => id,
-            None => {
-                self.warn(
-                    pos,
-                    format!("no material named \"{name}\"; using the default matte"),
-                );
-                self.default_material()
-            }
-        }
-    }
-
-    /// LuxRender's default material: matte, Kd 0.9.
-    pub(super) fn default_material(&mut self) -> MaterialId {
-        if let Some(id) = self.default_material {
-            return id;
-        }
-        let id = self.add_material(MaterialDesc::Matte {
-            kd: Tex::color(Vec3::splat(0.9)),
-            sigma: Tex::float(0.0),
-        });
-        self.default_material = Some(id);
-        id
     }
 
     // -----------------------------------------------------------------------------------------
@@ -715,7 +606,7 @@ impl<'s> Builder<'s> {
             self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
         }
         if self.block == Block::Options {
-            self.warn(&end, "no WorldBegin: the scene is empty");
+            self.warn(&end, "no WorldBegin: the scene is empty".into());
         }
         let options = std::mem::take(&mut self.options);
         let (camera, film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
@@ -732,6 +623,124 @@ impl<'s> Builder<'s> {
             warnings: self.warnings,
             assets: self.assets,
         })
+    }
+}
+
+impl ParseContext for Builder<'_> {
+    fn warn(&mut self, pos: &Pos, message: String) {
+        self.warnings.push(Warning {
+            pos: pos.clone(),
+            message,
+        });
+    }
+
+    fn warn_once(&mut self, key: String, pos: &Pos, message: String) {
+        if self.warned.insert(key) {
+            self.warn(pos, message);
+        }
+    }
+
+    fn ctm(&self) -> Mat4 {
+        self.ctm
+    }
+
+    fn find_texture(&self, name: &str, want_color: bool) -> Option<TexBinding> {
+        let mut any = None;
+        for t in self
+            .textures_in_scope
+            .iter()
+            .rev()
+            .filter(|t| t.name == name)
+        {
+            if t.is_color == want_color {
+                return Some(t.binding.clone());
+            }
+            any.get_or_insert(&t.binding);
+        }
+        any.cloned()
+    }
+
+    fn texture_is_color(&self, id: TextureId) -> bool {
+        self.textures[id.0 as usize].is_color
+    }
+
+    fn scaled_texture(&mut self, id: TextureId, factor: f32) -> TextureId {
+        let is_color = self.textures[id.0 as usize].is_color;
+        let name = format!("{} x {factor}", self.textures[id.0 as usize].name);
+        self.add_texture(TextureDesc {
+            name,
+            is_color,
+            kind: TextureKind::Scale {
+                tex1: Tex::Texture(id),
+                tex2: Tex::float(factor),
+            },
+        })
+    }
+
+    fn named_material(&mut self, name: &str, pos: &Pos) -> MaterialId {
+        match self.named_materials.get(name) {
+            Some(&id) => id,
+            None => {
+                self.warn(
+                    pos,
+                    format!("no material named \"{name}\"; using the default matte"),
+                );
+                self.default_material()
+            }
+        }
+    }
+
+    fn default_material(&mut self) -> MaterialId {
+        if let Some(id) = self.default_material {
+            return id;
+        }
+        let id = self.add_material(MaterialDesc::Matte {
+            kd: Tex::color(Vec3::splat(0.9)),
+            sigma: Tex::float(0.0),
+        });
+        self.default_material = Some(id);
+        id
+    }
+
+    fn read_asset(
+        &mut self,
+        path: &str,
+        kind: AssetKind,
+        pos: &Pos,
+    ) -> Result<Arc<[u8]>, ParseError> {
+        let bytes = self.source.read(path).map_err(|error| ParseError::Asset {
+            pos: pos.clone(),
+            error,
+        })?;
+        let r = AssetRef {
+            path: path.to_string(),
+            kind,
+        };
+        if self.asset_set.insert(r.clone()) {
+            self.assets.push(r);
+        }
+        Ok(bytes)
+    }
+
+    fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
+        let already = self.asset_set.contains(&AssetRef {
+            path: path.to_string(),
+            kind: AssetKind::Image,
+        });
+        let bytes = self.read_asset(path, AssetKind::Image, pos)?;
+        if already {
+            return Ok(());
+        }
+        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| e.to_string())
+            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+            .map(|_| ())
+            .map_err(|message| ParseError::Image {
+                pos: pos.clone(),
+                path: path.to_string(),
+                message,
+            })
     }
 }
 

@@ -6,6 +6,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::builder::{AreaLightParams, Builder};
+use super::context::ParseContext;
 use super::params::ParamList;
 use super::{ParseError, Pos};
 use crate::desc::{AreaLightDesc, EnvMapDesc, LightDesc};
@@ -85,7 +86,7 @@ impl Builder<'_> {
                 let from = params.vec3("from", Vec3::ZERO)?;
                 let to = params.vec3("to", Vec3::Z)?;
                 if params.float("theta", 0.0)? != 0.0 {
-                    self.warn(pos, "LightSource \"distant\": \"theta\" (a soft cone) is not supported; the light is a delta direction");
+                    self.warn(pos, "LightSource \"distant\": \"theta\" (a soft cone) is not supported; the light is a delta direction".into());
                 }
                 let Some(to_light) = self.ctm.transform_vector3(from - to).try_normalize() else {
                     return Err(ParseError::Invalid {

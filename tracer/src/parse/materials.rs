@@ -3,10 +3,12 @@
 
 use glam::Vec3;
 
-use super::builder::{Builder, TexBinding};
-use super::params::{ParamList, ParamType, TexValue, Values};
+use super::builder::Builder;
+use super::context::{ParseContext, TexBinding};
+use super::params::{ParamList, ParamType, TexValue};
 use super::{ParseError, Pos};
-use crate::desc::{Fresnel, MaterialDesc, MaterialId, Tex, TextureDesc, TextureKind};
+use crate::desc::MaterialDesc;
+use crate::param::{Fresnel, MaterialId, Tex};
 
 impl Builder<'_> {
     /// Describes a material, stores it and returns its id. Warns about parameters it did not
@@ -23,49 +25,6 @@ impl Builder<'_> {
         Ok(self.add_material(desc))
     }
 
-    fn color(
-        &mut self,
-        params: &ParamList,
-        name: &str,
-        default: f32,
-        clamp: bool,
-    ) -> Result<Tex, ParseError> {
-        let v = params.tex_color(name, Vec3::splat(default))?;
-        Ok(match self.resolve(v, true, Vec3::splat(default)) {
-            Tex::Const(c) if clamp => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
-            t => t,
-        })
-    }
-
-    fn float(&mut self, params: &ParamList, name: &str, default: f32) -> Result<Tex, ParseError> {
-        let v = params.tex_float(name, default)?;
-        Ok(self.resolve(v, false, Vec3::splat(default)))
-    }
-
-    /// A parameter this renderer does not model: silent at its default, a warning otherwise.
-    fn unsupported_unless(
-        &mut self,
-        params: &ParamList,
-        name: &str,
-        default: f32,
-    ) -> Result<(), ParseError> {
-        if let Some(p) = params.find(name) {
-            let is_default = matches!(&p.values, Values::Numbers(v) if v.len() == 1 && v[0] as f32 == default)
-                && matches!(p.ty, ParamType::Float | ParamType::Integer);
-            if !is_default {
-                let key = format!("unsupported|{}|{name}", params.statement);
-                let message = format!(
-                    "{}: \"{}\" is not supported and is ignored",
-                    params.statement,
-                    p.decl()
-                );
-                let pos = p.pos.clone();
-                self.warn_once(key, &pos, message);
-            }
-        }
-        Ok(())
-    }
-
     fn material_desc(
         &mut self,
         ty: &str,
@@ -74,18 +33,21 @@ impl Builder<'_> {
     ) -> Result<MaterialDesc, ParseError> {
         Ok(match ty {
             "matte" => MaterialDesc::Matte {
-                kd: self.color(params, "Kd", 0.9, true)?,
-                sigma: self.float(params, "sigma", 0.0)?,
+                kd: self.color_param(params, "Kd", 0.9, true)?,
+                sigma: self.float_param(params, "sigma", 0.0)?,
             },
             "glossy" | "glossy2" => {
-                let kd = self.color(params, "Kd", 1.0, true)?;
-                let ks = self.color(params, "Ks", 1.0, false)?;
-                let ka = self.color(params, "Ka", 0.0, true)?;
-                let index = self.float(params, "index", 0.0)?;
+                let kd = self.color_param(params, "Kd", 1.0, true)?;
+                let ks = self.color_param(params, "Ks", 1.0, false)?;
+                let ka = self.color_param(params, "Ka", 0.0, true)?;
+                let index = self.float_param(params, "index", 0.0)?;
                 let ks = match index {
                     Tex::Const(i) if i.x > 0.0 => {
                         let f = ((i.x - 1.0) / (i.x + 1.0)).powi(2);
-                        self.scaled(ks, f)
+                        match ks {
+                            Tex::Const(c) => Tex::Const(c * f),
+                            Tex::Texture(id) => Tex::Texture(self.scaled_texture(id, f)),
+                        }
                     }
                     Tex::Const(_) => ks,
                     Tex::Texture(_) => {
@@ -103,47 +65,47 @@ impl Builder<'_> {
                     Tex::Const(c) => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
                     t => t,
                 };
-                self.unsupported_unless(params, "sigma", 0.0)?;
+                self.unsupported_unless(params, "sigma", 0.0);
                 MaterialDesc::Glossy {
                     kd,
                     ks,
                     ka,
-                    depth: self.float(params, "d", 0.0)?,
-                    uroughness: self.float(params, "uroughness", 0.1)?,
-                    vroughness: self.float(params, "vroughness", 0.1)?,
+                    depth: self.float_param(params, "d", 0.0)?,
+                    uroughness: self.float_param(params, "uroughness", 0.1)?,
+                    vroughness: self.float_param(params, "vroughness", 0.1)?,
                     multibounce: params.bool("multibounce", false)?,
                 }
             }
             "mirror" => {
-                self.unsupported_unless(params, "film", 0.0)?;
+                self.unsupported_unless(params, "film", 0.0);
                 MaterialDesc::Mirror {
-                    kr: self.color(params, "Kr", 1.0, false)?,
+                    kr: self.color_param(params, "Kr", 1.0, false)?,
                 }
             }
             "glass" | "roughglass" | "glass2" => {
                 let rough = if ty == "roughglass" { 0.001 } else { 0.0 };
-                self.unsupported_unless(params, "film", 0.0)?;
-                self.unsupported_unless(params, "cauchyb", 0.0)?;
+                self.unsupported_unless(params, "film", 0.0);
+                self.unsupported_unless(params, "cauchyb", 0.0);
                 if ty == "glass2" {
-                    self.warn_once("glass2".into(), pos, "glass2 takes its index from volumes, which are not rendered; using index 1.5");
+                    self.warn_once("glass2".into(), pos, "glass2 takes its index from volumes, which are not rendered; using index 1.5".into());
                     params.ignore("dispersion");
                 }
                 MaterialDesc::Glass {
-                    kr: self.color(params, "Kr", 1.0, false)?,
-                    kt: self.color(params, "Kt", 1.0, false)?,
+                    kr: self.color_param(params, "Kr", 1.0, false)?,
+                    kt: self.color_param(params, "Kt", 1.0, false)?,
                     index: if ty == "glass2" {
                         Tex::float(1.5)
                     } else {
-                        self.float(params, "index", 1.5)?
+                        self.float_param(params, "index", 1.5)?
                     },
                     architectural: params.bool("architectural", false)?,
                     uroughness: if rough > 0.0 {
-                        self.float(params, "uroughness", rough)?
+                        self.float_param(params, "uroughness", rough)?
                     } else {
                         Tex::float(0.0)
                     },
                     vroughness: if rough > 0.0 {
-                        self.float(params, "vroughness", rough)?
+                        self.float_param(params, "vroughness", rough)?
                     } else {
                         Tex::float(0.0)
                     },
@@ -157,21 +119,21 @@ impl Builder<'_> {
                 let (eta, k) = self.metal_by_name(&name, pos);
                 MaterialDesc::Metal {
                     fresnel: Fresnel::Conductor { eta, k },
-                    uroughness: self.float(params, "uroughness", 0.1)?,
-                    vroughness: self.float(params, "vroughness", 0.1)?,
+                    uroughness: self.float_param(params, "uroughness", 0.1)?,
+                    vroughness: self.float_param(params, "vroughness", 0.1)?,
                 }
             }
             "metal2" => MaterialDesc::Metal {
                 fresnel: self.metal2_fresnel(params)?,
-                uroughness: self.float(params, "uroughness", 0.1)?,
-                vroughness: self.float(params, "vroughness", 0.1)?,
+                uroughness: self.float_param(params, "uroughness", 0.1)?,
+                vroughness: self.float_param(params, "vroughness", 0.1)?,
             },
             "mattetranslucent" => {
                 params.ignore("energyconserving");
                 MaterialDesc::MatteTranslucent {
-                    kr: self.color(params, "Kr", 1.0, true)?,
-                    kt: self.color(params, "Kt", 1.0, true)?,
-                    sigma: self.float(params, "sigma", 0.0)?,
+                    kr: self.color_param(params, "Kr", 1.0, true)?,
+                    kt: self.color_param(params, "Kt", 1.0, true)?,
+                    sigma: self.float_param(params, "sigma", 0.0)?,
                 }
             }
             "null" => MaterialDesc::Null,
@@ -189,12 +151,12 @@ impl Builder<'_> {
                 MaterialDesc::Mix {
                     a,
                     b,
-                    amount: self.float(params, "amount", 0.5)?,
+                    amount: self.float_param(params, "amount", 0.5)?,
                 }
             }
             other => {
                 self.warn(pos, format!("material \"{other}\" is not supported; using matte (with its Kd when given)"));
-                let kd = self.color(params, "Kd", 0.9, true)?;
+                let kd = self.color_param(params, "Kd", 0.9, true)?;
                 for p in &params.params {
                     params.ignore(&p.name);
                 }
@@ -213,14 +175,14 @@ impl Builder<'_> {
         if let Some(p) = params.find("fresnel") {
             if p.ty == ParamType::Color {
                 return Ok(Fresnel::Reflectance(
-                    self.color(params, "fresnel", 1.0, true)?,
+                    self.color_param(params, "fresnel", 1.0, true)?,
                 ));
             }
             return Ok(match params.tex_float("fresnel", 5.0)? {
                 TexValue::Const(c) => Fresnel::Index(Tex::Const(c)),
-                TexValue::Named { name, pos } => match self.find_texture(&name, true).cloned() {
+                TexValue::Named { name, pos } => match self.find_texture(&name, true) {
                     Some(TexBinding::Fresnel(f)) => f,
-                    Some(TexBinding::Texture(id)) if !self.textures[id.0 as usize].is_color => {
+                    Some(TexBinding::Texture(id)) if !self.texture_is_color(id) => {
                         Fresnel::Index(Tex::Texture(id))
                     }
                     Some(TexBinding::Texture(id)) => Fresnel::Reflectance(Tex::Texture(id)),
@@ -235,27 +197,10 @@ impl Builder<'_> {
             });
         }
         if params.count("Kr").is_some() {
-            return Ok(Fresnel::Reflectance(self.color(params, "Kr", 1.0, true)?));
+            return Ok(Fresnel::Reflectance(
+                self.color_param(params, "Kr", 1.0, true)?,
+            ));
         }
         Ok(Fresnel::Index(Tex::float(5.0)))
-    }
-
-    /// `t` times the constant `f`: folded into a constant, or a scale texture.
-    fn scaled(&mut self, t: Tex, f: f32) -> Tex {
-        match t {
-            Tex::Const(c) => Tex::Const(c * f),
-            Tex::Texture(id) => {
-                let is_color = self.textures[id.0 as usize].is_color;
-                let name = format!("{} x {f}", self.textures[id.0 as usize].name);
-                Tex::Texture(self.add_texture(TextureDesc {
-                    name,
-                    is_color,
-                    kind: TextureKind::Scale {
-                        tex1: t,
-                        tex2: Tex::float(f),
-                    },
-                }))
-            }
-        }
     }
 }

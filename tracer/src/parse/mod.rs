@@ -1,9 +1,6 @@
 //! The LuxRender 1.x scene parser: `.lxs` text -> statements with positions -> [`SceneDesc`]
 //! with LuxRender's defaults applied.
 //!
-//! OWNER: parser helper. Interface used by the renderer and the `yat check` command; keep the
-//! signatures.
-//!
 //! Module map: [`lexer`] (bytes -> tokens), [`reader`] (tokens -> statement arguments and
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
@@ -21,19 +18,23 @@
 //! - Statements after `WorldEnd` are ignored with one warning.
 
 mod builder;
+pub(crate) mod context;
+mod error;
 mod lexer;
 mod lights;
 mod materials;
 mod options;
-mod params;
-pub(crate) mod ply;
+pub(crate) mod params;
 mod reader;
 mod shapes;
 mod spectra;
 mod textures;
 
-use crate::assets::{AssetError, AssetSource};
-use crate::desc::{SceneDesc, SourcePos};
+use crate::assets::AssetSource;
+use crate::desc::SceneDesc;
+use crate::diag::SourcePos;
+
+pub use error::ParseError;
 
 pub use spectra::{blackbody_rgb, metal_preset};
 
@@ -41,65 +42,6 @@ pub use spectra::{blackbody_rgb, metal_preset};
 pub const MAX_INCLUDE_DEPTH: usize = 32;
 
 pub(crate) type Pos = SourcePos;
-
-impl SourcePos {
-    pub(crate) fn new(file: &str, line: u32, column: u32) -> Self {
-        Self {
-            file: file.to_string(),
-            line,
-            column,
-        }
-    }
-}
-
-#[derive(Debug, thiserror::Error)]
-pub enum ParseError {
-    /// The text is not a well-formed statement sequence.
-    #[error("{pos}: syntax error: {message}")]
-    Syntax { pos: SourcePos, message: String },
-    /// A parameter has the wrong type, count or value.
-    #[error("{pos}: {statement}: parameter \"{param}\": {message}")]
-    Parameter {
-        pos: SourcePos,
-        statement: String,
-        param: String,
-        message: String,
-    },
-    /// Well-formed but unusable input: bad mesh data, include cycles, a missing required value.
-    #[error("{pos}: {message}")]
-    Invalid { pos: SourcePos, message: String },
-    /// A referenced file (Include, PLY, image) cannot be read.
-    #[error("{pos}: {error}")]
-    Asset { pos: SourcePos, error: AssetError },
-    /// A referenced image exists but its header does not decode.
-    #[error("{pos}: image \"{path}\" does not decode: {message}")]
-    Image {
-        pos: SourcePos,
-        path: String,
-        message: String,
-    },
-    /// A PLY file is malformed.
-    #[error("{pos}: PLY file \"{path}\": {message}")]
-    Ply {
-        pos: SourcePos,
-        path: String,
-        message: String,
-    },
-}
-
-impl ParseError {
-    /// Where in the scene files the problem is.
-    pub fn pos(&self) -> &SourcePos {
-        match self {
-            ParseError::Syntax { pos, .. }
-            | ParseError::Parameter { pos, .. }
-            | ParseError::Invalid { pos, .. }
-            | ParseError::Asset { pos, .. }
-            | ParseError::Image { pos, .. }
-            | ParseError::Ply { pos, .. } => pos,
-        }
-    }
-}
 
 /// Parses the main scene file `main` (its name as given to `source`) and every file it
 /// includes, and builds the scene description. Warnings go into `SceneDesc::warnings`.

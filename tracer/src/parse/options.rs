@@ -5,6 +5,7 @@
 use glam::Mat4;
 
 use super::builder::Builder;
+use super::context::ParseContext;
 use super::params::ParamList;
 use super::{ParseError, Pos};
 use crate::desc::{
@@ -55,7 +56,7 @@ impl OptionsState {
                 desc
             }
             None => {
-                b.warn(end, "no Camera statement: using a perspective camera at the origin looking along +z");
+                b.warn(end, "no Camera statement: using a perspective camera at the origin looking along +z".into());
                 let pos = end.clone();
                 let c = CameraStatement {
                     ty: "perspective".into(),
@@ -372,7 +373,7 @@ fn camera(b: &mut Builder, c: &CameraStatement, film: &FilmDesc) -> Result<Camer
     if p.bool("autofocus", false)? {
         b.warn(
             &c.pos,
-            "Camera: autofocus is not supported; focaldistance is used as given",
+            "Camera: autofocus is not supported; focaldistance is used as given".into(),
         );
     }
     let camera_to_world = c.world_to_camera.inverse();

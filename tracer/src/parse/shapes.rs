@@ -6,9 +6,13 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 
 use super::builder::Builder;
+use super::context::ParseContext;
 use super::params::ParamList;
-use super::{ply, ParseError, Pos};
-use crate::desc::{AssetKind, Geometry, ShapeDesc, TriangleMesh};
+use super::{ParseError, Pos};
+use crate::assets::AssetKind;
+use crate::desc::{Geometry, ShapeDesc};
+use crate::mesh::ply;
+use crate::mesh::TriangleMesh;
 
 impl Builder<'_> {
     /// The geometry of `Shape "ty"`, or `None` (with a warning) for unsupported shapes.
@@ -287,7 +291,7 @@ pub fn world_area(shape: &ShapeDesc) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::desc::MaterialId;
+    use crate::param::MaterialId;
     use glam::Mat4;
 
     fn shape(geometry: Geometry, m: Mat4) -> ShapeDesc {

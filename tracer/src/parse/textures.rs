@@ -3,11 +3,13 @@
 
 use glam::Vec3;
 
-use super::builder::{Builder, TexBinding};
-use super::params::{ParamList, TexValue};
+use super::builder::Builder;
+use super::context::{ParseContext, TexBinding};
+use super::params::ParamList;
 use super::spectra::{blackbody_rgb, metal_preset};
 use super::{ParseError, Pos};
-use crate::desc::{Fresnel, Mapping2D, Tex, TextureDesc, TextureKind, Wrap};
+use crate::desc::{Mapping2D, TextureDesc, TextureKind, Wrap};
+use crate::param::{Fresnel, Tex};
 
 impl Builder<'_> {
     pub(super) fn texture(
@@ -49,7 +51,7 @@ impl Builder<'_> {
             } else {
                 params.tex_float(n, default)?
             };
-            Ok(b.resolve(v, is_color, Vec3::splat(default)))
+            Ok(b.tex(v, is_color, Vec3::splat(default)))
         };
         let texture_kind = match class {
             "imagemap" => {
@@ -102,7 +104,7 @@ impl Builder<'_> {
                     3 => TextureKind::Checkerboard3D {
                         tex1,
                         tex2,
-                        world_to_texture: self.ctm.inverse(),
+                        world_to_texture: self.ctm().inverse(),
                     },
                     d => {
                         let p = params.find("dimension").expect("read above");
@@ -124,7 +126,7 @@ impl Builder<'_> {
                 TextureKind::Mix {
                     tex1: tex(self, "tex1", 0.0)?,
                     tex2: tex(self, "tex2", 1.0)?,
-                    amount: self.resolve(amount, false, Vec3::splat(0.5)),
+                    amount: self.tex(amount, false, Vec3::splat(0.5)),
                 }
             }
             "blackbody" => {
@@ -161,7 +163,7 @@ impl Builder<'_> {
         Ok(Some(match class {
             "fresnelcolor" => {
                 let kr = params.tex_color("Kr", Vec3::splat(0.5))?;
-                Fresnel::Reflectance(self.resolve(kr, true, Vec3::splat(0.5)))
+                Fresnel::Reflectance(self.tex(kr, true, Vec3::splat(0.5)))
             }
             "fresnelname" | "preset" => {
                 let name = match params.string("filename")? {
@@ -199,7 +201,7 @@ impl Builder<'_> {
         let mapping = params.string_or("mapping", "uv")?;
         Ok(match mapping.as_str() {
             "spherical" | "cylindrical" => {
-                let world_to_texture = self.ctm.inverse();
+                let world_to_texture = self.ctm().inverse();
                 let uscale = params.float("uscale", 1.0)?;
                 let vscale = params.float("vscale", 1.0)?;
                 let udelta = params.float("udelta", 0.0)?;
@@ -227,7 +229,7 @@ impl Builder<'_> {
                 params.ignore("uscale");
                 params.ignore("vscale");
                 Mapping2D::Planar {
-                    world_to_texture: self.ctm.inverse(),
+                    world_to_texture: self.ctm().inverse(),
                     v1: params.vec3("v1", Vec3::X)?,
                     v2: params.vec3("v2", Vec3::Y)?,
                     udelta: params.float("udelta", 0.0)?,
@@ -249,27 +251,5 @@ impl Builder<'_> {
                 }
             }
         })
-    }
-
-    /// Resolves a texture-or-constant parameter; an undefined texture name is a warning and
-    /// falls back to `default`.
-    pub(super) fn resolve(&mut self, v: TexValue, want_color: bool, default: Vec3) -> Tex {
-        match v {
-            TexValue::Const(c) => Tex::Const(c),
-            TexValue::Named { name, pos } => match self.find_texture(&name, want_color) {
-                Some(TexBinding::Texture(id)) => Tex::Texture(*id),
-                Some(TexBinding::Fresnel(_)) => {
-                    self.warn(&pos, format!("texture \"{name}\" is a fresnel texture, usable only as metal2's fresnel; using the default"));
-                    Tex::Const(default)
-                }
-                None => {
-                    self.warn(
-                        &pos,
-                        format!("no texture named \"{name}\"; using the default"),
-                    );
-                    Tex::Const(default)
-                }
-            },
-        }
     }
 }

@@ -16,8 +16,9 @@ use std::collections::HashMap;
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::assets::AssetSource;
-use crate::desc::{SceneDesc, Tex, TextureDesc, TextureId, TextureKind, Wrap};
+use crate::desc::{SceneDesc, TextureDesc, TextureKind, Wrap};
 use crate::image_io::{self, RgbImage};
+use crate::param::{Tex, TextureId};
 pub use mapping::Mapping;
 
 /// What a texture lookup needs to know about the surface point.

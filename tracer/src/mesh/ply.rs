@@ -5,7 +5,7 @@ use glam::Vec3;
 use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
 
-use crate::desc::TriangleMesh;
+use crate::mesh::TriangleMesh;
 
 /// One element of any kind: vertex fields, or a face's index list. Elements other than
 /// vertices and faces are read and dropped.

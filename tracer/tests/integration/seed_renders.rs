@@ -11,11 +11,11 @@ use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene;
 use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings};
 
+use crate::util::seed_scenes;
+
+/// The seed project (its `renders/` beside the scene folder).
 fn seed_project() -> Option<PathBuf> {
-    let dir = match std::env::var_os("YAT_SEED_SCENES") {
-        Some(d) => PathBuf::from(d).join(".."),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/seed-project"),
-    };
+    let dir = seed_scenes()?.join("..");
     if dir.join("renders").is_dir() {
         Some(dir)
     } else {

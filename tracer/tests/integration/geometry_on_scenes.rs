@@ -3,7 +3,7 @@
 //! Prints build times and ray throughput, and checks that intersect, occluded and light
 //! sampling agree with one another on every scene.
 //!
-//! `cargo test --release -p yat-tracer --test geometry_on_scenes -- --ignored --nocapture`
+//! `cargo test --release -p yat-tracer --test integration geometry_on_scenes -- --ignored --nocapture`
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -17,9 +17,7 @@ use yat_tracer::lights::Lights;
 use yat_tracer::math::{offset_origin, Frame, Ray};
 use yat_tracer::parse::parse_scene;
 
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use crate::util::{seed_scenes, workspace_root};
 
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -39,17 +37,9 @@ fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
 #[test]
 #[ignore = "slow on real meshes: run in release with --ignored --nocapture"]
 fn bvh_and_lights_on_real_scenes() {
-    let seed = std::env::var_os("YAT_SEED_SCENES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace_root().join("../shared/seed-project/scenes"));
     let mut files = Vec::new();
-    if seed.is_dir() {
+    if let Some(seed) = seed_scenes() {
         scene_files(&seed, &mut files);
-    } else {
-        println!(
-            "seed scenes not found at {} (set YAT_SEED_SCENES): skipping them",
-            seed.display()
-        );
     }
     scene_files(&workspace_root().join("scenes"), &mut files);
     assert!(!files.is_empty());

@@ -3,7 +3,7 @@
 //! scenes` (or `$YAT_SEED_SCENES`); the tests skip with a message when they are absent.
 
 use std::f32::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec3;
 use yat_tracer::assets::FsSource;
@@ -11,21 +11,7 @@ use yat_tracer::desc::{CameraKind, Geometry, LightDesc, SceneDesc};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{parse_scene, ParseError};
 
-fn seed_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("YAT_SEED_SCENES") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/seed-project/scenes"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "seed scenes not found at {} (set YAT_SEED_SCENES); skipping",
-            dir.display()
-        );
-        None
-    }
-}
+use crate::util::seed_scenes;
 
 fn load(dir: &Path, scene: &str) -> Result<SceneDesc, ParseError> {
     let path = dir.join(scene);
@@ -86,7 +72,7 @@ const COMPLETE: &[&str] = &[
 
 #[test]
 fn every_complete_seed_scene_parses() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     for scene in COMPLETE {
         let d = load(&dir, scene).unwrap_or_else(|e| panic!("{scene}: {e}"));
         assert!(!d.shapes.is_empty(), "{scene}: no shapes");
@@ -106,7 +92,7 @@ fn every_complete_seed_scene_parses() {
 
 #[test]
 fn every_main_file_is_listed() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     // Main files are the .lxs files with a WorldBegin (Benchmarks/Lights.lxs is an include).
     let mut found = Vec::new();
     let mut stack = vec![dir.clone()];
@@ -148,7 +134,7 @@ const INCOMPLETE: &[(&str, &str)] = &[
 
 #[test]
 fn incomplete_seed_scenes_fail_naming_the_missing_file() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     for (scene, missing) in INCOMPLETE {
         let e = load(&dir, scene).expect_err(scene);
         let ParseError::Asset { error, .. } = &e else {
@@ -164,7 +150,7 @@ fn incomplete_seed_scenes_fail_naming_the_missing_file() {
 
 #[test]
 fn cornell_box_contents() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     let d = load(&dir, "CornellBox/cornell-box.lxs").unwrap();
     assert_eq!(d.shapes.len(), 8);
     assert_eq!(triangles(&d), 32);
@@ -190,7 +176,7 @@ fn cornell_box_contents() {
 
 #[test]
 fn depth_of_field_spheres_and_lens() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     for (scene, lens) in [
         ("DepthOfField/depth-of-field-control.lxs", 0.0),
         ("DepthOfField/depth-of-field-low.lxs", 0.05),
@@ -210,7 +196,7 @@ fn depth_of_field_spheres_and_lens() {
 
 #[test]
 fn fisheye_and_environment_scenes() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     let d = load(&dir, "CornellBoxFisheye/cornell-box-fisheye-high-fov.lxs").unwrap();
     assert_eq!(d.camera.kind, CameraKind::Fisheye { fov: 76.0 });
     let d = load(&dir, "MetalMario/metal-mario-bg1.lxs").unwrap();

@@ -1,0 +1,14 @@
+//! Triangle meshes: the data every mesh-like shape becomes, and reading them from PLY files.
+
+pub mod ply;
+
+use glam::Vec3;
+
+/// Triangle mesh data in object space. Quads are already split into triangles.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+    pub indices: Vec<[u32; 3]>,
+}

@@ -1,0 +1,127 @@
+//! The narrow interface between the parser's graphics state and the readers of each family of
+//! descriptions (materials, textures, lights, shapes, options): diagnostics, name lookup,
+//! referenced files and the current transform. Readers take `&mut dyn ParseContext`, so a new
+//! kind of material or light never needs to know how the builder keeps its state.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+
+use super::error::ParseError;
+use super::params::{ParamList, ParamType, TexValue, Values};
+use crate::assets::AssetKind;
+use crate::diag::SourcePos;
+use crate::param::{Fresnel, MaterialId, Tex, TextureId};
+
+/// What a texture name is bound to in the current attribute scope. Fresnel textures are not
+/// evaluated per hit: metal materials fold them into their description.
+#[derive(Clone, Debug)]
+pub enum TexBinding {
+    Texture(TextureId),
+    Fresnel(Fresnel),
+}
+
+pub trait ParseContext {
+    fn warn(&mut self, pos: &SourcePos, message: String);
+
+    /// A warning given once per `key` for the whole scene.
+    fn warn_once(&mut self, key: String, pos: &SourcePos, message: String);
+
+    /// The current transformation matrix (object, light or texture space to world).
+    fn ctm(&self) -> Mat4;
+
+    /// The texture named `name` in scope, preferring one of the requested kind (a float
+    /// texture used as a colour is splatted).
+    fn find_texture(&self, name: &str, want_color: bool) -> Option<TexBinding>;
+
+    /// Whether texture `id` was declared "color" (else "float").
+    fn texture_is_color(&self, id: TextureId) -> bool;
+
+    /// A new texture: texture `id` times the constant `factor`.
+    fn scaled_texture(&mut self, id: TextureId, factor: f32) -> TextureId;
+
+    /// The material made with `MakeNamedMaterial name`, or the default with a warning.
+    fn named_material(&mut self, name: &str, pos: &SourcePos) -> MaterialId;
+
+    /// LuxRender's default material (a shape with none, a dangling name).
+    fn default_material(&mut self) -> MaterialId;
+
+    /// Reads a referenced file and records it as one of the scene's assets.
+    fn read_asset(
+        &mut self,
+        path: &str,
+        kind: AssetKind,
+        pos: &SourcePos,
+    ) -> Result<Arc<[u8]>, ParseError>;
+
+    /// Checks that an image file exists and its header decodes, and records it as an asset.
+    fn check_image(&mut self, path: &str, pos: &SourcePos) -> Result<(), ParseError>;
+
+    /// Resolves a texture-or-constant parameter; an undefined texture name (or a fresnel
+    /// texture where a colour or float is wanted) is a warning and falls back to `default`.
+    fn tex(&mut self, v: TexValue, want_color: bool, default: Vec3) -> Tex {
+        match v {
+            TexValue::Const(c) => Tex::Const(c),
+            TexValue::Named { name, pos } => match self.find_texture(&name, want_color) {
+                Some(TexBinding::Texture(id)) => Tex::Texture(id),
+                Some(TexBinding::Fresnel(_)) => {
+                    self.warn(&pos, format!("texture \"{name}\" is a fresnel texture, usable only as metal2's fresnel; using the default"));
+                    Tex::Const(default)
+                }
+                None => {
+                    self.warn(
+                        &pos,
+                        format!("no texture named \"{name}\"; using the default"),
+                    );
+                    Tex::Const(default)
+                }
+            },
+        }
+    }
+
+    /// A colour parameter (constant or texture); constants are clamped to [0, 1] when `clamp`.
+    fn color_param(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f32,
+        clamp: bool,
+    ) -> Result<Tex, ParseError> {
+        let v = params.tex_color(name, Vec3::splat(default))?;
+        Ok(match self.tex(v, true, Vec3::splat(default)) {
+            Tex::Const(c) if clamp => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
+            t => t,
+        })
+    }
+
+    /// A float parameter (constant or texture).
+    fn float_param(
+        &mut self,
+        params: &ParamList,
+        name: &str,
+        default: f32,
+    ) -> Result<Tex, ParseError> {
+        let v = params.tex_float(name, default)?;
+        Ok(self.tex(v, false, Vec3::splat(default)))
+    }
+
+    /// A parameter this renderer does not model: silent at its default, a warning (once per
+    /// statement and parameter) otherwise.
+    fn unsupported_unless(&mut self, params: &ParamList, name: &str, default: f32) {
+        let Some(p) = params.find(name) else {
+            return;
+        };
+        let is_default = matches!(&p.values, Values::Numbers(v) if v.len() == 1 && v[0] as f32 == default)
+            && matches!(p.ty, ParamType::Float | ParamType::Integer);
+        if !is_default {
+            let key = format!("unsupported|{}|{name}", params.statement);
+            let message = format!(
+                "{}: \"{}\" is not supported and is ignored",
+                params.statement,
+                p.decl()
+            );
+            let pos = p.pos.clone();
+            self.warn_once(key, &pos, message);
+        }
+    }
+}

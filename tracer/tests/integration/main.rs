@@ -1,0 +1,10 @@
+//! The tracer's integration tests, one binary: the parser against its conventions and against
+//! malformed input, whole renders with numbers, and the seed scenes when they are present.
+
+mod geometry_on_scenes;
+mod parse_conventions;
+mod parse_errors;
+mod render;
+mod seed_renders;
+mod seed_scenes;
+mod util;
