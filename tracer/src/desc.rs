@@ -1,15 +1,24 @@
 //! The scene description: plain data produced by the parser and consumed by the renderer's
 //! build step. Every LuxRender default is already applied here, so nothing downstream needs to
 //! know the file format. Transforms are object-to-world; colours are linear RGB.
-
-use std::sync::Arc;
+//!
+//! Each concept keeps its own description, defaults and reading in its file: the camera in
+//! [`crate::camera`], the film in [`crate::film`], the pixel filter in [`crate::filter`], the
+//! surface integrator in [`crate::integrator::options`], the sampler in [`crate::sampler`],
+//! shapes in [`crate::shape`]; they are re-exported here.
 
 use glam::{Mat4, Vec3};
 
 pub use crate::assets::{AssetKind, AssetRef};
+pub use crate::camera::{CameraDesc, CameraKind};
 pub use crate::diag::{SourcePos, Warning};
+pub use crate::film::{FilmDesc, ToneMap};
+pub use crate::filter::{FilterDesc, FilterKind};
+pub use crate::integrator::options::{IntegratorDesc, RussianRoulette};
 pub use crate::mesh::TriangleMesh;
 pub use crate::param::{Fresnel, MaterialId, Tex, TextureId};
+pub use crate::sampler::SamplerDesc;
+pub use crate::shape::{AreaLightDesc, Geometry, ShapeDesc};
 
 #[derive(Clone, Debug)]
 pub struct SceneDesc {
@@ -25,112 +34,6 @@ pub struct SceneDesc {
     pub warnings: Vec<Warning>,
     /// Every file read or referenced besides the main file, in first-use order, no repeats.
     pub assets: Vec<AssetRef>,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Camera
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum CameraKind {
-    /// `fov` in degrees; spans the shorter screen-window axis (LuxRender rule).
-    Perspective {
-        fov: f32,
-    },
-    Orthographic,
-    /// The course's fisheye (docs/architecture.md): `fov` in degrees is the angle off the axis at the
-    /// circle's edge.
-    Fisheye {
-        fov: f32,
-    },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct CameraDesc {
-    pub kind: CameraKind,
-    /// Camera space: +x is image right, +y image up, +z the viewing direction.
-    pub camera_to_world: Mat4,
-    /// [xmin, xmax, ymin, ymax] in screen space (default follows the film aspect).
-    pub screen_window: [f32; 4],
-    pub lens_radius: f32,
-    pub focal_distance: f32,
-    pub hither: f32,
-    pub yon: f32,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Film, filter, sampler, integrator
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum ToneMap {
-    /// scale = 1.25 / Yavg x (118/255)^gamma over pixels with Y > 0.
-    AutoLinear,
-    Linear {
-        sensitivity: f32,
-        exposure: f32,
-        fstop: f32,
-    },
-    Reinhard {
-        prescale: f32,
-        postscale: f32,
-        burn: f32,
-    },
-    Contrast {
-        ywa: f32,
-    },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct FilmDesc {
-    pub xresolution: u32,
-    pub yresolution: u32,
-    pub gamma: f32,
-    pub tonemap: ToneMap,
-    /// Output name without extension, as the file gives it (default "luxout").
-    pub filename: String,
-    pub haltspp: Option<u32>,
-    pub halttime: Option<f32>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FilterKind {
-    Box,
-    Triangle,
-    Gaussian { alpha: f32 },
-    Mitchell { b: f32, c: f32 },
-    BlackmanHarris,
-    Sinc { tau: f32 },
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FilterDesc {
-    pub kind: FilterKind,
-    /// Half-widths in pixels.
-    pub xwidth: f32,
-    pub ywidth: f32,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RussianRoulette {
-    Efficiency,
-    Probability,
-    None,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct IntegratorDesc {
-    pub max_depth: u32,
-    pub rr_strategy: RussianRoulette,
-    pub rr_continue_prob: f32,
-    pub include_environment: bool,
-    /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
-    pub requested: String,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct SamplerDesc {
-    /// `pixelsamples` when the file gives it; the film's haltspp or the command line win.
-    pub pixel_samples: Option<u32>,
-    pub requested: String,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -273,52 +176,6 @@ pub enum MaterialDesc {
         /// Weight of `b`.
         amount: Tex,
     },
-}
-
-// ---------------------------------------------------------------------------------------------
-// Shapes
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum Geometry {
-    /// Shared between instances of the same object.
-    Mesh(Arc<TriangleMesh>),
-    Sphere {
-        radius: f32,
-        zmin: f32,
-        zmax: f32,
-        /// Degrees.
-        phimax: f32,
-    },
-    Disk {
-        height: f32,
-        radius: f32,
-        inner_radius: f32,
-        phimax: f32,
-    },
-    Cylinder {
-        radius: f32,
-        zmin: f32,
-        zmax: f32,
-        phimax: f32,
-    },
-    /// The course's infinite plane through the object-space origin with this normal.
-    Plane { normal: Vec3 },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct AreaLightDesc {
-    /// Emitted radiance: L x gain, already normalised by power x efficacy when given.
-    pub radiance: Vec3,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct ShapeDesc {
-    pub name: String,
-    pub geometry: Geometry,
-    pub object_to_world: Mat4,
-    pub reverse_orientation: bool,
-    pub material: MaterialId,
-    pub area_light: Option<AreaLightDesc>,
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,13 +1,167 @@
-//! Sample buffers and the film: per-pixel sums from units, merged in an order-independent way
-//! (exact fixed-point sums), tone mapped and written as PNG or linear EXR.
+//! `Film "fleximage" "integer xresolution" [800] "integer yresolution" [600] ...`: the film's
+//! description, LuxRender's defaults and their reading; sample buffers and the film: per-pixel
+//! sums from units, merged in an order-independent way (exact fixed-point sums), tone mapped
+//! and written as PNG or linear EXR.
+//!
+//! | parameter | type | default |
+//! |---|---|---|
+//! | `xresolution`, `yresolution` | integer in 1..65536 | 800, 600 |
+//! | `gamma` | float | 2.2 |
+//! | `tonemapkernel` | string: autolinear, linear, reinhard, contrast | autolinear |
+//! | `linear_sensitivity`, `linear_exposure`, `linear_fstop` | float | 50, 1, 2.8 |
+//! | `reinhard_prescale`, `reinhard_postscale`, `reinhard_burn` | float | 1, 1, 6 |
+//! | `contrast_ywa` | float | 1 |
+//! | `filename` | string | "luxout" |
+//! | `haltspp` | integer | none |
+//! | `halttime` | float | none |
+//!
+//! Every film type is read as "fleximage" (with a warning); a scene without a `Film`
+//! statement gets these defaults.
 
 use std::path::Path;
 
 use glam::Vec3;
 
-use crate::desc::{FilmDesc, ToneMap};
+use crate::diag::SourcePos;
 use crate::math::luminance;
-use crate::render::WorkUnit;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+use crate::render::unit::WorkUnit;
+
+/// The film type every `Film` statement is read as.
+pub const FILM_TYPE: &str = "fleximage";
+pub const DEFAULT_XRESOLUTION: i32 = 800;
+pub const DEFAULT_YRESOLUTION: i32 = 600;
+pub const DEFAULT_GAMMA: f32 = 2.2;
+pub const DEFAULT_TONEMAP_KERNEL: &str = "autolinear";
+pub const DEFAULT_LINEAR_SENSITIVITY: f32 = 50.0;
+pub const DEFAULT_LINEAR_EXPOSURE: f32 = 1.0;
+pub const DEFAULT_LINEAR_FSTOP: f32 = 2.8;
+pub const DEFAULT_REINHARD_PRESCALE: f32 = 1.0;
+pub const DEFAULT_REINHARD_POSTSCALE: f32 = 1.0;
+pub const DEFAULT_REINHARD_BURN: f32 = 6.0;
+pub const DEFAULT_CONTRAST_YWA: f32 = 1.0;
+/// Output name without extension.
+pub const DEFAULT_FILENAME: &str = "luxout";
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ToneMap {
+    /// scale = 1.25 / Yavg x (118/255)^gamma over pixels with Y > 0.
+    AutoLinear,
+    Linear {
+        sensitivity: f32,
+        exposure: f32,
+        fstop: f32,
+    },
+    Reinhard {
+        prescale: f32,
+        postscale: f32,
+        burn: f32,
+    },
+    Contrast {
+        ywa: f32,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmDesc {
+    pub xresolution: u32,
+    pub yresolution: u32,
+    pub gamma: f32,
+    pub tonemap: ToneMap,
+    /// Output name without extension, as the file gives it (default "luxout").
+    pub filename: String,
+    pub haltspp: Option<u32>,
+    pub halttime: Option<f32>,
+}
+
+impl FilmDesc {
+    /// The film of a scene without a `Film` statement: every default, no warnings.
+    pub fn defaults(ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+        Self::read(
+            ctx,
+            FILM_TYPE,
+            &ParamList::new(String::new(), Vec::new()),
+            None,
+        )
+    }
+
+    /// Reads `Film "ty"`; `pos` is None for the defaults (which warn about nothing).
+    pub fn read(
+        ctx: &mut dyn ParseContext,
+        ty: &str,
+        params: &ParamList,
+        pos: Option<&SourcePos>,
+    ) -> Result<Self, ParseError> {
+        if let Some(pos) = pos {
+            if ty != FILM_TYPE {
+                ctx.warn(pos, format!("Film \"{ty}\" is read as \"fleximage\""));
+            }
+        }
+        let resolution = |name: &str, default: i32| -> Result<u32, ParseError> {
+            let v = params.int(name, default)?;
+            match params.find(name) {
+                Some(p) if !(1..=65536).contains(&v) => {
+                    Err(params.error(p, format!("{v} is not a resolution in 1..65536")))
+                }
+                _ => Ok(v as u32),
+            }
+        };
+        let xresolution = resolution("xresolution", DEFAULT_XRESOLUTION)?;
+        let yresolution = resolution("yresolution", DEFAULT_YRESOLUTION)?;
+        let kernel = params.string_or("tonemapkernel", DEFAULT_TONEMAP_KERNEL)?;
+        let tonemap = match kernel.as_str() {
+            "autolinear" => ToneMap::AutoLinear,
+            "linear" => ToneMap::Linear {
+                sensitivity: params.float("linear_sensitivity", DEFAULT_LINEAR_SENSITIVITY)?,
+                exposure: params.float("linear_exposure", DEFAULT_LINEAR_EXPOSURE)?,
+                fstop: params.float("linear_fstop", DEFAULT_LINEAR_FSTOP)?,
+            },
+            "reinhard" => ToneMap::Reinhard {
+                prescale: params.float("reinhard_prescale", DEFAULT_REINHARD_PRESCALE)?,
+                postscale: params.float("reinhard_postscale", DEFAULT_REINHARD_POSTSCALE)?,
+                burn: params.float("reinhard_burn", DEFAULT_REINHARD_BURN)?,
+            },
+            "contrast" => ToneMap::Contrast {
+                ywa: params.float("contrast_ywa", DEFAULT_CONTRAST_YWA)?,
+            },
+            other => {
+                if let Some(pos) = pos {
+                    ctx.warn(
+                        pos,
+                        format!("Film: unknown tonemapkernel \"{other}\"; using autolinear"),
+                    );
+                }
+                ToneMap::AutoLinear
+            }
+        };
+        // The parameters of the kernels not chosen are legitimately present in exported files.
+        for name in [
+            "linear_sensitivity",
+            "linear_exposure",
+            "linear_fstop",
+            "linear_gamma",
+            "reinhard_prescale",
+            "reinhard_postscale",
+            "reinhard_burn",
+            "contrast_ywa",
+        ] {
+            params.ignore(name);
+        }
+        let haltspp = params.int("haltspp", -1)?;
+        let halttime = params.float("halttime", -1.0)?;
+        Ok(FilmDesc {
+            xresolution,
+            yresolution,
+            gamma: params.float("gamma", DEFAULT_GAMMA)?,
+            tonemap,
+            filename: params.string_or("filename", DEFAULT_FILENAME)?,
+            haltspp: (haltspp > 0).then_some(haltspp as u32),
+            halttime: (halttime > 0.0).then_some(halttime),
+        })
+    }
+}
 
 /// A unit's result: per pixel of its tile (row-major), the sum of sample radiance and the sum
 /// of sample weights. 16 bytes per pixel.

@@ -1,10 +1,140 @@
-//! Pixel reconstruction filters, used by filter importance sampling: a sample's offset from
-//! its pixel centre is drawn from |f| and carries weight sign(f), so every sample belongs to
-//! exactly one pixel and tiles need no borders (docs/architecture.md).
+//! `PixelFilter "mitchell" "float xwidth" [2] "float ywidth" [2] ...`: pixel reconstruction
+//! filters, their description, LuxRender's defaults and their reading.
+//!
+//! | type | parameters (defaults) | half-width default |
+//! |---|---|---|
+//! | `box` | | 0.5 |
+//! | `triangle` | | 2 |
+//! | `gaussian` | `alpha` (2) | 2 |
+//! | `mitchell` (the default) | `B` (1/3), `C` (1/3) | 2 |
+//! | `catmullrom` | (Mitchell with B = 0, C = 1/2) | 2 |
+//! | `blackmanharris` | | 4 |
+//! | `sinc` | `tau` (3) | 4 |
+//!
+//! Every type also takes `xwidth` and `ywidth` (positive half-widths in pixels). An unknown
+//! type is a warning and renders with the default mitchell.
+//!
+//! The filters are used by filter importance sampling: a sample's offset from its pixel centre
+//! is drawn from |f| and carries weight sign(f), so every sample belongs to exactly one pixel
+//! and tiles need no borders (docs/architecture.md).
 
 use glam::Vec2;
 
-use crate::desc::{FilterDesc, FilterKind};
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+/// Mitchell-Netravali's B and C when the file does not give them (and for unknown filters).
+pub const DEFAULT_MITCHELL_B: f32 = 1.0 / 3.0;
+pub const DEFAULT_MITCHELL_C: f32 = 1.0 / 3.0;
+/// Half-width of the box filter when the file does not say.
+pub const DEFAULT_BOX_WIDTH: f32 = 0.5;
+/// Half-width of the triangle, gaussian and mitchell filters when the file does not say.
+pub const DEFAULT_WIDTH: f32 = 2.0;
+/// Half-width of the blackmanharris and sinc filters when the file does not say.
+pub const DEFAULT_WIDE_WIDTH: f32 = 4.0;
+/// The gaussian's falloff when the file does not say.
+pub const DEFAULT_GAUSSIAN_ALPHA: f32 = 2.0;
+/// The sinc's tau when the file does not say.
+pub const DEFAULT_SINC_TAU: f32 = 3.0;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterKind {
+    Box,
+    Triangle,
+    Gaussian { alpha: f32 },
+    Mitchell { b: f32, c: f32 },
+    BlackmanHarris,
+    Sinc { tau: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterDesc {
+    pub kind: FilterKind,
+    /// Half-widths in pixels.
+    pub xwidth: f32,
+    pub ywidth: f32,
+}
+
+/// The filter of a scene without a `PixelFilter` statement.
+impl Default for FilterDesc {
+    fn default() -> Self {
+        Self {
+            kind: FilterKind::Mitchell {
+                b: DEFAULT_MITCHELL_B,
+                c: DEFAULT_MITCHELL_C,
+            },
+            xwidth: DEFAULT_WIDTH,
+            ywidth: DEFAULT_WIDTH,
+        }
+    }
+}
+
+impl FilterDesc {
+    /// Reads `PixelFilter "ty"`.
+    pub fn read(
+        ctx: &mut dyn ParseContext,
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+    ) -> Result<Self, ParseError> {
+        let (kind, width) = match ty {
+            "box" => (FilterKind::Box, DEFAULT_BOX_WIDTH),
+            "triangle" => (FilterKind::Triangle, DEFAULT_WIDTH),
+            "gaussian" => (
+                FilterKind::Gaussian {
+                    alpha: params.float("alpha", DEFAULT_GAUSSIAN_ALPHA)?,
+                },
+                DEFAULT_WIDTH,
+            ),
+            "mitchell" => {
+                params.ignore("supersample");
+                (
+                    FilterKind::Mitchell {
+                        b: params.float("B", DEFAULT_MITCHELL_B)?,
+                        c: params.float("C", DEFAULT_MITCHELL_C)?,
+                    },
+                    DEFAULT_WIDTH,
+                )
+            }
+            // Catmull-Rom is the Mitchell-Netravali filter with B = 0, C = 1/2.
+            "catmullrom" => (FilterKind::Mitchell { b: 0.0, c: 0.5 }, DEFAULT_WIDTH),
+            "blackmanharris" => (FilterKind::BlackmanHarris, DEFAULT_WIDE_WIDTH),
+            "sinc" => (
+                FilterKind::Sinc {
+                    tau: params.float("tau", DEFAULT_SINC_TAU)?,
+                },
+                DEFAULT_WIDE_WIDTH,
+            ),
+            other => {
+                ctx.warn(
+                    pos,
+                    format!("PixelFilter \"{other}\" is unknown; using mitchell"),
+                );
+                (
+                    FilterKind::Mitchell {
+                        b: DEFAULT_MITCHELL_B,
+                        c: DEFAULT_MITCHELL_C,
+                    },
+                    DEFAULT_WIDTH,
+                )
+            }
+        };
+        let width = |name: &str| -> Result<f32, ParseError> {
+            let w = params.float(name, width)?;
+            match params.find(name) {
+                Some(p) if w <= 0.0 => Err(params.error(p, "the filter width must be positive")),
+                _ => Ok(w),
+            }
+        };
+        Ok(FilterDesc {
+            kind,
+            xwidth: width("xwidth")?,
+            ywidth: width("ywidth")?,
+        })
+    }
+}
 
 const TABLE_SIZE: usize = 256;
 

@@ -540,14 +540,8 @@ fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
     let n_phi = segments.max(3);
     let mut mesh = TriangleMesh::default();
     let (rows, grid): (u32, Box<SurfacePoint>) = match *geometry {
-        Geometry::Sphere {
-            radius,
-            zmin,
-            zmax,
-            phimax,
-        } => {
-            let z0 = zmin.min(zmax).clamp(-radius, radius);
-            let z1 = zmin.max(zmax).clamp(-radius, radius);
+        Geometry::Sphere { radius, phimax, .. } => {
+            let (z0, z1) = geometry.sphere_z_range()?;
             let (th0, th1) = ((z0 / radius).acos(), (z1 / radius).acos());
             let phimax = phimax.clamp(0.0, 360.0).to_radians();
             let f = move |u: f32, v: f32| {

@@ -1,3 +1,13 @@
+//! `Sampler "sobol" "integer pixelsamples" [16]`: only the sample count carries over from the
+//! file; the algorithm is always ours.
+//!
+//! | parameter | type | default |
+//! |---|---|---|
+//! | `pixelsamples` | integer | none: the film's `haltspp`, the command line or 64 decide |
+//!
+//! Every other parameter is accepted and ignored. Without a `Sampler` statement the scene
+//! records `"random"`, LuxRender's default.
+//!
 //! The deterministic sampler: the value for (pixel, sample index, dimension, seed) is a pure
 //! function of those four numbers, so any thread, tile or machine that renders a sample draws
 //! the same numbers (pbrt-v4's padded Sobol design).
@@ -7,6 +17,43 @@
 //! every 2D projection stratified while decorrelating the pairs from each other.
 
 use glam::Vec2;
+
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+/// The sampler a scene without a `Sampler` statement records.
+pub const DEFAULT_SAMPLER: &str = "random";
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplerDesc {
+    /// `pixelsamples` when the file gives it; the film's haltspp or the command line win.
+    pub pixel_samples: Option<u32>,
+    pub requested: String,
+}
+
+impl Default for SamplerDesc {
+    fn default() -> Self {
+        Self {
+            pixel_samples: None,
+            requested: DEFAULT_SAMPLER.into(),
+        }
+    }
+}
+
+impl SamplerDesc {
+    /// Reads `Sampler "ty"`.
+    pub fn read(ty: String, params: &ParamList) -> Result<Self, ParseError> {
+        let n = params.int("pixelsamples", 0)?;
+        // The sampler's algorithm is ours; only its sample count carries over.
+        for p in &params.params {
+            params.ignore(&p.name);
+        }
+        Ok(Self {
+            pixel_samples: (n > 0).then_some(n as u32),
+            requested: ty,
+        })
+    }
+}
 
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 

@@ -6,10 +6,10 @@ use std::f32::consts::TAU;
 use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 
-use crate::desc::Geometry;
 use crate::math::Frame;
+use crate::shape::Geometry;
 
-use super::{SurfaceHit, SurfaceSample};
+use super::hit::{SurfaceHit, SurfaceSample};
 
 #[derive(Clone, Copy, Debug)]
 enum Quadric {
@@ -77,15 +77,9 @@ impl AnalyticShape {
             (phi > 0.0).then_some(phi)
         };
         let quadric = match *geometry {
-            Geometry::Sphere {
-                radius,
-                zmin,
-                zmax,
-                phimax,
-            } => {
+            Geometry::Sphere { radius, phimax, .. } => {
                 (radius > 0.0 && radius.is_finite()).then_some(())?;
-                let z_min = zmin.min(zmax).clamp(-radius, radius);
-                let z_max = zmin.max(zmax).clamp(-radius, radius);
+                let (z_min, z_max) = geometry.sphere_z_range()?;
                 (z_min < z_max).then_some(())?;
                 Quadric::Sphere {
                     radius,

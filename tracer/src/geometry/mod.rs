@@ -8,6 +8,7 @@
 //! are tested separately.
 
 mod analytic;
+mod hit;
 mod plane;
 mod triangle;
 
@@ -16,49 +17,24 @@ pub(crate) mod tests;
 
 use std::time::{Duration, Instant};
 
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use obvhs::BvhBuildParams;
 
-use crate::desc::{Geometry, SceneDesc};
+use crate::desc::SceneDesc;
 use crate::math::Ray;
+use crate::shape::Geometry;
 
 pub use analytic::AnalyticShape;
+pub use hit::{SurfaceHit, SurfaceSample};
 pub use triangle::TriangleSurface;
 
 use analytic::QuadricHit;
 use plane::InfinitePlane;
 use triangle::{TriangleEdges, WorldMesh};
-
-/// A ray's closest hit, with everything shading needs.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceHit {
-    pub t: f32,
-    pub p: Vec3,
-    /// Geometric normal, unit, on the shape's front side (ReverseOrientation applied).
-    pub ng: Vec3,
-    /// Shading normal (interpolated vertex normals, or `ng`), unit, flipped to ng's side.
-    pub ns: Vec3,
-    pub uv: Vec2,
-    /// Surface tangent along u (world space, not normalised; any tangent when uv is absent).
-    pub dpdu: Vec3,
-    /// Index into `SceneDesc::shapes` (material, area light).
-    pub shape: u32,
-    /// Primitive within the scene's geometry (for light sampling pdfs).
-    pub prim: u32,
-}
-
-/// A point sampled on a primitive's surface.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceSample {
-    pub p: Vec3,
-    pub n: Vec3,
-    /// Density with respect to area.
-    pub pdf_area: f32,
-}
 
 /// A BVH primitive: what the traversal reads, and where its shading data lives.
 #[derive(Clone, Copy, Debug)]

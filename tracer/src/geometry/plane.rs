@@ -5,7 +5,7 @@ use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3, Vec3A};
 
 use crate::math::Frame;
 
-use super::SurfaceHit;
+use super::hit::SurfaceHit;
 
 pub(crate) struct InfinitePlane {
     pub shape: u32,

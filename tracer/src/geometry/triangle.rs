@@ -6,7 +6,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec3A};
 use crate::math::Frame;
 use crate::mesh::TriangleMesh;
 
-use super::{SurfaceHit, SurfaceSample};
+use super::hit::{SurfaceHit, SurfaceSample};
 
 /// The uvs of a triangle whose mesh has none (pbrt's rule).
 const DEFAULT_UVS: [Vec2; 3] = [

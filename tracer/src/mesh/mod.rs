@@ -1,5 +1,7 @@
-//! Triangle meshes: the data every mesh-like shape becomes, and reading them from PLY files.
+//! Triangle meshes: the data every mesh-like shape becomes, reading them from inline shape
+//! parameters ([`inline`]) and from PLY files ([`ply`]).
 
+pub mod inline;
 pub mod ply;
 
 use glam::Vec3;

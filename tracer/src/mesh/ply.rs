@@ -120,6 +120,50 @@ pub fn read_mesh(bytes: &[u8]) -> Result<TriangleMesh, String> {
     Ok(mesh)
 }
 
+/// Reads a PLY file into a mesh and checks it ([`validate`]): what a `plymesh` shape uses.
+pub fn read_valid_mesh(bytes: &[u8]) -> Result<TriangleMesh, String> {
+    let mesh = read_mesh(bytes)?;
+    validate(&mesh)?;
+    Ok(mesh)
+}
+
+/// Checks a mesh read from a file: indices in range, attribute counts, finite values.
+pub fn validate(m: &TriangleMesh) -> Result<(), String> {
+    let n = m.positions.len();
+    if let Some((i, v)) = m
+        .indices
+        .iter()
+        .flatten()
+        .enumerate()
+        .find(|(_, &v)| v as usize >= n)
+    {
+        return Err(format!(
+            "face index {} (value {v}) is out of range: {n} vertices",
+            i + 1
+        ));
+    }
+    if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!("vertex {} has a non-finite position", i + 1));
+    }
+    if let Some(normals) = &m.normals {
+        if let Some(i) = normals.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {} has a non-finite normal", i + 1));
+        }
+    }
+    if let Some(uvs) = &m.uvs {
+        if let Some(i) = uvs
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(format!(
+                "vertex {} has a non-finite texture coordinate",
+                i + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

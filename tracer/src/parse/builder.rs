@@ -16,8 +16,9 @@ use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::Warning;
-use crate::mesh::TriangleMesh;
+use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
+use crate::shape::Geometry;
 
 /// Area light parameters kept in the graphics state; the radiance is known only once the
 /// world-space area of each shape is.
@@ -94,13 +95,13 @@ pub struct Builder<'s> {
     block: Block,
     /// Inside MotionBegin/End: whether the block's first transform was applied already.
     motion: Option<bool>,
-    pub(super) options: OptionsState,
+    options: OptionsState,
     textures_in_scope: Vec<NamedTexture>,
     named_materials: HashMap<String, MaterialId>,
     default_material: Option<MaterialId>,
     objects: HashMap<String, Vec<PendingShape>>,
     /// PLY meshes by file name, shared by every shape that loads the same file.
-    pub(super) ply_meshes: HashMap<String, Arc<TriangleMesh>>,
+    ply_meshes: HashMap<String, Arc<TriangleMesh>>,
     current_object: Option<(String, Vec<PendingShape>)>,
     pub(super) textures: Vec<TextureDesc>,
     pub(super) materials: Vec<MaterialDesc>,
@@ -333,7 +334,10 @@ impl<'s> Builder<'s> {
                     self.named_coords
                         .insert("camera".into(), self.ctm.inverse());
                 }
-                self.option(keyword, ty, params, pos)?;
+                let mut options = std::mem::take(&mut self.options);
+                let read = options.read(self, keyword, ty, params, pos);
+                self.options = options;
+                read?;
             }
             "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath"
             | "PortalShape" => r.skip_statement()?,
@@ -562,7 +566,7 @@ impl<'s> Builder<'s> {
         params: &ParamList,
         pos: &Pos,
     ) -> Result<(), ParseError> {
-        let Some(geometry) = self.geometry(ty, params, pos)? else {
+        let Some(geometry) = Geometry::read(self, ty, params, pos)? else {
             return Ok(());
         };
         let material = match self.gs.material {
@@ -594,7 +598,7 @@ impl<'s> Builder<'s> {
         desc.object_to_world = instance * desc.object_to_world;
         desc.area_light = shape
             .emitter
-            .map(|e| super::lights::area_light(&e, super::shapes::world_area(&desc)));
+            .map(|e| super::lights::area_light(&e, desc.world_area()));
         self.shapes.push(desc);
     }
 
@@ -720,6 +724,25 @@ impl ParseContext for Builder<'_> {
             self.assets.push(r);
         }
         Ok(bytes)
+    }
+
+    fn ply_mesh(&mut self, path: &str, pos: &Pos) -> Result<Arc<TriangleMesh>, ParseError> {
+        if let Some(m) = self.ply_meshes.get(path) {
+            return Ok(m.clone());
+        }
+        let bytes = self.read_asset(path, AssetKind::Ply, pos)?;
+        let mesh = ply::read_valid_mesh(&bytes).map_err(|message| ParseError::Ply {
+            pos: pos.clone(),
+            path: path.to_string(),
+            message,
+        })?;
+        let mesh = Arc::new(mesh);
+        self.ply_meshes.insert(path.to_string(), mesh.clone());
+        Ok(mesh)
+    }
+
+    fn warn_unused(&mut self, params: &ParamList) {
+        Builder::warn_unused(self, params)
     }
 
     fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {

@@ -11,6 +11,7 @@ use super::error::ParseError;
 use super::params::{ParamList, ParamType, TexValue, Values};
 use crate::assets::AssetKind;
 use crate::diag::SourcePos;
+use crate::mesh::TriangleMesh;
 use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 
 /// What a texture name is bound to in the current attribute scope. Fresnel textures are not
@@ -56,6 +57,14 @@ pub trait ParseContext {
 
     /// Checks that an image file exists and its header decodes, and records it as an asset.
     fn check_image(&mut self, path: &str, pos: &SourcePos) -> Result<(), ParseError>;
+
+    /// The triangle mesh of a PLY file, read, validated and recorded as an asset on first use
+    /// and shared by every later shape that names the same file.
+    fn ply_mesh(&mut self, path: &str, pos: &SourcePos) -> Result<Arc<TriangleMesh>, ParseError>;
+
+    /// Warns (once per statement type and parameter) about parameters nothing read, except
+    /// the exporter parameters that change nothing.
+    fn warn_unused(&mut self, params: &ParamList);
 
     /// Resolves a texture-or-constant parameter; an undefined texture name (or a fresnel
     /// texture where a colour or float is wanted) is a warning and falls back to `default`.

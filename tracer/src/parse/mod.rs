@@ -4,8 +4,9 @@
 //! Module map: [`lexer`] (bytes -> tokens), [`reader`] (tokens -> statement arguments and
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
-//! described: [`options`] (camera, film, filter, integrator, sampler), [`textures`],
-//! [`materials`], [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
+//! described: [`options`] (the camera, film, filter, integrator and sampler statements, read by
+//! their concepts), [`textures`], [`materials`], [`lights`], [`spectra`] (metal presets,
+//! blackbody). Shapes are read by [`crate::shape`] (meshes by [`crate::mesh`]).
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
@@ -19,14 +20,13 @@
 
 mod builder;
 pub(crate) mod context;
-mod error;
+pub(crate) mod error;
 mod lexer;
 mod lights;
 mod materials;
 mod options;
 pub(crate) mod params;
 mod reader;
-mod shapes;
 mod spectra;
 mod textures;
 

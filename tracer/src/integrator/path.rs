@@ -1,13 +1,27 @@
-//! Unidirectional path tracing with next-event estimation, multiple importance sampling of
+//! The path tracer: unidirectional path tracing with next-event estimation, multiple importance sampling of
 //! light and BSDF samples (power heuristic), and Russian roulette.
 
 use glam::Vec3;
 
-use crate::desc::RussianRoulette;
-use crate::geometry::SurfaceHit;
+use super::options::{IntegratorDesc, RussianRoulette};
+use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::lights::Lights;
+use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
-use crate::render::RenderScene;
 use crate::sampler::PixelSampler;
+
+/// What the path tracer needs from the scene. The renderer's built scene implements it, so the
+/// integrator does not depend on how the scene is built.
+pub trait PathScene {
+    /// The scene's SurfaceIntegrator settings.
+    fn integrator(&self) -> &IntegratorDesc;
+    /// Bounces per path (the settings' max depth, which the command line may override).
+    fn max_depth(&self) -> u32;
+    fn geometry(&self) -> &SceneGeometry;
+    fn lights(&self) -> &Lights;
+    /// The BSDF at a hit; `u_mix` resolves mix materials.
+    fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf;
+}
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
 /// null faces).
@@ -38,9 +52,9 @@ struct PrevScatter {
     specular: bool,
 }
 
-pub fn trace_path(scene: &RenderScene, mut ray: Ray, sampler: &mut PixelSampler) -> PathResult {
-    let integrator = &scene.desc().integrator;
-    let max_depth = scene.settings().max_depth;
+pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSampler) -> PathResult {
+    let integrator = scene.integrator();
+    let max_depth = scene.max_depth();
     let lights = scene.lights();
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
@@ -139,11 +153,11 @@ pub fn trace_path(scene: &RenderScene, mut ray: Ray, sampler: &mut PixelSampler)
 }
 
 /// One light sample, weighted against BSDF sampling by the power heuristic.
-fn direct_light(
-    scene: &RenderScene,
+fn direct_light<S: PathScene>(
+    scene: &S,
     hit: &SurfaceHit,
     wo: Vec3,
-    bsdf: &crate::material::Bsdf,
+    bsdf: &Bsdf,
     sampler: &mut PixelSampler,
     rays: &mut u32,
 ) -> Vec3 {

@@ -1,0 +1,31 @@
+//! What a ray query returns and what light sampling draws on a surface: the leaf the shape
+//! files and the scene geometry share.
+
+use glam::{Vec2, Vec3};
+
+/// A ray's closest hit, with everything shading needs.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub p: Vec3,
+    /// Geometric normal, unit, on the shape's front side (ReverseOrientation applied).
+    pub ng: Vec3,
+    /// Shading normal (interpolated vertex normals, or `ng`), unit, flipped to ng's side.
+    pub ns: Vec3,
+    pub uv: Vec2,
+    /// Surface tangent along u (world space, not normalised; any tangent when uv is absent).
+    pub dpdu: Vec3,
+    /// Index into `SceneDesc::shapes` (material, area light).
+    pub shape: u32,
+    /// Primitive within the scene's geometry (for light sampling pdfs).
+    pub prim: u32,
+}
+
+/// A point sampled on a primitive's surface.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceSample {
+    pub p: Vec3,
+    pub n: Vec3,
+    /// Density with respect to area.
+    pub pdf_area: f32,
+}

@@ -1,0 +1,122 @@
+//! `SurfaceIntegrator "path" ...`: the integrator's settings, LuxRender's defaults and their
+//! reading. Other integrators render as path tracing ("bidirectional" keeps its eye depth).
+//!
+//! | parameter | type | default |
+//! |---|---|---|
+//! | `maxdepth` (path), `eyedepth` (bidirectional) | integer | 16 |
+//! | `rrstrategy` | string: efficiency, probability, none | efficiency |
+//! | `rrcontinueprob` | float | 0.65 |
+//! | `includeenvironment` | bool | true |
+//!
+//! Without a `SurfaceIntegrator` statement the scene renders with `"path"` and these defaults.
+
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+/// Bounces per path when the file does not say.
+pub const DEFAULT_MAX_DEPTH: i32 = 16;
+/// Survival probability of `rrstrategy "probability"` when the file does not say.
+pub const DEFAULT_RR_CONTINUE_PROB: f32 = 0.65;
+/// Whether camera rays that escape see the environment.
+pub const DEFAULT_INCLUDE_ENVIRONMENT: bool = true;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RussianRoulette {
+    Efficiency,
+    Probability,
+    None,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegratorDesc {
+    pub max_depth: u32,
+    pub rr_strategy: RussianRoulette,
+    pub rr_continue_prob: f32,
+    pub include_environment: bool,
+    /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
+    pub requested: String,
+}
+
+impl IntegratorDesc {
+    /// The path integrator with every default, recorded as `requested`.
+    pub fn path_defaults(requested: &str) -> Self {
+        Self {
+            max_depth: DEFAULT_MAX_DEPTH as u32,
+            rr_strategy: RussianRoulette::Efficiency,
+            rr_continue_prob: DEFAULT_RR_CONTINUE_PROB,
+            include_environment: DEFAULT_INCLUDE_ENVIRONMENT,
+            requested: requested.to_string(),
+        }
+    }
+
+    /// Reads `SurfaceIntegrator "ty"`.
+    pub fn read(
+        ctx: &mut dyn ParseContext,
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+    ) -> Result<Self, ParseError> {
+        let depth = |name: &str| -> Result<u32, ParseError> {
+            let d = params.int(name, DEFAULT_MAX_DEPTH)?;
+            match params.find(name) {
+                Some(p) if d < 0 => Err(params.error(p, "the depth cannot be negative")),
+                _ => Ok(d as u32),
+            }
+        };
+        match ty {
+            "path" => {
+                let strategy = params.string_or("rrstrategy", "efficiency")?;
+                let rr_strategy = match strategy.as_str() {
+                    "efficiency" => RussianRoulette::Efficiency,
+                    "probability" => RussianRoulette::Probability,
+                    "none" => RussianRoulette::None,
+                    other => {
+                        ctx.warn(pos, format!("SurfaceIntegrator \"path\": unknown rrstrategy \"{other}\"; using efficiency"));
+                        RussianRoulette::Efficiency
+                    }
+                };
+                params.ignore("lightstrategy");
+                params.ignore("shadowraycount");
+                Ok(IntegratorDesc {
+                    max_depth: depth("maxdepth")?,
+                    rr_strategy,
+                    rr_continue_prob: params.float("rrcontinueprob", DEFAULT_RR_CONTINUE_PROB)?,
+                    include_environment: params
+                        .bool("includeenvironment", DEFAULT_INCLUDE_ENVIRONMENT)?,
+                    requested: ty.to_string(),
+                })
+            }
+            "bidirectional" => {
+                let max_depth = depth("eyedepth")?;
+                for name in [
+                    "lightdepth",
+                    "lightraycount",
+                    "lightpathstrategy",
+                    "lightstrategy",
+                    "eyerrthreshold",
+                    "lightrrthreshold",
+                ] {
+                    params.ignore(name);
+                }
+                ctx.warn_once(
+                    "bidirectional".into(),
+                    pos,
+                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth)"),
+                );
+                Ok(IntegratorDesc {
+                    max_depth,
+                    ..Self::path_defaults(ty)
+                })
+            }
+            other => {
+                for p in &params.params {
+                    params.ignore(&p.name);
+                }
+                ctx.warn(pos, format!("SurfaceIntegrator \"{other}\" is not available; rendering with \"path\" and its defaults"));
+                Ok(Self::path_defaults(other))
+            }
+        }
+    }
+}

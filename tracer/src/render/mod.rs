@@ -1,0 +1,16 @@
+//! The render API every node uses: settings, the unit plan, the built scene and rendering one
+//! unit into a sample buffer.
+//!
+//! Files: [`settings`] (resolved settings and command-line overrides), [`unit`] (a work unit
+//! and its counters: the leaf the film, the plan and the nodes share), [`plan`] (cutting an
+//! image into units), [`scene`] (the built scene and rendering one unit).
+
+pub mod plan;
+pub mod scene;
+pub mod settings;
+pub mod unit;
+
+pub use plan::{plan_units, PASSES, TILE_SIZE};
+pub use scene::{BuildError, RenderScene};
+pub use settings::{RenderOverrides, RenderSettings, DEFAULT_SPP};
+pub use unit::{UnitStats, WorkUnit};
