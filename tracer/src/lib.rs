@@ -1,10 +1,16 @@
 //! YAT's renderer as a library. It knows nothing of the network: the worker and coordinator
 //! crates drive it through [`render`].
 //!
-//! Data flow: `.lxs` text -> [`parse`] -> [`desc::SceneDesc`] (plain data, defaults applied)
-//! -> [`render::RenderScene::build`] (world-space geometry and BVH, decoded textures, light
-//! sampling tables) -> [`render::RenderScene::render_unit`] -> [`film::SampleBuffer`]s merged
-//! into a [`film::Film`].
+//! Data flow: `.lxs` text -> [`parse`] (the statements; each concept reads its own parameters:
+//! [`camera`], [`film`], [`filter`], [`sampler`], [`integrator::options`], [`shape`], ...) ->
+//! [`desc::SceneDesc`] (plain data, defaults applied) -> [`render::RenderScene::build`]
+//! (world-space geometry and BVH, decoded textures, light sampling tables) ->
+//! [`render::RenderScene::render_unit`] (per sample: [`sampler`], [`filter`], [`camera`], then
+//! [`integrator::trace_path`]) -> [`film::SampleBuffer`]s merged into a [`film::Film`].
+//!
+//! Leaves the layers above share: [`render::unit`] (work units, which the film's buffers are
+//! keyed by), [`render::settings`], [`geometry::SurfaceHit`]; the path tracer sees the built
+//! scene only through [`integrator::PathScene`].
 
 pub mod assets;
 pub mod camera;
