@@ -7,6 +7,7 @@
 //! into a [`film::Film`].
 
 pub mod assets;
+pub mod bxdf;
 pub mod camera;
 pub mod desc;
 pub mod diag;
