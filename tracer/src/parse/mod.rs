@@ -5,7 +5,8 @@
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
 //! described: [`options`] (camera, film, filter, integrator, sampler), [`textures`],
-//! [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
+//! [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody). Materials read
+//! themselves ([`crate::material`]); the builder only calls [`crate::material::MaterialDesc::read`].
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
