@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::Context;
 use yat_tracer::assets::FsSource;
 use yat_tracer::desc::{
-    AssetKind, CameraKind, FilterKind, Geometry, LightDesc, MaterialDesc, SceneDesc, ToneMap,
+    AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
 use yat_tracer::parse::parse_scene;
 
@@ -186,16 +186,7 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
             .chain(std::iter::repeat_n("area (shapes)", emitters)),
     );
     let _ = writeln!(s, "lights       {lights}");
-    let materials = counts(d.materials.iter().map(|m| match m {
-        MaterialDesc::Matte { .. } => "matte",
-        MaterialDesc::Glossy { .. } => "glossy",
-        MaterialDesc::Mirror { .. } => "mirror",
-        MaterialDesc::Glass { .. } => "glass",
-        MaterialDesc::Metal { .. } => "metal",
-        MaterialDesc::MatteTranslucent { .. } => "mattetranslucent",
-        MaterialDesc::Null => "null",
-        MaterialDesc::Mix { .. } => "mix",
-    }));
+    let materials = counts(d.materials.iter().map(|m| m.name()));
     let _ = writeln!(s, "materials    {} ({materials})", d.materials.len());
     let _ = writeln!(s, "textures     {}", d.textures.len());
     let assets = counts(d.assets.iter().map(|a| match a.kind {

@@ -127,56 +127,9 @@ pub struct TextureDesc {
 // ---------------------------------------------------------------------------------------------
 // Materials
 
-#[derive(Clone, Debug, PartialEq)]
-pub enum MaterialDesc {
-    Matte {
-        kd: Tex,
-        /// Oren-Nayar sigma in degrees.
-        sigma: Tex,
-    },
-    /// LuxRender's Glossy2: Kd, Ks (already multiplied by ((i-1)/(i+1))^2 when index > 0),
-    /// absorption Ka with depth d, anisotropic roughness.
-    Glossy {
-        kd: Tex,
-        ks: Tex,
-        ka: Tex,
-        depth: Tex,
-        uroughness: Tex,
-        vroughness: Tex,
-        multibounce: bool,
-    },
-    Mirror {
-        kr: Tex,
-    },
-    /// glass and roughglass: zero roughness is the smooth specular glass.
-    Glass {
-        kr: Tex,
-        kt: Tex,
-        index: Tex,
-        architectural: bool,
-        uroughness: Tex,
-        vroughness: Tex,
-    },
-    /// metal and metal2 both become a microfacet conductor.
-    Metal {
-        fresnel: Fresnel,
-        uroughness: Tex,
-        vroughness: Tex,
-    },
-    MatteTranslucent {
-        kr: Tex,
-        kt: Tex,
-        sigma: Tex,
-    },
-    /// Invisible: rays pass through (used on emitters).
-    Null,
-    Mix {
-        a: MaterialId,
-        b: MaterialId,
-        /// Weight of `b`.
-        amount: Tex,
-    },
-}
+pub use crate::material::{
+    Glass, Glossy, MaterialDesc, Matte, MatteTranslucent, Metal, Mirror, Mix, Null,
+};
 
 // ---------------------------------------------------------------------------------------------
 // Lights

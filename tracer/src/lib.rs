@@ -13,6 +13,7 @@
 //! scene only through [`integrator::PathScene`].
 
 pub mod assets;
+pub mod bxdf;
 pub mod camera;
 pub mod desc;
 pub mod diag;

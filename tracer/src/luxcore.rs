@@ -26,6 +26,7 @@ use crate::desc::{
     CameraKind, FilterKind, Geometry, LatLongConvention, LightDesc, Mapping2D, MaterialDesc,
     SceneDesc, ShapeDesc, TextureKind, Wrap,
 };
+use crate::desc::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix, Null};
 
 use crate::mesh::TriangleMesh;
 
@@ -167,58 +168,6 @@ fn texture_inputs(kind: &TextureKind) -> Vec<TextureId> {
     out
 }
 
-/// Textures a material reads directly, and the materials it mixes.
-fn material_inputs(m: &MaterialDesc) -> (Vec<TextureId>, Vec<MaterialId>) {
-    let mut t = Vec::new();
-    let mut mats = Vec::new();
-    match m {
-        MaterialDesc::Matte { kd, sigma } => [kd, sigma].iter().for_each(|x| push_tex(x, &mut t)),
-        MaterialDesc::Glossy {
-            kd,
-            ks,
-            ka,
-            depth,
-            uroughness,
-            vroughness,
-            ..
-        } => [kd, ks, ka, depth, uroughness, vroughness]
-            .iter()
-            .for_each(|x| push_tex(x, &mut t)),
-        MaterialDesc::Mirror { kr } => push_tex(kr, &mut t),
-        MaterialDesc::Glass {
-            kr,
-            kt,
-            index,
-            uroughness,
-            vroughness,
-            ..
-        } => [kr, kt, index, uroughness, vroughness]
-            .iter()
-            .for_each(|x| push_tex(x, &mut t)),
-        MaterialDesc::Metal {
-            fresnel,
-            uroughness,
-            vroughness,
-        } => {
-            match fresnel {
-                Fresnel::Reflectance(x) | Fresnel::Index(x) => push_tex(x, &mut t),
-                Fresnel::Conductor { .. } => {}
-            }
-            push_tex(uroughness, &mut t);
-            push_tex(vroughness, &mut t);
-        }
-        MaterialDesc::MatteTranslucent { kr, kt, sigma } => {
-            [kr, kt, sigma].iter().for_each(|x| push_tex(x, &mut t))
-        }
-        MaterialDesc::Null => {}
-        MaterialDesc::Mix { a, b, amount } => {
-            push_tex(amount, &mut t);
-            mats.extend([*a, *b]);
-        }
-    }
-    (t, mats)
-}
-
 /// The one non-uv mapping the material's textures use, if any: shapes with this material get
 /// it baked into their uvs. A material that also reads uv-mapped textures, or two different
 /// baked mappings, cannot be expressed.
@@ -232,9 +181,8 @@ fn material_bake(desc: &SceneDesc, material: MaterialId) -> Result<Option<Mappin
             continue;
         }
         if let Some(md) = desc.materials.get(m.0 as usize) {
-            let (t, mats) = material_inputs(md);
-            tex_stack.extend(t);
-            mat_stack.extend(mats);
+            tex_stack.extend(md.textures());
+            mat_stack.extend(md.materials());
         }
     }
     let mut baked: Vec<&Mapping2D> = Vec::new();
@@ -425,7 +373,7 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
     let prefix = format!("scene.materials.{name}");
     let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
     match m {
-        MaterialDesc::Matte { kd, sigma } => {
+        MaterialDesc::Matte(Matte { kd, sigma }) => {
             let rough = *sigma != Tex::float(0.0);
             set("type", quoted(if rough { "roughmatte" } else { "matte" }));
             set("kd", tex_value(kd, true));
@@ -433,7 +381,7 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
                 set("sigma", tex_value(sigma, false));
             }
         }
-        MaterialDesc::Glossy {
+        MaterialDesc::Glossy(Glossy {
             kd,
             ks,
             ka,
@@ -441,7 +389,7 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
             uroughness,
             vroughness,
             multibounce,
-        } => {
+        }) => {
             set("type", quoted("glossy2"));
             set("kd", tex_value(kd, true));
             set("ks", tex_value(ks, true));
@@ -451,18 +399,18 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
             set("vroughness", tex_value(vroughness, false));
             set("multibounce", u8::from(*multibounce).to_string());
         }
-        MaterialDesc::Mirror { kr } => {
+        MaterialDesc::Mirror(Mirror { kr }) => {
             set("type", quoted("mirror"));
             set("kr", tex_value(kr, true));
         }
-        MaterialDesc::Glass {
+        MaterialDesc::Glass(Glass {
             kr,
             kt,
             index,
             architectural,
             uroughness,
             vroughness,
-        } => {
+        }) => {
             let rough = *uroughness != Tex::float(0.0) || *vroughness != Tex::float(0.0);
             let kind = match (architectural, rough) {
                 (true, _) => "archglass",
@@ -479,11 +427,11 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
                 set("vroughness", tex_value(vroughness, false));
             }
         }
-        MaterialDesc::Metal {
+        MaterialDesc::Metal(Metal {
             fresnel,
             uroughness,
             vroughness,
-        } => {
+        }) => {
             set("type", quoted("metal2"));
             set("fresnel", quoted(&format!("{name}_fresnel")));
             set("uroughness", tex_value(uroughness, false));
@@ -506,22 +454,23 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
                 }
             }
         }
-        MaterialDesc::MatteTranslucent { kr, kt, .. } => {
+        MaterialDesc::MatteTranslucent(MatteTranslucent { kr, kt, .. }) => {
             set("type", quoted("mattetranslucent"));
             set("kr", tex_value(kr, true));
             set("kt", tex_value(kt, true));
         }
-        MaterialDesc::Null if emission.is_some() => {
+        MaterialDesc::Null(_) if emission.is_some() => {
             set("type", quoted("matte"));
             set("kd", "0 0 0".into());
         }
-        MaterialDesc::Null => set("type", quoted("null")),
-        MaterialDesc::Mix { a, b, amount } => {
+        MaterialDesc::Mix(Mix { a, b, amount }) => {
             set("type", quoted("mix"));
             set("material1", quoted(&mat_name(*a)));
             set("material2", quoted(&mat_name(*b)));
             set("amount", tex_value(amount, false));
         }
+        // Kinds with no parameters LuxCore needs (null) go by their name.
+        other => set("type", quoted(other.name())),
     }
     if let Some(radiance) = emission {
         p.set(format!("{prefix}.emission"), v3(radiance));
@@ -930,7 +879,7 @@ pub fn export(
                 write_material(
                     &mut p,
                     &name,
-                    m.unwrap_or(&MaterialDesc::Null),
+                    m.unwrap_or(&MaterialDesc::Null(Null)),
                     Some(area.radiance),
                 );
                 name

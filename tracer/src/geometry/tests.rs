@@ -45,10 +45,10 @@ pub(crate) fn scene_desc(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> Scen
             requested: "sobol".into(),
         },
         textures: Vec::new(),
-        materials: vec![MaterialDesc::Matte {
+        materials: vec![MaterialDesc::Matte(Matte {
             kd: Tex::float(0.5),
             sigma: Tex::float(0.0),
-        }],
+        })],
         shapes,
         lights,
         warnings: Vec::new(),

@@ -1,68 +1,170 @@
-//! Materials and their BSDFs: matte (Oren-Nayar), glossy (Glossy2), mirror, glass and rough
-//! glass, metal/metal2 (microfacet conductor), mattetranslucent, null, mix.
+//! Materials: what a `Material` / `MakeNamedMaterial` statement describes, and the BSDF it
+//! makes at a hit. One file per material, each with its `.lxs` syntax, parameters and
+//! defaults, its reading and its evaluation: [`matte`], [`glossy`] (glossy, glossy2),
+//! [`mirror`], [`glass`] (glass, roughglass, glass2), [`metal`] (metal, metal2),
+//! [`mattetranslucent`], [`null`], [`mix`]. They compose the lobes of [`crate::bxdf`];
+//! [`eval`] is what they see of the textures at a hit.
 //!
 //! A material is resolved per hit into a [`Bsdf`]: textures are evaluated at the hit, `mix`
 //! materials are resolved stochastically, and the result is a plain value.
+//!
+//! A new material is one new file plus one line in [`MaterialDesc::read`]'s name table (and
+//! one line in each `match` below).
 
-mod bsdf;
-mod bxdf;
-mod conductor;
-mod dielectric;
-mod diffuse;
-mod fresnel;
-mod ggx_albedo;
-mod glossy;
-mod local;
-mod microfacet;
+pub mod eval;
+pub mod glass;
+pub mod glossy;
+pub mod matte;
+pub mod mattetranslucent;
+pub mod metal;
+pub mod mirror;
+pub mod mix;
+pub mod null;
 
 #[cfg(test)]
 mod tests;
 
 use glam::Vec3;
 
-pub use bsdf::{Bsdf, BsdfSample};
+pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
+pub use glass::Glass;
+pub use glossy::Glossy;
+pub use matte::Matte;
+pub use mattetranslucent::MatteTranslucent;
+pub use metal::Metal;
+pub use mirror::Mirror;
+pub use mix::Mix;
+pub use null::Null;
 
-use crate::desc::{MaterialDesc, SceneDesc};
-
+use crate::bxdf::{ggx_albedo, Bxdf};
+use crate::diag::SourcePos;
 use crate::geometry::SurfaceHit;
 use crate::math::Frame;
-use crate::param::{Fresnel, MaterialId, Tex};
+use crate::param::{MaterialId, Tex, TextureId};
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
 use crate::texture::{TexturePoint, Textures};
-use bxdf::Bxdf;
-use conductor::{Conductor, ConductorFresnel};
-use dielectric::{Dielectric, Surface};
-use diffuse::{DiffuseReflection, DiffuseTranslucent, OrenNayar};
-use glossy::Glossy;
-use microfacet::TrowbridgeReitz;
+use eval::TextureEval;
 
-/// What a hit on an undefined material (an out-of-range id, or a mix cycle) shows: LuxRender's
-/// default matte.
-const DEFAULT_MATTE_KD: f32 = 0.9;
+/// A material's description: plain data with LuxRender's defaults applied, indexed by
+/// [`MaterialId`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialDesc {
+    Matte(Matte),
+    Glossy(Glossy),
+    Mirror(Mirror),
+    Glass(Glass),
+    Metal(Metal),
+    MatteTranslucent(MatteTranslucent),
+    Null(Null),
+    Mix(Mix),
+}
+
+impl MaterialDesc {
+    /// Reads `Material "ty"` (or `MakeNamedMaterial` with `"string type" ["ty"]`): the table
+    /// from LuxRender's material names to kinds. An unsupported type warns and becomes a matte
+    /// (with its Kd when given).
+    pub fn read(
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Ok(match ty {
+            "matte" => Self::Matte(Matte::read(params, pos, ctx)?),
+            "glossy" => Self::Glossy(Glossy::read(params, pos, ctx)?),
+            "glossy2" => Self::Glossy(Glossy::read(params, pos, ctx)?),
+            "mirror" => Self::Mirror(Mirror::read(params, pos, ctx)?),
+            "glass" => Self::Glass(Glass::read(params, pos, ctx)?),
+            "roughglass" => Self::Glass(Glass::read_rough(params, pos, ctx)?),
+            "glass2" => Self::Glass(Glass::read_glass2(params, pos, ctx)?),
+            "metal" => Self::Metal(Metal::read(params, pos, ctx)?),
+            "metal2" => Self::Metal(Metal::read_metal2(params, pos, ctx)?),
+            "mattetranslucent" => Self::MatteTranslucent(MatteTranslucent::read(params, pos, ctx)?),
+            "null" => Self::Null(Null),
+            "mix" => Self::Mix(Mix::read(params, pos, ctx)?),
+            other => {
+                ctx.warn(pos, format!("material \"{other}\" is not supported; using matte (with its Kd when given)"));
+                let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
+                for p in &params.params {
+                    params.ignore(&p.name);
+                }
+                Self::Matte(Matte {
+                    kd,
+                    sigma: Tex::float(matte::DEFAULT_SIGMA),
+                })
+            }
+        })
+    }
+
+    /// The kind's LuxRender name (glossy2, roughglass, glass2 and metal2 are read into the
+    /// glossy, glass and metal kinds).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Matte(_) => "matte",
+            Self::Glossy(_) => "glossy",
+            Self::Mirror(_) => "mirror",
+            Self::Glass(_) => "glass",
+            Self::Metal(_) => "metal",
+            Self::MatteTranslucent(_) => "mattetranslucent",
+            Self::Null(_) => "null",
+            Self::Mix(_) => "mix",
+        }
+    }
+
+    /// The textures the material reads directly, in parameter order.
+    pub fn textures(&self) -> Vec<TextureId> {
+        match self {
+            Self::Matte(m) => m.textures(),
+            Self::Glossy(m) => m.textures(),
+            Self::Mirror(m) => m.textures(),
+            Self::Glass(m) => m.textures(),
+            Self::Metal(m) => m.textures(),
+            Self::MatteTranslucent(m) => m.textures(),
+            Self::Null(m) => m.textures(),
+            Self::Mix(m) => m.textures(),
+        }
+    }
+
+    /// The materials it refers to (those a `mix` chooses between).
+    pub fn materials(&self) -> Vec<MaterialId> {
+        match self {
+            Self::Mix(m) => m.materials(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The lobe of a leaf material at a hit (a `mix` resolved by [`Materials`] first; an
+    /// unresolved one shows the default matte).
+    fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+        match self {
+            Self::Matte(m) => m.bxdf(eval),
+            Self::Glossy(m) => m.bxdf(eval),
+            Self::Mirror(m) => m.bxdf(eval),
+            Self::Glass(m) => m.bxdf(eval),
+            Self::Metal(m) => m.bxdf(eval),
+            Self::MatteTranslucent(m) => m.bxdf(eval),
+            Self::Null(m) => m.bxdf(),
+            Self::Mix(_) => Matte::default_bxdf(),
+        }
+    }
+}
 
 pub struct Materials {
     materials: Vec<MaterialDesc>,
 }
 
-/// Reflectances are clamped to [0, 1] (as LuxRender does) so no texture can create energy;
-/// NaN becomes 0.
-fn unit(c: Vec3) -> Vec3 {
-    c.max(Vec3::ZERO).min(Vec3::ONE)
-}
-
 impl Materials {
-    pub fn build(desc: &SceneDesc) -> Self {
-        Self::new(desc.materials.clone())
-    }
-
     /// The materials indexed by [`MaterialId`].
     pub fn new(materials: Vec<MaterialDesc>) -> Self {
         let multibounce = materials.iter().any(|m| {
             matches!(
                 m,
-                MaterialDesc::Glossy {
+                MaterialDesc::Glossy(Glossy {
                     multibounce: true,
                     ..
-                }
+                })
             )
         });
         if multibounce {
@@ -72,31 +174,17 @@ impl Materials {
     }
 
     /// Follows `mix` materials down to a leaf. At each level `u_mix` chooses a side against
-    /// the amount and is rescaled to [0, 1) within the chosen side, so nested mixes draw on
-    /// the same number without correlation between levels.
-    fn resolve(
-        &self,
-        id: MaterialId,
-        at: &TexturePoint,
-        textures: &Textures,
-        u_mix: f32,
-    ) -> Option<&MaterialDesc> {
+    /// the amount and is rescaled to [0, 1) within the chosen side (see [`Mix::choose`]).
+    fn resolve(&self, id: MaterialId, eval: &TextureEval, u_mix: f32) -> Option<&MaterialDesc> {
         let mut material = self.materials.get(id.0 as usize)?;
         let mut u = u_mix;
         // A well-formed scene cannot nest deeper than it has materials; more means a cycle.
         for _ in 0..=self.materials.len() {
-            let MaterialDesc::Mix { a, b, amount } = material else {
+            let MaterialDesc::Mix(mix) = material else {
                 return Some(material);
             };
-            let amount = textures.eval(*amount, at).x.clamp(0.0, 1.0);
-            let next = if u < amount {
-                u /= amount;
-                b
-            } else {
-                u = (u - amount) / (1.0 - amount);
-                a
-            };
-            u = u.clamp(0.0, 1.0 - f32::EPSILON);
+            let next;
+            (next, u) = mix.choose(eval, u);
             material = self.materials.get(next.0 as usize)?;
         }
         Some(material)
@@ -113,109 +201,17 @@ impl Materials {
         textures: &Textures,
         u_mix: f32,
     ) -> Bsdf {
-        let at = TexturePoint {
-            p: p_object,
-            uv: hit.uv,
+        let eval = TextureEval {
+            textures,
+            at: TexturePoint {
+                p: p_object,
+                uv: hit.uv,
+            },
         };
-        let color = |t: Tex| unit(textures.eval(t, &at));
-        let float = |t: Tex| textures.eval(t, &at).x;
-        let roughness = |u: Tex, v: Tex| TrowbridgeReitz::from_roughness(float(u), float(v));
-
-        let bxdf = match self.resolve(id, &at, textures, u_mix) {
+        let bxdf = match self.resolve(id, &eval, u_mix) {
+            Some(material) => material.bxdf(&eval),
             // A dangling id or a mix cycle (resolve gives up on it).
-            None | Some(MaterialDesc::Mix { .. }) => Bxdf::Diffuse(DiffuseReflection {
-                r: Vec3::splat(DEFAULT_MATTE_KD),
-                roughness: OrenNayar::new(0.0),
-            }),
-            Some(&MaterialDesc::Matte { kd, sigma }) => Bxdf::Diffuse(DiffuseReflection {
-                r: color(kd),
-                roughness: OrenNayar::new(float(sigma)),
-            }),
-            Some(&MaterialDesc::MatteTranslucent { kr, kt, sigma }) => {
-                let r = color(kr);
-                // LuxRender's "energyconserving" rule, always on: what is reflected cannot
-                // also be transmitted.
-                let t = color(kt) * (Vec3::ONE - r);
-                Bxdf::Translucent(DiffuseTranslucent {
-                    r,
-                    t,
-                    roughness: OrenNayar::new(float(sigma)),
-                })
-            }
-            Some(&MaterialDesc::Glossy {
-                kd,
-                ks,
-                ka,
-                depth,
-                uroughness,
-                vroughness,
-                multibounce,
-            }) => {
-                let distrib = roughness(uroughness, vroughness);
-                let multibounce_alpha = match (multibounce, distrib) {
-                    (true, Some(_)) => {
-                        let (u, v) = (float(uroughness), float(vroughness));
-                        Some((u.max(0.0) * v.max(0.0)).sqrt().clamp(0.0, 1.0))
-                    }
-                    _ => None,
-                };
-                Bxdf::Glossy(Glossy {
-                    kd: color(kd),
-                    ks: color(ks),
-                    ka: color(ka),
-                    depth: float(depth).max(0.0),
-                    distrib,
-                    multibounce_alpha,
-                })
-            }
-            Some(&MaterialDesc::Mirror { kr }) => Bxdf::Conductor(Conductor {
-                fresnel: ConductorFresnel::Constant(color(kr)),
-                distrib: None,
-            }),
-            Some(&MaterialDesc::Glass {
-                kr,
-                kt,
-                index,
-                architectural,
-                uroughness,
-                vroughness,
-            }) => {
-                let eta = float(index);
-                let surface = if architectural {
-                    Surface::Thin
-                } else {
-                    match roughness(uroughness, vroughness) {
-                        Some(distrib) => Surface::Rough(distrib),
-                        None => Surface::Smooth,
-                    }
-                };
-                Bxdf::Dielectric(Dielectric {
-                    kr: color(kr),
-                    kt: color(kt),
-                    // A non-positive index is meaningless; treat it as no interface.
-                    eta: if eta > 0.0 { eta } else { 1.0 },
-                    surface,
-                })
-            }
-            Some(MaterialDesc::Metal {
-                fresnel,
-                uroughness,
-                vroughness,
-            }) => {
-                let fresnel = match *fresnel {
-                    Fresnel::Conductor { eta, k } => ConductorFresnel::Complex { eta, k },
-                    Fresnel::Index(index) => ConductorFresnel::Complex {
-                        eta: Vec3::splat(float(index).max(1e-3)),
-                        k: Vec3::ZERO,
-                    },
-                    Fresnel::Reflectance(r0) => ConductorFresnel::Schlick { r0: color(r0) },
-                };
-                Bxdf::Conductor(Conductor {
-                    fresnel,
-                    distrib: roughness(*uroughness, *vroughness),
-                })
-            }
-            Some(MaterialDesc::Null) => Bxdf::PassThrough,
+            None => Matte::default_bxdf(),
         };
         Bsdf::new(Frame::from_normal_tangent(hit.ns, hit.dpdu), hit.ng, bxdf)
     }

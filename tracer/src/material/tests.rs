@@ -46,14 +46,14 @@ fn rgb(r: f32, g: f32, b: f32) -> Tex {
 }
 
 fn matte(kd: f32, sigma: f32) -> MaterialDesc {
-    MaterialDesc::Matte {
+    MaterialDesc::Matte(Matte {
         kd: c(kd),
         sigma: c(sigma),
-    }
+    })
 }
 
 fn glossy(kd: f32, ks: f32, u: f32, v: f32, multibounce: bool) -> MaterialDesc {
-    MaterialDesc::Glossy {
+    MaterialDesc::Glossy(Glossy {
         kd: c(kd),
         ks: c(ks),
         ka: c(0.0),
@@ -61,29 +61,29 @@ fn glossy(kd: f32, ks: f32, u: f32, v: f32, multibounce: bool) -> MaterialDesc {
         uroughness: c(u),
         vroughness: c(v),
         multibounce,
-    }
+    })
 }
 
 fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
-    MaterialDesc::Glass {
+    MaterialDesc::Glass(Glass {
         kr: c(1.0),
         kt: c(1.0),
         index: c(index),
         architectural,
         uroughness: c(roughness),
         vroughness: c(roughness),
-    }
+    })
 }
 
 fn gold(u: f32, v: f32) -> MaterialDesc {
-    MaterialDesc::Metal {
+    MaterialDesc::Metal(Metal {
         fresnel: Fresnel::Conductor {
             eta: Vec3::new(0.143, 0.374, 1.442),
             k: Vec3::new(3.983, 2.385, 1.603),
         },
         uroughness: c(u),
         vroughness: c(v),
-    }
+    })
 }
 
 /// Every kind of BSDF over a range of parameters, named for failure messages.
@@ -94,19 +94,19 @@ fn cases() -> Vec<(&'static str, MaterialDesc)> {
         ("oren-nayar 60deg", matte(1.0, 60.0)),
         (
             "mattetranslucent",
-            MaterialDesc::MatteTranslucent {
+            MaterialDesc::MatteTranslucent(MatteTranslucent {
                 kr: c(0.5),
                 kt: c(1.0),
                 sigma: c(0.0),
-            },
+            }),
         ),
         (
             "mattetranslucent rough",
-            MaterialDesc::MatteTranslucent {
+            MaterialDesc::MatteTranslucent(MatteTranslucent {
                 kr: c(0.3),
                 kt: c(0.9),
                 sigma: c(30.0),
-            },
+            }),
         ),
         ("glossy ks .04 r .05", glossy(1.0, 0.04, 0.05, 0.05, false)),
         ("glossy ks .04 r .3", glossy(1.0, 0.04, 0.3, 0.3, false)),
@@ -121,7 +121,7 @@ fn cases() -> Vec<(&'static str, MaterialDesc)> {
         ("glossy smooth coat", glossy(1.0, 0.1, 0.0, 0.0, false)),
         (
             "glossy absorbing",
-            MaterialDesc::Glossy {
+            MaterialDesc::Glossy(Glossy {
                 kd: c(1.0),
                 ks: c(0.1),
                 ka: rgb(0.9, 0.3, 0.0),
@@ -129,9 +129,9 @@ fn cases() -> Vec<(&'static str, MaterialDesc)> {
                 uroughness: c(0.2),
                 vroughness: c(0.2),
                 multibounce: false,
-            },
+            }),
         ),
-        ("mirror", MaterialDesc::Mirror { kr: c(1.0) }),
+        ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) })),
         ("glass 1.5", glass(1.5, 0.0, false)),
         ("glass 2.4", glass(2.4, 0.0, false)),
         ("architectural", glass(1.5, 0.0, true)),
@@ -144,19 +144,19 @@ fn cases() -> Vec<(&'static str, MaterialDesc)> {
         ("gold aniso .05/.6", gold(0.05, 0.6)),
         (
             "metal2 index 5",
-            MaterialDesc::Metal {
+            MaterialDesc::Metal(Metal {
                 fresnel: Fresnel::Index(c(5.0)),
                 uroughness: c(0.3),
                 vroughness: c(0.3),
-            },
+            }),
         ),
         (
             "metal2 reflectance",
-            MaterialDesc::Metal {
+            MaterialDesc::Metal(Metal {
                 fresnel: Fresnel::Reflectance(rgb(1.0, 0.7, 0.3)),
                 uroughness: c(0.5),
                 vroughness: c(0.5),
-            },
+            }),
         ),
     ]
 }
@@ -268,7 +268,7 @@ fn directional_albedo_never_exceeds_one() {
 fn white_lambert_albedo_is_one_and_lossless_bsdfs_keep_all_energy() {
     for (name, material, expected) in [
         ("lambert", matte(1.0, 0.0), 1.0),
-        ("mirror", MaterialDesc::Mirror { kr: c(1.0) }, 1.0),
+        ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) }), 1.0),
         ("glass", glass(1.5, 0.0, false), 1.0),
         ("architectural", glass(1.5, 0.0, true), 1.0),
         ("lambert 0.5", matte(0.5, 0.0), 0.5),
@@ -351,11 +351,11 @@ fn reciprocity() {
         ("glossy multibounce", glossy(0.8, 0.3, 0.6, 0.6, true)),
         (
             "mattetranslucent",
-            MaterialDesc::MatteTranslucent {
+            MaterialDesc::MatteTranslucent(MatteTranslucent {
                 kr: c(0.4),
                 kt: c(0.5),
                 sigma: c(25.0),
-            },
+            }),
         ),
     ];
     for (name, material) in reciprocal {
@@ -501,17 +501,17 @@ fn mix_chooses_each_side_in_proportion_to_amount() {
     let materials = Materials::new(vec![
         matte(0.2, 0.0),
         matte(0.8, 0.0),
-        MaterialDesc::Mix {
+        MaterialDesc::Mix(Mix {
             a: MaterialId(0),
             b: MaterialId(1),
             amount: c(0.3),
-        },
+        }),
         matte(0.5, 0.0),
-        MaterialDesc::Mix {
+        MaterialDesc::Mix(Mix {
             a: MaterialId(2),
             b: MaterialId(3),
             amount: c(0.5),
-        },
+        }),
     ]);
     let hit = hit_with(Vec3::Z, Vec3::Z);
     let textures = Textures::default();
@@ -547,12 +547,12 @@ fn mix_chooses_each_side_in_proportion_to_amount() {
 
 #[test]
 fn null_passes_through_and_bad_ids_fall_back_to_matte() {
-    assert!(bsdf_of(MaterialDesc::Null).is_pass_through());
-    let materials = Materials::new(vec![MaterialDesc::Mix {
+    assert!(bsdf_of(MaterialDesc::Null(Null)).is_pass_through());
+    let materials = Materials::new(vec![MaterialDesc::Mix(Mix {
         a: MaterialId(0),
         b: MaterialId(0),
         amount: c(0.5),
-    }]);
+    })]);
     let hit = hit_with(Vec3::Z, Vec3::Z);
     for id in [0, 7] {
         let bsdf = materials.bsdf(MaterialId(id), &hit, hit.p, &Textures::default(), 0.3);

@@ -14,6 +14,7 @@ use super::reader::Reader;
 use super::{ParseError, Pos, MAX_INCLUDE_DEPTH};
 use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
+use crate::desc::Matte;
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::Warning;
 use crate::mesh::{ply, TriangleMesh};
@@ -552,6 +553,20 @@ impl<'s> Builder<'s> {
         TextureId(self.textures.len() as u32 - 1)
     }
 
+    /// Describes a material, stores it and returns its id. Warns about parameters it did not
+    /// read.
+    fn material(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<MaterialId, ParseError> {
+        params.ignore("type");
+        let desc = MaterialDesc::read(ty, params, pos, self)?;
+        self.warn_unused(params);
+        Ok(self.add_material(desc))
+    }
+
     pub(super) fn add_material(&mut self, m: MaterialDesc) -> MaterialId {
         self.materials.push(m);
         MaterialId(self.materials.len() as u32 - 1)
@@ -698,10 +713,7 @@ impl ParseContext for Builder<'_> {
         if let Some(id) = self.default_material {
             return id;
         }
-        let id = self.add_material(MaterialDesc::Matte {
-            kd: Tex::color(Vec3::splat(0.9)),
-            sigma: Tex::float(0.0),
-        });
+        let id = self.add_material(MaterialDesc::Matte(Matte::default()));
         self.default_material = Some(id);
         id
     }

@@ -5,8 +5,9 @@
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
 //! described: [`options`] (the camera, film, filter, integrator and sampler statements, read by
-//! their concepts), [`textures`], [`materials`], [`lights`], [`spectra`] (metal presets,
-//! blackbody). Shapes are read by [`crate::shape`] (meshes by [`crate::mesh`]).
+//! their concepts), [`textures`], [`lights`], [`spectra`] (metal presets, blackbody). Materials
+//! read themselves ([`crate::material`]), shapes too ([`crate::shape`], meshes by
+//! [`crate::mesh`]).
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
@@ -23,11 +24,10 @@ pub(crate) mod context;
 pub(crate) mod error;
 mod lexer;
 mod lights;
-mod materials;
 mod options;
 pub(crate) mod params;
 mod reader;
-mod spectra;
+pub(crate) mod spectra;
 mod textures;
 
 use crate::assets::AssetSource;

@@ -53,7 +53,7 @@ impl RenderScene {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: FilterSampler::new(&desc.filter),
             textures: Textures::build(desc, source)?,
-            materials: Materials::build(desc),
+            materials: Materials::new(desc.materials.clone()),
             geometry,
             lights,
             world_to_object: desc

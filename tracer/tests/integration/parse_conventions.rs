@@ -124,14 +124,17 @@ fn nested_attribute_blocks_restore_state() {
         Vec3::X
     ));
     assert!(inner.reverse_orientation && middle.reverse_orientation && inner.area_light.is_some());
-    assert_eq!(d.materials[inner.material.0 as usize], MaterialDesc::Null);
+    assert_eq!(
+        d.materials[inner.material.0 as usize],
+        MaterialDesc::Null(Null)
+    );
     assert_eq!(outer.object_to_world, Mat4::IDENTITY);
     assert!(!outer.reverse_orientation && outer.area_light.is_none());
     // The texture defined inside the block went out of scope with it.
-    let MaterialDesc::Matte {
+    let MaterialDesc::Matte(Matte {
         kd: Tex::Texture(id),
         ..
-    } = d.materials[outer.material.0 as usize]
+    }) = d.materials[outer.material.0 as usize]
     else {
         panic!("matte with a texture expected")
     };
@@ -258,12 +261,12 @@ fn material_defaults_and_rules() {
     let mat = |i: usize| &d.materials[d.shapes[i].material.0 as usize];
     assert_eq!(
         *mat(0),
-        MaterialDesc::Matte {
+        MaterialDesc::Matte(Matte {
             kd: Tex::color(Vec3::splat(0.9)),
             sigma: Tex::float(0.0)
-        }
+        })
     );
-    let MaterialDesc::Glossy {
+    let MaterialDesc::Glossy(Glossy {
         kd,
         ks,
         ka,
@@ -271,7 +274,7 @@ fn material_defaults_and_rules() {
         uroughness,
         multibounce,
         ..
-    } = mat(1)
+    }) = mat(1)
     else {
         panic!()
     };
@@ -289,7 +292,7 @@ fn material_defaults_and_rules() {
         (*ka, *depth, *uroughness, *multibounce),
         (Tex::float(0.0), Tex::float(0.0), Tex::float(0.1), false)
     );
-    let MaterialDesc::Glossy { ks, kd, .. } = mat(2) else {
+    let MaterialDesc::Glossy(Glossy { ks, kd, .. }) = mat(2) else {
         panic!()
     };
     assert_eq!(
@@ -297,14 +300,14 @@ fn material_defaults_and_rules() {
         (Tex::float(0.4), Tex::float(1.0)),
         "\"float Ks\" is a grey colour"
     );
-    let MaterialDesc::Glass {
+    let MaterialDesc::Glass(Glass {
         kr,
         kt,
         index,
         architectural,
         uroughness,
         ..
-    } = mat(3)
+    }) = mat(3)
     else {
         panic!()
     };
@@ -318,18 +321,18 @@ fn material_defaults_and_rules() {
             Tex::float(0.001)
         )
     );
-    let MaterialDesc::Mix { a, b, amount } = mat(4) else {
+    let MaterialDesc::Mix(Mix { a, b, amount }) = mat(4) else {
         panic!()
     };
     assert_eq!(
         d.materials[a.0 as usize],
-        MaterialDesc::Mirror {
+        MaterialDesc::Mirror(Mirror {
             kr: Tex::float(1.0)
-        }
+        })
     );
     assert!(matches!(
         d.materials[b.0 as usize],
-        MaterialDesc::Matte { .. }
+        MaterialDesc::Matte(Matte { .. })
     ));
     assert_eq!(*amount, Tex::float(0.25));
     // NamedMaterial stays current for later shapes.
@@ -341,10 +344,10 @@ fn shape_without_material_is_default_matte() {
     let d = world("Shape \"sphere\"");
     assert_eq!(
         d.materials[d.shapes[0].material.0 as usize],
-        MaterialDesc::Matte {
+        MaterialDesc::Matte(Matte {
             kd: Tex::color(Vec3::splat(0.9)),
             sigma: Tex::float(0.0)
-        }
+        })
     );
 }
 
@@ -364,11 +367,11 @@ fn metals_and_fresnel_textures() {
          Material \"metal2\" \"texture fresnel\" \"fn\"\nShape \"sphere\"",
     );
     let fresnel = |i: usize| match &d.materials[d.shapes[i].material.0 as usize] {
-        MaterialDesc::Metal {
+        MaterialDesc::Metal(Metal {
             fresnel,
             uroughness,
             ..
-        } => {
+        }) => {
             assert_eq!(*uroughness, Tex::float(0.1));
             fresnel.clone()
         }

@@ -135,10 +135,10 @@ fn white_furnace_converges_to_the_sky_radiance() {
             &mut desc,
             Vec3::ZERO,
             1.0,
-            MaterialDesc::Matte {
+            MaterialDesc::Matte(Matte {
                 kd: Tex::float(albedo),
                 sigma: Tex::float(0.0),
-            },
+            }),
         );
         constant_sky(&mut desc, Vec3::splat(0.5));
         let film = render(&desc, &MemorySource::new(), 64);
@@ -171,10 +171,10 @@ fn saturated_interreflection_converges_without_fireflies() {
         &mut desc,
         Vec3::ZERO,
         2.0,
-        MaterialDesc::Matte {
+        MaterialDesc::Matte(Matte {
             kd: Tex::color(albedo),
             sigma: Tex::float(0.0),
-        },
+        }),
     );
     let shape = desc.shapes.last_mut().unwrap();
     shape.reverse_orientation = true;
@@ -213,10 +213,10 @@ fn zero_lens_radius_gives_exactly_the_pinhole_image() {
             &mut desc,
             Vec3::ZERO,
             1.0,
-            MaterialDesc::Matte {
+            MaterialDesc::Matte(Matte {
                 kd: Tex::float(0.7),
                 sigma: Tex::float(0.0),
-            },
+            }),
         );
         constant_sky(&mut desc, Vec3::ONE);
         render(&desc, &MemorySource::new(), 8).radiance()
@@ -241,10 +241,10 @@ fn thin_lens_blurs_out_of_focus_objects() {
             &mut desc,
             Vec3::ZERO,
             1.0,
-            MaterialDesc::Matte {
+            MaterialDesc::Matte(Matte {
                 kd: Tex::float(0.0),
                 sigma: Tex::float(0.0),
-            },
+            }),
         );
         constant_sky(&mut desc, Vec3::ONE);
         let film = render(&desc, &MemorySource::new(), 32);
@@ -341,10 +341,10 @@ fn rendering_is_deterministic_in_any_order() {
         &mut desc,
         Vec3::ZERO,
         1.0,
-        MaterialDesc::Matte {
+        MaterialDesc::Matte(Matte {
             kd: Tex::float(0.8),
             sigma: Tex::float(0.0),
-        },
+        }),
     );
     constant_sky(&mut desc, Vec3::new(0.3, 0.5, 0.9));
     let settings = settings(&desc, 8);
@@ -392,10 +392,10 @@ fn planar_mapping_follows_the_object_space() {
             },
         },
     });
-    desc.materials.push(MaterialDesc::Matte {
+    desc.materials.push(MaterialDesc::Matte(Matte {
         kd: Tex::Texture(TextureId(0)),
         sigma: Tex::float(0.0),
-    });
+    }));
     desc.shapes.push(ShapeDesc {
         name: "quad".into(),
         geometry: Geometry::Mesh(Arc::new(TriangleMesh {

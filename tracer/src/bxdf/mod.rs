@@ -1,44 +1,32 @@
 //! The scattering functions in the local shading frame (z = shading normal), one variant per
-//! kind of material, dispatched by match (no heap, no virtual calls).
+//! lobe, dispatched by match (no heap, no virtual calls). Materials (crate::material) build
+//! them per hit from their evaluated parameters; [`bsdf::Bsdf`] places one in the world (it
+//! imports this enum; nothing here imports it).
+//!
+//! Files: [`sample`] (the shared [`LocalSample`]), [`local`] (local-frame helpers), [`fresnel`],
+//! [`microfacet`] (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the
+//! lobes [`diffuse`], [`conductor`], [`dielectric`], [`coated`], and [`bsdf`] (world frame).
+
+pub mod bsdf;
+pub mod coated;
+pub mod conductor;
+pub mod dielectric;
+pub mod diffuse;
+pub mod fresnel;
+pub mod ggx_albedo;
+pub mod local;
+pub mod microfacet;
+pub mod sample;
 
 use glam::{Vec2, Vec3};
 
-use super::conductor::Conductor;
-use super::dielectric::Dielectric;
-use super::diffuse::{DiffuseReflection, DiffuseTranslucent};
-use super::glossy::Glossy;
-use super::local::flip_z;
+pub use sample::LocalSample;
 
-/// A sampled direction in the local frame.
-#[derive(Clone, Copy, Debug)]
-pub struct LocalSample {
-    pub wi: Vec3,
-    pub f: Vec3,
-    pub pdf: f32,
-    pub specular: bool,
-}
-
-impl LocalSample {
-    /// None when the density is zero or not finite (the direction cannot be used).
-    pub fn non_specular(wi: Vec3, f: Vec3, pdf: f32) -> Option<Self> {
-        (pdf > 0.0 && pdf.is_finite() && f.is_finite()).then_some(Self {
-            wi,
-            f,
-            pdf,
-            specular: false,
-        })
-    }
-
-    /// `probability` is the discrete probability with which the lobe was chosen.
-    pub fn specular(wi: Vec3, f: Vec3, probability: f32) -> Option<Self> {
-        (probability > 0.0 && f.is_finite()).then_some(Self {
-            wi,
-            f,
-            pdf: probability,
-            specular: true,
-        })
-    }
-}
+use coated::Coated;
+use conductor::Conductor;
+use dielectric::Dielectric;
+use diffuse::{DiffuseReflection, DiffuseTranslucent};
+use local::flip_z;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Bxdf {
@@ -48,7 +36,7 @@ pub enum Bxdf {
     Translucent(DiffuseTranslucent),
     Conductor(Conductor),
     Dielectric(Dielectric),
-    Glossy(Glossy),
+    Coated(Coated),
 }
 
 impl Bxdf {
@@ -57,7 +45,7 @@ impl Bxdf {
             Bxdf::PassThrough => true,
             Bxdf::Conductor(c) => c.is_specular(),
             Bxdf::Dielectric(d) => d.is_specular(),
-            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Glossy(_) => false,
+            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Coated(_) => false,
         }
     }
 
@@ -79,7 +67,7 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.f(wo, wi),
             Bxdf::Conductor(c) => c.f(wo, wi),
             Bxdf::Dielectric(d) => d.f(wo, wi),
-            Bxdf::Glossy(g) => g.f(wo, wi),
+            Bxdf::Coated(g) => g.f(wo, wi),
         }
     }
 
@@ -95,7 +83,7 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.pdf(wo, wi),
             Bxdf::Conductor(c) => c.pdf(wo, wi),
             Bxdf::Dielectric(d) => d.pdf(wo, wi),
-            Bxdf::Glossy(g) => g.pdf(wo, wi),
+            Bxdf::Coated(g) => g.pdf(wo, wi),
         }
     }
 
@@ -108,7 +96,7 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.sample(wo, u_lobe, u),
             Bxdf::Conductor(c) => c.sample(wo, u),
             Bxdf::Dielectric(d) => d.sample(wo, u_lobe, u),
-            Bxdf::Glossy(g) => g.sample(wo, u_lobe, u),
+            Bxdf::Coated(g) => g.sample(wo, u_lobe, u),
         }?;
         Some(if mirrored {
             LocalSample {

@@ -9,10 +9,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::bxdf::LocalSample;
 use super::fresnel;
 use super::local::{reflect, refract, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
+use super::sample::LocalSample;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Surface {

@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::bxdf::{Bxdf, LocalSample};
+use super::sample::LocalSample;
+use super::Bxdf;
 use crate::math::Frame;
 
 /// A sampled scattering direction.

@@ -5,8 +5,8 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::bxdf::LocalSample;
 use super::local::{cosine_hemisphere_pdf, flip_z, same_hemisphere, sample_cosine_hemisphere};
+use super::sample::LocalSample;
 
 /// The Oren-Nayar roughness terms (pbrt's qualitative model); A = 1, B = 0 is Lambert.
 #[derive(Clone, Copy, Debug, PartialEq)]

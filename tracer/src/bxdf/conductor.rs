@@ -2,10 +2,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::bxdf::LocalSample;
 use super::fresnel;
 use super::local::{reflect, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
+use super::sample::LocalSample;
 
 /// Where a conductor's reflectance comes from.
 #[derive(Clone, Copy, Debug)]

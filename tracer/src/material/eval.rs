@@ -1,0 +1,49 @@
+//! What a material's evaluation sees at a hit: its texture-or-constant parameters evaluated at
+//! the hit point. A leaf of the material family, so the material files never import
+//! `material/mod.rs`.
+
+use glam::Vec3;
+
+use crate::bxdf::microfacet::TrowbridgeReitz;
+use crate::param::{Tex, TextureId};
+use crate::texture::{TexturePoint, Textures};
+
+/// The scene's textures and the point they are evaluated at.
+pub struct TextureEval<'a> {
+    pub textures: &'a Textures,
+    pub at: TexturePoint,
+}
+
+/// Reflectances are clamped to [0, 1] (as LuxRender does) so no texture can create energy;
+/// NaN becomes 0.
+fn unit(c: Vec3) -> Vec3 {
+    c.max(Vec3::ZERO).min(Vec3::ONE)
+}
+
+impl TextureEval<'_> {
+    /// A colour parameter, clamped to [0, 1].
+    pub fn color(&self, t: Tex) -> Vec3 {
+        unit(self.textures.eval(t, &self.at))
+    }
+
+    /// A float parameter.
+    pub fn float(&self, t: Tex) -> f32 {
+        self.textures.eval(t, &self.at).x
+    }
+
+    /// The microfacet distribution for (u, v) roughness; None is a perfectly smooth surface.
+    pub fn roughness(&self, u: Tex, v: Tex) -> Option<TrowbridgeReitz> {
+        TrowbridgeReitz::from_roughness(self.float(u), self.float(v))
+    }
+}
+
+/// The textures among `params`, in order (what a material references).
+pub fn texture_ids(params: &[&Tex]) -> Vec<TextureId> {
+    params
+        .iter()
+        .filter_map(|t| match t {
+            Tex::Texture(id) => Some(*id),
+            Tex::Const(_) => None,
+        })
+        .collect()
+}

@@ -1,0 +1,147 @@
+//! `Material "glass"`, `"roughglass"` and `"glass2"`: a dielectric interface, smooth, rough
+//! (microfacet) or architectural (thin, no refraction).
+//!
+//! ```text
+//! Material "glass" "color Kr" [1 1 1] "color Kt" [1 1 1] "float index" [1.5]
+//! Material "roughglass" "float uroughness" [0.05] "float vroughness" [0.05]
+//! ```
+//!
+//! | parameter | type | default |
+//! |---|---|---|
+//! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
+//! | `Kt` | color texture (likewise) | 1 ([`DEFAULT_KT`]) |
+//! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 always uses 1.5 (its index comes from volumes, which are not rendered: a warning) |
+//! | `architectural` | bool | false |
+//! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
+//! | `film`, `cauchyb` | float | 0; not supported (a warning otherwise) |
+//! | `dispersion` | bool, glass2 only | ignored |
+//!
+//! A non-positive index is treated as no interface (index 1).
+
+use super::eval::{texture_ids, TextureEval};
+use crate::bxdf::dielectric::{Dielectric, Surface};
+use crate::bxdf::Bxdf;
+use crate::diag::SourcePos;
+use crate::param::{Tex, TextureId};
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+pub const DEFAULT_KR: f32 = 1.0;
+pub const DEFAULT_KT: f32 = 1.0;
+pub const DEFAULT_INDEX: f32 = 1.5;
+/// roughglass's default roughness (glass and glass2 are smooth: roughness 0).
+pub const DEFAULT_ROUGHGLASS_ROUGHNESS: f32 = 0.001;
+
+/// glass and roughglass: zero roughness is the smooth specular glass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Glass {
+    pub kr: Tex,
+    pub kt: Tex,
+    pub index: Tex,
+    pub architectural: bool,
+    pub uroughness: Tex,
+    pub vroughness: Tex,
+}
+
+impl Glass {
+    /// `Material "glass"`.
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read_as("glass", params, pos, ctx)
+    }
+
+    /// `Material "roughglass"`.
+    pub fn read_rough(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read_as("roughglass", params, pos, ctx)
+    }
+
+    /// `Material "glass2"`.
+    pub fn read_glass2(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read_as("glass2", params, pos, ctx)
+    }
+
+    fn read_as(
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let rough = if ty == "roughglass" {
+            DEFAULT_ROUGHGLASS_ROUGHNESS
+        } else {
+            0.0
+        };
+        ctx.unsupported_unless(params, "film", 0.0);
+        ctx.unsupported_unless(params, "cauchyb", 0.0);
+        if ty == "glass2" {
+            ctx.warn_once(
+                "glass2".into(),
+                pos,
+                "glass2 takes its index from volumes, which are not rendered; using index 1.5"
+                    .into(),
+            );
+            params.ignore("dispersion");
+        }
+        Ok(Self {
+            kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
+            kt: ctx.color_param(params, "Kt", DEFAULT_KT, false)?,
+            index: if ty == "glass2" {
+                Tex::float(DEFAULT_INDEX)
+            } else {
+                ctx.float_param(params, "index", DEFAULT_INDEX)?
+            },
+            architectural: params.bool("architectural", false)?,
+            uroughness: if rough > 0.0 {
+                ctx.float_param(params, "uroughness", rough)?
+            } else {
+                Tex::float(0.0)
+            },
+            vroughness: if rough > 0.0 {
+                ctx.float_param(params, "vroughness", rough)?
+            } else {
+                Tex::float(0.0)
+            },
+        })
+    }
+
+    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+        let eta = eval.float(self.index);
+        let surface = if self.architectural {
+            Surface::Thin
+        } else {
+            match eval.roughness(self.uroughness, self.vroughness) {
+                Some(distrib) => Surface::Rough(distrib),
+                None => Surface::Smooth,
+            }
+        };
+        Bxdf::Dielectric(Dielectric {
+            kr: eval.color(self.kr),
+            kt: eval.color(self.kt),
+            // A non-positive index is meaningless; treat it as no interface.
+            eta: if eta > 0.0 { eta } else { 1.0 },
+            surface,
+        })
+    }
+
+    pub fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[
+            &self.kr,
+            &self.kt,
+            &self.index,
+            &self.uroughness,
+            &self.vroughness,
+        ])
+    }
+}
