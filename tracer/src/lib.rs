@@ -24,4 +24,5 @@ pub mod param;
 pub mod parse;
 pub mod render;
 pub mod sampler;
+pub mod spectra;
 pub mod texture;

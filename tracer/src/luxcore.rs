@@ -30,7 +30,9 @@ use crate::desc::{
 use crate::mesh::TriangleMesh;
 
 use crate::param::{Fresnel, MaterialId, Tex, TextureId};
-use crate::texture::{Mapping, TexturePoint};
+use crate::texture::{
+    Checkerboard2D, Checkerboard3D, Constant, ImageMap, Mix, Scale, TexturePoint,
+};
 
 /// Half the side of the quad an infinite plane becomes (scene units).
 const PLANE_HALF_SIZE: f32 = 1.0e4;
@@ -132,15 +134,6 @@ fn is_baked(mapping: &Mapping2D) -> bool {
     !matches!(mapping, Mapping2D::Uv { .. })
 }
 
-fn texture_mapping(kind: &TextureKind) -> Option<&Mapping2D> {
-    match kind {
-        TextureKind::ImageMap { mapping, .. } | TextureKind::Checkerboard2D { mapping, .. } => {
-            Some(mapping)
-        }
-        _ => None,
-    }
-}
-
 fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
     if let Tex::Texture(id) = t {
         out.push(*id);
@@ -150,19 +143,8 @@ fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
 /// Textures a texture reads directly.
 fn texture_inputs(kind: &TextureKind) -> Vec<TextureId> {
     let mut out = Vec::new();
-    match kind {
-        TextureKind::Checkerboard2D { tex1, tex2, .. }
-        | TextureKind::Checkerboard3D { tex1, tex2, .. }
-        | TextureKind::Scale { tex1, tex2 } => {
-            push_tex(tex1, &mut out);
-            push_tex(tex2, &mut out);
-        }
-        TextureKind::Mix { tex1, tex2, amount } => {
-            push_tex(tex1, &mut out);
-            push_tex(tex2, &mut out);
-            push_tex(amount, &mut out);
-        }
-        TextureKind::ImageMap { .. } | TextureKind::Constant(_) => {}
+    for t in kind.references() {
+        push_tex(&t, &mut out);
     }
     out
 }
@@ -247,7 +229,7 @@ fn material_bake(desc: &SceneDesc, material: MaterialId) -> Result<Option<Mappin
             continue;
         };
         tex_stack.extend(texture_inputs(&td.kind));
-        match texture_mapping(&td.kind) {
+        match td.kind.mapping() {
             Some(m) if is_baked(m) && !baked.contains(&m) => baked.push(m),
             Some(m) if is_baked(m) => {}
             Some(_) => uv_mapped = true,
@@ -338,13 +320,13 @@ fn write_textures(
         let prefix = format!("scene.textures.{}", tex_name(TextureId(i as u32)));
         let color = t.is_color;
         match &t.kind {
-            TextureKind::ImageMap {
+            TextureKind::ImageMap(ImageMap {
                 filename,
                 gamma,
                 gain,
                 wrap,
                 mapping,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("imagemap"));
                 let path = scene_dir.join(filename);
                 p.set(format!("{prefix}.file"), quoted(&path.to_string_lossy()));
@@ -362,21 +344,21 @@ fn write_textures(
                 }
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard2D {
+            TextureKind::Checkerboard2D(Checkerboard2D {
                 tex1,
                 tex2,
                 mapping,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard2d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard3D {
+            TextureKind::Checkerboard3D(Checkerboard3D {
                 tex1,
                 tex2,
                 world_to_texture,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard3d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
@@ -390,20 +372,29 @@ fn write_textures(
                     t.name
                 ));
             }
-            TextureKind::Constant(c) => {
+            TextureKind::Constant(Constant { value }) => {
                 p.set(format!("{prefix}.type"), quoted("constfloat3"));
-                p.set(format!("{prefix}.value"), v3(*c));
+                p.set(format!("{prefix}.value"), v3(*value));
             }
-            TextureKind::Scale { tex1, tex2 } => {
+            TextureKind::Scale(Scale { tex1, tex2 }) => {
                 p.set(format!("{prefix}.type"), quoted("scale"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
             }
-            TextureKind::Mix { tex1, tex2, amount } => {
+            TextureKind::Mix(Mix { tex1, tex2, amount }) => {
                 p.set(format!("{prefix}.type"), quoted("mix"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 p.set(format!("{prefix}.amount"), tex_value(amount, false));
+            }
+            // A texture type the exporter does not map yet (none today).
+            #[allow(unreachable_patterns)]
+            other => {
+                return Err(ExportError::Unsupported(format!(
+                    "texture \"{}\": no LuxCore equivalent for type \"{}\"",
+                    t.name,
+                    other.name()
+                )))
             }
         }
     }
@@ -767,19 +758,16 @@ fn export_shape(
             .map_or(Vec2::ZERO, |&[u, v]| Vec2::new(u, v))
     };
     let uvs: Option<Vec<Vec2>> = match material_bake(desc, shape.material)? {
-        Some(mapping) => {
-            let mapping = Mapping::new(&mapping);
-            Some(
-                (0..mesh.positions.len())
-                    .map(|i| {
-                        mapping.map(&TexturePoint {
-                            p: mesh.positions[i],
-                            uv: object_uv(i),
-                        })
+        Some(mapping) => Some(
+            (0..mesh.positions.len())
+                .map(|i| {
+                    mapping.map(&TexturePoint {
+                        p: mesh.positions[i],
+                        uv: object_uv(i),
                     })
-                    .collect(),
-            )
-        }
+                })
+                .collect(),
+        ),
         None => mesh
             .uvs
             .as_ref()

@@ -4,8 +4,9 @@
 //! Module map: [`lexer`] (bytes -> tokens), [`reader`] (tokens -> statement arguments and
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
-//! described: [`options`] (camera, film, filter, integrator, sampler), [`textures`],
-//! [`materials`], [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
+//! described: [`options`] (camera, film, filter, integrator, sampler),
+//! [`materials`], [`lights`], [`shapes`] (with [`ply`]). Textures are read by
+//! [`crate::texture`]; metal presets and blackbody colours are in [`crate::spectra`].
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
@@ -19,7 +20,7 @@
 
 mod builder;
 pub(crate) mod context;
-mod error;
+pub(crate) mod error;
 mod lexer;
 mod lights;
 mod materials;
@@ -27,8 +28,6 @@ mod options;
 pub(crate) mod params;
 mod reader;
 mod shapes;
-mod spectra;
-mod textures;
 
 use crate::assets::AssetSource;
 use crate::desc::SceneDesc;
@@ -36,7 +35,7 @@ use crate::diag::SourcePos;
 
 pub use error::ParseError;
 
-pub use spectra::{blackbody_rgb, metal_preset};
+pub use crate::spectra::{blackbody_rgb, metal_preset};
 
 /// Include files may nest this deep (the main file is depth 0).
 pub const MAX_INCLUDE_DEPTH: usize = 32;

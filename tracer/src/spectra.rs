@@ -1,5 +1,6 @@
 //! Spectral data reduced to RGB: LuxRender's built-in metal presets (complex index of
-//! refraction per channel) and blackbody colours.
+//! refraction per channel) and blackbody colours. A leaf module: the texture and material
+//! readers use it; `crate::parse` re-exports both functions.
 
 use glam::Vec3;
 
