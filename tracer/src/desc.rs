@@ -37,99 +37,14 @@ pub struct SceneDesc {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Textures
+// Textures: described in crate::texture, one file per type.
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Wrap {
-    Repeat,
-    Black,
-    White,
-    Clamp,
-}
-
-/// 2D texture-coordinate generation. `world_to_texture` is the inverse of the transform current
-/// at the `Texture` statement.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Mapping2D {
-    /// s = uscale x u + udelta, t = vscale x v + vdelta.
-    Uv {
-        uscale: f32,
-        vscale: f32,
-        udelta: f32,
-        vdelta: f32,
-    },
-    /// s = uscale x phi / 2pi + udelta, t = vscale x theta / pi + vdelta.
-    Spherical {
-        world_to_texture: Mat4,
-        uscale: f32,
-        vscale: f32,
-        udelta: f32,
-        vdelta: f32,
-    },
-    /// s = uscale x phi / 2pi + udelta, t = vscale x (1 - z) / 2 + vdelta.
-    Cylindrical {
-        world_to_texture: Mat4,
-        uscale: f32,
-        vscale: f32,
-        udelta: f32,
-        vdelta: f32,
-    },
-    /// s = dot(p, v1) + udelta, t = dot(p, v2) + vdelta with p in texture space.
-    Planar {
-        world_to_texture: Mat4,
-        v1: Vec3,
-        v2: Vec3,
-        udelta: f32,
-        vdelta: f32,
-    },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum TextureKind {
-    ImageMap {
-        /// Path as written, relative to the main file's folder; listed in `assets`.
-        filename: String,
-        gamma: f32,
-        gain: f32,
-        wrap: Wrap,
-        mapping: Mapping2D,
-    },
-    Checkerboard2D {
-        tex1: Tex,
-        tex2: Tex,
-        mapping: Mapping2D,
-    },
-    Checkerboard3D {
-        tex1: Tex,
-        tex2: Tex,
-        world_to_texture: Mat4,
-    },
-    Constant(Vec3),
-    Scale {
-        tex1: Tex,
-        tex2: Tex,
-    },
-    Mix {
-        tex1: Tex,
-        tex2: Tex,
-        amount: Tex,
-    },
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct TextureDesc {
-    pub name: String,
-    /// "float" or "color" textures: a float texture's value is splatted over RGB.
-    pub is_color: bool,
-    pub kind: TextureKind,
-}
+pub use crate::texture::{Mapping2D, TextureDesc, TextureKind, Wrap};
 
 // ---------------------------------------------------------------------------------------------
 // Materials
 
-pub use crate::material::{
-    Glass, Glossy, MaterialDesc, Matte, MatteTranslucent, Metal, Mirror, Mix, Null,
-};
+pub use crate::material::MaterialDesc;
 
 // ---------------------------------------------------------------------------------------------
 // Lights

@@ -32,4 +32,5 @@ pub mod parse;
 pub mod render;
 pub mod sampler;
 pub mod shape;
+pub mod spectra;
 pub mod texture;

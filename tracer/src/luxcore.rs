@@ -26,12 +26,16 @@ use crate::desc::{
     CameraKind, FilterKind, Geometry, LatLongConvention, LightDesc, Mapping2D, MaterialDesc,
     SceneDesc, ShapeDesc, TextureKind, Wrap,
 };
-use crate::desc::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix, Null};
+use crate::material::{
+    Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix as MixMaterial, Null,
+};
 
 use crate::mesh::TriangleMesh;
 
 use crate::param::{Fresnel, MaterialId, Tex, TextureId};
-use crate::texture::{Mapping, TexturePoint};
+use crate::texture::{
+    Checkerboard2D, Checkerboard3D, Constant, ImageMap, Mix, Scale, TexturePoint,
+};
 
 /// Half the side of the quad an infinite plane becomes (scene units).
 const PLANE_HALF_SIZE: f32 = 1.0e4;
@@ -133,15 +137,6 @@ fn is_baked(mapping: &Mapping2D) -> bool {
     !matches!(mapping, Mapping2D::Uv { .. })
 }
 
-fn texture_mapping(kind: &TextureKind) -> Option<&Mapping2D> {
-    match kind {
-        TextureKind::ImageMap { mapping, .. } | TextureKind::Checkerboard2D { mapping, .. } => {
-            Some(mapping)
-        }
-        _ => None,
-    }
-}
-
 fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
     if let Tex::Texture(id) = t {
         out.push(*id);
@@ -151,19 +146,8 @@ fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
 /// Textures a texture reads directly.
 fn texture_inputs(kind: &TextureKind) -> Vec<TextureId> {
     let mut out = Vec::new();
-    match kind {
-        TextureKind::Checkerboard2D { tex1, tex2, .. }
-        | TextureKind::Checkerboard3D { tex1, tex2, .. }
-        | TextureKind::Scale { tex1, tex2 } => {
-            push_tex(tex1, &mut out);
-            push_tex(tex2, &mut out);
-        }
-        TextureKind::Mix { tex1, tex2, amount } => {
-            push_tex(tex1, &mut out);
-            push_tex(tex2, &mut out);
-            push_tex(amount, &mut out);
-        }
-        TextureKind::ImageMap { .. } | TextureKind::Constant(_) => {}
+    for t in kind.references() {
+        push_tex(&t, &mut out);
     }
     out
 }
@@ -195,7 +179,7 @@ fn material_bake(desc: &SceneDesc, material: MaterialId) -> Result<Option<Mappin
             continue;
         };
         tex_stack.extend(texture_inputs(&td.kind));
-        match texture_mapping(&td.kind) {
+        match td.kind.mapping() {
             Some(m) if is_baked(m) && !baked.contains(&m) => baked.push(m),
             Some(m) if is_baked(m) => {}
             Some(_) => uv_mapped = true,
@@ -286,13 +270,13 @@ fn write_textures(
         let prefix = format!("scene.textures.{}", tex_name(TextureId(i as u32)));
         let color = t.is_color;
         match &t.kind {
-            TextureKind::ImageMap {
+            TextureKind::ImageMap(ImageMap {
                 filename,
                 gamma,
                 gain,
                 wrap,
                 mapping,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("imagemap"));
                 let path = scene_dir.join(filename);
                 p.set(format!("{prefix}.file"), quoted(&path.to_string_lossy()));
@@ -310,21 +294,21 @@ fn write_textures(
                 }
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard2D {
+            TextureKind::Checkerboard2D(Checkerboard2D {
                 tex1,
                 tex2,
                 mapping,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard2d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard3D {
+            TextureKind::Checkerboard3D(Checkerboard3D {
                 tex1,
                 tex2,
                 world_to_texture,
-            } => {
+            }) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard3d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
@@ -338,20 +322,29 @@ fn write_textures(
                     t.name
                 ));
             }
-            TextureKind::Constant(c) => {
+            TextureKind::Constant(Constant { value }) => {
                 p.set(format!("{prefix}.type"), quoted("constfloat3"));
-                p.set(format!("{prefix}.value"), v3(*c));
+                p.set(format!("{prefix}.value"), v3(*value));
             }
-            TextureKind::Scale { tex1, tex2 } => {
+            TextureKind::Scale(Scale { tex1, tex2 }) => {
                 p.set(format!("{prefix}.type"), quoted("scale"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
             }
-            TextureKind::Mix { tex1, tex2, amount } => {
+            TextureKind::Mix(Mix { tex1, tex2, amount }) => {
                 p.set(format!("{prefix}.type"), quoted("mix"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 p.set(format!("{prefix}.amount"), tex_value(amount, false));
+            }
+            // A texture type the exporter does not map yet (none today).
+            #[allow(unreachable_patterns)]
+            other => {
+                return Err(ExportError::Unsupported(format!(
+                    "texture \"{}\": no LuxCore equivalent for type \"{}\"",
+                    t.name,
+                    other.name()
+                )))
             }
         }
     }
@@ -463,7 +456,7 @@ fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<
             set("type", quoted("matte"));
             set("kd", "0 0 0".into());
         }
-        MaterialDesc::Mix(Mix { a, b, amount }) => {
+        MaterialDesc::Mix(MixMaterial { a, b, amount }) => {
             set("type", quoted("mix"));
             set("material1", quoted(&mat_name(*a)));
             set("material2", quoted(&mat_name(*b)));
@@ -710,19 +703,16 @@ fn export_shape(
             .map_or(Vec2::ZERO, |&[u, v]| Vec2::new(u, v))
     };
     let uvs: Option<Vec<Vec2>> = match material_bake(desc, shape.material)? {
-        Some(mapping) => {
-            let mapping = Mapping::new(&mapping);
-            Some(
-                (0..mesh.positions.len())
-                    .map(|i| {
-                        mapping.map(&TexturePoint {
-                            p: mesh.positions[i],
-                            uv: object_uv(i),
-                        })
+        Some(mapping) => Some(
+            (0..mesh.positions.len())
+                .map(|i| {
+                    mapping.map(&TexturePoint {
+                        p: mesh.positions[i],
+                        uv: object_uv(i),
                     })
-                    .collect(),
-            )
-        }
+                })
+                .collect(),
+        ),
         None => mesh
             .uvs
             .as_ref()

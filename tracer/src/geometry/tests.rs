@@ -5,6 +5,7 @@ use glam::{Mat4, Vec2, Vec3, Vec3A};
 
 use super::*;
 use crate::desc::*;
+use crate::material::Matte;
 use crate::math::Ray;
 
 /// A scene description with the given shapes and lights and plain values elsewhere.

@@ -26,7 +26,6 @@ use crate::param::{Fresnel, Tex, TextureId};
 use crate::parse::context::{ParseContext, TexBinding};
 use crate::parse::error::ParseError;
 use crate::parse::params::{ParamList, ParamType, TexValue};
-use crate::parse::spectra::metal_by_name;
 
 pub const DEFAULT_PRESET: &str = "aluminium";
 /// LuxRender's metal2 default Fresnel term: index 5, no absorption.
@@ -52,7 +51,7 @@ impl Metal {
             Some(f) => f,
             None => params.string_or("name", DEFAULT_PRESET)?,
         };
-        let (eta, k) = metal_by_name(&name, pos, ctx);
+        let (eta, k) = ctx.metal_by_name(&name, pos);
         Ok(Self {
             fresnel: Fresnel::Conductor { eta, k },
             uroughness: ctx.float_param(params, "uroughness", DEFAULT_ROUGHNESS)?,

@@ -14,12 +14,13 @@ use super::reader::Reader;
 use super::{ParseError, Pos, MAX_INCLUDE_DEPTH};
 use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
-use crate::desc::Matte;
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::Warning;
+use crate::material::Matte;
 use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::shape::Geometry;
+use crate::texture::{self, Defined, Scale};
 
 /// Area light parameters kept in the graphics state; the radiance is known only once the
 /// world-space area of each shape is.
@@ -384,7 +385,8 @@ impl<'s> Builder<'s> {
                 let kind = r.string("the texture kind (\"float\" or \"color\")")?;
                 let class = r.string("the texture type")?;
                 let params = r.params(format!("Texture \"{class}\""))?;
-                self.texture(name, &kind, &class, &params, pos)?;
+                let defined = texture::read(&name, &kind, &class, &params, pos, self)?;
+                self.define_texture(name, defined);
                 self.warn_unused(&params);
             }
             "Material" => {
@@ -548,6 +550,19 @@ impl<'s> Builder<'s> {
         });
     }
 
+    /// Binds what a `Texture` statement defined (if anything) to its name.
+    fn define_texture(&mut self, name: String, defined: Option<Defined>) {
+        match defined {
+            Some(Defined::Texture(desc)) => {
+                let is_color = desc.is_color;
+                let id = self.add_texture(desc);
+                self.bind_texture(name, is_color, TexBinding::Texture(id));
+            }
+            Some(Defined::Fresnel(f)) => self.bind_texture(name, true, TexBinding::Fresnel(f)),
+            None => {}
+        }
+    }
+
     pub(super) fn add_texture(&mut self, t: TextureDesc) -> TextureId {
         self.textures.push(t);
         TextureId(self.textures.len() as u32 - 1)
@@ -689,10 +704,10 @@ impl ParseContext for Builder<'_> {
         self.add_texture(TextureDesc {
             name,
             is_color,
-            kind: TextureKind::Scale {
+            kind: TextureKind::Scale(Scale {
                 tex1: Tex::Texture(id),
                 tex2: Tex::float(factor),
-            },
+            }),
         })
     }
 

@@ -13,6 +13,7 @@ use crate::assets::AssetKind;
 use crate::diag::SourcePos;
 use crate::mesh::TriangleMesh;
 use crate::param::{Fresnel, MaterialId, Tex, TextureId};
+use crate::spectra::metal_preset;
 
 /// What a texture name is bound to in the current attribute scope. Fresnel textures are not
 /// evaluated per hit: metal materials fold them into their description.
@@ -86,6 +87,20 @@ pub trait ParseContext {
                 }
             },
         }
+    }
+
+    /// A named metal preset's complex index (eta, k), or aluminium with a warning (LuxRender's
+    /// fallback for an unknown name or an .nk data file). Used by the `fresnelname` texture
+    /// and the `metal` material.
+    fn metal_by_name(&mut self, name: &str, pos: &SourcePos) -> (Vec3, Vec3) {
+        if let Some(p) = metal_preset(name) {
+            return p;
+        }
+        self.warn(
+            pos,
+            format!("metal \"{name}\" is not a built-in preset (.nk data files are not read); using aluminium"),
+        );
+        metal_preset("aluminium").expect("aluminium is a preset")
     }
 
     /// A colour parameter (constant or texture); constants are clamped to [0, 1] when `clamp`.

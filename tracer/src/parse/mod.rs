@@ -5,9 +5,9 @@
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
 //! described: [`options`] (the camera, film, filter, integrator and sampler statements, read by
-//! their concepts), [`textures`], [`lights`], [`spectra`] (metal presets, blackbody). Materials
-//! read themselves ([`crate::material`]), shapes too ([`crate::shape`], meshes by
-//! [`crate::mesh`]).
+//! their concepts), [`lights`]. Materials, textures and shapes read themselves
+//! ([`crate::material`], [`crate::texture`], [`crate::shape`], meshes by [`crate::mesh`]); metal
+//! presets and blackbody colours are in [`crate::spectra`].
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
@@ -27,8 +27,6 @@ mod lights;
 mod options;
 pub(crate) mod params;
 mod reader;
-pub(crate) mod spectra;
-mod textures;
 
 use crate::assets::AssetSource;
 use crate::desc::SceneDesc;
@@ -36,7 +34,7 @@ use crate::diag::SourcePos;
 
 pub use error::ParseError;
 
-pub use spectra::{blackbody_rgb, metal_preset};
+pub use crate::spectra::{blackbody_rgb, metal_preset};
 
 /// Include files may nest this deep (the main file is depth 0).
 pub const MAX_INCLUDE_DEPTH: usize = 32;

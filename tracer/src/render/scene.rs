@@ -52,7 +52,7 @@ impl RenderScene {
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: FilterSampler::new(&desc.filter),
-            textures: Textures::build(desc, source)?,
+            textures: Textures::new(&desc.textures, source)?,
             materials: Materials::new(desc.materials.clone()),
             geometry,
             lights,

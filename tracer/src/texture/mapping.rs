@@ -1,12 +1,77 @@
 //! 2D texture-coordinate generation (LuxRender's TextureMapping2D): (s, t) from the surface
-//! uv or from the position in texture space.
+//! uv or from the position in texture space, for the textures that take a `mapping` (imagemap,
+//! checkerboard with dimension 2).
+//!
+//! ```text
+//! Texture "name" "color" "imagemap" "string mapping" "planar" "vector v1" [1 0 0] ...
+//! ```
+//!
+//! | parameter        | mappings                  | default  |
+//! |------------------|---------------------------|----------|
+//! | `string mapping` | uv, spherical, cylindrical, planar | uv (an unknown name warns) |
+//! | `float uscale`   | uv, spherical, cylindrical | 1 (planar ignores it) |
+//! | `float vscale`   | uv, spherical, cylindrical | 1 (planar ignores it) |
+//! | `float udelta`   | all                       | 0        |
+//! | `float vdelta`   | all                       | 0        |
+//! | `vector v1`      | planar                    | (1, 0, 0) |
+//! | `vector v2`      | planar                    | (0, 1, 0) |
+//!
+//! Spherical, cylindrical and planar mappings work in texture space: the inverse of the
+//! transform current at the `Texture` statement, applied to the shaded point's object-space
+//! position.
 
 use std::f32::consts::{PI, TAU};
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::TexturePoint;
-use crate::desc::Mapping2D;
+use super::common::TexturePoint;
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+pub const DEFAULT_MAPPING: &str = "uv";
+pub const DEFAULT_SCALE: f32 = 1.0;
+pub const DEFAULT_DELTA: f32 = 0.0;
+pub const DEFAULT_V1: Vec3 = Vec3::X;
+pub const DEFAULT_V2: Vec3 = Vec3::Y;
+
+/// 2D texture-coordinate generation. `world_to_texture` is the inverse of the transform current
+/// at the `Texture` statement.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mapping2D {
+    /// s = uscale x u + udelta, t = vscale x v + vdelta.
+    Uv {
+        uscale: f32,
+        vscale: f32,
+        udelta: f32,
+        vdelta: f32,
+    },
+    /// s = uscale x phi / 2pi + udelta, t = vscale x theta / pi + vdelta.
+    Spherical {
+        world_to_texture: Mat4,
+        uscale: f32,
+        vscale: f32,
+        udelta: f32,
+        vdelta: f32,
+    },
+    /// s = uscale x phi / 2pi + udelta, t = vscale x (1 - z) / 2 + vdelta.
+    Cylindrical {
+        world_to_texture: Mat4,
+        uscale: f32,
+        vscale: f32,
+        udelta: f32,
+        vdelta: f32,
+    },
+    /// s = dot(p, v1) + udelta, t = dot(p, v2) + vdelta with p in texture space.
+    Planar {
+        world_to_texture: Mat4,
+        v1: Vec3,
+        v2: Vec3,
+        udelta: f32,
+        vdelta: f32,
+    },
+}
 
 /// Azimuth of `p` around z in [0, 2pi) (LuxRender's SphericalPhi).
 fn spherical_phi(p: Vec3) -> f32 {
@@ -18,111 +83,109 @@ fn spherical_phi(p: Vec3) -> f32 {
     }
 }
 
-#[derive(Clone, Debug)]
-pub enum Mapping {
-    Uv {
-        scale: Vec2,
-        delta: Vec2,
-    },
-    /// s = phi / 2pi, t = theta / pi of the direction from the texture-space origin.
-    Spherical {
-        world_to_texture: Mat4,
-        scale: Vec2,
-        delta: Vec2,
-    },
-    /// s = phi / 2pi around the texture-space z axis, t = (1 - z) / 2.
-    Cylindrical {
-        world_to_texture: Mat4,
-        scale: Vec2,
-        delta: Vec2,
-    },
-    /// s = dot(p, v1) + udelta, t = dot(p, v2) + vdelta with p in texture space.
-    Planar {
-        world_to_texture: Mat4,
-        v1: Vec3,
-        v2: Vec3,
-        delta: Vec2,
-    },
-}
+impl Mapping2D {
+    /// The mapping parameters of a texture statement.
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let mapping = params.string_or("mapping", DEFAULT_MAPPING)?;
+        Ok(match mapping.as_str() {
+            "spherical" | "cylindrical" => {
+                let world_to_texture = ctx.ctm().inverse();
+                let uscale = params.float("uscale", DEFAULT_SCALE)?;
+                let vscale = params.float("vscale", DEFAULT_SCALE)?;
+                let udelta = params.float("udelta", DEFAULT_DELTA)?;
+                let vdelta = params.float("vdelta", DEFAULT_DELTA)?;
+                if mapping == "spherical" {
+                    Mapping2D::Spherical {
+                        world_to_texture,
+                        uscale,
+                        vscale,
+                        udelta,
+                        vdelta,
+                    }
+                } else {
+                    Mapping2D::Cylindrical {
+                        world_to_texture,
+                        uscale,
+                        vscale,
+                        udelta,
+                        vdelta,
+                    }
+                }
+            }
+            "planar" => {
+                // LuxRender's planar mapping has no scale; exporters write one anyway.
+                params.ignore("uscale");
+                params.ignore("vscale");
+                Mapping2D::Planar {
+                    world_to_texture: ctx.ctm().inverse(),
+                    v1: params.vec3("v1", DEFAULT_V1)?,
+                    v2: params.vec3("v2", DEFAULT_V2)?,
+                    udelta: params.float("udelta", DEFAULT_DELTA)?,
+                    vdelta: params.float("vdelta", DEFAULT_DELTA)?,
+                }
+            }
+            other => {
+                if other != "uv" {
+                    ctx.warn(
+                        pos,
+                        format!("unknown texture mapping \"{other}\"; using uv"),
+                    );
+                }
+                Mapping2D::Uv {
+                    uscale: params.float("uscale", DEFAULT_SCALE)?,
+                    vscale: params.float("vscale", DEFAULT_SCALE)?,
+                    udelta: params.float("udelta", DEFAULT_DELTA)?,
+                    vdelta: params.float("vdelta", DEFAULT_DELTA)?,
+                }
+            }
+        })
+    }
 
-impl Mapping {
-    pub fn new(desc: &Mapping2D) -> Self {
-        match *desc {
+    /// Texture coordinates (s, t) of a surface point.
+    pub fn map(&self, at: &TexturePoint) -> Vec2 {
+        match *self {
             Mapping2D::Uv {
                 uscale,
                 vscale,
                 udelta,
                 vdelta,
-            } => Mapping::Uv {
-                scale: Vec2::new(uscale, vscale),
-                delta: Vec2::new(udelta, vdelta),
-            },
+            } => Vec2::new(uscale, vscale) * at.uv + Vec2::new(udelta, vdelta),
             Mapping2D::Spherical {
                 world_to_texture,
                 uscale,
                 vscale,
                 udelta,
                 vdelta,
-            } => Mapping::Spherical {
-                world_to_texture,
-                scale: Vec2::new(uscale, vscale),
-                delta: Vec2::new(udelta, vdelta),
-            },
+            } => {
+                let p = world_to_texture.transform_point3(at.p).normalize_or_zero();
+                let theta = p.z.clamp(-1.0, 1.0).acos();
+                Vec2::new(uscale, vscale) * Vec2::new(spherical_phi(p) / TAU, theta / PI)
+                    + Vec2::new(udelta, vdelta)
+            }
             Mapping2D::Cylindrical {
                 world_to_texture,
                 uscale,
                 vscale,
                 udelta,
                 vdelta,
-            } => Mapping::Cylindrical {
-                world_to_texture,
-                scale: Vec2::new(uscale, vscale),
-                delta: Vec2::new(udelta, vdelta),
-            },
+            } => {
+                let p = world_to_texture.transform_point3(at.p);
+                Vec2::new(uscale, vscale) * Vec2::new(spherical_phi(p) / TAU, 0.5 - 0.5 * p.z)
+                    + Vec2::new(udelta, vdelta)
+            }
             Mapping2D::Planar {
                 world_to_texture,
                 v1,
                 v2,
                 udelta,
                 vdelta,
-            } => Mapping::Planar {
-                world_to_texture,
-                v1,
-                v2,
-                delta: Vec2::new(udelta, vdelta),
-            },
-        }
-    }
-
-    /// Texture coordinates (s, t) of a surface point.
-    pub fn map(&self, at: &TexturePoint) -> Vec2 {
-        match self {
-            Mapping::Uv { scale, delta } => *scale * at.uv + *delta,
-            Mapping::Spherical {
-                world_to_texture,
-                scale,
-                delta,
-            } => {
-                let p = world_to_texture.transform_point3(at.p).normalize_or_zero();
-                let theta = p.z.clamp(-1.0, 1.0).acos();
-                *scale * Vec2::new(spherical_phi(p) / TAU, theta / PI) + *delta
-            }
-            Mapping::Cylindrical {
-                world_to_texture,
-                scale,
-                delta,
             } => {
                 let p = world_to_texture.transform_point3(at.p);
-                *scale * Vec2::new(spherical_phi(p) / TAU, 0.5 - 0.5 * p.z) + *delta
-            }
-            Mapping::Planar {
-                world_to_texture,
-                v1,
-                v2,
-                delta,
-            } => {
-                let p = world_to_texture.transform_point3(at.p);
-                Vec2::new(p.dot(*v1), p.dot(*v2)) + *delta
+                Vec2::new(p.dot(v1), p.dot(v2)) + Vec2::new(udelta, vdelta)
             }
         }
     }
@@ -139,26 +202,24 @@ mod tests {
     #[test]
     fn uv_mapping_scales_then_offsets() {
         // Blender's export: vscale -1, vdelta 1 turns v upside down.
-        let m = Mapping::new(&Mapping2D::Uv {
+        let m = Mapping2D::Uv {
             uscale: 2.0,
             vscale: -1.0,
             udelta: 0.25,
             vdelta: 1.0,
-        });
+        };
         let st = m.map(&at(Vec3::ZERO, Vec2::new(0.5, 0.2)));
         assert!((st - Vec2::new(1.25, 0.8)).length() < 1e-6, "{st}");
     }
 
     #[test]
     fn spherical_mapping_angles() {
-        let spherical = |vscale: f32, vdelta: f32| {
-            Mapping::new(&Mapping2D::Spherical {
-                world_to_texture: Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
-                uscale: 1.0,
-                vscale,
-                udelta: 0.0,
-                vdelta,
-            })
+        let spherical = |vscale: f32, vdelta: f32| Mapping2D::Spherical {
+            world_to_texture: Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+            uscale: 1.0,
+            vscale,
+            udelta: 0.0,
+            vdelta,
         };
         let m = spherical(1.0, 0.0);
         // A point above the texture-space origin is at theta 0; one on -y at phi 3pi/2.
@@ -173,13 +234,13 @@ mod tests {
 
     #[test]
     fn cylindrical_mapping_angles_and_height() {
-        let m = Mapping::new(&Mapping2D::Cylindrical {
+        let m = Mapping2D::Cylindrical {
             world_to_texture: Mat4::IDENTITY,
             uscale: 2.0,
             vscale: 1.0,
             udelta: -0.5,
             vdelta: 0.0,
-        });
+        };
         // phi = pi gives s = 2 x 0.5 - 0.5.
         let st = m.map(&at(Vec3::new(-1.0, 0.0, 0.5), Vec2::ZERO));
         assert!((st - Vec2::new(0.5, 0.25)).length() < 1e-6, "{st}");
@@ -187,13 +248,13 @@ mod tests {
 
     #[test]
     fn planar_mapping_projects_texture_space_position() {
-        let m = Mapping::new(&Mapping2D::Planar {
+        let m = Mapping2D::Planar {
             world_to_texture: Mat4::from_scale(Vec3::splat(2.0)),
             v1: Vec3::X,
             v2: Vec3::Y,
             udelta: 0.5,
             vdelta: 1.0,
-        });
+        };
         let st = m.map(&at(Vec3::new(1.0, -1.0, 7.0), Vec2::ZERO));
         assert!((st - Vec2::new(2.5, -1.0)).length() < 1e-6, "{st}");
     }

@@ -1,35 +1,193 @@
-//! Textures: imagemap, checkerboard 2D/3D, constant, scale, mix, with uv, spherical,
-//! cylindrical and planar mappings. Images are decoded once at build time.
+//! Textures: one file per LuxRender texture type, each with its `.lxs` statement, parameters,
+//! defaults, reading and evaluation: [`imagemap`], [`checkerboard`] (2D and 3D), [`constant`],
+//! [`scale`], [`mix`], [`blackbody`] (read as a constant), and [`fresnel`] (the fresnel
+//! textures metal2 folds in). [`mapping`] holds the 2D mappings (uv, spherical, cylindrical,
+//! planar); [`common`] the surface point, the evaluator interface and the statement header
+//! every texture file shares.
+//!
+//! This file maps names to kinds (one line each in [`TextureKind::read`]), says what a kind is
+//! called and what it references, and evaluates the scene's textures ([`Textures`]: built once
+//! per scene, images decoded once and shared).
 //!
 //! Float textures are evaluated like colour textures and their value is splatted over RGB
 //! (an image used as a float texture gives the mean of its channels, LuxRender's default
 //! "channel").
+//!
+//! A new texture type is a new file here (struct, defaults, `read`, `eval`) plus its lines in
+//! [`TextureKind`]: the variant, the name table, `name()`, `references()` and the dispatch in
+//! [`Textures::eval`]. A texture that evaluates other textures takes `&impl TextureEval`.
 
-mod image;
-mod mapping;
+pub mod blackbody;
+pub mod checkerboard;
+pub mod common;
+pub mod constant;
+pub mod fresnel;
+pub mod imagemap;
+pub mod mapping;
+pub mod mix;
+pub mod scale;
 
 #[cfg(test)]
 mod tests;
 
 use std::collections::HashMap;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::Vec3;
 
 use crate::assets::AssetSource;
-use crate::desc::{SceneDesc, TextureDesc, TextureKind, Wrap};
+use crate::diag::SourcePos;
 use crate::image_io::{self, RgbImage};
-use crate::param::{Tex, TextureId};
-pub use mapping::Mapping;
+use crate::param::{Fresnel, Tex, TextureId};
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
 
-/// What a texture lookup needs to know about the surface point.
-#[derive(Clone, Copy, Debug)]
-pub struct TexturePoint {
-    /// Position in the shaded shape's object space: planar, spherical, cylindrical and 3D
-    /// checkerboard mappings project it (then apply the Texture's own transform). The seed
-    /// scenes are composed this way: their planar-mapped walls are scaled unit quads that show
-    /// the image once per unit of object space, whatever their size in the world.
-    pub p: Vec3,
-    pub uv: Vec2,
+pub use checkerboard::{Checkerboard, Checkerboard2D, Checkerboard3D};
+pub use common::{Declared, TextureEval, TexturePoint};
+pub use constant::Constant;
+pub use imagemap::{ImageMap, Wrap};
+pub use mapping::Mapping2D;
+pub use mix::Mix;
+pub use scale::Scale;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureDesc {
+    pub name: String,
+    /// "float" or "color" textures: a float texture's value is splatted over RGB.
+    pub is_color: bool,
+    pub kind: TextureKind,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureKind {
+    ImageMap(ImageMap),
+    Checkerboard2D(Checkerboard2D),
+    Checkerboard3D(Checkerboard3D),
+    Constant(Constant),
+    Scale(Scale),
+    Mix(Mix),
+}
+
+/// What a `Texture` statement defines under its name.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Defined {
+    Texture(TextureDesc),
+    /// A fresnel texture: bound by name, folded into metal2 (see [`fresnel`]).
+    Fresnel(Fresnel),
+}
+
+/// Reads `Texture "name" "kind" "type" params`. An unknown kind is an error; an unsupported
+/// type is a warning and defines nothing (`None`).
+pub fn read(
+    name: &str,
+    kind: &str,
+    class: &str,
+    params: &ParamList,
+    pos: &SourcePos,
+    ctx: &mut dyn ParseContext,
+) -> Result<Option<Defined>, ParseError> {
+    let is_color = match kind {
+        "color" | "spectrum" => true,
+        "float" => false,
+        "fresnel" => return Ok(fresnel::read(class, params, pos, ctx)?.map(Defined::Fresnel)),
+        other => {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: format!(
+                    "Texture \"{name}\": unknown texture kind \"{other}\" (expected \"float\", \"color\" or \"fresnel\")"
+                ),
+            })
+        }
+    };
+    // LuxRender also accepts the fresnel texture types under "color".
+    if fresnel::is_fresnel_type(class) {
+        return Ok(fresnel::read(class, params, pos, ctx)?.map(Defined::Fresnel));
+    }
+    let decl = Declared { name, is_color };
+    let Some(kind) = TextureKind::read(class, &decl, params, pos, ctx)? else {
+        for p in &params.params {
+            params.ignore(&p.name);
+        }
+        ctx.warn(
+            pos,
+            format!("Texture \"{name}\": type \"{class}\" is not supported; the texture is left undefined"),
+        );
+        return Ok(None);
+    };
+    Ok(Some(Defined::Texture(TextureDesc {
+        name: name.to_string(),
+        is_color,
+        kind,
+    })))
+}
+
+impl TextureKind {
+    /// The texture of LuxRender type `class`; `None` for a type this renderer does not know.
+    pub fn read(
+        class: &str,
+        decl: &Declared,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Option<Self>, ParseError> {
+        Ok(Some(match class {
+            "imagemap" => Self::ImageMap(ImageMap::read(decl, params, pos, ctx)?),
+            "checkerboard" => Checkerboard::read(decl, params, pos, ctx)?.into(),
+            "constant" => Self::Constant(Constant::read(decl, params)?),
+            "scale" => Self::Scale(Scale::read(decl, params, ctx)?),
+            "mix" => Self::Mix(Mix::read(decl, params, ctx)?),
+            "blackbody" => Self::Constant(blackbody::read(params)?),
+            _ => return Ok(None),
+        }))
+    }
+
+    /// The LuxRender type name (a blackbody reads as a constant).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::ImageMap(_) => "imagemap",
+            Self::Checkerboard2D(_) | Self::Checkerboard3D(_) => "checkerboard",
+            Self::Constant(_) => "constant",
+            Self::Scale(_) => "scale",
+            Self::Mix(_) => "mix",
+        }
+    }
+
+    /// The textures (or constants) this texture reads, in parameter order.
+    pub fn references(&self) -> Vec<Tex> {
+        match self {
+            Self::ImageMap(_) | Self::Constant(_) => Vec::new(),
+            Self::Checkerboard2D(t) => vec![t.tex1, t.tex2],
+            Self::Checkerboard3D(t) => vec![t.tex1, t.tex2],
+            Self::Scale(t) => vec![t.tex1, t.tex2],
+            Self::Mix(t) => vec![t.tex1, t.tex2, t.amount],
+        }
+    }
+
+    /// The image file this texture reads, and the gamma it is decoded with.
+    pub fn file(&self) -> Option<(&str, f32)> {
+        match self {
+            Self::ImageMap(t) => Some((&t.filename, t.gamma)),
+            _ => None,
+        }
+    }
+
+    /// The 2D mapping this texture looks itself up with, if it has one.
+    pub fn mapping(&self) -> Option<&Mapping2D> {
+        match self {
+            Self::ImageMap(ImageMap { mapping, .. })
+            | Self::Checkerboard2D(Checkerboard2D { mapping, .. }) => Some(mapping),
+            _ => None,
+        }
+    }
+}
+
+impl From<Checkerboard> for TextureKind {
+    fn from(c: Checkerboard) -> Self {
+        match c {
+            Checkerboard::D2(c) => Self::Checkerboard2D(c),
+            Checkerboard::D3(c) => Self::Checkerboard3D(c),
+        }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -44,40 +202,12 @@ pub enum TextureError {
 }
 
 #[derive(Clone, Debug)]
-enum Node {
-    Image {
-        image: usize,
-        gain: f32,
-        wrap: Wrap,
-        mapping: Mapping,
-    },
-    Checkerboard2D {
-        tex1: Tex,
-        tex2: Tex,
-        mapping: Mapping,
-    },
-    Checkerboard3D {
-        tex1: Tex,
-        tex2: Tex,
-        world_to_texture: Mat4,
-    },
-    Constant(Vec3),
-    Scale {
-        tex1: Tex,
-        tex2: Tex,
-    },
-    Mix {
-        tex1: Tex,
-        tex2: Tex,
-        amount: Tex,
-    },
-}
-
-#[derive(Clone, Debug)]
 struct Texture {
-    node: Node,
+    kind: TextureKind,
     /// Float textures splat the mean of their value over RGB.
     is_color: bool,
+    /// Index into [`Textures::images`] of the file [`TextureKind::file`] names.
+    image: Option<usize>,
 }
 
 /// The scene's textures, ready to evaluate; decoded images are shared by every texture that
@@ -88,29 +218,14 @@ pub struct Textures {
     images: Vec<RgbImage>,
 }
 
-/// The textures a texture refers to.
-fn references(kind: &TextureKind) -> Vec<Tex> {
-    match kind {
-        TextureKind::ImageMap { .. } | TextureKind::Constant(_) => Vec::new(),
-        TextureKind::Checkerboard2D { tex1, tex2, .. }
-        | TextureKind::Checkerboard3D { tex1, tex2, .. }
-        | TextureKind::Scale { tex1, tex2 } => vec![*tex1, *tex2],
-        TextureKind::Mix { tex1, tex2, amount } => vec![*tex1, *tex2, *amount],
-    }
-}
-
 impl Textures {
-    pub fn build(desc: &SceneDesc, source: &dyn AssetSource) -> Result<Self, TextureError> {
-        Self::new(&desc.textures, source)
-    }
-
     /// The textures indexed by [`TextureId`], reading image files through `source`.
     pub fn new(descs: &[TextureDesc], source: &dyn AssetSource) -> Result<Self, TextureError> {
         let mut images = Vec::new();
         let mut decoded: HashMap<(&str, u32), usize> = HashMap::new();
         let mut textures = Vec::with_capacity(descs.len());
         for (index, desc) in descs.iter().enumerate() {
-            for tex in references(&desc.kind) {
+            for tex in desc.kind.references() {
                 if let Tex::Texture(TextureId(used)) = tex {
                     if used as usize >= index {
                         return Err(TextureError::ForwardReference {
@@ -120,63 +235,25 @@ impl Textures {
                     }
                 }
             }
-            let node = match &desc.kind {
-                TextureKind::ImageMap {
-                    filename,
-                    gamma,
-                    gain,
-                    wrap,
-                    mapping,
-                } => {
-                    let key = (filename.as_str(), gamma.to_bits());
-                    let image = match decoded.get(&key) {
+            let image = match desc.kind.file() {
+                Some((filename, gamma)) => {
+                    let key = (filename, gamma.to_bits());
+                    Some(match decoded.get(&key) {
                         Some(&image) => image,
                         None => {
                             let bytes = source.read(filename)?;
-                            images.push(image_io::decode(&bytes, filename, *gamma)?);
+                            images.push(image_io::decode(&bytes, filename, gamma)?);
                             decoded.insert(key, images.len() - 1);
                             images.len() - 1
                         }
-                    };
-                    Node::Image {
-                        image,
-                        gain: *gain,
-                        wrap: *wrap,
-                        mapping: Mapping::new(mapping),
-                    }
+                    })
                 }
-                TextureKind::Checkerboard2D {
-                    tex1,
-                    tex2,
-                    mapping,
-                } => Node::Checkerboard2D {
-                    tex1: *tex1,
-                    tex2: *tex2,
-                    mapping: Mapping::new(mapping),
-                },
-                TextureKind::Checkerboard3D {
-                    tex1,
-                    tex2,
-                    world_to_texture,
-                } => Node::Checkerboard3D {
-                    tex1: *tex1,
-                    tex2: *tex2,
-                    world_to_texture: *world_to_texture,
-                },
-                TextureKind::Constant(c) => Node::Constant(*c),
-                TextureKind::Scale { tex1, tex2 } => Node::Scale {
-                    tex1: *tex1,
-                    tex2: *tex2,
-                },
-                TextureKind::Mix { tex1, tex2, amount } => Node::Mix {
-                    tex1: *tex1,
-                    tex2: *tex2,
-                    amount: *amount,
-                },
+                None => None,
             };
             textures.push(Texture {
-                node,
+                kind: desc.kind.clone(),
                 is_color: desc.is_color,
+                image,
             });
         }
         Ok(Self { textures, images })
@@ -194,42 +271,29 @@ impl Textures {
     }
 
     fn eval_texture(&self, texture: &Texture, at: &TexturePoint) -> Vec3 {
-        let value = match &texture.node {
-            Node::Image {
-                image,
-                gain,
-                wrap,
-                mapping,
-            } => image::lookup(&self.images[*image], mapping.map(at), *wrap, *gain),
-            Node::Checkerboard2D {
-                tex1,
-                tex2,
-                mapping,
-            } => {
-                let st = mapping.map(at).floor();
-                let first = (st.x + st.y).rem_euclid(2.0) == 0.0;
-                self.eval(if first { *tex1 } else { *tex2 }, at)
-            }
-            Node::Checkerboard3D {
-                tex1,
-                tex2,
-                world_to_texture,
-            } => {
-                let p = world_to_texture.transform_point3(at.p).floor();
-                let first = (p.x + p.y + p.z).rem_euclid(2.0) == 0.0;
-                self.eval(if first { *tex1 } else { *tex2 }, at)
-            }
-            Node::Constant(c) => *c,
-            Node::Scale { tex1, tex2 } => self.eval(*tex1, at) * self.eval(*tex2, at),
-            Node::Mix { tex1, tex2, amount } => {
-                let t = self.eval(*amount, at).x;
-                self.eval(*tex1, at) * (1.0 - t) + self.eval(*tex2, at) * t
-            }
+        let value = match &texture.kind {
+            TextureKind::ImageMap(t) => t.eval(at, self.image(texture)),
+            TextureKind::Checkerboard2D(t) => t.eval(at, self),
+            TextureKind::Checkerboard3D(t) => t.eval(at, self),
+            TextureKind::Constant(t) => t.eval(),
+            TextureKind::Scale(t) => t.eval(at, self),
+            TextureKind::Mix(t) => t.eval(at, self),
         };
         if texture.is_color {
             value
         } else {
             Vec3::splat(value.element_sum() / 3.0)
         }
+    }
+
+    /// The decoded file of a texture that reads one.
+    fn image(&self, texture: &Texture) -> &RgbImage {
+        &self.images[texture.image.expect("decoded in Textures::new")]
+    }
+}
+
+impl TextureEval for Textures {
+    fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3 {
+        Textures::eval(self, tex, at)
     }
 }

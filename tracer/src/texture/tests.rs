@@ -6,7 +6,6 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::*;
 use crate::assets::MemorySource;
-use crate::desc::{Mapping2D, TextureDesc, TextureKind, Wrap};
 
 const W: u32 = 4;
 const H: u32 = 2;
@@ -51,13 +50,13 @@ fn imagemap(wrap: Wrap, gamma: f32, gain: f32, mapping: Mapping2D) -> TextureDes
     TextureDesc {
         name: "image".into(),
         is_color: true,
-        kind: TextureKind::ImageMap {
+        kind: TextureKind::ImageMap(ImageMap {
             filename: "tex/test.png".into(),
             gamma,
             gain,
             wrap,
             mapping,
-        },
+        }),
     }
 }
 
@@ -186,7 +185,7 @@ fn constant(name: &str, c: Vec3) -> TextureDesc {
     TextureDesc {
         name: name.into(),
         is_color: true,
-        kind: TextureKind::Constant(c),
+        kind: TextureKind::Constant(Constant { value: c }),
     }
 }
 
@@ -196,7 +195,7 @@ fn checkerboards_alternate() {
         TextureDesc {
             name: "check2d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard2D {
+            kind: TextureKind::Checkerboard2D(Checkerboard2D {
                 tex1: Tex::color(Vec3::ONE),
                 tex2: Tex::color(Vec3::ZERO),
                 mapping: Mapping2D::Uv {
@@ -205,16 +204,16 @@ fn checkerboards_alternate() {
                     udelta: 0.0,
                     vdelta: 0.0,
                 },
-            },
+            }),
         },
         TextureDesc {
             name: "check3d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard3D {
+            kind: TextureKind::Checkerboard3D(Checkerboard3D {
                 tex1: Tex::color(Vec3::ONE),
                 tex2: Tex::color(Vec3::ZERO),
                 world_to_texture: Mat4::from_scale(Vec3::splat(2.0)),
-            },
+            }),
         },
     ];
     let textures = Textures::new(&descs, &MemorySource::new()).unwrap();
@@ -255,19 +254,19 @@ fn scale_and_mix_combine_their_inputs() {
         TextureDesc {
             name: "scale".into(),
             is_color: true,
-            kind: TextureKind::Scale {
+            kind: TextureKind::Scale(Scale {
                 tex1: Tex::Texture(TextureId(0)),
                 tex2: Tex::Texture(TextureId(1)),
-            },
+            }),
         },
         TextureDesc {
             name: "mix".into(),
             is_color: true,
-            kind: TextureKind::Mix {
+            kind: TextureKind::Mix(Mix {
                 tex1: Tex::Texture(TextureId(0)),
                 tex2: Tex::Texture(TextureId(1)),
                 amount: Tex::float(0.25),
-            },
+            }),
         },
     ];
     let textures = Textures::new(&descs, &MemorySource::new()).unwrap();
@@ -298,10 +297,10 @@ fn bad_inputs_are_errors() {
     let forward = TextureDesc {
         name: "scale".into(),
         is_color: true,
-        kind: TextureKind::Scale {
+        kind: TextureKind::Scale(Scale {
             tex1: Tex::Texture(TextureId(0)),
             tex2: Tex::float(1.0),
-        },
+        }),
     };
     let err = Textures::new(&[forward], &MemorySource::new())
         .err()

@@ -6,8 +6,10 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
+use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
+use yat_tracer::texture::{Checkerboard3D, Constant, ImageMap, Mix};
 
 fn source(files: &[(&str, &[u8])]) -> MemorySource {
     let mut s = MemorySource::new();
@@ -140,7 +142,9 @@ fn nested_attribute_blocks_restore_state() {
     };
     assert_eq!(
         d.textures[id.0 as usize].kind,
-        TextureKind::Constant(Vec3::new(0.1, 0.2, 0.3))
+        TextureKind::Constant(Constant {
+            value: Vec3::new(0.1, 0.2, 0.3)
+        })
     );
 }
 
@@ -321,7 +325,7 @@ fn material_defaults_and_rules() {
             Tex::float(0.001)
         )
     );
-    let MaterialDesc::Mix(Mix { a, b, amount }) = mat(4) else {
+    let MaterialDesc::Mix(material::Mix { a, b, amount }) = mat(4) else {
         panic!()
     };
     assert_eq!(
@@ -424,7 +428,7 @@ fn textures_map_to_descriptions() {
     let inv = Mat4::from_translation(Vec3::new(0.0, 0.0, -2.0));
     assert_eq!(
         *t(0),
-        TextureKind::ImageMap {
+        TextureKind::ImageMap(ImageMap {
             filename: "tex/a.png".into(),
             gamma: 2.2,
             gain: 1.0,
@@ -435,9 +439,9 @@ fn textures_map_to_descriptions() {
                 udelta: 0.0,
                 vdelta: 1.0
             },
-        }
+        })
     );
-    let TextureKind::ImageMap {
+    let TextureKind::ImageMap(ImageMap {
         mapping:
             Mapping2D::Planar {
                 world_to_texture,
@@ -446,7 +450,7 @@ fn textures_map_to_descriptions() {
                 ..
             },
         ..
-    } = t(1)
+    }) = t(1)
     else {
         panic!("{:?}", t(1))
     };
@@ -454,21 +458,21 @@ fn textures_map_to_descriptions() {
     assert!(!d.textures[1].is_color && d.textures[0].is_color);
     assert_eq!(
         *t(2),
-        TextureKind::Checkerboard3D {
+        TextureKind::Checkerboard3D(Checkerboard3D {
             tex1: Tex::float(1.0),
             tex2: Tex::Texture(TextureId(1)),
             world_to_texture: inv
-        }
+        })
     );
     assert_eq!(
         *t(3),
-        TextureKind::Mix {
+        TextureKind::Mix(Mix {
             tex1: Tex::Texture(TextureId(0)),
             tex2: Tex::float(1.0),
             amount: Tex::float(0.3)
-        }
+        })
     );
-    let TextureKind::Constant(c) = t(4) else {
+    let TextureKind::Constant(Constant { value: c }) = t(4) else {
         panic!()
     };
     assert!((luminance(*c) - 1.0).abs() < 1e-4 && c.x > c.z);

@@ -7,7 +7,9 @@ use glam::{Mat4, Vec3, Vec4};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
 use yat_tracer::film::Film;
+use yat_tracer::material::Matte;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
+use yat_tracer::texture::Checkerboard2D;
 
 /// A camera at `eye` looking along +y with z up (camera x = world x, camera y = world z).
 fn camera(kind: CameraKind, eye: Vec3, lens_radius: f32, focal_distance: f32) -> CameraDesc {
@@ -380,7 +382,7 @@ fn planar_mapping_follows_the_object_space() {
     desc.textures.push(TextureDesc {
         name: "checks".into(),
         is_color: true,
-        kind: TextureKind::Checkerboard2D {
+        kind: TextureKind::Checkerboard2D(Checkerboard2D {
             tex1: Tex::float(1.0),
             tex2: Tex::float(0.0),
             mapping: Mapping2D::Planar {
@@ -390,7 +392,7 @@ fn planar_mapping_follows_the_object_space() {
                 udelta: 0.0,
                 vdelta: 0.0,
             },
-        },
+        }),
     });
     desc.materials.push(MaterialDesc::Matte(Matte {
         kd: Tex::Texture(TextureId(0)),

@@ -1,10 +1,9 @@
 //! Spectral data reduced to RGB: LuxRender's built-in metal presets (complex index of
-//! refraction per channel) and blackbody colours.
+//! refraction per channel) and blackbody colours. A leaf module: the texture and material
+//! readers use it; `crate::parse` re-exports both functions.
 
 use glam::Vec3;
 
-use super::context::ParseContext;
-use crate::diag::SourcePos;
 use crate::math::luminance;
 
 /// Complex index of refraction (eta, k) of LuxRender's named metals, sampled at 650, 550 and
@@ -20,23 +19,6 @@ pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
         _ => return None,
     };
     Some((Vec3::from_array(eta), Vec3::from_array(k)))
-}
-
-/// A named metal preset, or aluminium with a warning (LuxRender's fallback for an unknown name
-/// or an .nk data file). Used by `Material "metal"` and the `fresnelname` texture.
-pub(crate) fn metal_by_name(
-    name: &str,
-    pos: &SourcePos,
-    ctx: &mut dyn ParseContext,
-) -> (Vec3, Vec3) {
-    if let Some(p) = metal_preset(name) {
-        return p;
-    }
-    ctx.warn(
-        pos,
-        format!("metal \"{name}\" is not a built-in preset (.nk data files are not read); using aluminium"),
-    );
-    metal_preset("aluminium").expect("aluminium is a preset")
 }
 
 /// Linear sRGB colour of a blackbody at `kelvin`, scaled to luminance 1 (a blackbody texture

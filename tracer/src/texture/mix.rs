@@ -1,0 +1,51 @@
+//! A blend of two textures by a float texture.
+//!
+//! ```text
+//! Texture "name" "color"|"float" "mix" "texture tex1" "a" "texture tex2" "b" "float amount" 0.3
+//! ```
+//!
+//! | parameter      | default | notes |
+//! |----------------|---------|-------|
+//! | `tex1`         | 0       | texture or constant of the declared kind |
+//! | `tex2`         | 1       | texture or constant of the declared kind |
+//! | `float amount` | 0.5     | texture or constant: the weight of `tex2` |
+
+use glam::Vec3;
+
+use super::common::{Declared, TextureEval, TexturePoint};
+use crate::param::Tex;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+pub const DEFAULT_TEX1: f32 = 0.0;
+pub const DEFAULT_TEX2: f32 = 1.0;
+pub const DEFAULT_AMOUNT: f32 = 0.5;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mix {
+    pub tex1: Tex,
+    pub tex2: Tex,
+    /// Weight of `tex2` (a float texture: its first channel).
+    pub amount: Tex,
+}
+
+impl Mix {
+    pub fn read(
+        decl: &Declared,
+        params: &ParamList,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let amount = params.tex_float("amount", DEFAULT_AMOUNT)?;
+        Ok(Mix {
+            tex1: decl.tex(ctx, params, "tex1", DEFAULT_TEX1)?,
+            tex2: decl.tex(ctx, params, "tex2", DEFAULT_TEX2)?,
+            amount: ctx.tex(amount, false, Vec3::splat(DEFAULT_AMOUNT)),
+        })
+    }
+
+    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+        let t = textures.eval(self.amount, at).x;
+        textures.eval(self.tex1, at) * (1.0 - t) + textures.eval(self.tex2, at) * t
+    }
+}

@@ -1,0 +1,47 @@
+//! The product of two textures (channel by channel).
+//!
+//! ```text
+//! Texture "name" "color"|"float" "scale" "texture tex1" "a" "float tex2" 0.5
+//! ```
+//!
+//! | parameter | default | notes |
+//! |-----------|---------|-------|
+//! | `tex1`    | 1       | texture or constant of the declared kind |
+//! | `tex2`    | 1       | texture or constant of the declared kind |
+//!
+//! The parser also makes scale textures itself: glossy's textured `Ks` times the reflectance
+//! of its constant `index`.
+
+use glam::Vec3;
+
+use super::common::{Declared, TextureEval, TexturePoint};
+use crate::param::Tex;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+pub const DEFAULT_TEX1: f32 = 1.0;
+pub const DEFAULT_TEX2: f32 = 1.0;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scale {
+    pub tex1: Tex,
+    pub tex2: Tex,
+}
+
+impl Scale {
+    pub fn read(
+        decl: &Declared,
+        params: &ParamList,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Ok(Scale {
+            tex1: decl.tex(ctx, params, "tex1", DEFAULT_TEX1)?,
+            tex2: decl.tex(ctx, params, "tex2", DEFAULT_TEX2)?,
+        })
+    }
+
+    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+        textures.eval(self.tex1, at) * textures.eval(self.tex2, at)
+    }
+}
