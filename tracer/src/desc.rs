@@ -8,6 +8,10 @@ use glam::{Mat4, Vec3};
 
 pub use crate::assets::{AssetKind, AssetRef};
 pub use crate::diag::{SourcePos, Warning};
+pub use crate::lights::{
+    AreaLightDesc, DistantLight, EnvMapDesc, InfiniteLight, LatLongConvention, LightDesc,
+    PointLight, SpotLight,
+};
 pub use crate::mesh::TriangleMesh;
 pub use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 
@@ -306,12 +310,6 @@ pub enum Geometry {
 }
 
 #[derive(Clone, Debug, PartialEq)]
-pub struct AreaLightDesc {
-    /// Emitted radiance: L x gain, already normalised by power x efficacy when given.
-    pub radiance: Vec3,
-}
-
-#[derive(Clone, Debug, PartialEq)]
 pub struct ShapeDesc {
     pub name: String,
     pub geometry: Geometry,
@@ -319,53 +317,4 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Lights
-
-/// How a LatLong map is indexed (docs/architecture.md): the seed tracer's u = (pi + phi) / 2pi, or
-/// LuxRender's s = phi / 2pi with phi in [0, 2pi). Both use t = theta / pi.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum LatLongConvention {
-    #[default]
-    Seed,
-    LuxRender,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct EnvMapDesc {
-    /// Path as written; listed in `assets`.
-    pub filename: String,
-    pub gamma: f32,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum LightDesc {
-    Point {
-        position: Vec3,
-        /// Radiant intensity (L x gain, normalised by power x efficacy when given).
-        intensity: Vec3,
-    },
-    Spot {
-        position: Vec3,
-        /// Unit direction in world space.
-        direction: Vec3,
-        intensity: Vec3,
-        /// Degrees, LuxRender semantics (full cone half-angle, and falloff width).
-        cone_angle: f32,
-        cone_delta_angle: f32,
-    },
-    Distant {
-        /// Unit direction the light travels *towards* the scene is `-to_light`.
-        to_light: Vec3,
-        radiance: Vec3,
-    },
-    Infinite {
-        /// L x gain; multiplies the map when there is one.
-        radiance: Vec3,
-        map: Option<EnvMapDesc>,
-        /// Light space has z up; this maps it to world space.
-        light_to_world: Mat4,
-    },
 }

@@ -5,7 +5,7 @@
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
 //! described: [`options`] (camera, film, filter, integrator, sampler), [`textures`],
-//! [`materials`], [`lights`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
+//! [`materials`], [`shapes`] (with [`ply`]), [`spectra`] (metal presets, blackbody).
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
 //! - An empty file, or one without `Camera`/`WorldBegin`, loads with LuxRender's defaults and a
@@ -19,9 +19,8 @@
 
 mod builder;
 pub(crate) mod context;
-mod error;
+pub(crate) mod error;
 mod lexer;
-mod lights;
 mod materials;
 mod options;
 pub(crate) mod params;

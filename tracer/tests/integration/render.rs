@@ -82,11 +82,11 @@ fn add_sphere(desc: &mut SceneDesc, centre: Vec3, radius: f32, material: Materia
 }
 
 fn constant_sky(desc: &mut SceneDesc, radiance: Vec3) {
-    desc.lights.push(LightDesc::Infinite {
+    desc.lights.push(LightDesc::Infinite(InfiniteLight {
         radiance,
         map: None,
         light_to_world: Mat4::IDENTITY,
-    });
+    }));
 }
 
 fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
@@ -301,14 +301,14 @@ fn environment_marker_shows_up_in_the_convention_direction() {
             Vec4::W,
         );
         let mut desc = scene(cam, 8);
-        desc.lights.push(LightDesc::Infinite {
+        desc.lights.push(LightDesc::Infinite(InfiniteLight {
             radiance: Vec3::ONE,
             map: Some(EnvMapDesc {
                 filename: "marker.png".into(),
                 gamma: 1.0,
             }),
             light_to_world: Mat4::IDENTITY,
-        });
+        }));
         let mut settings = settings(&desc, 4);
         settings.latlong = convention;
         let scene = RenderScene::build(&desc, &source, &settings).unwrap();
