@@ -177,11 +177,8 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         d.lights
             .iter()
             .map(|l| match l {
-                LightDesc::Point { .. } => "point",
-                LightDesc::Spot { .. } => "spot",
-                LightDesc::Distant { .. } => "distant",
-                LightDesc::Infinite { map: Some(_), .. } => "infinite (map)",
-                LightDesc::Infinite { map: None, .. } => "infinite",
+                LightDesc::Infinite(i) if i.map.is_some() => "infinite (map)",
+                l => l.name(),
             })
             .chain(std::iter::repeat_n("area (shapes)", emitters)),
     );

@@ -1,15 +1,90 @@
-//! Area lights: a shape whose front side emits constant radiance. Points are sampled uniformly
-//! by area over the whole shape (triangles chosen by an area table), except whole spheres,
-//! which are sampled inside the cone they subtend (only their visible cap).
+//! Area lights: a shape whose front side emits constant radiance. The statement sets the
+//! emission of every shape that follows in its attribute block:
+//!
+//! ```text
+//! AreaLightSource "area" "color L" [1 1 1] "float gain" [1] "float power" [100] "float efficacy" [17]
+//! ```
+//!
+//! | parameter  | default | meaning                                                          |
+//! |------------|---------|------------------------------------------------------------------|
+//! | `L`        | 1 1 1   | colour                                                           |
+//! | `gain`     | 1       | multiplies `L`                                                   |
+//! | `power`    | 100     | watts; with `efficacy` > 0 the gain is scaled so the shape emits that many lumens |
+//! | `efficacy` | 17      | lumens per watt                                                  |
+//!
+//! Other types are read as `"area"` with a warning. The radiance is known once the shape's
+//! world-space area is (LuxRender's normalisation divides by it).
+//!
+//! Points are sampled uniformly by area over the whole shape (triangles chosen by an area
+//! table), except whole spheres, which are sampled inside the cone they subtend (only their
+//! visible cap).
 
 use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3};
 
+use crate::diag::SourcePos;
 use crate::geometry::{AnalyticShape, ShapeSurface, SurfaceSample, TriangleSurface};
 use crate::math::{luminance, Frame};
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+use crate::shape::AreaLightDesc;
 
 use super::distribution::Distribution1D;
+use super::emission::{normalised_gain, DEFAULT_GAIN, DEFAULT_L};
+use super::sample::LightSample;
+
+/// `power`, watts.
+pub const DEFAULT_POWER: f32 = 100.0;
+/// `efficacy`, lumens per watt.
+pub const DEFAULT_EFFICACY: f32 = 17.0;
+
+/// Area light parameters kept in the graphics state; the radiance is known only once the
+/// world-space area of each shape is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLightParams {
+    pub l: Vec3,
+    pub gain: f32,
+    pub power: f32,
+    pub efficacy: f32,
+}
+
+impl AreaLightParams {
+    /// Reads `AreaLightSource "ty"`.
+    pub(crate) fn read(
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        if ty != "area" {
+            ctx.warn(
+                pos,
+                format!("AreaLightSource \"{ty}\" is treated as \"area\""),
+            );
+        }
+        Ok(Self {
+            l: params.color("L", DEFAULT_L)?,
+            gain: params.float("gain", DEFAULT_GAIN)?,
+            power: params.float("power", DEFAULT_POWER)?,
+            efficacy: params.float("efficacy", DEFAULT_EFFICACY)?,
+        })
+    }
+
+    /// The emission of a shape of world-space area `area`.
+    pub fn desc(&self, area: f32) -> AreaLightDesc {
+        let gain = normalised_gain(
+            self.gain,
+            self.power,
+            self.efficacy,
+            area * PI * luminance(self.l),
+        );
+        AreaLightDesc {
+            radiance: self.l * gain,
+        }
+    }
+}
 
 /// Points this close to a sphere light (squared distance to its centre over radius^2) sample
 /// it by area, not by cone: a point on the sphere itself (an emitting sphere seen from
@@ -21,7 +96,8 @@ const ON_SPHERE: f32 = 1.0 + 1e-3;
 /// Taylor expansions: 1 - cos(theta_max) would cancel catastrophically (pbrt-v4).
 const SMALL_CONE_SIN2: f32 = 0.000_685_23;
 
-pub(super) struct AreaLight {
+/// An area light ready to sample.
+pub struct AreaLight {
     radiance: Vec3,
     emitter: Emitter,
 }
@@ -42,7 +118,7 @@ enum Emitter {
 }
 
 /// A point on the light as seen from a shading point.
-pub(super) struct EmitterSample {
+pub struct EmitterSample {
     pub wi: Vec3,
     pub dist: f32,
     /// Solid-angle density.
@@ -124,6 +200,18 @@ impl AreaLight {
         let cos_light = -point.n.dot(wi);
         let pdf = point.pdf_area * dist2 / cos_light;
         (cos_light > 0.0 && pdf.is_finite()).then_some(EmitterSample { wi, dist, pdf })
+    }
+
+    /// [`Self::sample`] as a light sample, for a light chosen with probability `pmf`.
+    pub fn sample_chosen(&self, from: Vec3, u: Vec2, pmf: f32) -> Option<LightSample> {
+        let s = self.sample(from, u)?;
+        Some(LightSample {
+            wi: s.wi,
+            li: self.radiance(),
+            pdf: pmf * s.pdf,
+            dist: s.dist,
+            delta: false,
+        })
     }
 
     /// The solid-angle density of [`Self::sample`] from `from` at the light point `p` with
@@ -210,4 +298,32 @@ fn sample_sphere_cone(
         dist,
         pdf,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn area_gain_follows_power_and_efficacy() {
+        let e = AreaLightParams {
+            l: Vec3::new(1.0, 0.5, 0.25),
+            gain: 2.0,
+            power: 100.0,
+            efficacy: 17.0,
+        };
+        let area = 0.5;
+        let r = e.desc(area).radiance;
+        let expected_gain = 2.0 * 100.0 * 17.0 / (area * PI * luminance(e.l));
+        assert!((r - e.l * expected_gain).abs().max_element() < 1e-3 * expected_gain);
+        // Emitted luminous power then equals gain x power x efficacy: Y(L x gain) x area x pi.
+        assert!((luminance(r) * area * PI - 2.0 * 1700.0).abs() < 0.5);
+        let off = AreaLightParams {
+            power: 0.0,
+            ..e.clone()
+        };
+        assert_eq!(off.desc(area).radiance, e.l * 2.0);
+        // An infinite plane has no finite power: the gain stays as given.
+        assert_eq!(e.desc(f32::INFINITY).radiance, e.l * 2.0);
+    }
 }

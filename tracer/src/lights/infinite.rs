@@ -1,17 +1,133 @@
 //! The infinite light: constant radiance, or radiance times a LatLong environment map that is
-//! importance-sampled by luminance.
+//! importance-sampled by luminance (`infinitesample` is read as the same light).
+//!
+//! ```text
+//! LightSource "infinite" "color L" [1 1 1] "float gain" [1] "string mapname" ["sky.exr"]
+//!     "string mapping" ["latlong"] "float gamma" [1]
+//! ```
+//!
+//! | parameter | default   | meaning                                                         |
+//! |-----------|-----------|-----------------------------------------------------------------|
+//! | `L`       | 1 1 1     | colour; multiplies the map when there is one                    |
+//! | `gain`    | 1         | multiplies `L`                                                  |
+//! | `mapname` | (none)    | LatLong image in light space (z up); empty means none           |
+//! | `mapping` | "latlong" | anything else is a warning and read as latlong                  |
+//! | `gamma`   | 1         | the map's encoding gamma                                        |
+//!
+//! Light space is mapped to the world by the current transform.
 
 use std::f32::consts::{PI, TAU};
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use crate::desc::LatLongConvention;
-use crate::image_io::{Edge, RgbImage};
+use crate::assets::AssetSource;
+use crate::diag::SourcePos;
+use crate::image_io::{self, Edge, RgbImage};
 use crate::math::luminance;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
 
 use super::distribution::Distribution2D;
+use super::emission::{emits, Emission};
+use super::error::LightError;
 
-pub(super) struct InfiniteLight {
+/// `mapping`: the only one modelled.
+pub const DEFAULT_MAPPING: &str = "latlong";
+/// `gamma` of the map.
+pub const DEFAULT_GAMMA: f32 = 1.0;
+
+/// How a LatLong map is indexed (docs/architecture.md): the seed tracer's u = (pi + phi) / 2pi, or
+/// LuxRender's s = phi / 2pi with phi in [0, 2pi). Both use t = theta / pi.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LatLongConvention {
+    #[default]
+    Seed,
+    LuxRender,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvMapDesc {
+    /// Path as written; listed in `assets`.
+    pub filename: String,
+    pub gamma: f32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct InfiniteLight {
+    /// L x gain; multiplies the map when there is one.
+    pub radiance: Vec3,
+    pub map: Option<EnvMapDesc>,
+    /// Light space has z up; this maps it to world space.
+    pub light_to_world: Mat4,
+}
+
+impl InfiniteLight {
+    pub(crate) fn read(
+        e: Emission,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let mapping = params.string_or("mapping", DEFAULT_MAPPING)?;
+        if mapping != DEFAULT_MAPPING {
+            ctx.warn(
+                pos,
+                format!("LightSource \"infinite\": mapping \"{mapping}\" is not supported; using latlong"),
+            );
+        }
+        let gamma = params.float("gamma", DEFAULT_GAMMA)?;
+        let map = match params.string("mapname")? {
+            Some(filename) if !filename.is_empty() => {
+                ctx.check_image(&filename, pos)?;
+                Some(EnvMapDesc { filename, gamma })
+            }
+            _ => None,
+        };
+        Ok(Self {
+            radiance: e.l * e.gain,
+            map,
+            light_to_world: ctx.ctm(),
+        })
+    }
+
+    /// The light to sample, if it emits: its map read from `source` and decoded.
+    pub fn light(
+        &self,
+        source: &dyn AssetSource,
+        latlong: LatLongConvention,
+    ) -> Result<Option<Environment>, LightError> {
+        if !emits(self.radiance) {
+            return Ok(None);
+        }
+        let image = match &self.map {
+            Some(map) => Some(load_map(source, &map.filename, map.gamma)?),
+            None => None,
+        };
+        if Environment::is_singular(&self.light_to_world) {
+            tracing::warn!("infinite light: singular transform, using the identity");
+        }
+        Ok(Some(Environment::new(
+            self.radiance,
+            image,
+            &self.light_to_world,
+            latlong,
+        )))
+    }
+}
+
+fn load_map(source: &dyn AssetSource, filename: &str, gamma: f32) -> Result<RgbImage, LightError> {
+    let bytes = source.read(filename)?;
+    let image = image_io::decode(&bytes, filename, gamma)?;
+    Ok(if image.is_empty() {
+        RgbImage::from_linear(1, 1, vec![Vec3::ZERO])
+    } else {
+        image
+    })
+}
+
+/// An infinite light ready to sample: the map decoded and its distribution built.
+pub struct Environment {
     radiance: Vec3,
     map: Option<LatLongMap>,
     world_to_light: Mat3,
@@ -21,7 +137,7 @@ pub(super) struct InfiniteLight {
     abs_det: f32,
 }
 
-impl InfiniteLight {
+impl Environment {
     /// A singular `light_to_world` is replaced by the identity (reported by the caller).
     pub fn new(
         radiance: Vec3,

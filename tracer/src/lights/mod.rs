@@ -1,15 +1,28 @@
-//! Lights: area lights on shapes, point, spot, distant and infinite (constant or LatLong map,
-//! importance-sampled by luminance), and the choice of which light to sample.
+//! Lights: what a `LightSource` statement describes ([`LightDesc`], one file per kind, read
+//! through the name table [`read`]), area lights on shapes ([`area`]), and the sampler the
+//! integrator asks ([`Lights`]): point, spot, distant, infinite (constant or LatLong map,
+//! importance-sampled by luminance) and area lights, and the choice of which light to sample.
 //!
 //! A light is chosen with probability proportional to an estimate of its power. The infinite
 //! lights act as one mixture: a direction sampled from any of them carries the sum of their
 //! radiance and the mixture's density, which is what `environment` and `pdf_environment`
 //! return for an escaping ray, so MIS sees the same numbers from both sides.
+//!
+//! Files: one per kind (`point`, `spot`, `distant`, `infinite`, `area`), each with its
+//! statement, parameters and defaults, reading and sampling; the leaves they share:
+//! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
+//! types), `error`, `distribution` (sampling tables). A new kind is one new file, one line in
+//! [`read`] and one line in each `match` below.
 
 mod area;
+mod distant;
 mod distribution;
+mod emission;
+mod error;
 mod infinite;
-mod punctual;
+mod point;
+mod sample;
+mod spot;
 
 #[cfg(test)]
 mod tests;
@@ -17,36 +30,100 @@ mod tests;
 use glam::{Vec2, Vec3};
 
 use crate::assets::AssetSource;
-use crate::desc::{LatLongConvention, LightDesc, SceneDesc};
+use crate::diag::SourcePos;
 use crate::geometry::{SceneGeometry, SurfaceHit};
-use crate::image_io::{self, RgbImage};
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+use crate::shape::AreaLightDesc;
+
+pub use area::AreaLightParams;
+pub use distant::DistantLight;
+pub use error::LightError;
+pub use infinite::{EnvMapDesc, InfiniteLight, LatLongConvention};
+pub use point::PointLight;
+pub use sample::LightSample;
+pub use spot::SpotLight;
 
 use area::AreaLight;
 use distribution::Distribution1D;
-use infinite::InfiniteLight;
-use punctual::{DeltaSample, DistantLight, PointLight, SpotLight};
+use emission::Emission;
+use infinite::Environment;
+use spot::SpotCone;
 
-/// A light sample as seen from a shading point.
-#[derive(Clone, Copy, Debug)]
-pub struct LightSample {
-    /// Unit direction from the shading point towards the light.
-    pub wi: Vec3,
-    /// Radiance arriving along `-wi` (intensity / dist^2 for point lights).
-    pub li: Vec3,
-    /// Solid-angle density including the probability of choosing this light; for delta lights
-    /// the choice probability alone.
-    pub pdf: f32,
-    /// Distance to the sampled point (f32::INFINITY for infinite and distant lights).
-    pub dist: f32,
-    pub delta: bool,
+/// A `LightSource` statement as described: plain data with LuxRender's defaults applied.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightDesc {
+    Point(PointLight),
+    Spot(SpotLight),
+    Distant(DistantLight),
+    Infinite(InfiniteLight),
+}
+
+impl LightDesc {
+    /// The LuxRender type name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            LightDesc::Point(_) => "point",
+            LightDesc::Spot(_) => "spot",
+            LightDesc::Distant(_) => "distant",
+            LightDesc::Infinite(_) => "infinite",
+        }
+    }
+
+    /// The files the light references (as written; the scene lists them in its assets).
+    pub fn files(&self) -> Vec<&str> {
+        match self {
+            LightDesc::Infinite(l) => l.map.iter().map(|m| m.filename.as_str()).collect(),
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// Reads `LightSource "ty"`: None for a type that is skipped (with a warning).
+pub(crate) fn read(
+    ty: &str,
+    params: &ParamList,
+    pos: &SourcePos,
+    ctx: &mut dyn ParseContext,
+) -> Result<Option<LightDesc>, ParseError> {
+    let e = Emission::read(params)?;
+    Ok(Some(match ty {
+        "point" | "goniometric" => LightDesc::Point(PointLight::read(e, params, pos, ctx)?),
+        "spot" => LightDesc::Spot(SpotLight::read(e, params, pos, ctx)?),
+        "distant" => LightDesc::Distant(DistantLight::read(e, params, pos, ctx)?),
+        "infinite" | "infinitesample" => {
+            LightDesc::Infinite(InfiniteLight::read(e, params, pos, ctx)?)
+        }
+        "sun" | "sky" | "sky2" | "sunsky" | "sunsky2" => {
+            ignore_all(params);
+            ctx.warn_once(
+                format!("light|{ty}"),
+                pos,
+                format!("LightSource \"{ty}\" is not supported; the light is skipped"),
+            );
+            return Ok(None);
+        }
+        other => {
+            ignore_all(params);
+            ctx.warn(pos, format!("unknown LightSource \"{other}\" skipped"));
+            return Ok(None);
+        }
+    }))
+}
+
+fn ignore_all(params: &ParamList) {
+    for p in &params.params {
+        params.ignore(&p.name);
+    }
 }
 
 enum Light {
     Area(AreaLight),
     Point(PointLight),
-    Spot(SpotLight),
+    Spot(SpotCone),
     Distant(DistantLight),
-    Infinite(InfiniteLight),
+    Infinite(Environment),
 }
 
 /// An infinite light never starves: it gets at least this fraction of the other lights' power
@@ -63,35 +140,33 @@ pub struct Lights {
     infinite: Vec<u32>,
 }
 
-#[derive(Debug, thiserror::Error)]
-pub enum LightError {
-    #[error(transparent)]
-    Asset(#[from] crate::assets::AssetError),
-    #[error(transparent)]
-    Decode(#[from] crate::image_io::DecodeError),
-}
-
 impl Lights {
-    pub fn build(
-        desc: &SceneDesc,
+    /// The lights of a scene: `shapes` gives, for every shape in order, its name and its area
+    /// light (sampled on `geometry`'s surface of that shape), `lights` the `LightSource`s; maps
+    /// are read from `source` and indexed by `latlong`.
+    pub fn build<'a>(
+        shapes: impl IntoIterator<Item = (&'a str, Option<&'a AreaLightDesc>)>,
+        lights: &[LightDesc],
         geometry: &SceneGeometry,
         source: &dyn AssetSource,
         latlong: LatLongConvention,
     ) -> Result<Self, LightError> {
+        let descs = lights;
         let mut lights = Vec::new();
-        let mut shape_light = vec![None; desc.shapes.len()];
-        for (index, shape) in desc.shapes.iter().enumerate() {
-            let Some(area_light) = &shape.area_light else {
+        let mut shape_light = Vec::new();
+        for (index, (name, area_light)) in shapes.into_iter().enumerate() {
+            shape_light.push(None);
+            let Some(area_light) = area_light else {
                 continue;
             };
-            if !emits(area_light.radiance) {
+            if !emission::emits(area_light.radiance) {
                 continue;
             }
             let Some(surface) = geometry.shape_surface(index as u32) else {
                 tracing::warn!(
                     "shape \"{}\": area light ignored (an infinite plane or a degenerate shape \
                      has no surface to sample)",
-                    shape.name
+                    name
                 );
                 continue;
             };
@@ -102,68 +177,14 @@ impl Lights {
             }
         }
 
-        for light in &desc.lights {
-            match light {
-                LightDesc::Point {
-                    position,
-                    intensity,
-                } => {
-                    if emits(*intensity) {
-                        lights.push(Light::Point(PointLight {
-                            position: *position,
-                            intensity: *intensity,
-                        }));
-                    }
-                }
-                LightDesc::Spot {
-                    position,
-                    direction,
-                    intensity,
-                    cone_angle,
-                    cone_delta_angle,
-                } => {
-                    if emits(*intensity) {
-                        lights.push(Light::Spot(SpotLight::new(
-                            *position,
-                            *direction,
-                            *intensity,
-                            *cone_angle,
-                            *cone_delta_angle,
-                        )));
-                    }
-                }
-                LightDesc::Distant { to_light, radiance } => {
-                    let to_light = to_light.normalize_or_zero();
-                    if emits(*radiance) && to_light != Vec3::ZERO {
-                        lights.push(Light::Distant(DistantLight {
-                            to_light,
-                            radiance: *radiance,
-                        }));
-                    }
-                }
-                LightDesc::Infinite {
-                    radiance,
-                    map,
-                    light_to_world,
-                } => {
-                    if !emits(*radiance) {
-                        continue;
-                    }
-                    let image = match map {
-                        Some(map) => Some(load_map(source, &map.filename, map.gamma)?),
-                        None => None,
-                    };
-                    if InfiniteLight::is_singular(light_to_world) {
-                        tracing::warn!("infinite light: singular transform, using the identity");
-                    }
-                    lights.push(Light::Infinite(InfiniteLight::new(
-                        *radiance,
-                        image,
-                        light_to_world,
-                        latlong,
-                    )));
-                }
-            }
+        for desc in descs {
+            let light = match desc {
+                LightDesc::Point(l) => l.light().map(Light::Point),
+                LightDesc::Spot(l) => l.light().map(Light::Spot),
+                LightDesc::Distant(l) => l.light().map(Light::Distant),
+                LightDesc::Infinite(l) => l.light(source, latlong)?.map(Light::Infinite),
+            };
+            lights.extend(light);
         }
 
         let scene_radius = geometry
@@ -209,45 +230,33 @@ impl Lights {
     /// it). None when the chosen light contributes nothing from here.
     pub fn sample(&self, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
         let (index, pmf, _) = self.selection.sample_discrete(u_select)?;
-        let delta = |s: DeltaSample| LightSample {
-            wi: s.wi,
-            li: s.li,
-            pdf: pmf,
-            dist: s.dist,
-            delta: true,
-        };
         match &self.lights[index] {
-            Light::Area(light) => {
-                let s = light.sample(p, u)?;
-                Some(LightSample {
-                    wi: s.wi,
-                    li: light.radiance(),
-                    pdf: pmf * s.pdf,
-                    dist: s.dist,
-                    delta: false,
-                })
-            }
-            Light::Point(light) => light.sample(p).map(delta),
-            Light::Spot(light) => light.sample(p).map(delta),
-            Light::Distant(light) => Some(delta(light.sample())),
-            Light::Infinite(light) => {
-                let (wi, pdf, li) = light.sample(u)?;
-                // A lone infinite light is the whole mixture: its own density and radiance
-                // serve, without looking the direction up again.
-                let (li, pdf) = if self.infinite.len() == 1 {
-                    (li, pmf * pdf)
-                } else {
-                    self.environment_and_pdf(wi)
-                };
-                (pdf > 0.0).then_some(LightSample {
-                    wi,
-                    li,
-                    pdf,
-                    dist: f32::INFINITY,
-                    delta: false,
-                })
-            }
+            Light::Area(light) => light.sample_chosen(p, u, pmf),
+            Light::Point(light) => light.sample(p).map(|s| s.chosen(pmf)),
+            Light::Spot(light) => light.sample(p).map(|s| s.chosen(pmf)),
+            Light::Distant(light) => Some(light.sample().chosen(pmf)),
+            Light::Infinite(light) => self.sample_environment(light, u, pmf),
         }
+    }
+
+    /// A direction sampled from one of the infinite lights (chosen with probability `pmf`),
+    /// with the radiance and density of the whole mixture.
+    fn sample_environment(&self, light: &Environment, u: Vec2, pmf: f32) -> Option<LightSample> {
+        let (wi, pdf, li) = light.sample(u)?;
+        // A lone infinite light is the whole mixture: its own density and radiance
+        // serve, without looking the direction up again.
+        let (li, pdf) = if self.infinite.len() == 1 {
+            (li, pmf * pdf)
+        } else {
+            self.environment_and_pdf(wi)
+        };
+        (pdf > 0.0).then_some(LightSample {
+            wi,
+            li,
+            pdf,
+            dist: f32::INFINITY,
+            delta: false,
+        })
     }
 
     fn area_light(&self, shape: u32) -> Option<(u32, &AreaLight)> {
@@ -300,7 +309,7 @@ impl Lights {
             .fold((Vec3::ZERO, 0.0), |(r, p), (ri, pi)| (r + ri, p + pi))
     }
 
-    fn infinite_lights(&self) -> impl Iterator<Item = (usize, &InfiniteLight)> {
+    fn infinite_lights(&self) -> impl Iterator<Item = (usize, &Environment)> {
         self.infinite
             .iter()
             .filter_map(|&i| match &self.lights[i as usize] {
@@ -308,19 +317,4 @@ impl Lights {
                 _ => None,
             })
     }
-}
-
-/// Whether a colour can light anything.
-fn emits(c: Vec3) -> bool {
-    c.is_finite() && c.max_element() > 0.0
-}
-
-fn load_map(source: &dyn AssetSource, filename: &str, gamma: f32) -> Result<RgbImage, LightError> {
-    let bytes = source.read(filename)?;
-    let image = image_io::decode(&bytes, filename, gamma)?;
-    Ok(if image.is_empty() {
-        RgbImage::from_linear(1, 1, vec![Vec3::ZERO])
-    } else {
-        image
-    })
 }

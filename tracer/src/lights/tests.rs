@@ -6,7 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::*;
 use crate::assets::MemorySource;
-use crate::desc::{AreaLightDesc, EnvMapDesc, Geometry, ShapeDesc};
+use crate::desc::{AreaLightDesc, Geometry, SceneDesc, ShapeDesc};
 use crate::geometry::tests::{mesh, scene_desc, shape, sphere};
 use crate::math::{luminance, Ray};
 
@@ -18,8 +18,16 @@ fn build_with(
 ) -> (SceneGeometry, Lights) {
     let desc = scene_desc(shapes, lights);
     let geometry = SceneGeometry::build(&desc);
-    let lights = Lights::build(&desc, &geometry, source, latlong).unwrap();
+    let lights =
+        Lights::build(area_lights(&desc), &desc.lights, &geometry, source, latlong).unwrap();
     (geometry, lights)
+}
+
+/// Each shape's name and area light, as `Lights::build` takes them.
+fn area_lights(desc: &SceneDesc) -> impl Iterator<Item = (&str, Option<&AreaLightDesc>)> {
+    desc.shapes
+        .iter()
+        .map(|s| (s.name.as_str(), s.area_light.as_ref()))
 }
 
 fn build(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> (SceneGeometry, Lights) {
@@ -62,10 +70,10 @@ fn disk(radius: f32) -> Geometry {
 }
 
 fn point(position: Vec3, intensity: f32) -> LightDesc {
-    LightDesc::Point {
+    LightDesc::Point(PointLight {
         position,
         intensity: Vec3::splat(intensity),
-    }
+    })
 }
 
 /// Monte Carlo estimate of the irradiance at `p` on a surface facing `n`, by light sampling.
@@ -261,13 +269,13 @@ fn area_lights_emit_from_the_front_only() {
 
 #[test]
 fn delta_lights_follow_their_definitions() {
-    let spot = LightDesc::Spot {
+    let spot = LightDesc::Spot(SpotLight {
         position: Vec3::ZERO,
         direction: -Vec3::Z,
         intensity: Vec3::splat(8.0),
         cone_angle: 30.0,
         cone_delta_angle: 10.0,
-    };
+    });
     let (_, lights) = build(vec![], vec![spot]);
     let at_angle = |deg: f32| {
         let p = Vec3::new(deg.to_radians().sin(), 0.0, -deg.to_radians().cos()) * 2.0;
@@ -285,10 +293,10 @@ fn delta_lights_follow_their_definitions() {
         .to_degrees();
     assert!((at_angle(mid) - 1.0).abs() < 1e-3, "{}", at_angle(mid));
 
-    let distant = LightDesc::Distant {
+    let distant = LightDesc::Distant(DistantLight {
         to_light: Vec3::new(0.0, 1.0, 1.0).normalize(),
         radiance: Vec3::new(1.0, 2.0, 3.0),
-    };
+    });
     let lights_d = vec![
         point(Vec3::new(0.0, 0.0, 4.0), 1.0),
         point(Vec3::new(0.0, 0.0, -4.0), 3.0),
@@ -333,14 +341,14 @@ fn png(width: u32, height: u32, texel: impl Fn(u32, u32) -> [u8; 3]) -> Arc<[u8]
 }
 
 fn env_light(filename: &str, light_to_world: Mat4) -> LightDesc {
-    LightDesc::Infinite {
+    LightDesc::Infinite(InfiniteLight {
         radiance: Vec3::ONE,
         map: Some(EnvMapDesc {
             filename: filename.into(),
             gamma: 1.0,
         }),
         light_to_world,
-    }
+    })
 }
 
 fn env_lights(source: &MemorySource, light: LightDesc, convention: LatLongConvention) -> Lights {
@@ -524,11 +532,11 @@ fn env_map_sampling_estimates_the_map_integral() {
 
 #[test]
 fn constant_infinite_light_is_uniform_and_shares_with_other_lights() {
-    let sky = LightDesc::Infinite {
+    let sky = LightDesc::Infinite(InfiniteLight {
         radiance: Vec3::splat(0.5),
         map: None,
         light_to_world: Mat4::IDENTITY,
-    };
+    });
     let (_, lights) = build(vec![], vec![sky.clone()]);
     assert_eq!(
         lights.environment(Vec3::new(0.3, -0.2, 0.9).normalize()),
@@ -553,7 +561,8 @@ fn a_missing_env_map_is_an_error_naming_the_file() {
     let desc = scene_desc(vec![], vec![env_light("maps/sky.hdr", Mat4::IDENTITY)]);
     let geometry = SceneGeometry::build(&desc);
     let err = Lights::build(
-        &desc,
+        area_lights(&desc),
+        &desc.lights,
         &geometry,
         &MemorySource::new(),
         LatLongConvention::Seed,
@@ -564,9 +573,15 @@ fn a_missing_env_map_is_an_error_naming_the_file() {
 
     let mut source = MemorySource::new();
     source.insert("maps/sky.hdr", Arc::from(&b"not an image"[..]));
-    let err = Lights::build(&desc, &geometry, &source, LatLongConvention::Seed)
-        .err()
-        .expect("undecodable file");
+    let err = Lights::build(
+        area_lights(&desc),
+        &desc.lights,
+        &geometry,
+        &source,
+        LatLongConvention::Seed,
+    )
+    .err()
+    .expect("undecodable file");
     assert!(matches!(err, LightError::Decode(_)) && err.to_string().contains("maps/sky.hdr"));
 }
 

@@ -16,21 +16,12 @@ use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::Warning;
+use crate::lights::AreaLightParams;
 use crate::material::Matte;
 use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::shape::Geometry;
 use crate::texture::{self, Defined, Scale};
-
-/// Area light parameters kept in the graphics state; the radiance is known only once the
-/// world-space area of each shape is.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AreaLightParams {
-    pub l: Vec3,
-    pub gain: f32,
-    pub power: f32,
-    pub efficacy: f32,
-}
 
 #[derive(Clone, Debug, Default)]
 struct GraphicsState {
@@ -421,24 +412,15 @@ impl<'s> Builder<'s> {
                 if self.current_object.is_some() {
                     self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined".into());
                 }
-                self.light(&ty, &params, pos)?;
+                if let Some(light) = crate::lights::read(&ty, &params, pos, self)? {
+                    self.lights.push(light);
+                }
                 self.warn_unused(&params);
             }
             "AreaLightSource" => {
                 let ty = r.string("the area light type")?;
                 let params = r.params(format!("AreaLightSource \"{ty}\""))?;
-                if ty != "area" {
-                    self.warn(
-                        pos,
-                        format!("AreaLightSource \"{ty}\" is treated as \"area\""),
-                    );
-                }
-                self.gs.area_light = Some(AreaLightParams {
-                    l: params.color("L", Vec3::ONE)?,
-                    gain: params.float("gain", 1.0)?,
-                    power: params.float("power", 100.0)?,
-                    efficacy: params.float("efficacy", 17.0)?,
-                });
+                self.gs.area_light = Some(AreaLightParams::read(&ty, &params, pos, self)?);
                 self.warn_unused(&params);
             }
             "Shape" => {
@@ -626,9 +608,7 @@ impl<'s> Builder<'s> {
     fn emit_shape(&mut self, shape: PendingShape, instance: Mat4) {
         let mut desc = shape.desc;
         desc.object_to_world = instance * desc.object_to_world;
-        desc.area_light = shape
-            .emitter
-            .map(|e| super::lights::area_light(&e, desc.world_area()));
+        desc.area_light = shape.emitter.map(|e| e.desc(desc.world_area()));
         self.shapes.push(desc);
     }
 

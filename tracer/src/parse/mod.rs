@@ -5,8 +5,8 @@
 //! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
 //! described: [`options`] (the camera, film, filter, integrator and sampler statements, read by
-//! their concepts), [`lights`]. Materials, textures and shapes read themselves
-//! ([`crate::material`], [`crate::texture`], [`crate::shape`], meshes by [`crate::mesh`]); metal
+//! their concepts). Materials, textures, lights and shapes read themselves ([`crate::material`],
+//! [`crate::texture`], [`crate::lights`], [`crate::shape`], meshes by [`crate::mesh`]); metal
 //! presets and blackbody colours are in [`crate::spectra`].
 //!
 //! Choices where LuxRender leaves room (each is pinned by a test):
@@ -23,7 +23,6 @@ mod builder;
 pub(crate) mod context;
 pub(crate) mod error;
 mod lexer;
-mod lights;
 mod options;
 pub(crate) mod params;
 mod reader;

@@ -48,7 +48,15 @@ impl RenderScene {
         settings: &RenderSettings,
     ) -> Result<Self, BuildError> {
         let geometry = SceneGeometry::build(desc);
-        let lights = Lights::build(desc, &geometry, source, settings.latlong)?;
+        let shapes = desc.shapes.iter();
+        let area_lights = shapes.map(|s| (s.name.as_str(), s.area_light.as_ref()));
+        let lights = Lights::build(
+            area_lights,
+            &desc.lights,
+            &geometry,
+            source,
+            settings.latlong,
+        )?;
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: FilterSampler::new(&desc.filter),

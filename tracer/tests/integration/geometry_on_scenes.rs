@@ -55,8 +55,16 @@ fn bvh_and_lights_on_real_scenes() {
             }
         };
         let geometry = SceneGeometry::build(&desc);
-        let lights = Lights::build(&desc, &geometry, &source, LatLongConvention::Seed)
-            .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let area_lights = desc.shapes.iter();
+        let area_lights = area_lights.map(|s| (s.name.as_str(), s.area_light.as_ref()));
+        let lights = Lights::build(
+            area_lights,
+            &desc.lights,
+            &geometry,
+            &source,
+            LatLongConvention::Seed,
+        )
+        .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         if lights.is_empty() {
             println!("{name:<40} no lights (a fragment meant for Include?)");
             continue;

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
+use yat_tracer::lights::{DistantLight, InfiniteLight, PointLight, SpotLight};
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
@@ -525,22 +526,22 @@ fn lights_follow_luxrender_rules() {
          Scale -1 1 1\nLightSource \"infinite\" \"color L\" [0.5 0.5 0.5] \"float gain\" 2\n\
          TransformEnd\nLightSource \"sunsky\"\nLightSource \"sky\"",
     );
-    let LightDesc::Point {
+    let LightDesc::Point(PointLight {
         position,
         intensity,
-    } = &d.lights[0]
+    }) = &d.lights[0]
     else {
         panic!()
     };
     assert!(close(*position, Vec3::new(1.0, 2.0, 4.0)));
     assert!(close(*intensity, Vec3::splat(20.0 / (4.0 * PI))));
-    let LightDesc::Spot {
+    let LightDesc::Spot(SpotLight {
         position,
         direction,
         intensity,
         cone_angle,
         cone_delta_angle,
-    } = &d.lights[1]
+    }) = &d.lights[1]
     else {
         panic!()
     };
@@ -548,15 +549,15 @@ fn lights_follow_luxrender_rules() {
     assert_eq!((*cone_angle, *cone_delta_angle), (30.0, 5.0));
     let solid = 2.0 * PI * (1.0 - 0.5 * (25f32.to_radians().cos() + 30f32.to_radians().cos()));
     assert!(close(*intensity, Vec3::splat(1.0 / solid)));
-    let LightDesc::Distant { to_light, radiance } = &d.lights[2] else {
+    let LightDesc::Distant(DistantLight { to_light, radiance }) = &d.lights[2] else {
         panic!()
     };
     assert!(close(*to_light, Vec3::Z) && *radiance == Vec3::splat(2.0));
-    let LightDesc::Infinite {
+    let LightDesc::Infinite(InfiniteLight {
         radiance,
         map,
         light_to_world,
-    } = &d.lights[3]
+    }) = &d.lights[3]
     else {
         panic!()
     };

@@ -7,6 +7,7 @@ use glam::{Mat4, Vec3, Vec4};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
 use yat_tracer::film::Film;
+use yat_tracer::lights::InfiniteLight;
 use yat_tracer::material::Matte;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
 use yat_tracer::texture::Checkerboard2D;
@@ -84,11 +85,11 @@ fn add_sphere(desc: &mut SceneDesc, centre: Vec3, radius: f32, material: Materia
 }
 
 fn constant_sky(desc: &mut SceneDesc, radiance: Vec3) {
-    desc.lights.push(LightDesc::Infinite {
+    desc.lights.push(LightDesc::Infinite(InfiniteLight {
         radiance,
         map: None,
         light_to_world: Mat4::IDENTITY,
-    });
+    }));
 }
 
 fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
@@ -303,14 +304,14 @@ fn environment_marker_shows_up_in_the_convention_direction() {
             Vec4::W,
         );
         let mut desc = scene(cam, 8);
-        desc.lights.push(LightDesc::Infinite {
+        desc.lights.push(LightDesc::Infinite(InfiniteLight {
             radiance: Vec3::ONE,
             map: Some(EnvMapDesc {
                 filename: "marker.png".into(),
                 gamma: 1.0,
             }),
             light_to_world: Mat4::IDENTITY,
-        });
+        }));
         let mut settings = settings(&desc, 4);
         settings.latlong = convention;
         let scene = RenderScene::build(&desc, &source, &settings).unwrap();

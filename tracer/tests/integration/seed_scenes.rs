@@ -8,6 +8,7 @@ use std::path::Path;
 use glam::Vec3;
 use yat_tracer::assets::FsSource;
 use yat_tracer::desc::{CameraKind, Geometry, LightDesc, SceneDesc};
+use yat_tracer::lights::InfiniteLight;
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{parse_scene, ParseError};
 
@@ -204,7 +205,7 @@ fn fisheye_and_environment_scenes() {
         .lights
         .iter()
         .filter_map(|l| match l {
-            LightDesc::Infinite { map: Some(m), .. } => Some(m.filename.as_str()),
+            LightDesc::Infinite(InfiniteLight { map: Some(m), .. }) => Some(m.filename.as_str()),
             _ => None,
         })
         .collect();

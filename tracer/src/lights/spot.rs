@@ -1,0 +1,167 @@
+//! The spot light: a point light inside a cone, with LuxRender's smoothstep falloff.
+//!
+//! ```text
+//! LightSource "spot" "color L" [1 1 1] "float gain" [1] "point from" [0 0 0] "point to" [0 0 1]
+//!     "float coneangle" [30] "float conedeltaangle" [5] "float power" [0] "float efficacy" [0]
+//! ```
+//!
+//! | parameter        | default | meaning                                                    |
+//! |------------------|---------|------------------------------------------------------------|
+//! | `L`              | 1 1 1   | colour                                                     |
+//! | `gain`           | 1       | multiplies `L`                                             |
+//! | `from`, `to`     | 0 0 0, 0 0 1 | position and aim (must differ), in the current transform |
+//! | `coneangle`      | 30      | degrees: no light outside                                  |
+//! | `conedeltaangle` | 5       | degrees: width of the falloff band inside the cone's edge  |
+//! | `power`          | 0       | watts; with `efficacy` > 0 the gain is scaled to emit that many lumens |
+//! | `efficacy`       | 0       | lumens per watt                                            |
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use crate::diag::SourcePos;
+use crate::math::luminance;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+use super::emission::{emits, normalised_gain, Emission};
+use super::point::PointLight;
+use super::sample::DeltaSample;
+
+/// `from`.
+pub const DEFAULT_FROM: Vec3 = Vec3::ZERO;
+/// `to`.
+pub const DEFAULT_TO: Vec3 = Vec3::Z;
+/// `coneangle`, degrees.
+pub const DEFAULT_CONE_ANGLE: f32 = 30.0;
+/// `conedeltaangle`, degrees.
+pub const DEFAULT_CONE_DELTA_ANGLE: f32 = 5.0;
+/// `power` (0: no normalisation).
+pub const DEFAULT_POWER: f32 = 0.0;
+/// `efficacy` (0: no normalisation).
+pub const DEFAULT_EFFICACY: f32 = 0.0;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpotLight {
+    pub position: Vec3,
+    /// Unit direction in world space.
+    pub direction: Vec3,
+    pub intensity: Vec3,
+    /// Degrees, LuxRender semantics (full cone half-angle, and falloff width).
+    pub cone_angle: f32,
+    pub cone_delta_angle: f32,
+}
+
+impl SpotLight {
+    pub(crate) fn read(
+        e: Emission,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let from = params.vec3("from", DEFAULT_FROM)?;
+        let to = params.vec3("to", DEFAULT_TO)?;
+        let cone_angle = params.float("coneangle", DEFAULT_CONE_ANGLE)?;
+        let cone_delta_angle = params.float("conedeltaangle", DEFAULT_CONE_DELTA_ANGLE)?;
+        let ctm = ctx.ctm();
+        let Some(direction) = ctm.transform_vector3(to - from).try_normalize() else {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: "LightSource \"spot\": \"from\" and \"to\" must differ".into(),
+            });
+        };
+        let cos_total = cone_angle.to_radians().cos();
+        let cos_falloff_start = (cone_angle - cone_delta_angle).to_radians().cos();
+        let gain = normalised_gain(
+            e.gain,
+            params.float("power", DEFAULT_POWER)?,
+            params.float("efficacy", DEFAULT_EFFICACY)?,
+            2.0 * PI * luminance(e.l) * (1.0 - 0.5 * (cos_falloff_start + cos_total)),
+        );
+        Ok(Self {
+            position: ctm.transform_point3(from),
+            direction,
+            intensity: e.l * gain,
+            cone_angle,
+            cone_delta_angle,
+        })
+    }
+
+    /// The light to sample, if it emits.
+    pub fn light(&self) -> Option<SpotCone> {
+        emits(self.intensity).then(|| {
+            SpotCone::new(
+                self.position,
+                self.direction,
+                self.intensity,
+                self.cone_angle,
+                self.cone_delta_angle,
+            )
+        })
+    }
+}
+
+/// A spot light ready to sample.
+pub struct SpotCone {
+    point: PointLight,
+    direction: Vec3,
+    /// cos(coneangle): no light outside.
+    cos_total: f32,
+    /// cos(coneangle - conedeltaangle): full intensity inside.
+    cos_falloff_start: f32,
+}
+
+impl SpotCone {
+    /// Angles in degrees.
+    pub fn new(
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        cone_angle: f32,
+        cone_delta_angle: f32,
+    ) -> Self {
+        let cone = cone_angle.clamp(0.0, 180.0);
+        let start = (cone - cone_delta_angle.max(0.0)).max(0.0);
+        Self {
+            point: PointLight {
+                position,
+                intensity,
+            },
+            direction: direction.normalize_or(Vec3::Z),
+            cos_total: cone.to_radians().cos(),
+            cos_falloff_start: start.to_radians().cos(),
+        }
+    }
+
+    pub fn sample(&self, from: Vec3) -> Option<DeltaSample> {
+        let s = self.point.sample(from)?;
+        let falloff = self.falloff(-s.wi.dot(self.direction));
+        (falloff > 0.0).then(|| DeltaSample {
+            li: s.li * falloff,
+            ..s
+        })
+    }
+
+    /// Smoothstep from the cone's edge to where the falloff starts.
+    fn falloff(&self, cos_theta: f32) -> f32 {
+        if self.cos_falloff_start <= self.cos_total {
+            return if cos_theta >= self.cos_total {
+                1.0
+            } else {
+                0.0
+            };
+        }
+        let t = ((cos_theta - self.cos_total) / (self.cos_falloff_start - self.cos_total))
+            .clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    }
+
+    /// pbrt-v4's estimate: the full cone to where the falloff starts, half of the falloff band.
+    pub fn power(&self) -> f32 {
+        luminance(self.point.intensity)
+            * 2.0
+            * PI
+            * (1.0 - 0.5 * (self.cos_falloff_start + self.cos_total))
+    }
+}
