@@ -24,9 +24,9 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use obvhs::BvhBuildParams;
 
-use crate::desc::SceneDesc;
 use crate::math::Ray;
 use crate::shape::Geometry;
+use crate::shape::ShapeDesc;
 
 pub use analytic::AnalyticShape;
 pub use hit::{SurfaceHit, SurfaceSample};
@@ -94,14 +94,15 @@ enum Closest {
 }
 
 impl SceneGeometry {
-    pub fn build(desc: &SceneDesc) -> Self {
+    /// The scene's shapes, indexed as given (hits report that index).
+    pub fn build(shapes: &[ShapeDesc]) -> Self {
         let start = Instant::now();
         let mut meshes = Vec::new();
         let mut analytic = Vec::new();
         let mut planes = Vec::new();
         let mut aabbs = Vec::new();
         let mut prims = Vec::new();
-        for (index, shape) in desc.shapes.iter().enumerate() {
+        for (index, shape) in shapes.iter().enumerate() {
             let index = index as u32;
             let m = &shape.object_to_world;
             let ro = shape.reverse_orientation;

@@ -111,7 +111,7 @@ fn triangle_hit_has_t_normal_uv_and_interpolated_shading_normal() {
         )],
         vec![],
     );
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     assert_eq!(geometry.triangle_count(), 1);
     let hit = geometry
         .intersect(&down(Vec3::new(0.25, 0.5, 3.0)), f32::INFINITY)
@@ -135,7 +135,7 @@ fn triangle_hit_has_t_normal_uv_and_interpolated_shading_normal() {
         )],
         vec![],
     );
-    let hit = SceneGeometry::build(&desc)
+    let hit = SceneGeometry::build(&desc.shapes)
         .intersect(&down(Vec3::new(0.25, 0.5, 1.0)), f32::INFINITY)
         .unwrap();
     assert!(
@@ -146,7 +146,7 @@ fn triangle_hit_has_t_normal_uv_and_interpolated_shading_normal() {
     assert!(close(hit.ns, hit.ng, 0.0));
 
     // Outside the triangle, behind the origin, beyond tmax: no hit.
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     assert!(geometry
         .intersect(&down(Vec3::new(0.75, 0.5, 1.0)), f32::INFINITY)
         .is_none());
@@ -168,7 +168,7 @@ fn shading_normal_is_flipped_to_the_geometric_side() {
         vec![shape(Geometry::Mesh(Arc::new(m)), Mat4::IDENTITY)],
         vec![],
     );
-    let hit = SceneGeometry::build(&desc)
+    let hit = SceneGeometry::build(&desc.shapes)
         .intersect(&down(Vec3::new(0.2, 0.2, 1.0)), f32::INFINITY)
         .unwrap();
     assert!(close(hit.ng, Vec3::Z, 1e-6) && close(hit.ns, Vec3::Z, 1e-6));
@@ -179,7 +179,7 @@ fn reverse_orientation_and_mirroring_transforms_set_the_front_side() {
     let ng_of = |geometry: Geometry, m: Mat4, reverse: bool, from: Vec3, dir: Vec3| {
         let mut s = shape(geometry, m);
         s.reverse_orientation = reverse;
-        SceneGeometry::build(&scene_desc(vec![s], vec![]))
+        SceneGeometry::build(&scene_desc(vec![s], vec![]).shapes)
             .intersect(&Ray::new(from, dir), f32::INFINITY)
             .unwrap()
             .ng
@@ -242,7 +242,7 @@ fn sphere_hits_have_pbrt_t_normal_uv_and_tangent() {
         vec![shape(sphere(2.0), Mat4::from_translation(centre))],
         vec![],
     );
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     assert_eq!(geometry.triangle_count(), 0);
 
     let hit = geometry
@@ -299,7 +299,8 @@ fn sphere_z_and_phi_limits_clip_hits() {
         zmax: 1.0,
         phimax: 360.0,
     };
-    let geometry = SceneGeometry::build(&scene_desc(vec![shape(cut, Mat4::IDENTITY)], vec![]));
+    let geometry =
+        SceneGeometry::build(&scene_desc(vec![shape(cut, Mat4::IDENTITY)], vec![]).shapes);
     let hit = geometry
         .intersect(&down(Vec3::new(0.0, 0.0, 10.0)), f32::INFINITY)
         .unwrap();
@@ -318,7 +319,8 @@ fn sphere_z_and_phi_limits_clip_hits() {
         zmax: 1.0,
         phimax: 90.0,
     };
-    let geometry = SceneGeometry::build(&scene_desc(vec![shape(quarter, Mat4::IDENTITY)], vec![]));
+    let geometry =
+        SceneGeometry::build(&scene_desc(vec![shape(quarter, Mat4::IDENTITY)], vec![]).shapes);
     let d = Vec3::new(1.0, 1.0, 0.0).normalize();
     let hit = geometry
         .intersect(&Ray::new(d * 5.0, -d), f32::INFINITY)
@@ -345,7 +347,8 @@ fn disk_and_cylinder_hits_follow_pbrt() {
         inner_radius: 1.0,
         phimax: 360.0,
     };
-    let geometry = SceneGeometry::build(&scene_desc(vec![shape(disk, Mat4::IDENTITY)], vec![]));
+    let geometry =
+        SceneGeometry::build(&scene_desc(vec![shape(disk, Mat4::IDENTITY)], vec![]).shapes);
     let hit = geometry
         .intersect(&down(Vec3::new(0.0, 1.5, 3.0)), f32::INFINITY)
         .unwrap();
@@ -370,7 +373,7 @@ fn disk_and_cylinder_hits_follow_pbrt() {
         phimax: 360.0,
     };
     let m = Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2);
-    let geometry = SceneGeometry::build(&scene_desc(vec![shape(cylinder, m)], vec![]));
+    let geometry = SceneGeometry::build(&scene_desc(vec![shape(cylinder, m)], vec![]).shapes);
     // Object z = 2 is world -y = 2 after the rotation about x; the outside faces -x here.
     let target = m.transform_point3(Vec3::new(-1.0, 0.0, 2.0));
     let hit = geometry
@@ -399,7 +402,7 @@ fn planes_are_hit_without_the_bvh() {
         ],
         vec![],
     );
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     let hit = geometry
         .intersect(&down(Vec3::new(5.0, 5.0, 1.0)), f32::INFINITY)
         .unwrap();
@@ -438,7 +441,7 @@ fn bad_input_is_skipped_without_panics() {
         ],
         vec![],
     );
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     assert_eq!(geometry.triangle_count(), 2);
     assert!(geometry
         .intersect(&down(Vec3::new(0.2, 0.2, 2.0)), f32::INFINITY)
@@ -447,7 +450,7 @@ fn bad_input_is_skipped_without_panics() {
     assert!(geometry.intersect(&nan_ray, f32::INFINITY).is_none());
     assert!(!geometry.occluded(&nan_ray, f32::INFINITY));
 
-    let empty = SceneGeometry::build(&scene_desc(vec![], vec![]));
+    let empty = SceneGeometry::build(&scene_desc(vec![], vec![]).shapes);
     assert!(empty.intersect(&down(Vec3::Z), f32::INFINITY).is_none());
     assert!(!empty.occluded(&down(Vec3::Z), f32::INFINITY));
     assert!(empty.bounds().is_none());
@@ -529,7 +532,7 @@ fn brute_force(geometry: &SceneGeometry, ray: &Ray, tmax: f32) -> Option<(f32, u
 #[test]
 fn bvh_matches_brute_force_and_occluded_matches_intersect() {
     let mut rng = fastrand::Rng::with_seed(7);
-    let geometry = SceneGeometry::build(&random_scene(&mut rng));
+    let geometry = SceneGeometry::build(&random_scene(&mut rng).shapes);
     assert_eq!(geometry.triangle_count(), 3000);
     assert_eq!(geometry.prims.len(), 3030);
     let (mut hits, mut blocked) = (0, 0);
@@ -665,7 +668,7 @@ fn bvh_throughput() {
             )],
             vec![],
         );
-        let geometry = SceneGeometry::build(&desc);
+        let geometry = SceneGeometry::build(&desc.shapes);
         println!(
             "{} triangles: build {:.0} ms",
             geometry.triangle_count(),

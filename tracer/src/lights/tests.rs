@@ -17,7 +17,7 @@ fn build_with(
     latlong: LatLongConvention,
 ) -> (SceneGeometry, Lights) {
     let desc = scene_desc(shapes, lights);
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     let lights =
         Lights::build(area_lights(&desc), &desc.lights, &geometry, source, latlong).unwrap();
     (geometry, lights)
@@ -559,7 +559,7 @@ fn constant_infinite_light_is_uniform_and_shares_with_other_lights() {
 #[test]
 fn a_missing_env_map_is_an_error_naming_the_file() {
     let desc = scene_desc(vec![], vec![env_light("maps/sky.hdr", Mat4::IDENTITY)]);
-    let geometry = SceneGeometry::build(&desc);
+    let geometry = SceneGeometry::build(&desc.shapes);
     let err = Lights::build(
         area_lights(&desc),
         &desc.lights,

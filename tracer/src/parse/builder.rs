@@ -8,13 +8,14 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 
 use super::context::{ParseContext, TexBinding};
+use super::error::ParseError;
 use super::options::OptionsState;
 use super::params::ParamList;
 use super::reader::Reader;
-use super::{ParseError, Pos, MAX_INCLUDE_DEPTH};
 use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
+use crate::diag::SourcePos as Pos;
 use crate::diag::Warning;
 use crate::lights::AreaLightParams;
 use crate::material::Matte;
@@ -22,6 +23,9 @@ use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::shape::Geometry;
 use crate::texture::{self, Defined, Scale};
+
+/// Include files may nest this deep (the main file is depth 0).
+pub const MAX_INCLUDE_DEPTH: usize = 32;
 
 #[derive(Clone, Debug, Default)]
 struct GraphicsState {

@@ -31,14 +31,10 @@ use crate::assets::AssetSource;
 use crate::desc::SceneDesc;
 use crate::diag::SourcePos;
 
+pub use builder::MAX_INCLUDE_DEPTH;
 pub use error::ParseError;
 
 pub use crate::spectra::{blackbody_rgb, metal_preset};
-
-/// Include files may nest this deep (the main file is depth 0).
-pub const MAX_INCLUDE_DEPTH: usize = 32;
-
-pub(crate) type Pos = SourcePos;
 
 /// Parses the main scene file `main` (its name as given to `source`) and every file it
 /// includes, and builds the scene description. Warnings go into `SceneDesc::warnings`.

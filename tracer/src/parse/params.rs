@@ -6,7 +6,8 @@ use std::cell::Cell;
 
 use glam::Vec3;
 
-use super::{ParseError, Pos};
+use super::error::ParseError;
+use crate::diag::SourcePos as Pos;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamType {

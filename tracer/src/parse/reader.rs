@@ -2,9 +2,10 @@
 //! (strings or numbers, brackets optional around a numeric array) and a parameter list of
 //! `"type name" value-or-[values]` pairs; a statement ends where the next keyword begins.
 
+use super::error::ParseError;
 use super::lexer::{LexError, Lexer, Token, TokenKind};
 use super::params::{Param, ParamList, ParamType, Values};
-use super::{ParseError, Pos};
+use crate::diag::SourcePos as Pos;
 
 pub struct Reader<'a> {
     lexer: Lexer<'a>,

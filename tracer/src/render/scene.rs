@@ -47,7 +47,7 @@ impl RenderScene {
         source: &dyn AssetSource,
         settings: &RenderSettings,
     ) -> Result<Self, BuildError> {
-        let geometry = SceneGeometry::build(desc);
+        let geometry = SceneGeometry::build(&desc.shapes);
         let shapes = desc.shapes.iter();
         let area_lights = shapes.map(|s| (s.name.as_str(), s.area_light.as_ref()));
         let lights = Lights::build(

@@ -54,7 +54,7 @@ fn bvh_and_lights_on_real_scenes() {
                 continue;
             }
         };
-        let geometry = SceneGeometry::build(&desc);
+        let geometry = SceneGeometry::build(&desc.shapes);
         let area_lights = desc.shapes.iter();
         let area_lights = area_lights.map(|s| (s.name.as_str(), s.area_light.as_ref()));
         let lights = Lights::build(
