@@ -66,7 +66,7 @@ impl DistantLight {
     /// The light to sample (with `to_light` normalised), if it emits.
     pub fn light(&self) -> Option<DistantLight> {
         let to_light = self.to_light.normalize_or_zero();
-        (emits(self.radiance) && to_light != Vec3::ZERO).then(|| DistantLight {
+        (emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
             to_light,
             radiance: self.radiance,
         })
