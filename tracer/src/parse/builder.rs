@@ -170,22 +170,6 @@ impl<'s> Builder<'s> {
         }
     }
 
-    /// Warns once per statement type and parameter about parameters nothing read.
-    pub(super) fn warn_unused(&mut self, params: &ParamList) {
-        let unused: Vec<(String, Pos)> = params
-            .unused()
-            .filter(|p| !is_exporter_param(&p.name))
-            .map(|p| (p.decl(), p.pos.clone()))
-            .collect();
-        for (decl, pos) in unused {
-            self.warn_once(
-                format!("param|{}|{decl}", params.statement),
-                &pos,
-                format!("{}: unknown parameter \"{decl}\" ignored", params.statement),
-            );
-        }
-    }
-
     // -----------------------------------------------------------------------------------------
     // Files and statements
 
@@ -753,7 +737,18 @@ impl ParseContext for Builder<'_> {
     }
 
     fn warn_unused(&mut self, params: &ParamList) {
-        Builder::warn_unused(self, params)
+        let unused: Vec<(String, Pos)> = params
+            .unused()
+            .filter(|p| !is_exporter_param(&p.name))
+            .map(|p| (p.decl(), p.pos.clone()))
+            .collect();
+        for (decl, pos) in unused {
+            self.warn_once(
+                format!("param|{}|{decl}", params.statement),
+                &pos,
+                format!("{}: unknown parameter \"{decl}\" ignored", params.statement),
+            );
+        }
     }
 
     fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
