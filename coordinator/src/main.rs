@@ -2,11 +2,13 @@
 
 mod check;
 mod checkpoint;
+mod cli;
 mod distributed;
 mod export_cmd;
 mod interim;
 mod manifest;
 mod render_cmd;
+mod shutdown;
 
 use clap::{Parser, Subcommand};
 
@@ -26,7 +28,7 @@ enum Command {
     /// Render a scene in-process, or over gRPC workers with --workers / --local-workers.
     Render(render_cmd::RenderArgs),
     /// Serve renders to a coordinator over gRPC.
-    Worker(yat_worker::WorkerArgs),
+    Worker(cli::worker::WorkerArgs),
     /// Parse a scene and report what it contains, without rendering.
     Check(check::CheckArgs),
     /// Write a scene as LuxCoreRender SDL and PLY meshes (for side-by-side benchmarks).
@@ -43,7 +45,7 @@ fn main() -> std::process::ExitCode {
         .init();
     let result = match Cli::parse().command {
         Command::Render(args) => render_cmd::run(args),
-        Command::Worker(args) => yat_worker::run(args),
+        Command::Worker(args) => cli::worker::run(args),
         Command::Check(args) => check::run(args),
         Command::ExportLuxcore(args) => export_cmd::run(args),
     };
