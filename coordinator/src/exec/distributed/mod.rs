@@ -19,9 +19,9 @@ use tonic::transport::{Certificate, ClientTlsConfig};
 use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
 
 use crate::checkpoint::Checkpoint;
+use crate::cli::render::{seconds, RenderJob, RenderOutcome};
 use crate::interim::InterimClock;
 use crate::manifest::SceneManifest;
-use crate::render_cmd::{seconds, RenderJob, RenderOutcome};
 use local::LocalWorker;
 use node::{run_node, Event, Node, NodeConfig, Shared};
 use report::{process_cpu_time, DistributedReport, Progress};

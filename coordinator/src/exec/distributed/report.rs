@@ -5,7 +5,7 @@ use std::time::Duration;
 use indicatif::ProgressBar;
 
 use super::node::NodeReport;
-use crate::render_cmd::progress_bar;
+use crate::cli::render::progress_bar;
 
 /// Progress over samples, with units and live workers in the message.
 pub struct Progress {

@@ -15,10 +15,11 @@ use yat_tracer::render::{
     plan_units, RenderOverrides, RenderScene, RenderSettings, UnitStats, WorkUnit,
 };
 
-use crate::checkpoint::{Checkpoint, CheckpointFile, Interrupt, Interrupted, RenderIdentity};
-use crate::distributed::DistributedArgs;
+use crate::checkpoint::{Checkpoint, CheckpointFile, RenderIdentity};
+use crate::exec::distributed::DistributedArgs;
 use crate::interim::{InterimClock, InterimOutputs, PreviewFile};
 use crate::manifest::SceneManifest;
+use crate::shutdown::{Interrupt, Interrupted};
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum LatLongArg {
@@ -227,7 +228,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
 
     let (outcome, build_time, triangles) = match manifest {
         Some(manifest) if args.distributed.is_active() => (
-            crate::distributed::render(&args.distributed, &job, manifest)?,
+            crate::exec::distributed::render(&args.distributed, &job, manifest)?,
             None,
             None,
         ),

@@ -8,7 +8,7 @@ use yat_tracer::assets::FsSource;
 use yat_tracer::luxcore::{export, ExportOptions};
 use yat_tracer::parse::parse_scene;
 
-use crate::render_cmd::LatLongArg;
+use crate::cli::render::LatLongArg;
 
 #[derive(clap::Args)]
 pub struct ExportArgs {

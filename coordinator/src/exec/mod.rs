@@ -1,0 +1,4 @@
+//! Who renders a job: the in-process executor and the distributed one, siblings that share
+//! progress reporting and never import each other.
+
+pub mod distributed;
