@@ -8,4 +8,5 @@ pub mod cli;
 pub mod exec;
 pub mod interim;
 pub mod manifest;
+pub mod scene;
 pub mod shutdown;

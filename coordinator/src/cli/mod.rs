@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod export;
+pub mod latlong;
 pub mod render;
 pub mod worker;
 

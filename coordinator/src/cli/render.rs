@@ -8,35 +8,19 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use yat_tracer::assets::FsSource;
-use yat_tracer::desc::{LatLongConvention, SceneDesc};
+use yat_tracer::desc::SceneDesc;
 use yat_tracer::film::Film;
 use yat_tracer::render::{
     plan_units, RenderOverrides, RenderScene, RenderSettings, UnitStats, WorkUnit,
 };
 
+use super::latlong::LatLongArg;
 use crate::checkpoint::{Checkpoint, CheckpointFile, RenderIdentity};
 use crate::exec::distributed::DistributedArgs;
 use crate::interim::{InterimClock, InterimOutputs, PreviewFile};
 use crate::manifest::SceneManifest;
+use crate::scene::{ParsedScene, Warnings};
 use crate::shutdown::{Interrupt, Interrupted};
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum LatLongArg {
-    /// The course tracer's u = (pi + phi) / 2pi: seed scenes look as their authors made them.
-    Seed,
-    /// LuxRender's s = phi / 2pi, for scenes made in LuxRender.
-    Luxrender,
-}
-
-impl From<LatLongArg> for LatLongConvention {
-    fn from(arg: LatLongArg) -> Self {
-        match arg {
-            LatLongArg::Seed => LatLongConvention::Seed,
-            LatLongArg::Luxrender => LatLongConvention::LuxRender,
-        }
-    }
-}
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -165,21 +149,16 @@ pub struct RenderOutcome {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let main_name = args
-        .scene
-        .file_name()
-        .and_then(|n| n.to_str())
-        .with_context(|| format!("not a scene file path: {}", args.scene.display()))?
-        .to_string();
-    let source = FsSource::for_main_file(&args.scene);
-    let desc = yat_tracer::parse::parse_scene(&main_name, &source)
-        .with_context(|| format!("cannot load {}", args.scene.display()))?;
-    let parse_time = started.elapsed();
-    if !args.quiet {
-        for w in &desc.warnings {
-            eprintln!("{w}");
-        }
-    }
+    let scene = ParsedScene::load(
+        &args.scene,
+        if args.quiet {
+            Warnings::Keep
+        } else {
+            Warnings::Print
+        },
+    )?;
+    let parse_time = scene.parse_time;
+    let desc = &scene.desc;
     let overrides = RenderOverrides {
         spp: args.spp,
         max_depth: args.maxdepth,
@@ -187,7 +166,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         resolution: args.resolution,
         latlong: args.latlong.into(),
     };
-    let settings = RenderSettings::resolve(&desc, &overrides);
+    let settings = RenderSettings::resolve(desc, &overrides);
     let output_png = args
         .output
         .clone()
@@ -196,7 +175,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let preview_every = seconds("preview-every", args.preview_every)?;
     // The files by content: what workers receive, and what names the render for its checkpoint.
     let manifest = if args.distributed.is_active() || !checkpoint_every.is_zero() {
-        Some(SceneManifest::read(&args.scene, &desc)?)
+        Some(SceneManifest::read(&scene)?)
     } else {
         None
     };
@@ -212,8 +191,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         Interrupt::default()
     };
+    let ParsedScene {
+        path: main_file,
+        source,
+        desc,
+        ..
+    } = scene;
     let job = RenderJob {
-        main_file: args.scene.clone(),
+        main_file,
         desc,
         settings,
         interim: InterimOutputs {
