@@ -7,6 +7,8 @@ pub mod checkpoint;
 pub mod cli;
 pub mod exec;
 pub mod interim;
+pub mod job;
 pub mod manifest;
+pub mod render_report;
 pub mod scene;
 pub mod shutdown;

@@ -4,6 +4,7 @@ pub mod check;
 pub mod export;
 pub mod latlong;
 pub mod render;
+pub mod seconds;
 pub mod worker;
 
 use clap::{Parser, Subcommand};

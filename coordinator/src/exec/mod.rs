@@ -2,3 +2,5 @@
 //! progress reporting and never import each other.
 
 pub mod distributed;
+pub mod in_process;
+pub mod progress;

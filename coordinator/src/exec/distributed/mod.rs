@@ -19,12 +19,14 @@ use tonic::transport::{Certificate, ClientTlsConfig};
 use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
 
 use crate::checkpoint::Checkpoint;
-use crate::cli::render::{seconds, RenderJob, RenderOutcome};
+use crate::cli::seconds::seconds;
+use crate::exec::progress::Progress;
 use crate::interim::InterimClock;
+use crate::job::{RenderJob, RenderOutcome};
 use crate::manifest::SceneManifest;
 use local::LocalWorker;
 use node::{run_node, Event, Node, NodeConfig, Shared};
-use report::{process_cpu_time, DistributedReport, Progress};
+use report::{process_cpu_time, DistributedReport};
 use schedule::{Schedule, UnitDeadline};
 
 /// Command-line options of a distributed render (flattened into `yat render`).
@@ -187,12 +189,10 @@ impl RenderLoop<'_> {
         mut checkpoint: Checkpoint,
         mut events: mpsc::UnboundedReceiver<Event>,
     ) -> anyhow::Result<RenderOutcome> {
-        let quiet = self.job.quiet;
         let progress = Progress::new(
             self.shared.schedule.sample_count(),
             checkpoint.done_samples(self.units),
-            self.units.len(),
-            quiet,
+            self.job.quiet,
         );
         let mut tasks = JoinSet::new();
         for node in self.nodes {
@@ -214,29 +214,25 @@ impl RenderLoop<'_> {
                             break Err(e.into());
                         }
                         stats += unit_stats;
-                        progress.update(
-                            unit_stats.samples,
-                            checkpoint.done_count(),
-                            self.alive(),
-                            self.nodes.len(),
-                        );
+                        progress.add_samples(unit_stats.samples);
+                        progress.set_status(self.status(&checkpoint));
                     }
-                    Event::Notice(line) => progress.say(quiet, &line),
+                    Event::Notice(line) => progress.say(&line),
                     Event::Fatal(e) => break Err(e),
                 },
                 _ = tick.tick() => {
                     if self.job.interrupt.is_set() {
                         break Err(anyhow::anyhow!("interrupted"));
                     }
-                    progress.update(0, checkpoint.done_count(), self.alive(), self.nodes.len());
+                    progress.set_status(self.status(&checkpoint));
                     let due = self.job.interim.due(&mut clock);
                     if due.any() {
                         // Lets the runtime's other thread serve the workers meanwhile.
                         let failed = tokio::task::block_in_place(|| {
-                            self.job.interim.stage(due, &checkpoint, &self.job.desc.film).finish()
+                            self.job.interim.stage(due, &checkpoint, &self.job.scene.desc.film).finish()
                         });
                         for e in failed {
-                            progress.say(quiet, &format!("{e:#}"));
+                            progress.say(&format!("{e:#}"));
                         }
                     }
                     if self.alive() > 0 {
@@ -251,7 +247,7 @@ impl RenderLoop<'_> {
                         && waiting_noticed.elapsed() >= WAITING_NOTICE_EVERY
                     {
                         waiting_noticed = Instant::now();
-                        progress.say(quiet, &format!(
+                        progress.say(&format!(
                             "waiting for workers: none connected for {:.0} s ({}){}",
                             since.elapsed().as_secs_f64(),
                             self.last_errors(),
@@ -270,7 +266,19 @@ impl RenderLoop<'_> {
         Ok(RenderOutcome {
             film: checkpoint.into_film(),
             stats,
+            build: None,
         })
+    }
+
+    /// Units merged and workers connected, after the progress bar's ETA.
+    fn status(&self, checkpoint: &Checkpoint) -> String {
+        format!(
+            "| units {}/{}, workers {}/{}",
+            checkpoint.done_count(),
+            self.units.len(),
+            self.alive(),
+            self.nodes.len()
+        )
     }
 
     fn alive(&self) -> usize {
