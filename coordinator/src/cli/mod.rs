@@ -1,6 +1,7 @@
 //! The `yat` subcommands: each maps its flags onto the library's plain types and runs.
 
 pub mod check;
+pub mod distributed;
 pub mod export;
 pub mod latlong;
 pub mod render;

@@ -7,10 +7,10 @@ use std::time::Instant;
 use anyhow::Context;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
+use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
 use crate::checkpoint::{CheckpointFile, RenderIdentity};
-use crate::exec::distributed::DistributedArgs;
 use crate::exec::{distributed, in_process};
 use crate::interim::{InterimOutputs, PreviewFile};
 use crate::job::RenderJob;
@@ -102,8 +102,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| PathBuf::from(format!("{}.png", scene.desc.film.filename)));
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
     let preview_every = seconds("preview-every", args.preview_every)?;
+    let distributed = args.distributed.config()?;
     // The files by content: what workers receive, and what names the render for its checkpoint.
-    let manifest = if args.distributed.is_active() || !checkpoint_every.is_zero() {
+    let manifest = if distributed.is_some() || !checkpoint_every.is_zero() {
         Some(SceneManifest::read(&scene)?)
     } else {
         None
@@ -134,11 +135,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         interrupt,
     };
 
-    let outcome = match manifest {
-        Some(manifest) if args.distributed.is_active() => {
-            distributed::render(&args.distributed, &job, manifest)?
-        }
-        manifest => {
+    let outcome = match (distributed, manifest) {
+        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest)?,
+        (_, manifest) => {
             // The in-process render reads the files itself: their copies go before it starts.
             drop(manifest);
             in_process::render(&job, args.threads)?
