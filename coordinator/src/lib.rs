@@ -1,7 +1,10 @@
-//! YAT's coordinator as a library: the `yat` subcommands ([`cli`]), and what a render is made
-//! of: the scene and its files by content ([`manifest`]), the checkpoint and the interim
-//! outputs, the executors ([`exec`]: in-process, or over gRPC workers), and interrupt handling.
-//! The `yat` binary (`main.rs`) only parses the command line and dispatches.
+//! YAT's coordinator as a library; the `yat` binary (`main.rs`) only parses the command line
+//! and dispatches to [`cli`].
+//!
+//! A render goes: [`scene`] loads the scene, [`cli::render`] makes a [`job`] of it (settings,
+//! outputs, the [`checkpoint`] and the [`interim`] outputs, the scene's files by content in
+//! [`manifest`]), an executor in [`exec`] renders it (in-process, or over gRPC workers), and
+//! [`render_report`] says what it cost. [`shutdown`] turns Ctrl-C and SIGTERM into a stop.
 
 pub mod checkpoint;
 pub mod cli;

@@ -10,8 +10,7 @@ use tonic::transport::{Certificate, ClientTlsConfig, Identity};
 /// `--token` / `YAT_TOKEN`: the shared secret (see [`crate::auth`]).
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct TokenFlag {
-    /// The shared secret: a worker started with it refuses requests that do not carry it, and
-    /// a coordinator sends it with every request.
+    /// The shared token: a worker refuses requests without it, a coordinator sends it.
     #[arg(long, env = "YAT_TOKEN", hide_env_values = true)]
     pub token: Option<String>,
 }

@@ -102,9 +102,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| PathBuf::from(format!("{}.png", scene.desc.film.filename)));
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
     let preview_every = seconds("preview-every", args.preview_every)?;
-    let distributed = args.distributed.config()?;
+    let workers = args.distributed.config()?;
     // The files by content: what workers receive, and what names the render for its checkpoint.
-    let manifest = if distributed.is_some() || !checkpoint_every.is_zero() {
+    let manifest = if workers.is_some() || !checkpoint_every.is_zero() {
         Some(SceneManifest::read(&scene)?)
     } else {
         None
@@ -135,7 +135,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         interrupt,
     };
 
-    let outcome = match (distributed, manifest) {
+    let outcome = match (workers, manifest) {
         (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest)?,
         (_, manifest) => {
             // The in-process render reads the files itself: their copies go before it starts.

@@ -35,27 +35,28 @@ pub struct NodeReport {
 }
 
 pub struct Node {
-    pub client: ClientConfig,
+    /// How to reach it.
+    pub config: ClientConfig,
     /// The process, for a worker this coordinator started.
     pub local: Option<LocalWorker>,
     pub report: Mutex<NodeReport>,
 }
 
 impl Node {
-    pub fn new(client: ClientConfig, local: Option<LocalWorker>) -> Self {
+    pub fn new(config: ClientConfig, local: Option<LocalWorker>) -> Self {
         let report = NodeReport {
-            address: client.address.clone(),
+            address: config.address.clone(),
             ..NodeReport::default()
         };
         Self {
-            client,
+            config,
             local,
             report: Mutex::new(report),
         }
     }
 
     pub fn address(&self) -> &str {
-        &self.client.address
+        &self.config.address
     }
 
     pub fn update(&self, f: impl FnOnce(&mut NodeReport)) {

@@ -85,7 +85,7 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
 
 async fn session(node: &Node, shared: &Shared) -> Result<(), SessionError> {
     let address = node.address();
-    let mut client = WorkerClient::connect(&node.client).await?;
+    let mut client = WorkerClient::connect(&node.config).await?;
 
     let hello = pb::HandshakeRequest {
         protocol_version: PROTOCOL_VERSION,
