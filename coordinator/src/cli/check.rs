@@ -1,4 +1,4 @@
-//! `yat check`: parse a scene and print a summary. OWNER: parser helper.
+//! `yat check`: parse a scene and print a summary.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
