@@ -9,8 +9,6 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context;
@@ -345,43 +343,6 @@ impl<W: Write> Write for DigestingWriter<W> {
     fn flush(&mut self) -> std::io::Result<()> {
         self.out.flush()
     }
-}
-
-/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render with
-/// its checkpoint saved, a second one ends the process at once.
-#[derive(Clone, Default)]
-pub struct Interrupt(Arc<AtomicBool>);
-
-/// Exit status of a render stopped by a signal (128 + SIGINT, as shells report it).
-pub const INTERRUPTED_EXIT_CODE: i32 = 130;
-
-impl Interrupt {
-    pub fn install() -> anyhow::Result<Self> {
-        let flag = Arc::new(AtomicBool::new(false));
-        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            // Registered first, so it sees the flag as the previous signal left it.
-            signal_hook::flag::register_conditional_shutdown(
-                signal,
-                INTERRUPTED_EXIT_CODE,
-                flag.clone(),
-            )
-            .context("cannot watch for Ctrl-C")?;
-            signal_hook::flag::register(signal, flag.clone()).context("cannot watch for Ctrl-C")?;
-        }
-        Ok(Self(flag))
-    }
-
-    pub fn is_set(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
-/// The error of a render stopped by Ctrl-C or SIGTERM; `main` exits with
-/// [`INTERRUPTED_EXIT_CODE`] on it.
-#[derive(Debug, thiserror::Error)]
-#[error("interrupted: {kept}")]
-pub struct Interrupted {
-    pub kept: String,
 }
 
 #[cfg(test)]

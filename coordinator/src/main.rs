@@ -1,39 +1,12 @@
-//! The `yat` command: render (in-process or over workers), worker, check, export-luxcore.
+//! The `yat` command: parses the command line and dispatches to the subcommand (`yat::cli`).
 
-mod check;
-mod checkpoint;
-mod distributed;
-mod export_cmd;
-mod interim;
-mod manifest;
-mod render_cmd;
+use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::Parser;
+use yat::cli::{self, Cli, Command};
+use yat::shutdown::{Interrupted, INTERRUPTED_EXIT_CODE};
 
-#[derive(Parser)]
-#[command(
-    name = "yat",
-    version,
-    about = "YAT: a path tracer for LuxRender scenes, on one machine or many"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Render a scene in-process, or over gRPC workers with --workers / --local-workers.
-    Render(render_cmd::RenderArgs),
-    /// Serve renders to a coordinator over gRPC.
-    Worker(yat_worker::WorkerArgs),
-    /// Parse a scene and report what it contains, without rendering.
-    Check(check::CheckArgs),
-    /// Write a scene as LuxCoreRender SDL and PLY meshes (for side-by-side benchmarks).
-    ExportLuxcore(export_cmd::ExportArgs),
-}
-
-fn main() -> std::process::ExitCode {
+fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_env("YAT_LOG")
@@ -42,18 +15,17 @@ fn main() -> std::process::ExitCode {
         .with_writer(std::io::stderr)
         .init();
     let result = match Cli::parse().command {
-        Command::Render(args) => render_cmd::run(args),
-        Command::Worker(args) => yat_worker::run(args),
-        Command::Check(args) => check::run(args),
-        Command::ExportLuxcore(args) => export_cmd::run(args),
+        Command::Render(args) => cli::render::run(args),
+        Command::Worker(args) => cli::worker::run(args),
+        Command::Check(args) => cli::check::run(args),
+        Command::ExportLuxcore(args) => cli::export::run(args),
     };
     match result {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("Error: {e:?}");
-            let interrupted = e.is::<checkpoint::Interrupted>();
-            std::process::ExitCode::from(if interrupted {
-                checkpoint::INTERRUPTED_EXIT_CODE as u8
+            ExitCode::from(if e.is::<Interrupted>() {
+                INTERRUPTED_EXIT_CODE
             } else {
                 1
             })

@@ -2,15 +2,15 @@
 //! the coordinator and named by content hash.
 
 use std::collections::HashMap;
-use std::path::Path;
 
 use anyhow::Context;
 use prost::bytes::Bytes;
 use yat_proto::hash::sha256_hex;
 use yat_proto::pb;
-use yat_tracer::assets::{AssetError, AssetSource, FsSource};
-use yat_tracer::desc::SceneDesc;
+use yat_tracer::assets::{AssetError, AssetSource};
 use yat_tracer::render::RenderSettings;
+
+use crate::scene::ParsedScene;
 
 pub struct SceneManifest {
     pub main: pb::SceneFile,
@@ -23,12 +23,8 @@ impl SceneManifest {
     /// Reads the main file and the assets the parse listed, as the in-process render would. A
     /// referenced file that does not exist is left out: the worker then misses it exactly as an
     /// in-process render does.
-    pub fn read(main_file: &Path, desc: &SceneDesc) -> anyhow::Result<Self> {
-        let source = FsSource::for_main_file(main_file);
-        let main_name = main_file
-            .file_name()
-            .and_then(|n| n.to_str())
-            .with_context(|| format!("not a scene file path: {}", main_file.display()))?;
+    pub fn read(scene: &ParsedScene) -> anyhow::Result<Self> {
+        let source = &scene.source;
         let mut blobs = HashMap::new();
         let mut add = |written: &str| -> anyhow::Result<Option<pb::SceneFile>> {
             let bytes = match source.read(written) {
@@ -45,10 +41,10 @@ impl SceneManifest {
                 sha256,
             }))
         };
-        let main =
-            add(main_name)?.with_context(|| format!("{} has vanished", main_file.display()))?;
-        let mut assets = Vec::with_capacity(desc.assets.len());
-        for asset in &desc.assets {
+        let main = add(&scene.main_name)?
+            .with_context(|| format!("{} has vanished", scene.path.display()))?;
+        let mut assets = Vec::with_capacity(scene.desc.assets.len());
+        for asset in &scene.desc.assets {
             match add(&asset.path)? {
                 Some(file) => assets.push(file),
                 None => tracing::warn!("{}: not found, not sent to workers", asset.path),

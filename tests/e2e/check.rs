@@ -1,27 +1,13 @@
 //! `yat check` end to end: the real binary on a seed scene and on a scene whose Include is
 //! missing.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-fn seed_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("YAT_SEED_SCENES") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/seed-project/scenes"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "seed scenes not found at {} (set YAT_SEED_SCENES); skipping",
-            dir.display()
-        );
-        None
-    }
-}
+use crate::util::{seed_dir, YAT};
 
 fn check(scene: &Path) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_yat"))
+    let out = Command::new(YAT)
         .arg("check")
         .arg(scene)
         .env_remove("RUST_BACKTRACE")

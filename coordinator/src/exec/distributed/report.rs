@@ -1,50 +1,9 @@
-//! What a distributed render shows: the progress bar, the per-worker summary and its JSON form.
+//! What a distributed render reports at its end: the per-worker summary and its JSON form
+//! (`--workers-json`).
 
 use std::time::Duration;
 
-use indicatif::ProgressBar;
-
 use super::node::NodeReport;
-use crate::render_cmd::progress_bar;
-
-/// Progress over samples, with units and live workers in the message.
-pub struct Progress {
-    bar: ProgressBar,
-    units_total: usize,
-}
-
-impl Progress {
-    pub fn new(total_samples: u64, done_samples: u64, units_total: usize, quiet: bool) -> Self {
-        Self {
-            bar: progress_bar(total_samples, done_samples, quiet),
-            units_total,
-        }
-    }
-
-    pub fn update(&self, samples: u64, units_done: usize, alive: usize, workers: usize) {
-        self.bar.inc(samples);
-        self.bar.set_message(format!(
-            "| units {units_done}/{}, workers {alive}/{workers}",
-            self.units_total
-        ));
-    }
-
-    /// A line above the bar, or on stderr when there is no bar to draw (not a terminal).
-    pub fn say(&self, quiet: bool, line: &str) {
-        if quiet {
-            return;
-        }
-        if self.bar.is_hidden() {
-            eprintln!("{line}");
-        } else {
-            self.bar.println(line);
-        }
-    }
-
-    pub fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
-}
 
 /// `--workers-json`: the whole render's figures and each worker's.
 #[derive(serde::Serialize)]

@@ -2,12 +2,10 @@
 //! sockets on loopback. Every image must be bit-identical to the in-process render, whatever
 //! the workers do.
 
-mod common;
-
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use common::*;
+use crate::util::*;
 
 /// The in-process render of the test scene: (PNG bytes, EXR bytes).
 fn reference(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {

@@ -1,15 +1,11 @@
 //! End-to-end: a render stopped by a crash (SIGKILL) or by Ctrl-C (SIGINT), in-process or on
 //! workers, resumes from its checkpoint to exactly the image of a render never stopped.
 
-// Helpers shared by the end-to-end tests; this one uses a few of them.
-#[allow(dead_code)]
-mod common;
-
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::*;
+use crate::util::*;
 
 /// Enough samples that each of the 32 units takes a noticeable time, so that a render can be
 /// stopped half-way.

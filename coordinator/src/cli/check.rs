@@ -1,16 +1,14 @@
-//! `yat check`: parse a scene and print a summary. OWNER: parser helper.
+//! `yat check`: parse a scene and print a summary.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use std::time::Instant;
 
-use anyhow::Context;
-use yat_tracer::assets::FsSource;
 use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
-use yat_tracer::parse::parse_scene;
+
+use crate::scene::{ParsedScene, Warnings};
 
 #[derive(clap::Args)]
 pub struct CheckArgs {
@@ -19,22 +17,13 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: CheckArgs) -> anyhow::Result<()> {
-    let main = args
-        .scene
-        .file_name()
-        .and_then(|n| n.to_str())
-        .with_context(|| format!("\"{}\" is not a scene file path", args.scene.display()))?;
-    let source = FsSource::for_main_file(&args.scene);
-    let start = Instant::now();
-    let desc = parse_scene(main, &source)
-        .with_context(|| format!("cannot load scene {}", args.scene.display()))?;
-    let elapsed = start.elapsed();
+    let scene = ParsedScene::load(&args.scene, Warnings::Keep)?;
     print!(
         "{}",
         summary(
             &args.scene.display().to_string(),
-            &desc,
-            elapsed.as_secs_f64()
+            &scene.desc,
+            scene.parse_time.as_secs_f64()
         )
     );
     Ok(())

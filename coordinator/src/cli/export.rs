@@ -4,11 +4,10 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use yat_tracer::assets::FsSource;
 use yat_tracer::luxcore::{export, ExportOptions};
-use yat_tracer::parse::parse_scene;
 
-use crate::render_cmd::LatLongArg;
+use super::latlong::LatLongArg;
+use crate::scene::{ParsedScene, Warnings};
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
@@ -25,14 +24,7 @@ pub struct ExportArgs {
 }
 
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
-    let main = args
-        .scene
-        .file_name()
-        .and_then(|n| n.to_str())
-        .with_context(|| format!("\"{}\" is not a scene file path", args.scene.display()))?;
-    let source = FsSource::for_main_file(&args.scene);
-    let desc = parse_scene(main, &source)
-        .with_context(|| format!("cannot load scene {}", args.scene.display()))?;
+    let desc = ParsedScene::load(&args.scene, Warnings::Keep)?.desc;
     let scene_dir = std::path::absolute(&args.scene)?
         .parent()
         .map(PathBuf::from)

@@ -1,0 +1,160 @@
+//! `yat render`: load the scene, make the render job from the flags, hand it to the in-process
+//! executor or the distributed one, then write the image the scene's Film names and report.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use yat_tracer::render::{RenderOverrides, RenderSettings};
+
+use super::distributed::DistributedArgs;
+use super::latlong::LatLongArg;
+use super::seconds::seconds;
+use crate::checkpoint::{CheckpointFile, RenderIdentity};
+use crate::exec::{distributed, in_process};
+use crate::interim::{InterimOutputs, PreviewFile};
+use crate::job::RenderJob;
+use crate::manifest::SceneManifest;
+use crate::render_report::RenderReport;
+use crate::scene::{ParsedScene, Warnings};
+use crate::shutdown::Interrupt;
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// The main .lxs file.
+    pub scene: PathBuf,
+    /// Output PNG (default: the Film's filename plus .png, in the current folder).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write linear radiance as OpenEXR next to the PNG.
+    #[arg(long)]
+    pub exr: bool,
+    /// Samples per pixel (default: the Film's haltspp, else 64).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Maximum path depth (default: the scene's integrator depth).
+    #[arg(long)]
+    pub maxdepth: Option<u32>,
+    /// Render threads for an in-process render (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seed of the sampler: the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Image size WxH, overriding the Film (the camera's screen window is kept).
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// LatLong environment-map convention.
+    #[arg(long, value_enum, default_value = "seed")]
+    pub latlong: LatLongArg,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Write the render's figures (times, samples/s, rays/s, memory) as JSON to this file.
+    #[arg(long)]
+    pub stats_json: Option<PathBuf>,
+    /// Save the render so far to `<output>.resume` this often (and on Ctrl-C), so that running
+    /// the same command again resumes it; 0 disables checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    pub checkpoint_every: f64,
+    /// Rewrite `<output>.preview.png` this often during the render; 0 disables.
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub preview_every: f64,
+    #[command(flatten)]
+    pub distributed: DistributedArgs,
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, got {s:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=65_536).contains(&n))
+            .ok_or_else(|| format!("bad size {v:?} in {s:?} (1 to 65536)"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let scene = ParsedScene::load(
+        &args.scene,
+        if args.quiet {
+            Warnings::Keep
+        } else {
+            Warnings::Print
+        },
+    )?;
+    let overrides = RenderOverrides {
+        spp: args.spp,
+        max_depth: args.maxdepth,
+        seed: Some(args.seed),
+        resolution: args.resolution,
+        latlong: args.latlong.into(),
+    };
+    let settings = RenderSettings::resolve(&scene.desc, &overrides);
+    let output_png = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", scene.desc.film.filename)));
+    let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
+    let preview_every = seconds("preview-every", args.preview_every)?;
+    let workers = args.distributed.config()?;
+    // The files by content: what workers receive, and what names the render for its checkpoint.
+    let manifest = if workers.is_some() || !checkpoint_every.is_zero() {
+        Some(SceneManifest::read(&scene)?)
+    } else {
+        None
+    };
+    let checkpoint = manifest
+        .as_ref()
+        .filter(|_| !checkpoint_every.is_zero())
+        .map(|m| {
+            let identity = RenderIdentity::of(&m.load_request(&settings));
+            CheckpointFile::beside(&output_png, identity, checkpoint_every)
+        });
+    let interrupt = if checkpoint.is_some() {
+        Interrupt::install()?
+    } else {
+        Interrupt::default()
+    };
+    let job = RenderJob {
+        scene,
+        settings,
+        interim: InterimOutputs {
+            preview: (!preview_every.is_zero())
+                .then(|| PreviewFile::beside(&output_png, preview_every)),
+            checkpoint,
+        },
+        output_png,
+        exr: args.exr,
+        quiet: args.quiet,
+        interrupt,
+    };
+
+    let outcome = match (workers, manifest) {
+        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest)?,
+        (_, manifest) => {
+            // The in-process render reads the files itself: their copies go before it starts.
+            drop(manifest);
+            in_process::render(&job, args.threads)?
+        }
+    };
+    let build_time = outcome.build.as_ref().map(|b| b.time).unwrap_or_default();
+    let render_time = started.elapsed() - job.scene.parse_time - build_time;
+
+    job.write_final(&outcome.film)?;
+    let report = RenderReport::new(&job, &outcome, render_time);
+    if let Some(path) = &args.stats_json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if !args.quiet {
+        println!("wrote {}", job.output_png.display());
+        report.print();
+    }
+    Ok(())
+}

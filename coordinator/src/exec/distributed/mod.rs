@@ -1,0 +1,113 @@
+//! Rendering over gRPC workers: the coordinator ships the scene's files to every worker, hands
+//! out the units of the fixed plan pull-style, re-queues what a failing worker held, and merges
+//! each unit's result once. The plan and the exact film sums make the image bit-identical to an
+//! in-process render whatever the workers do.
+
+pub mod config;
+
+mod client;
+mod local;
+mod node;
+mod render_loop;
+mod report;
+mod schedule;
+mod session;
+mod session_error;
+mod shared;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::Context;
+use tokio::sync::mpsc;
+use yat_tracer::render::plan_units;
+
+use crate::job::{RenderJob, RenderOutcome};
+use crate::manifest::SceneManifest;
+use client::ClientConfig;
+use config::DistributedConfig;
+use local::LocalWorker;
+use node::Node;
+use render_loop::RenderLoop;
+use report::{process_cpu_time, DistributedReport};
+use schedule::{Schedule, UnitDeadline};
+use shared::Shared;
+
+/// Renders `job` on the workers `config` names or starts; `manifest` holds the scene's files.
+pub fn render(
+    config: &DistributedConfig,
+    job: &RenderJob,
+    manifest: SceneManifest,
+) -> anyhow::Result<RenderOutcome> {
+    let cpu_start = process_cpu_time();
+    let started = Instant::now();
+    let mut nodes = Vec::new();
+    for address in &config.workers {
+        let client = ClientConfig {
+            address: address.trim().to_string(),
+            token: config.token.clone(),
+            tls: config.tls.clone(),
+        };
+        client.validate()?;
+        nodes.push(Node::new(client, None));
+    }
+    if config.local_workers > 0 {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        for worker in LocalWorker::spawn_all(config.local_workers, cores)? {
+            let client = ClientConfig {
+                address: worker.address.clone(),
+                token: Some(worker.token.clone()),
+                tls: None,
+            };
+            nodes.push(Node::new(client, Some(worker)));
+        }
+    }
+    let nodes: Vec<Arc<Node>> = nodes.into_iter().map(Arc::new).collect();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .thread_name("yat-net")
+        .enable_all()
+        .build()
+        .context("cannot start the network runtime")?;
+    let units = plan_units(&job.settings);
+    let start = job.resume(&units);
+    let (events, event_rx) = mpsc::unbounded_channel();
+    let shared = Arc::new(Shared {
+        schedule: Schedule::new(units.clone(), |u| start.is_done(u)),
+        deadline: UnitDeadline::new(config.unit_deadline),
+        load_request: manifest.load_request(&job.settings),
+        manifest,
+        events,
+    });
+    let render_loop = RenderLoop {
+        job,
+        units: &units,
+        nodes: &nodes,
+        shared: &shared,
+        timeout: config.timeout,
+    };
+    let outcome = runtime.block_on(render_loop.run(start, event_rx));
+    // Ends the node loops and closes connections; then `nodes` drops the local workers.
+    drop(runtime);
+
+    let report = DistributedReport::new(
+        started.elapsed(),
+        process_cpu_time().saturating_sub(cpu_start),
+        shared.schedule.len(),
+        outcome.as_ref().map_or(0, |o| o.stats.samples),
+        nodes
+            .iter()
+            .map(|n| n.report.lock().unwrap().clone())
+            .collect(),
+    );
+    if let Some(path) = &config.workers_json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let outcome = outcome?;
+    if !job.quiet {
+        report.print();
+    }
+    Ok(outcome)
+}

@@ -1,0 +1,65 @@
+//! One worker as the coordinator sees it: how to reach it, the process behind it when this
+//! coordinator started it, and what it did in this render.
+
+use std::sync::Mutex;
+
+use super::client::ClientConfig;
+use super::local::LocalWorker;
+
+/// What a worker did in this render (the final summary and `--workers-json`).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct NodeReport {
+    pub address: String,
+    pub hostname: String,
+    pub threads: u32,
+    /// Units whose results were merged.
+    pub units: u64,
+    pub samples: u64,
+    /// Sessions lost (connection errors, deadlines, bad replies) and units given back.
+    pub failures: u64,
+    pub units_requeued: u64,
+    /// Scene-file bytes uploaded.
+    pub blob_bytes_sent: u64,
+    /// Every request's encoded bytes, blobs included.
+    pub bytes_sent: u64,
+    /// Every reply's encoded bytes.
+    pub bytes_received: u64,
+    /// Sample-buffer bytes and the pixels they cover, for bytes per pixel.
+    pub result_bytes: u64,
+    pub result_pixels: u64,
+    #[serde(skip)]
+    pub connected: bool,
+    /// Why this worker will not be used again, if so.
+    pub gone: Option<String>,
+    pub last_error: Option<String>,
+}
+
+pub struct Node {
+    /// How to reach it.
+    pub config: ClientConfig,
+    /// The process, for a worker this coordinator started.
+    pub local: Option<LocalWorker>,
+    pub report: Mutex<NodeReport>,
+}
+
+impl Node {
+    pub fn new(config: ClientConfig, local: Option<LocalWorker>) -> Self {
+        let report = NodeReport {
+            address: config.address.clone(),
+            ..NodeReport::default()
+        };
+        Self {
+            config,
+            local,
+            report: Mutex::new(report),
+        }
+    }
+
+    pub fn address(&self) -> &str {
+        &self.config.address
+    }
+
+    pub fn update(&self, f: impl FnOnce(&mut NodeReport)) {
+        f(&mut self.report.lock().unwrap());
+    }
+}

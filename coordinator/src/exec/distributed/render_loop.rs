@@ -1,0 +1,184 @@
+//! The render loop of a distributed render: merges results into the checkpoint as they come,
+//! writes the interim outputs as often as the job asks, and watches that some worker is there
+//! to render.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::bail;
+use tokio::sync::mpsc;
+use tokio::task::JoinSet;
+use yat_tracer::render::{UnitStats, WorkUnit};
+
+use super::node::Node;
+use super::session::run_node;
+use super::shared::{Event, Shared};
+use crate::checkpoint::Checkpoint;
+use crate::exec::progress::Progress;
+use crate::interim::InterimClock;
+use crate::job::{RenderJob, RenderOutcome};
+
+/// How long the render waits without any worker before saying so (and again after each such
+/// period).
+const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
+
+pub struct RenderLoop<'a> {
+    pub job: &'a RenderJob,
+    pub units: &'a [WorkUnit],
+    pub nodes: &'a [Arc<Node>],
+    pub shared: &'a Arc<Shared>,
+    pub timeout: Option<Duration>,
+}
+
+impl RenderLoop<'_> {
+    /// Merges results into `checkpoint` as they come until every unit is in, watching that
+    /// some worker is there to render and saving the checkpoint as often as the job asks.
+    pub async fn run(
+        self,
+        mut checkpoint: Checkpoint,
+        mut events: mpsc::UnboundedReceiver<Event>,
+    ) -> anyhow::Result<RenderOutcome> {
+        let progress = Progress::new(
+            self.shared.schedule.sample_count(),
+            checkpoint.done_samples(self.units),
+            self.job.quiet,
+        );
+        let mut tasks = JoinSet::new();
+        for node in self.nodes {
+            tasks.spawn(run_node(node.clone(), self.shared.clone()));
+        }
+        let mut stats = UnitStats::default();
+        let mut clock = InterimClock::default();
+        let mut alone_since = Some(Instant::now());
+        let mut waiting_noticed = Instant::now();
+        let mut tick = tokio::time::interval(Duration::from_millis(250));
+        let result = loop {
+            if checkpoint.is_complete() {
+                break Ok(());
+            }
+            tokio::select! {
+                event = events.recv() => match event.expect("the shared state holds a sender") {
+                    Event::Result { buffer, stats: unit_stats } => {
+                        if let Err(e) = checkpoint.add(&buffer) {
+                            break Err(e.into());
+                        }
+                        stats += unit_stats;
+                        progress.add_samples(unit_stats.samples);
+                        progress.set_status(self.status(&checkpoint));
+                    }
+                    Event::Notice(line) => progress.say(&line),
+                    Event::Fatal(e) => break Err(e),
+                },
+                _ = tick.tick() => {
+                    if self.job.interrupt.is_set() {
+                        break Err(anyhow::anyhow!("interrupted"));
+                    }
+                    progress.set_status(self.status(&checkpoint));
+                    let due = self.job.interim.due(&mut clock);
+                    if due.any() {
+                        // Lets the runtime's other thread serve the workers meanwhile.
+                        let failed = tokio::task::block_in_place(|| {
+                            self.job.interim.stage(due, &checkpoint, &self.job.scene.desc.film).finish()
+                        });
+                        for e in failed {
+                            progress.say(&format!("{e:#}"));
+                        }
+                    }
+                    if self.alive() > 0 {
+                        alone_since = None;
+                        continue;
+                    }
+                    let since = *alone_since.get_or_insert_with(Instant::now);
+                    if let Err(e) = self.check_workers_remain(since) {
+                        break Err(e);
+                    }
+                    if since.elapsed() >= WAITING_NOTICE_EVERY
+                        && waiting_noticed.elapsed() >= WAITING_NOTICE_EVERY
+                    {
+                        waiting_noticed = Instant::now();
+                        progress.say(&format!(
+                            "waiting for workers: none connected for {:.0} s ({}){}",
+                            since.elapsed().as_secs_f64(),
+                            self.last_errors(),
+                            self.timeout.map_or(String::new(), |t| format!(
+                                "; giving up after {:.0} s", t.as_secs_f64()))
+                        ));
+                    }
+                }
+            }
+        };
+        tasks.abort_all();
+        progress.finish();
+        if let Err(why) = result {
+            return Err(self.job.stopped(&checkpoint, self.units, why));
+        }
+        Ok(RenderOutcome {
+            film: checkpoint.into_film(),
+            stats,
+            build: None,
+        })
+    }
+
+    /// Units merged and workers connected, after the progress bar's ETA.
+    fn status(&self, checkpoint: &Checkpoint) -> String {
+        format!(
+            "| units {}/{}, workers {}/{}",
+            checkpoint.done_count(),
+            self.units.len(),
+            self.alive(),
+            self.nodes.len()
+        )
+    }
+
+    fn alive(&self) -> usize {
+        self.nodes
+            .iter()
+            .filter(|n| n.report.lock().unwrap().connected)
+            .count()
+    }
+
+    /// Fails when no worker can come back, or when the wait has exceeded --timeout.
+    fn check_workers_remain(&self, alone_since: Instant) -> anyhow::Result<()> {
+        let reports: Vec<_> = self
+            .nodes
+            .iter()
+            .map(|n| n.report.lock().unwrap().clone())
+            .collect();
+        if reports.iter().all(|r| r.gone.is_some()) {
+            let reasons: Vec<_> = reports
+                .iter()
+                .map(|r| format!("{}: {}", r.address, r.gone.as_deref().unwrap_or_default()))
+                .collect();
+            bail!(
+                "no worker can render this scene:\n  {}",
+                reasons.join("\n  ")
+            );
+        }
+        if let Some(timeout) = self.timeout {
+            if alone_since.elapsed() >= timeout {
+                bail!(
+                    "no worker connected for {:.0} s (--timeout); last errors: {}",
+                    timeout.as_secs_f64(),
+                    self.last_errors()
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn last_errors(&self) -> String {
+        self.nodes
+            .iter()
+            .map(|n| {
+                let r = n.report.lock().unwrap();
+                let why = r
+                    .gone
+                    .as_deref()
+                    .or(r.last_error.as_deref())
+                    .unwrap_or("connecting");
+                format!("{}: {why}", r.address)
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}

@@ -1,0 +1,88 @@
+//! The figures of one render: printed at its end and written by `--stats-json`.
+
+use std::time::Duration;
+
+use crate::job::{RenderJob, RenderOutcome};
+
+#[derive(serde::Serialize)]
+pub struct RenderReport {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub triangles: Option<usize>,
+    pub parse_seconds: f64,
+    pub build_seconds: Option<f64>,
+    pub render_seconds: f64,
+    pub samples: u64,
+    pub rays: u64,
+    pub dropped_samples: u64,
+    pub samples_per_second: f64,
+    pub rays_per_second: f64,
+    pub peak_memory_bytes: Option<u64>,
+}
+
+impl RenderReport {
+    /// The figures of `job`, rendered into `outcome` in `render_time` (parse and build apart).
+    pub fn new(job: &RenderJob, outcome: &RenderOutcome, render_time: Duration) -> Self {
+        let render_secs = render_time.as_secs_f64().max(1e-9);
+        let stats = &outcome.stats;
+        Self {
+            scene: job.scene.path.display().to_string(),
+            width: job.settings.width,
+            height: job.settings.height,
+            spp: job.settings.spp,
+            max_depth: job.settings.max_depth,
+            triangles: outcome.build.as_ref().map(|b| b.triangles),
+            parse_seconds: job.scene.parse_time.as_secs_f64(),
+            build_seconds: outcome.build.as_ref().map(|b| b.time.as_secs_f64()),
+            render_seconds: render_secs,
+            samples: stats.samples,
+            rays: stats.rays,
+            dropped_samples: stats.dropped,
+            samples_per_second: stats.samples as f64 / render_secs,
+            rays_per_second: stats.rays as f64 / render_secs,
+            peak_memory_bytes: peak_memory_bytes(),
+        }
+    }
+
+    pub fn print(&self) {
+        println!(
+            "{}x{} at {} spp, depth {}{}",
+            self.width,
+            self.height,
+            self.spp,
+            self.max_depth,
+            self.triangles
+                .map_or(String::new(), |t| format!(", {t} triangles"))
+        );
+        println!(
+            "parse {:.3} s{}, render {:.3} s",
+            self.parse_seconds,
+            self.build_seconds
+                .map_or(String::new(), |b| format!(", build {b:.3} s")),
+            self.render_seconds
+        );
+        println!(
+            "{:.3} M samples/s, {:.3} M rays/s{}{}",
+            self.samples_per_second / 1e6,
+            self.rays_per_second / 1e6,
+            self.peak_memory_bytes
+                .map_or(String::new(), |m| format!(", peak memory {} MB", m >> 20)),
+            if self.dropped_samples > 0 {
+                format!(", {} NaN/Inf samples dropped", self.dropped_samples)
+            } else {
+                String::new()
+            }
+        );
+    }
+}
+
+/// The process's peak resident set size, where the OS reports it (Linux).
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}

@@ -1,0 +1,64 @@
+//! Interrupt handling: Ctrl-C (SIGINT) and SIGTERM, as a flag a render polls ([`Interrupt`]),
+//! the error of a render they stopped ([`Interrupted`]), or a future a server awaits
+//! ([`signalled`]).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::Context;
+use tokio::signal::unix::SignalKind;
+
+/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render with
+/// its checkpoint saved, a second one ends the process at once.
+#[derive(Clone, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+/// Exit status of a render stopped by a signal (128 + SIGINT, as shells report it).
+pub const INTERRUPTED_EXIT_CODE: u8 = 130;
+
+impl Interrupt {
+    pub fn install() -> anyhow::Result<Self> {
+        let flag = Arc::new(AtomicBool::new(false));
+        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            // Registered first, so it sees the flag as the previous signal left it.
+            signal_hook::flag::register_conditional_shutdown(
+                signal,
+                i32::from(INTERRUPTED_EXIT_CODE),
+                flag.clone(),
+            )
+            .context("cannot watch for Ctrl-C")?;
+            signal_hook::flag::register(signal, flag.clone()).context("cannot watch for Ctrl-C")?;
+        }
+        Ok(Self(flag))
+    }
+
+    pub fn is_set(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// The error of a render stopped by Ctrl-C or SIGTERM; `main` exits with
+/// [`INTERRUPTED_EXIT_CODE`] on it.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted: {kept}")]
+pub struct Interrupted {
+    pub kept: String,
+}
+
+/// Resolves at the first Ctrl-C or SIGTERM: a server's cue to stop taking requests and finish
+/// those under way.
+pub async fn signalled() {
+    let terminate = async {
+        match tokio::signal::unix::signal(SignalKind::terminate()) {
+            Ok(mut terminate) => {
+                terminate.recv().await;
+            }
+            // Without a SIGTERM handler the signal keeps its default action: the process ends.
+            Err(_) => std::future::pending().await,
+        }
+    };
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {}
+        _ = terminate => {}
+    }
+}

@@ -1,0 +1,78 @@
+//! The worker's errors: a request's ([`NodeError`], which the gRPC layer maps to the status
+//! codes `render.proto` documents) and starting or running the server ([`ServeError`]).
+
+use std::path::PathBuf;
+
+use yat_proto::convert::WireError;
+use yat_proto::PROTOCOL_VERSION;
+use yat_tracer::parse::ParseError;
+use yat_tracer::render::BuildError;
+
+/// Why the node refused or failed a request.
+#[derive(Debug, thiserror::Error)]
+pub enum NodeError {
+    #[error(
+        "protocol version mismatch: this worker speaks version {PROTOCOL_VERSION}, \
+         the client ({client}) version {version}"
+    )]
+    ProtocolVersion { client: String, version: u32 },
+    /// A message that does not describe a valid render, unit or file.
+    #[error(transparent)]
+    Wire(#[from] WireError),
+    #[error("\"{path}\": malformed sha256 \"{sha256}\"")]
+    MalformedHash { path: String, sha256: String },
+    #[error("empty blob stream")]
+    EmptyBlobStream,
+    #[error("a blob's first chunk must name its sha256 (64 lowercase hex digits)")]
+    UnnamedBlob,
+    #[error("blob {hash} has {size} bytes; this worker accepts at most {max}")]
+    BlobTooLarge { hash: String, size: u64, max: u64 },
+    #[error("blob {hash}: more bytes than the declared {size}")]
+    BlobTooLong { hash: String, size: u64 },
+    #[error("blob {hash}: received {received} bytes of the declared {size}")]
+    BlobTooShort {
+        hash: String,
+        size: u64,
+        received: u64,
+    },
+    #[error("blob hash mismatch: declared {declared}, content hashes to {actual}")]
+    BlobHashMismatch { declared: String, actual: String },
+    #[error("blob {sha256} (\"{path}\") is missing: upload it first")]
+    BlobMissing { sha256: String, path: String },
+    #[error("blob cache: {0}")]
+    BlobCache(#[source] std::io::Error),
+    #[error("{path}: {source}")]
+    SceneParse {
+        path: String,
+        source: Box<ParseError>,
+    },
+    #[error("{path}: {source}")]
+    SceneBuild { path: String, source: BuildError },
+    #[error("scene {0} is not loaded here: load it again")]
+    SceneNotLoaded(String),
+    #[error("unit {0} panicked")]
+    UnitPanicked(u32),
+    #[error("render thread vanished")]
+    RenderThreadVanished,
+    /// The task storing a blob failed (it panicked).
+    #[error("{0}")]
+    BlobTask(#[source] tokio::task::JoinError),
+    /// The task building a scene failed (it panicked).
+    #[error("scene build failed: {0}")]
+    BuildTask(#[source] tokio::task::JoinError),
+}
+
+/// Why the worker could not start or stopped serving.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError {
+    #[error("cannot use the cache folder {}", .0.display())]
+    CacheFolder(PathBuf, #[source] std::io::Error),
+    #[error("cannot create the blob cache")]
+    Cache(#[source] std::io::Error),
+    #[error(transparent)]
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+    #[error("invalid TLS certificate or key")]
+    Tls(#[source] tonic::transport::Error),
+    #[error("the gRPC server failed")]
+    Server(#[source] tonic::transport::Error),
+}

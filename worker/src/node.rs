@@ -1,0 +1,245 @@
+//! The render node's logic on plain types: what a coordinator may ask of a worker (handshake,
+//! blobs, scenes, units, counters) and the state it takes (the blob and scene caches, the render
+//! threads, the counters). The gRPC layer only carries requests in and errors out.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use prost::Message;
+use yat_proto::convert::{unit_from_wire, WireError};
+use yat_proto::hash::{is_sha256_hex, sha256_hex};
+use yat_proto::{pb, DEFAULT_MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
+use yat_tracer::render::RenderSettings;
+
+use crate::blobs::BlobStore;
+use crate::config::WorkerConfig;
+use crate::error::{NodeError, ServeError};
+use crate::loaded_scene::LoadedScene;
+use crate::pool::RenderPool;
+use crate::scenes::SceneCache;
+use crate::upload::BlobUpload;
+
+/// Scenes a worker keeps built at once.
+const SCENE_CACHE_CAPACITY: usize = 4;
+
+/// What the worker tells coordinators about itself.
+pub struct Capabilities {
+    pub threads: u32,
+    pub max_message_bytes: u64,
+    pub max_blob_bytes: u64,
+    pub features: Vec<String>,
+}
+
+#[derive(Default)]
+struct Counters {
+    units_done: AtomicU64,
+    samples_done: AtomicU64,
+    blob_bytes_received: AtomicU64,
+    result_bytes_sent: AtomicU64,
+    units_in_flight: AtomicU64,
+}
+
+pub struct Node {
+    capabilities: Capabilities,
+    blobs: Arc<BlobStore>,
+    scenes: SceneCache<LoadedScene>,
+    pool: RenderPool,
+    /// Test hook: a pause before each unit, to make a worker slow on purpose.
+    throttle: Duration,
+    counters: Counters,
+    started: Instant,
+}
+
+impl Node {
+    pub fn new(config: &WorkerConfig) -> Result<Self, ServeError> {
+        let threads = config.threads.max(1);
+        let blobs = BlobStore::new(config.memory_cache_bytes, config.cache_dir.as_deref())
+            .map_err(|e| match &config.cache_dir {
+                Some(dir) => ServeError::CacheFolder(dir.clone(), e),
+                None => ServeError::Cache(e),
+            })?;
+        let mut features = Vec::new();
+        if config.cache_dir.is_some() {
+            features.push("disk-cache".to_string());
+        }
+        if config.tls.is_some() {
+            features.push("tls".to_string());
+        }
+        Ok(Self {
+            capabilities: Capabilities {
+                threads: threads as u32,
+                max_message_bytes: DEFAULT_MAX_MESSAGE_BYTES as u64,
+                max_blob_bytes: config.max_blob_bytes,
+                features,
+            },
+            blobs: Arc::new(blobs),
+            scenes: SceneCache::new(SCENE_CACHE_CAPACITY),
+            pool: RenderPool::new(threads)?,
+            throttle: config.throttle,
+            counters: Counters::default(),
+            started: Instant::now(),
+        })
+    }
+
+    pub fn capabilities(&self) -> &Capabilities {
+        &self.capabilities
+    }
+
+    /// The worker's version and capabilities, for a client of the same protocol version.
+    pub fn handshake(
+        &self,
+        request: &pb::HandshakeRequest,
+    ) -> Result<pb::HandshakeReply, NodeError> {
+        if request.protocol_version != PROTOCOL_VERSION {
+            return Err(NodeError::ProtocolVersion {
+                client: request.client.clone(),
+                version: request.protocol_version,
+            });
+        }
+        tracing::info!("handshake from {}", request.client);
+        let caps = &self.capabilities;
+        Ok(pb::HandshakeReply {
+            protocol_version: PROTOCOL_VERSION,
+            threads: caps.threads,
+            hostname: gethostname::gethostname().to_string_lossy().into_owned(),
+            max_message_bytes: caps.max_message_bytes,
+            max_blob_bytes: caps.max_blob_bytes,
+            features: caps.features.clone(),
+            software: format!("yat {}", env!("CARGO_PKG_VERSION")),
+        })
+    }
+
+    /// The requested blobs this worker does not hold, in request order.
+    pub fn missing_blobs(&self, request: pb::HasBlobsRequest) -> pb::HasBlobsReply {
+        let missing = request
+            .sha256
+            .into_iter()
+            .filter(|h| !self.blobs.contains(h))
+            .collect();
+        pb::HasBlobsReply { missing }
+    }
+
+    /// Starts receiving a blob, named and sized by its first chunk.
+    pub fn begin_blob(&self, hash: String, size: u64) -> Result<BlobUpload, NodeError> {
+        BlobUpload::begin(hash, size, self.capabilities.max_blob_bytes)
+    }
+
+    /// Stores a blob received whole and verified.
+    pub async fn store_blob(&self, upload: BlobUpload) -> Result<pb::PutBlobReply, NodeError> {
+        let (hash, data) = upload.finish()?;
+        let stored_bytes = data.len() as u64;
+        let blobs = self.blobs.clone();
+        tokio::task::spawn_blocking(move || blobs.insert(&hash, data.into()))
+            .await
+            .map_err(NodeError::BlobTask)?
+            .map_err(NodeError::BlobCache)?;
+        self.counters
+            .blob_bytes_received
+            .fetch_add(stored_bytes, Ordering::Relaxed);
+        Ok(pb::PutBlobReply { stored_bytes })
+    }
+
+    /// Builds the scene the request names, unless it is built already.
+    pub async fn load_scene(
+        &self,
+        request: pb::LoadSceneRequest,
+    ) -> Result<pb::LoadSceneReply, NodeError> {
+        // Protobuf encoding of the same message is the same bytes: the id names the files'
+        // contents, their paths and the settings, identically on every worker.
+        let scene_id = sha256_hex(&request.encode_to_vec());
+        let main = request.main.ok_or(WireError::Missing("main file"))?;
+        let settings = request.settings.ok_or(WireError::Missing("settings"))?;
+        let settings = RenderSettings::try_from(&settings)?;
+        for file in std::iter::once(&main).chain(&request.assets) {
+            if !is_sha256_hex(&file.sha256) {
+                return Err(NodeError::MalformedHash {
+                    path: file.path.clone(),
+                    sha256: file.sha256.clone(),
+                });
+            }
+        }
+        let started = Instant::now();
+        let assets = request.assets;
+        let blobs = self.blobs.clone();
+        let build = || async move {
+            tokio::task::spawn_blocking(move || {
+                LoadedScene::build(&blobs, &main, &assets, settings)
+            })
+            .await
+            .map_err(NodeError::BuildTask)?
+        };
+        let (loaded, built) = self.scenes.get_or_build(&scene_id, build).await?;
+        Ok(pb::LoadSceneReply {
+            scene_id,
+            triangle_count: loaded.triangle_count,
+            build_seconds: if built {
+                started.elapsed().as_secs_f64()
+            } else {
+                0.0
+            },
+            warnings: loaded.warnings.clone(),
+        })
+    }
+
+    /// Renders one unit of a loaded scene.
+    pub async fn render_unit(
+        &self,
+        request: pb::RenderUnitRequest,
+    ) -> Result<pb::RenderUnitReply, NodeError> {
+        let loaded = self
+            .scenes
+            .get(&request.scene_id)
+            .ok_or(NodeError::SceneNotLoaded(request.scene_id))?;
+        let unit = request.unit.as_ref().ok_or(WireError::Missing("unit"))?;
+        let unit = unit_from_wire(unit, &loaded.settings)?;
+        let _in_flight = InFlight::enter(&self.counters.units_in_flight);
+        if !self.throttle.is_zero() {
+            tokio::time::sleep(self.throttle).await;
+        }
+        let rendered = self.pool.render(loaded, unit).await?;
+        let c = &self.counters;
+        c.units_done.fetch_add(1, Ordering::Relaxed);
+        c.samples_done
+            .fetch_add(rendered.stats.samples, Ordering::Relaxed);
+        c.result_bytes_sent
+            .fetch_add(rendered.pixels.len() as u64, Ordering::Relaxed);
+        Ok(pb::RenderUnitReply {
+            index: unit.index,
+            pixels: rendered.pixels,
+            stats: Some(rendered.stats.into()),
+            render_seconds: rendered.elapsed.as_secs_f64(),
+        })
+    }
+
+    /// The worker's counters since it started.
+    pub fn stats(&self) -> pb::StatsReply {
+        let c = &self.counters;
+        pb::StatsReply {
+            units_done: c.units_done.load(Ordering::Relaxed),
+            samples_done: c.samples_done.load(Ordering::Relaxed),
+            blob_bytes_received: c.blob_bytes_received.load(Ordering::Relaxed),
+            result_bytes_sent: c.result_bytes_sent.load(Ordering::Relaxed),
+            blobs_cached: self.blobs.len() as u64,
+            scenes_cached: self.scenes.len() as u64,
+            units_in_flight: c.units_in_flight.load(Ordering::Relaxed),
+            uptime_seconds: self.started.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// Counts a unit as in flight until dropped, even when the coordinator gives up on it.
+struct InFlight<'a>(&'a AtomicU64);
+
+impl<'a> InFlight<'a> {
+    fn enter(counter: &'a AtomicU64) -> Self {
+        counter.fetch_add(1, Ordering::Relaxed);
+        Self(counter)
+    }
+}
+
+impl Drop for InFlight<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
+}

@@ -1,0 +1,197 @@
+//! The worker over gRPC, started in-process with `serve` on a loopback port: what it refuses,
+//! with which status codes (the contract `render.proto` documents).
+
+use std::time::Duration;
+
+use tokio::net::TcpListener;
+use tonic::Code;
+use yat_proto::hash::sha256_hex;
+use yat_proto::{pb, RenderNodeClient, PROTOCOL_VERSION};
+use yat_worker::{serve, WorkerConfig};
+
+/// One render thread, no token, no TLS, and a 1000-byte blob limit.
+fn config() -> WorkerConfig {
+    WorkerConfig {
+        threads: 1,
+        cache_dir: None,
+        memory_cache_bytes: 1 << 20,
+        max_blob_bytes: 1000,
+        token: None,
+        tls: None,
+        throttle: Duration::ZERO,
+    }
+}
+
+/// A worker on a loopback port and a client to it; the worker serves until the test's runtime
+/// ends.
+async fn worker() -> RenderNodeClient<tonic::transport::Channel> {
+    let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let address = listener.local_addr().unwrap();
+    tokio::spawn(serve(listener, config(), std::future::pending()));
+    RenderNodeClient::connect(format!("http://{address}"))
+        .await
+        .unwrap()
+}
+
+fn chunks(hash: &str, size: u64, parts: &[&'static [u8]]) -> Vec<pb::BlobChunk> {
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, data)| pb::BlobChunk {
+            sha256: if i == 0 {
+                hash.to_string()
+            } else {
+                String::new()
+            },
+            size: if i == 0 { size } else { 0 },
+            data: prost::bytes::Bytes::from_static(data),
+        })
+        .collect()
+}
+
+#[tokio::test]
+async fn blobs_are_verified_before_they_are_stored() {
+    let mut client = worker().await;
+    let good = sha256_hex(b"hello world");
+    let uploader = client.clone();
+    let put = |c: Vec<pb::BlobChunk>| {
+        let mut client = uploader.clone();
+        async move { client.put_blob(tokio_stream::iter(c)).await }
+    };
+    let wrong_hash = sha256_hex(b"something else");
+    let refused = [
+        (
+            chunks(&wrong_hash, 11, &[b"hello ", b"world"]),
+            Code::InvalidArgument,
+        ),
+        (
+            chunks(&good, 5, &[b"hello ", b"world"]),
+            Code::InvalidArgument,
+        ),
+        (
+            chunks(&good, 12, &[b"hello ", b"world"]),
+            Code::InvalidArgument,
+        ),
+        (
+            chunks("../etc/passwd", 11, &[b"hello world"]),
+            Code::InvalidArgument,
+        ),
+        (
+            chunks(&good, 5000, &[b"hello world"]),
+            Code::ResourceExhausted,
+        ),
+    ];
+    for (stream, code) in refused {
+        assert_eq!(put(stream).await.unwrap_err().code(), code);
+    }
+    let query = pb::HasBlobsRequest {
+        sha256: vec![good.clone(), wrong_hash.clone()],
+    };
+    let missing = client.has_blobs(query.clone()).await.unwrap().into_inner();
+    assert_eq!(missing.missing, vec![good.clone(), wrong_hash.clone()]);
+
+    let stored = put(chunks(&good, 11, &[b"hello ", b"world"]))
+        .await
+        .unwrap();
+    assert_eq!(stored.into_inner().stored_bytes, 11);
+    let missing = client.has_blobs(query).await.unwrap().into_inner();
+    assert_eq!(missing.missing, vec![wrong_hash]);
+    let stats = client
+        .stats(pb::StatsRequest {})
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!((stats.blob_bytes_received, stats.blobs_cached), (11, 1));
+}
+
+#[tokio::test]
+async fn other_protocol_versions_and_unknown_scenes_are_refused() {
+    let mut client = worker().await;
+    let hello = |protocol_version| pb::HandshakeRequest {
+        protocol_version,
+        client: "test".into(),
+    };
+    let reply = client.handshake(hello(PROTOCOL_VERSION)).await.unwrap();
+    assert_eq!(reply.into_inner().threads, 1);
+    let refused = client
+        .handshake(hello(PROTOCOL_VERSION + 1))
+        .await
+        .unwrap_err();
+    assert_eq!(refused.code(), Code::FailedPrecondition);
+    assert!(refused.message().contains(&format!(
+        "version {PROTOCOL_VERSION}, the client (test) version {}",
+        PROTOCOL_VERSION + 1
+    )));
+    let unit = pb::RenderUnitRequest {
+        scene_id: "nothing".into(),
+        unit: None,
+    };
+    let status = client.render_unit(unit).await.unwrap_err();
+    assert_eq!(status.code(), Code::NotFound);
+}
+
+#[tokio::test]
+async fn scene_loads_fail_with_the_documented_codes() {
+    let mut client = worker().await;
+    let settings = pb::RenderSettings {
+        width: 8,
+        height: 8,
+        spp: 1,
+        max_depth: 1,
+        ..Default::default()
+    };
+    let load = |path: &str, text: &[u8]| pb::LoadSceneRequest {
+        main: Some(pb::SceneFile {
+            path: path.into(),
+            sha256: sha256_hex(text),
+        }),
+        assets: vec![],
+        settings: Some(settings),
+    };
+    let without_main = pb::LoadSceneRequest {
+        main: None,
+        ..load("a.lxs", b"")
+    };
+    let status = client.load_scene(without_main).await.unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert_eq!(status.message(), "the request lacks its main file");
+
+    let broken: &'static [u8] = b"Film \"fleximage\" \"integer xresolution\" [64\nWorldBegin\n";
+    let status = client
+        .load_scene(load("bad.lxs", broken))
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::FailedPrecondition, "not uploaded yet");
+    assert!(status.message().contains("upload it first"), "{status:?}");
+
+    let hash = sha256_hex(broken);
+    client
+        .put_blob(tokio_stream::iter(chunks(
+            &hash,
+            broken.len() as u64,
+            &[broken],
+        )))
+        .await
+        .unwrap();
+    let status = client
+        .load_scene(load("bad.lxs", broken))
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert!(status.message().starts_with("bad.lxs: "), "{status:?}");
+}
+
+#[tokio::test]
+async fn serve_returns_once_its_shutdown_resolves() {
+    let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let server = tokio::spawn(serve(listener, config(), async {
+        let _ = stopped.await;
+    }));
+    stop.send(()).unwrap();
+    let served = tokio::time::timeout(Duration::from_secs(10), server)
+        .await
+        .expect("serve returned")
+        .unwrap();
+    assert!(served.is_ok(), "{served:?}");
+}
