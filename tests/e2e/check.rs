@@ -4,7 +4,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::util::{seed_dir, YAT};
+use crate::util::YAT;
+use crate::workspace::seed_scenes;
 
 fn check(scene: &Path) -> (bool, String, String) {
     let out = Command::new(YAT)
@@ -22,7 +23,7 @@ fn check(scene: &Path) -> (bool, String, String) {
 
 #[test]
 fn check_summarises_a_seed_scene() {
-    let Some(dir) = seed_dir() else { return };
+    let Some(dir) = seed_scenes() else { return };
     let (ok, stdout, stderr) = check(&dir.join("CornellBox/cornell-box.lxs"));
     assert!(ok, "{stdout}\n{stderr}");
     assert!(stdout.contains("resolution   960x540"), "{stdout}");

@@ -1,7 +1,10 @@
 //! End-to-end tests: the real `yat` binary, real workers, real sockets. One test binary; each
-//! module is a part of the command line.
+//! module is a part of the command line, and `architecture` checks the workspace's import graph.
 
+mod architecture;
 mod check;
 mod distributed;
 mod resume;
 mod util;
+#[path = "../fixtures/workspace.rs"]
+mod workspace;

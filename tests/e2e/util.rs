@@ -7,24 +7,6 @@ use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
-/// The original course's scenes (`YAT_SEED_SCENES`, else `../shared/seed-project/scenes` beside
-/// the repository), or `None` after saying why the test skips them.
-pub fn seed_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("YAT_SEED_SCENES") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/seed-project/scenes"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!(
-            "seed scenes not found at {} (set YAT_SEED_SCENES); skipping",
-            dir.display()
-        );
-        None
-    }
-}
-
 /// A closed box lit by an area light, with a glossy sphere, its materials in an Include'd file
 /// and a poster textured with a PNG image map. Returns the main file.
 pub fn write_scene(dir: &Path) -> PathBuf {

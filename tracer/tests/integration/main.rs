@@ -7,4 +7,5 @@ mod parse_errors;
 mod render;
 mod seed_renders;
 mod seed_scenes;
+#[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
