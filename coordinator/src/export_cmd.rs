@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use yat_luxcore::{export, ExportOptions};
 use yat_tracer::assets::FsSource;
-use yat_tracer::luxcore::{export, ExportOptions};
 use yat_tracer::parse::parse_scene;
 
 use crate::render_cmd::LatLongArg;

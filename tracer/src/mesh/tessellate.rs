@@ -102,8 +102,8 @@ pub fn plane_quad(normal: Vec3, half_size: f32) -> TriangleMesh {
     let n = normal.normalize_or_zero();
     let s = n.any_orthonormal_vector();
     let t = n.cross(s);
-    let corners =
-        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| (s * a + t * b) * half_size);
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .map(|(a, b)| (s * a + t * b) * half_size);
     TriangleMesh {
         positions: corners.to_vec(),
         normals: None,
