@@ -8,18 +8,18 @@ use yat_tracer::desc::{Mapping2D, MaterialId, SceneDesc, Tex, TextureId, Texture
 use crate::error::ExportError;
 
 /// Whether a 2D mapping is one LuxCore lacks and the export bakes into vertex uvs.
-pub fn is_baked(mapping: &Mapping2D) -> bool {
+fn is_baked(mapping: &Mapping2D) -> bool {
     !matches!(mapping, Mapping2D::Uv { .. })
 }
 
-pub fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
+fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
     if let Tex::Texture(id) = t {
         out.push(*id);
     }
 }
 
 /// Textures a texture reads directly.
-pub fn texture_inputs(kind: &TextureKind) -> Vec<TextureId> {
+fn texture_inputs(kind: &TextureKind) -> Vec<TextureId> {
     let mut out = Vec::new();
     for t in kind.references() {
         push_tex(&t, &mut out);

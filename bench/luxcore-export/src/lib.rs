@@ -10,20 +10,21 @@
 //! course's fisheye camera).
 //!
 //! It reads only the scene description ([`yat_tracer::desc`]) and the tracer's mesh helpers.
-//! One file per part of the output: [`props`] (the SDL text and the names of things),
-//! [`camera`] (camera and `render.cfg`), [`textures`], [`materials`], [`bake`] (mappings baked
-//! into vertex uvs), [`shapes`] (meshes and objects), [`ply`] (the PLY files), [`lights`].
+//! One file per part of the output: `props` (the SDL text and the names of things), `camera`
+//! (camera and `render.cfg`), `textures`, `materials`, `bake` (mappings baked into vertex
+//! uvs), `shapes` (meshes and objects), `ply` (the PLY files), `lights`; `options` and `error`
+//! are the leaves they share.
 
-pub mod bake;
-pub mod camera;
-pub mod error;
-pub mod lights;
-pub mod materials;
-pub mod options;
-pub mod ply;
-pub mod props;
-pub mod shapes;
-pub mod textures;
+mod bake;
+mod camera;
+mod error;
+mod lights;
+mod materials;
+mod options;
+mod ply;
+mod props;
+mod shapes;
+mod textures;
 
 use std::path::Path;
 

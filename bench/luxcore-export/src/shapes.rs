@@ -65,7 +65,7 @@ pub fn write_shapes(
 
 /// The shape's mesh in world space, wound so LuxCore's front face (counter-clockwise, the
 /// geometric normal cross(p1 - p0, p2 - p0)) is YAT's.
-pub fn export_shape(
+fn export_shape(
     desc: &SceneDesc,
     shape: &ShapeDesc,
     opts: &ExportOptions,

@@ -12,7 +12,7 @@ use crate::props::{matrix, quoted, tex_name, tex_value, v3, Props};
 
 /// LuxCore's uvmapping2d is YAT's uv mapping (scale, then offset), and both read image row
 /// t x height counted from the top, so the parameters carry over unchanged.
-pub fn write_mapping(p: &mut Props, prefix: &str, mapping: &Mapping2D) {
+fn write_mapping(p: &mut Props, prefix: &str, mapping: &Mapping2D) {
     p.set(format!("{prefix}.mapping.type"), quoted("uvmapping2d"));
     let (scale, delta) = match *mapping {
         Mapping2D::Uv {
