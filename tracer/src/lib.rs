@@ -23,7 +23,6 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod lights;
-pub mod luxcore;
 pub mod material;
 pub mod math;
 pub mod mesh;

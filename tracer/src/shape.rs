@@ -95,8 +95,8 @@ impl Geometry {
     }
 
     /// A sphere's z range: zmin and zmax in order, clamped to [-|radius|, |radius|]. None for
-    /// other shapes. The renderer, the area of an emitting sphere and the exporter's
-    /// tessellation all use this range.
+    /// other shapes. The renderer, the area of an emitting sphere and the tessellation
+    /// ([`crate::mesh::tessellate`]) all use this range.
     pub fn sphere_z_range(&self) -> Option<(f32, f32)> {
         let Geometry::Sphere {
             radius, zmin, zmax, ..

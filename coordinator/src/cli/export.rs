@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use yat_tracer::luxcore::{export, ExportOptions};
+use yat_luxcore::{export, ExportOptions};
 
 use super::latlong::LatLongArg;
 use crate::scene::{ParsedScene, Warnings};

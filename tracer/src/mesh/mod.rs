@@ -1,8 +1,10 @@
 //! Triangle meshes: the data every mesh-like shape becomes, reading them from inline shape
-//! parameters ([`inline`]) and from PLY files ([`ply`]).
+//! parameters ([`inline`]) and from PLY files ([`ply`]), and making them from the analytic
+//! shapes ([`tessellate`]).
 
 pub mod inline;
 pub mod ply;
+pub mod tessellate;
 
 use glam::Vec3;
 

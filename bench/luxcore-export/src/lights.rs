@@ -1,0 +1,92 @@
+//! Lights (`scene.lights.light<N>`): point, spot, distant and infinite lights as LuxCore's;
+//! a kind with no LuxCore mapping is left out with a note naming it.
+
+use std::f32::consts::PI;
+use std::path::Path;
+
+use glam::Mat4;
+use yat_tracer::desc::{LatLongConvention, LightDesc};
+use yat_tracer::lights::{DistantLight, InfiniteLight, PointLight, SpotLight};
+
+use crate::options::ExportOptions;
+use crate::props::{matrix, quoted, v3, Props};
+
+pub fn write_light(
+    p: &mut Props,
+    index: usize,
+    light: &LightDesc,
+    scene_dir: &Path,
+    opts: &ExportOptions,
+    notes: &mut Vec<String>,
+) {
+    let prefix = format!("scene.lights.light{index}");
+    let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
+    match light {
+        LightDesc::Point(PointLight {
+            position,
+            intensity,
+        }) => {
+            set("type", quoted("point"));
+            set("position", v3(*position));
+            set("color", v3(*intensity));
+            set("gain", "1 1 1".into());
+            set("power", "0".into());
+            set("efficency", "0".into());
+        }
+        LightDesc::Spot(SpotLight {
+            position,
+            direction,
+            intensity,
+            cone_angle,
+            cone_delta_angle,
+        }) => {
+            set("type", quoted("spot"));
+            set("position", v3(*position));
+            set("target", v3(*position + *direction));
+            set("color", v3(*intensity));
+            set("gain", "1 1 1".into());
+            set("power", "0".into());
+            set("efficency", "0".into());
+            set("coneangle", cone_angle.to_string());
+            set("conedeltaangle", cone_delta_angle.to_string());
+        }
+        LightDesc::Distant(DistantLight { to_light, radiance }) => {
+            set("type", quoted("distant"));
+            set("direction", v3(-*to_light));
+            set("color", v3(*radiance));
+            set("gain", "1 1 1".into());
+        }
+        LightDesc::Infinite(InfiniteLight {
+            radiance,
+            map: None,
+            ..
+        }) => {
+            set("type", quoted("constantinfinite"));
+            set("color", v3(*radiance));
+            set("gain", "1 1 1".into());
+        }
+        LightDesc::Infinite(InfiniteLight {
+            radiance,
+            map: Some(map),
+            light_to_world,
+        }) => {
+            set("type", quoted("infinite"));
+            let path = scene_dir.join(&map.filename);
+            set("file", quoted(&path.to_string_lossy()));
+            set("gamma", map.gamma.to_string());
+            set("gain", v3(*radiance));
+            // The seed's u = (pi + phi) / 2pi is LuxRender's phi / 2pi half a turn on.
+            let turn = match opts.latlong {
+                LatLongConvention::LuxRender => Mat4::IDENTITY,
+                LatLongConvention::Seed => Mat4::from_rotation_z(PI),
+            };
+            set("transformation", matrix(&(*light_to_world * turn)));
+        }
+        // A kind added later that LuxCore has no mapping for yet.
+        #[allow(unreachable_patterns)]
+        other => notes.push(format!(
+            "light {index} (\"{}\"): not exported",
+            other.name()
+        )),
+    }
+}

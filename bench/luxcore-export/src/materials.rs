@@ -1,0 +1,121 @@
+//! Materials (`scene.materials.<name>`): each YAT material as its LuxCore equivalent, with
+//! the emission of an area light when the material is an emitter's.
+
+use glam::Vec3;
+use yat_tracer::desc::{Fresnel, MaterialDesc, Tex};
+use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix};
+
+use crate::props::{mat_name, quoted, tex_value, v3, Props};
+
+/// Writes material `m` under `name`; `emission` is added for emitting shapes (a null material
+/// that emits becomes black matte: it shows the light and reflects nothing).
+pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<Vec3>) {
+    let prefix = format!("scene.materials.{name}");
+    let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
+    match m {
+        MaterialDesc::Matte(Matte { kd, sigma }) => {
+            let rough = *sigma != Tex::float(0.0);
+            set("type", quoted(if rough { "roughmatte" } else { "matte" }));
+            set("kd", tex_value(kd, true));
+            if rough {
+                set("sigma", tex_value(sigma, false));
+            }
+        }
+        MaterialDesc::Glossy(Glossy {
+            kd,
+            ks,
+            ka,
+            depth,
+            uroughness,
+            vroughness,
+            multibounce,
+        }) => {
+            set("type", quoted("glossy2"));
+            set("kd", tex_value(kd, true));
+            set("ks", tex_value(ks, true));
+            set("ka", tex_value(ka, true));
+            set("d", tex_value(depth, false));
+            set("uroughness", tex_value(uroughness, false));
+            set("vroughness", tex_value(vroughness, false));
+            set("multibounce", u8::from(*multibounce).to_string());
+        }
+        MaterialDesc::Mirror(Mirror { kr }) => {
+            set("type", quoted("mirror"));
+            set("kr", tex_value(kr, true));
+        }
+        MaterialDesc::Glass(Glass {
+            kr,
+            kt,
+            index,
+            architectural,
+            uroughness,
+            vroughness,
+        }) => {
+            let rough = *uroughness != Tex::float(0.0) || *vroughness != Tex::float(0.0);
+            let kind = match (architectural, rough) {
+                (true, _) => "archglass",
+                (false, true) => "roughglass",
+                (false, false) => "glass",
+            };
+            set("type", quoted(kind));
+            set("kr", tex_value(kr, true));
+            set("kt", tex_value(kt, true));
+            set("interiorior", tex_value(index, false));
+            set("exteriorior", "1".into());
+            if rough && !architectural {
+                set("uroughness", tex_value(uroughness, false));
+                set("vroughness", tex_value(vroughness, false));
+            }
+        }
+        MaterialDesc::Metal(Metal {
+            fresnel,
+            uroughness,
+            vroughness,
+        }) => {
+            set("type", quoted("metal2"));
+            set("fresnel", quoted(&format!("{name}_fresnel")));
+            set("uroughness", tex_value(uroughness, false));
+            set("vroughness", tex_value(vroughness, false));
+            let fprefix = format!("scene.textures.{name}_fresnel");
+            match fresnel {
+                Fresnel::Reflectance(kr) => {
+                    p.set(format!("{fprefix}.type"), quoted("fresnelcolor"));
+                    p.set(format!("{fprefix}.kr"), tex_value(kr, true));
+                }
+                Fresnel::Index(n) => {
+                    p.set(format!("{fprefix}.type"), quoted("fresnelconst"));
+                    p.set(format!("{fprefix}.n"), tex_value(n, true));
+                    p.set(format!("{fprefix}.k"), "0 0 0");
+                }
+                Fresnel::Conductor { eta, k } => {
+                    p.set(format!("{fprefix}.type"), quoted("fresnelconst"));
+                    p.set(format!("{fprefix}.n"), v3(*eta));
+                    p.set(format!("{fprefix}.k"), v3(*k));
+                }
+            }
+        }
+        MaterialDesc::MatteTranslucent(MatteTranslucent { kr, kt, .. }) => {
+            set("type", quoted("mattetranslucent"));
+            set("kr", tex_value(kr, true));
+            set("kt", tex_value(kt, true));
+        }
+        MaterialDesc::Null(_) if emission.is_some() => {
+            set("type", quoted("matte"));
+            set("kd", "0 0 0".into());
+        }
+        MaterialDesc::Mix(Mix { a, b, amount }) => {
+            set("type", quoted("mix"));
+            set("material1", quoted(&mat_name(*a)));
+            set("material2", quoted(&mat_name(*b)));
+            set("amount", tex_value(amount, false));
+        }
+        // Kinds with no parameters LuxCore needs (null) go by their name.
+        other => set("type", quoted(other.name())),
+    }
+    if let Some(radiance) = emission {
+        p.set(format!("{prefix}.emission"), v3(radiance));
+        p.set(format!("{prefix}.emission.gain"), "1 1 1");
+        p.set(format!("{prefix}.emission.power"), 0);
+        p.set(format!("{prefix}.emission.efficency"), 0);
+    }
+}

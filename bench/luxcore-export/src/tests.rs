@@ -1,0 +1,171 @@
+//! The export's unit tests: small scenes parsed from text, their SDL and PLY checked.
+
+use std::path::Path;
+
+use glam::Vec3;
+use yat_tracer::assets::MemorySource;
+use yat_tracer::desc::SceneDesc;
+use yat_tracer::mesh::ply::read_mesh;
+use yat_tracer::parse::parse_scene;
+
+use crate::{export, ExportOptions, LuxCoreScene};
+
+fn parse(world: &str, camera: &str) -> SceneDesc {
+    let text = format!(
+        "LookAt 0 -5 1  0 0 1  0 0 1\n{camera}\n\
+         Film \"fleximage\" \"integer xresolution\" [64] \"integer yresolution\" [32]\n\
+         WorldBegin\n{world}\nWorldEnd\n"
+    );
+    let mut png = Vec::new();
+    image::RgbImage::new(2, 2)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let mut source = MemorySource::new();
+    source.insert("main.lxs", text.into_bytes().into());
+    source.insert("c.png", png.into());
+    parse_scene("main.lxs", &source).expect("test scene parses")
+}
+
+fn export_world(world: &str) -> LuxCoreScene {
+    let desc = parse(world, "Camera \"perspective\" \"float fov\" [40]");
+    export(&desc, Path::new("/scenes"), &ExportOptions::default()).expect("exports")
+}
+
+/// The value of `key` in SDL text.
+fn value<'a>(scn: &'a str, key: &str) -> &'a str {
+    scn.lines()
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(" = "))
+        .unwrap_or_else(|| panic!("{key} missing from\n{scn}"))
+}
+
+fn floats(s: &str) -> Vec<f32> {
+    s.split_whitespace().map(|x| x.parse().unwrap()).collect()
+}
+
+#[test]
+fn camera_keeps_lookat_fov_and_screen_window() {
+    let lux = export_world("");
+    let scn = &lux.scene;
+    assert_eq!(value(scn, "scene.camera.type"), "\"perspective\"");
+    assert_eq!(
+        floats(value(scn, "scene.camera.lookat.orig")),
+        [0.0, -5.0, 1.0]
+    );
+    let target = floats(value(scn, "scene.camera.lookat.target"));
+    assert!((target[1] + 4.0).abs() < 1e-5 && (target[2] - 1.0).abs() < 1e-5);
+    assert_eq!(floats(value(scn, "scene.camera.fieldofview")), [40.0]);
+    assert_eq!(
+        floats(value(scn, "scene.camera.screenwindow")),
+        [-2.0, 2.0, -1.0, 1.0]
+    );
+    assert_eq!(value(&lux.config, "film.width"), "64");
+}
+
+#[test]
+fn fisheye_is_refused() {
+    let desc = parse("", "Camera \"fisheye\" \"float fov\" [90]");
+    let err = export(&desc, Path::new("."), &ExportOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("fisheye"), "{err}");
+}
+
+#[test]
+fn emitter_gets_its_own_black_material_with_the_parsed_radiance() {
+    let lux = export_world(
+        "AttributeBegin\nMaterial \"null\"\n\
+         AreaLightSource \"area\" \"color L\" [1 0.5 0.25] \"float gain\" [4] \"float power\" [0]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 2 1 0 2 0 1 2]\n\
+         AttributeEnd",
+    );
+    let scn = &lux.scene;
+    assert_eq!(value(scn, "scene.objects.object0.material"), "\"emitter0\"");
+    assert_eq!(value(scn, "scene.materials.emitter0.type"), "\"matte\"");
+    assert_eq!(floats(value(scn, "scene.materials.emitter0.kd")), [0.0; 3]);
+    assert_eq!(
+        floats(value(scn, "scene.materials.emitter0.emission")),
+        [4.0, 2.0, 1.0]
+    );
+}
+
+#[test]
+fn meshes_are_world_space_and_reverse_orientation_swaps_winding() {
+    let shape = "Shape \"trianglemesh\" \"integer indices\" [0 1 2] \
+                 \"point P\" [0 0 0 1 0 0 0 1 0]";
+    for (reverse, mirror) in [(false, false), (true, false), (false, true), (true, true)] {
+        let lux = export_world(&format!(
+            "AttributeBegin\nTranslate 1 2 3\n{}{}{shape}\nAttributeEnd",
+            if reverse { "ReverseOrientation\n" } else { "" },
+            if mirror { "Scale -1 1 1\n" } else { "" },
+        ));
+        let mesh = read_mesh(&lux.meshes[0].1).expect("our PLY reads back");
+        let x = if mirror { -1.0 } else { 1.0 };
+        assert_eq!(
+            mesh.positions,
+            [
+                Vec3::new(1.0, 2.0, 3.0),
+                Vec3::new(1.0 + x, 2.0, 3.0),
+                Vec3::new(1.0, 3.0, 3.0)
+            ]
+        );
+        let swapped = reverse ^ mirror;
+        let expected = if swapped { [0, 2, 1] } else { [0, 1, 2] };
+        assert_eq!(
+            mesh.indices,
+            [expected],
+            "reverse {reverse} mirror {mirror}"
+        );
+    }
+}
+
+#[test]
+fn planar_mapping_is_baked_into_vertex_uvs() {
+    let lux = export_world(
+        "Texture \"checks\" \"color\" \"imagemap\" \"string filename\" [\"c.png\"] \
+         \"string mapping\" [\"planar\"] \"float udelta\" [0.5] \"float vdelta\" [0.25]\n\
+         Material \"matte\" \"texture Kd\" [\"checks\"]\n\
+         AttributeBegin\nTranslate 10 0 0\nScale 3 3 3\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0]\n\
+         AttributeEnd",
+    );
+    let scn = &lux.scene;
+    assert_eq!(value(scn, "scene.textures.tex0.file"), "\"/scenes/c.png\"");
+    assert_eq!(
+        floats(value(scn, "scene.textures.tex0.mapping.uvscale")),
+        [1.0, 1.0]
+    );
+    assert_eq!(
+        floats(value(scn, "scene.textures.tex0.mapping.uvdelta")),
+        [0.0, 0.0]
+    );
+    // Planar mapping projects the object-space point: (0,0), (1,0), (0,1) plus delta.
+    let mesh = read_mesh(&lux.meshes[0].1).unwrap();
+    assert_eq!(mesh.uvs.unwrap(), [[0.5, 0.25], [1.5, 0.25], [0.5, 1.25]]);
+}
+
+#[test]
+fn uv_mapping_parameters_carry_over_and_metal2_gets_a_fresnel_texture() {
+    let lux = export_world(
+        "Texture \"t\" \"color\" \"imagemap\" \"string filename\" [\"c.png\"] \
+         \"float vscale\" [-1] \"float vdelta\" [1]\n\
+         Material \"metal2\" \"color fresnel\" [0.4 0.4 0.4] \"float uroughness\" [0.1] \
+         \"float vroughness\" [0.1]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1 0]",
+    );
+    let scn = &lux.scene;
+    assert_eq!(
+        floats(value(scn, "scene.textures.tex0.mapping.uvscale")),
+        [1.0, -1.0]
+    );
+    assert_eq!(
+        floats(value(scn, "scene.textures.tex0.mapping.uvdelta")),
+        [0.0, 1.0]
+    );
+    let m = value(scn, "scene.objects.object0.material").trim_matches('"');
+    assert_eq!(
+        value(scn, &format!("scene.materials.{m}.type")),
+        "\"metal2\""
+    );
+    let fresnel = value(scn, &format!("scene.materials.{m}.fresnel")).trim_matches('"');
+    let fresnel = format!("scene.textures.{fresnel}");
+    assert_eq!(value(scn, &format!("{fresnel}.type")), "\"fresnelcolor\"");
+    assert_eq!(floats(value(scn, &format!("{fresnel}.kr"))), [0.4; 3]);
+}
