@@ -12,6 +12,11 @@
 //! keyed by), [`render::settings`], [`geometry::SurfaceHit`]; the path tracer sees the built
 //! scene only through [`integrator::PathScene`].
 
+// Lets test fixtures shared with the integration tests (tests/fixtures) name this crate
+// `yat_tracer` from inside it too.
+#[cfg(test)]
+extern crate self as yat_tracer;
+
 pub mod assets;
 pub mod bxdf;
 pub mod camera;

@@ -8,53 +8,32 @@ use crate::desc::*;
 use crate::material::Matte;
 use crate::math::Ray;
 
-/// A scene description with the given shapes and lights and plain values elsewhere.
+#[path = "../../../tests/fixtures/scene.rs"]
+mod fixture;
+use fixture::empty_scene;
+
+/// A scene description with the given shapes and lights, one matte material and plain values
+/// elsewhere.
 pub(crate) fn scene_desc(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> SceneDesc {
-    SceneDesc {
-        camera: CameraDesc {
-            kind: CameraKind::Perspective { fov: 90.0 },
-            camera_to_world: Mat4::IDENTITY,
-            screen_window: [-1.0, 1.0, -1.0, 1.0],
-            lens_radius: 0.0,
-            focal_distance: 1e30,
-            hither: 1e-3,
-            yon: 1e30,
-        },
-        film: FilmDesc {
-            xresolution: 16,
-            yresolution: 16,
-            gamma: 2.2,
-            tonemap: ToneMap::AutoLinear,
-            filename: "test".into(),
-            haltspp: None,
-            halttime: None,
-        },
-        filter: FilterDesc {
-            kind: FilterKind::Box,
-            xwidth: 0.5,
-            ywidth: 0.5,
-        },
-        integrator: IntegratorDesc {
-            max_depth: 4,
-            rr_strategy: RussianRoulette::None,
-            rr_continue_prob: 0.65,
-            include_environment: true,
-            requested: "path".into(),
-        },
-        sampler: SamplerDesc {
-            pixel_samples: None,
-            requested: "sobol".into(),
-        },
-        textures: Vec::new(),
-        materials: vec![MaterialDesc::Matte(Matte {
-            kd: Tex::float(0.5),
-            sigma: Tex::float(0.0),
-        })],
-        shapes,
-        lights,
-        warnings: Vec::new(),
-        assets: Vec::new(),
-    }
+    let camera = CameraDesc {
+        kind: CameraKind::Perspective { fov: 90.0 },
+        camera_to_world: Mat4::IDENTITY,
+        screen_window: [-1.0, 1.0, -1.0, 1.0],
+        lens_radius: 0.0,
+        focal_distance: 1e30,
+        hither: 1e-3,
+        yon: 1e30,
+    };
+    let mut desc = empty_scene(camera, 16);
+    desc.integrator.max_depth = 4;
+    desc.integrator.rr_strategy = RussianRoulette::None;
+    desc.materials = vec![MaterialDesc::Matte(Matte {
+        kd: Tex::float(0.5),
+        sigma: Tex::float(0.0),
+    })];
+    desc.shapes = shapes;
+    desc.lights = lights;
+    desc
 }
 
 pub(crate) fn shape(geometry: Geometry, object_to_world: Mat4) -> ShapeDesc {

@@ -5,6 +5,8 @@ mod geometry_on_scenes;
 mod parse_conventions;
 mod parse_errors;
 mod render;
+#[path = "../../../tests/fixtures/scene.rs"]
+mod scene;
 mod seed_renders;
 mod seed_scenes;
 #[path = "../../../tests/fixtures/workspace.rs"]

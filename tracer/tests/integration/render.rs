@@ -12,6 +12,8 @@ use yat_tracer::material::Matte;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
 use yat_tracer::texture::Checkerboard2D;
 
+use crate::scene::empty_scene as scene;
+
 /// A camera at `eye` looking along +y with z up (camera x = world x, camera y = world z).
 fn camera(kind: CameraKind, eye: Vec3, lens_radius: f32, focal_distance: f32) -> CameraDesc {
     CameraDesc {
@@ -27,43 +29,6 @@ fn camera(kind: CameraKind, eye: Vec3, lens_radius: f32, focal_distance: f32) ->
         focal_distance,
         hither: 1e-3,
         yon: 1e30,
-    }
-}
-
-fn scene(camera: CameraDesc, size: u32) -> SceneDesc {
-    SceneDesc {
-        camera,
-        film: FilmDesc {
-            xresolution: size,
-            yresolution: size,
-            gamma: 2.2,
-            tonemap: ToneMap::AutoLinear,
-            filename: "test".into(),
-            haltspp: None,
-            halttime: None,
-        },
-        filter: FilterDesc {
-            kind: FilterKind::Box,
-            xwidth: 0.5,
-            ywidth: 0.5,
-        },
-        integrator: IntegratorDesc {
-            max_depth: 16,
-            rr_strategy: RussianRoulette::Efficiency,
-            rr_continue_prob: 0.65,
-            include_environment: true,
-            requested: "path".into(),
-        },
-        sampler: SamplerDesc {
-            pixel_samples: None,
-            requested: "sobol".into(),
-        },
-        textures: vec![],
-        materials: vec![],
-        shapes: vec![],
-        lights: vec![],
-        warnings: vec![],
-        assets: vec![],
     }
 }
 
