@@ -12,16 +12,8 @@ use crate::util::*;
 const LONG: [&str; 4] = ["--spp", "256", "--resolution", "128x96"];
 
 fn long_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut command = Command::new(YAT);
+    let mut command = render_command_with(scene, out, &LONG, extra);
     command
-        .arg("render")
-        .arg(scene)
-        .arg("-o")
-        .arg(out)
-        .arg("--exr")
-        .args(LONG)
-        .args(extra)
-        .env_remove("YAT_TOKEN")
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());

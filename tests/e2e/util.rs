@@ -188,6 +188,12 @@ impl Drop for Worker {
 
 /// `yat render SCENE -o OUT --exr` with the test settings and `extra` arguments.
 pub fn render_command(scene: &Path, out: &Path, extra: &[&str]) -> Command {
+    render_command_with(scene, out, &SETTINGS, extra)
+}
+
+/// `yat render SCENE -o OUT --exr` with `settings` (spp, resolution...) and `extra` arguments,
+/// free of the caller's token and unit deadline.
+pub fn render_command_with(scene: &Path, out: &Path, settings: &[&str], extra: &[&str]) -> Command {
     let mut command = Command::new(YAT);
     command
         .arg("render")
@@ -195,7 +201,7 @@ pub fn render_command(scene: &Path, out: &Path, extra: &[&str]) -> Command {
         .arg("-o")
         .arg(out)
         .arg("--exr")
-        .args(SETTINGS)
+        .args(settings)
         .args(extra)
         .env_remove("YAT_TOKEN")
         .env_remove("YAT_UNIT_DEADLINE");
