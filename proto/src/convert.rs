@@ -11,9 +11,6 @@ use crate::pb;
 /// Bytes per pixel in a sample buffer: RGB sums and the weight sum, four f32.
 pub const BYTES_PER_PIXEL: usize = 16;
 
-/// Largest image a worker accepts (a 16k x 16k render).
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
-
 /// Largest unit a worker renders: its reply stays at 4 MiB, under every message limit.
 pub const MAX_UNIT_PIXELS: u64 = 1 << 18;
 
@@ -54,18 +51,6 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
     type Error = WireError;
 
     fn try_from(s: &pb::RenderSettings) -> Result<Self, WireError> {
-        if s.width == 0 || s.height == 0 || s.spp == 0 {
-            return Err(WireError::Settings(format!(
-                "width {}, height {} and spp {} must be positive",
-                s.width, s.height, s.spp
-            )));
-        }
-        if u64::from(s.width) * u64::from(s.height) > MAX_IMAGE_PIXELS {
-            return Err(WireError::Settings(format!(
-                "{}x{} exceeds {MAX_IMAGE_PIXELS} pixels",
-                s.width, s.height
-            )));
-        }
         let latlong = match pb::LatLongConvention::try_from(s.latlong) {
             Ok(pb::LatLongConvention::LatlongSeed) => LatLongConvention::Seed,
             Ok(pb::LatLongConvention::LatlongLuxrender) => LatLongConvention::LuxRender,
@@ -76,14 +61,18 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
                 )))
             }
         };
-        Ok(Self {
+        let settings = Self {
             width: s.width,
             height: s.height,
             spp: s.spp,
             max_depth: s.max_depth,
             seed: s.seed,
             latlong,
-        })
+        };
+        settings
+            .check()
+            .map_err(|e| WireError::Settings(e.to_string()))?;
+        Ok(settings)
     }
 }
 

@@ -1,10 +1,11 @@
 //! YAT's gRPC protocol: the messages and the `RenderNode` service generated from
 //! `render.proto`, and what both ends of a connection share: the protocol version, conversions
 //! between the wire messages and the tracer's types, the sample-buffer encoding, content hashes,
-//! the token check and the network flags.
+//! the token check, the drain signal and the network flags.
 
 pub mod auth;
 pub mod convert;
+pub mod drain;
 pub mod flags;
 pub mod hash;
 

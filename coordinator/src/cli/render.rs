@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
+use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use super::distributed::DistributedArgs;
@@ -72,8 +73,8 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
         v.trim()
             .parse::<u32>()
             .ok()
-            .filter(|&n| (1..=65_536).contains(&n))
-            .ok_or_else(|| format!("bad size {v:?} in {s:?} (1 to 65536)"))
+            .filter(|&n| (1..=MAX_SIDE).contains(&n))
+            .ok_or_else(|| format!("bad size {v:?} in {s:?} (1 to {MAX_SIDE})"))
     };
     Ok((parse(w)?, parse(h)?))
 }
@@ -96,6 +97,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         latlong: args.latlong.into(),
     };
     let settings = RenderSettings::resolve(&scene.desc, &overrides);
+    settings
+        .check()
+        .with_context(|| format!("cannot render {}", args.scene.display()))?;
     let output_png = args
         .output
         .clone()

@@ -12,5 +12,5 @@ pub mod unit;
 
 pub use plan::{plan_units, PASSES, TILE_SIZE};
 pub use scene::{BuildError, RenderScene};
-pub use settings::{RenderOverrides, RenderSettings, DEFAULT_SPP};
+pub use settings::{RenderOverrides, RenderSettings, SettingsError, DEFAULT_SPP};
 pub use unit::{UnitStats, WorkUnit};

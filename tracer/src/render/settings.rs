@@ -28,7 +28,51 @@ pub struct RenderOverrides {
 /// Samples per pixel when neither the file nor the command line says.
 pub const DEFAULT_SPP: u32 = 64;
 
+/// Widest or tallest image, in pixels.
+pub const MAX_SIDE: u32 = 65_536;
+/// Largest image, in pixels (a 16k x 16k render): its film is 8 GiB of sums.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+/// Most samples per pixel: 16.7 million, far beyond any converged image, small enough that
+/// every count a plan derives from it (samples of a unit, of the image) fits its integer.
+pub const MAX_SPP: u32 = 1 << 24;
+/// Deepest path: LuxRender's default is 10, scenes use up to a few hundred.
+pub const MAX_DEPTH: u32 = 1 << 12;
+
+/// Settings outside what a render can be planned for.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum SettingsError {
+    #[error("the image size {width}x{height} must be positive")]
+    EmptyImage { width: u32, height: u32 },
+    #[error("the image size {width}x{height} exceeds the limit of {MAX_SIDE} pixels a side and {MAX_IMAGE_PIXELS} pixels in all")]
+    ImageTooLarge { width: u32, height: u32 },
+    #[error("{0} samples per pixel: at least 1 and at most {MAX_SPP}")]
+    Spp(u32),
+    #[error("path depth {0} exceeds the limit of {MAX_DEPTH}")]
+    Depth(u32),
+}
+
 impl RenderSettings {
+    /// Checks the settings against the limits above, which every node enforces alike.
+    pub fn check(&self) -> Result<(), SettingsError> {
+        let (width, height) = (self.width, self.height);
+        if width == 0 || height == 0 {
+            return Err(SettingsError::EmptyImage { width, height });
+        }
+        if width > MAX_SIDE
+            || height > MAX_SIDE
+            || u64::from(width) * u64::from(height) > MAX_IMAGE_PIXELS
+        {
+            return Err(SettingsError::ImageTooLarge { width, height });
+        }
+        if self.spp == 0 || self.spp > MAX_SPP {
+            return Err(SettingsError::Spp(self.spp));
+        }
+        if self.max_depth > MAX_DEPTH {
+            return Err(SettingsError::Depth(self.max_depth));
+        }
+        Ok(())
+    }
+
     pub fn resolve(desc: &SceneDesc, overrides: &RenderOverrides) -> Self {
         let (width, height) = overrides
             .resolution
@@ -47,5 +91,50 @@ impl RenderSettings {
             seed: overrides.seed.unwrap_or(0),
             latlong: overrides.latlong,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(width: u32, height: u32, spp: u32, max_depth: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            spp,
+            max_depth,
+            seed: 0,
+            latlong: LatLongConvention::Seed,
+        }
+    }
+
+    #[test]
+    fn limits_are_inclusive_and_name_what_is_wrong() {
+        assert_eq!(settings(MAX_SIDE, 4096, MAX_SPP, MAX_DEPTH).check(), Ok(()));
+        assert_eq!(
+            settings(0, 10, 1, 1).check(),
+            Err(SettingsError::EmptyImage {
+                width: 0,
+                height: 10
+            })
+        );
+        assert!(matches!(
+            settings(MAX_SIDE + 1, 1, 1, 1).check(),
+            Err(SettingsError::ImageTooLarge { .. })
+        ));
+        assert!(matches!(
+            settings(MAX_SIDE, MAX_SIDE, 1, 1).check(),
+            Err(SettingsError::ImageTooLarge { .. })
+        ));
+        assert_eq!(
+            settings(8, 8, u32::MAX, 1).check(),
+            Err(SettingsError::Spp(u32::MAX))
+        );
+        assert_eq!(settings(8, 8, 0, 1).check(), Err(SettingsError::Spp(0)));
+        assert_eq!(
+            settings(8, 8, 1, MAX_DEPTH + 1).check(),
+            Err(SettingsError::Depth(MAX_DEPTH + 1))
+        );
     }
 }
