@@ -114,7 +114,7 @@ pub fn render(
     // Ends the node loops and closes connections; then `roster` drops the local workers.
     drop(runtime);
 
-    let report = DistributedReport::new(
+    let mut report = DistributedReport::new(
         started.elapsed(),
         process_cpu_time().saturating_sub(cpu_start),
         shared.schedule.len(),
@@ -125,6 +125,7 @@ pub fn render(
             .map(|n| n.report.lock().unwrap().clone())
             .collect(),
     );
+    report.units_copied = shared.schedule.copies();
     if let Some(path) = &config.workers_json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
