@@ -262,7 +262,8 @@ fn main() -> anyhow::Result<()> {
     if args.workers == 0 || args.threads == 0 {
         bail!("--workers and --threads must be at least 1");
     }
-    if !(args.sample_us > 0.0 && args.sample_us < 1e6) || !(0.0..1.0).contains(&args.spread) {
+    let sample_us_ok = args.sample_us > 0.0 && args.sample_us < 1e6;
+    if !sample_us_ok || !(0.0..1.0).contains(&args.spread) {
         bail!("--sample-us must be in (0, 1e6) and --spread in [0, 1)");
     }
     let scene = args.scene.clone().unwrap_or_else(default_scene);
@@ -304,6 +305,8 @@ fn main() -> anyhow::Result<()> {
     if !status.success() {
         bail!("the coordinator failed: {status}");
     }
+    // Lets the servers see the coordinator's connections close, ending the calls cut short.
+    std::thread::sleep(Duration::from_millis(200));
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
     let log = log.lock().unwrap().clone();
     print_figures(&args, &scene, &report, &log)?;

@@ -2,6 +2,7 @@
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::time::Duration;
 
 use yat_proto::flags::{ClientTlsFlags, TokenFlag};
 
@@ -42,6 +43,21 @@ pub struct DistributedArgs {
     pub unit_deadline: Option<f64>,
 }
 
+/// Re-resolving more often than this would only load the name servers.
+const MIN_RESOLVE_EVERY: Duration = Duration::from_millis(100);
+
+/// `--resolve-every`: zero (resolve once) or at least `MIN_RESOLVE_EVERY`.
+fn resolve_every(value: f64) -> anyhow::Result<Duration> {
+    let every = seconds("resolve-every", value)?;
+    if !every.is_zero() && every < MIN_RESOLVE_EVERY {
+        anyhow::bail!(
+            "--resolve-every must be 0 (resolve once) or at least {} s",
+            MIN_RESOLVE_EVERY.as_secs_f64()
+        );
+    }
+    Ok(every)
+}
+
 impl DistributedArgs {
     /// The distributed render these flags ask for, or `None` for an in-process render.
     pub fn config(&self) -> anyhow::Result<Option<DistributedConfig>> {
@@ -50,7 +66,7 @@ impl DistributedArgs {
         }
         Ok(Some(DistributedConfig {
             workers: self.workers.clone(),
-            resolve_every: seconds("resolve-every", self.resolve_every)?,
+            resolve_every: resolve_every(self.resolve_every)?,
             dns_server: self.dns_server,
             local_workers: self.local_workers,
             token: self.token.token.clone(),

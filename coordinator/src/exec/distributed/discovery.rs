@@ -8,7 +8,7 @@
 //! fails to resolve keeps its last good answer. Which worker renders which unit never changes
 //! the image, so none of this touches the bit-identical promise.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashSet};
 use std::net::{IpAddr, SocketAddr};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -187,8 +187,9 @@ impl ClientTemplate {
 /// A worker of the render and the task serving it.
 struct Member {
     node: Arc<Node>,
-    /// The name it was found under; `None` for a listed address or a local worker.
-    name: Option<String>,
+    /// The `--workers` entry (name and port) it was found under; `None` for a listed address
+    /// or a local worker.
+    entry: Option<String>,
     address: Option<SocketAddr>,
     task: Option<JoinHandle<()>>,
     removed: bool,
@@ -218,7 +219,7 @@ impl Roster {
         let task = tokio::spawn(run_node(node.clone(), self.shared.clone()));
         self.members.lock().unwrap().push(Member {
             node,
-            name: None,
+            entry: None,
             address: None,
             task: Some(task),
             removed: false,
@@ -255,20 +256,19 @@ impl Roster {
         }
     }
 
-    /// Makes the workers under `name` exactly `answer`: new addresses join, addresses that
-    /// came back rejoin, missing ones are removed. Returns (joined, removed).
+    /// Makes the workers found under `host`:`port` exactly `answer`: new addresses join,
+    /// addresses that came back rejoin, missing ones are removed. Returns (joined, removed).
     fn follow_answer(
         &self,
         client: &ClientTemplate,
-        name: &str,
+        (host, port): (&str, u16),
         answer: &BTreeSet<SocketAddr>,
     ) -> (usize, usize) {
+        let entry = format!("{host}:{port}");
+        let ours = |m: &Member| m.entry.as_deref() == Some(entry.as_str());
         let mut members = self.members.lock().unwrap();
         let mut removed = 0;
-        for member in members
-            .iter_mut()
-            .filter(|m| m.name.as_deref() == Some(name))
-        {
+        for member in members.iter_mut().filter(|m| ours(m)) {
             let in_answer = member.address.is_some_and(|a| answer.contains(&a));
             if !in_answer && !member.removed {
                 member.removed = true;
@@ -283,11 +283,20 @@ impl Roster {
                 removed += 1;
             }
         }
+        // An address already in the render (listed, or under another entry) is one worker.
+        let elsewhere: HashSet<String> = members
+            .iter()
+            .filter(|m| !ours(m) && !m.removed)
+            .map(|m| m.node.address().to_string())
+            .collect();
         let mut joined = 0;
         for &address in answer {
+            if elsewhere.contains(&address.to_string()) {
+                continue;
+            }
             let existing = members
                 .iter_mut()
-                .find(|m| m.name.as_deref() == Some(name) && m.address == Some(address));
+                .find(|m| ours(m) && m.address == Some(address));
             let node = match existing {
                 Some(member) if member.removed => {
                     member.removed = false;
@@ -298,13 +307,13 @@ impl Roster {
                     continue;
                 }
                 Some(_) => continue,
-                None => Arc::new(Node::new(client.for_address(name, address), None)),
+                None => Arc::new(Node::new(client.for_address(host, address), None)),
             };
-            node.update(|r| r.dns_name = Some(name.to_string()));
+            node.update(|r| r.dns_name = Some(host.to_string()));
             let task = tokio::spawn(run_node(node.clone(), self.shared.clone()));
             members.push(Member {
                 node,
-                name: Some(name.to_string()),
+                entry: Some(entry.clone()),
                 address: Some(address),
                 task: Some(task),
                 removed: false,
@@ -423,7 +432,8 @@ impl Discovery {
                 MAX_ADDRESSES_PER_NAME + left_out
             ));
         }
-        let (joined, removed) = roster.follow_answer(&self.client, &name.host, &answer);
+        let (joined, removed) =
+            roster.follow_answer(&self.client, (&name.host, name.port), &answer);
         if joined + removed > 0 {
             shared.notice(format!(
                 "{} resolves to {} address(es): {joined} joined, {removed} removed",
@@ -528,7 +538,7 @@ mod tests {
             "127.0.0.2:1".parse().unwrap(),
         ];
         let follow = |answer: &[SocketAddr]| {
-            roster.follow_answer(&client, "w.test", &answer.iter().copied().collect())
+            roster.follow_answer(&client, ("w.test", 1), &answer.iter().copied().collect())
         };
         let gone = |i: usize| roster.nodes()[i].report.lock().unwrap().gone.clone();
         assert_eq!(follow(&[a, b]), (2, 0));
@@ -549,14 +559,30 @@ mod tests {
         assert_eq!((roster.nodes().len(), roster.current_count()), (2, 2));
         assert_eq!(follow(&[]), (0, 2));
         assert_eq!(roster.current_count(), 0);
+        let listed = client.for_address("listed", a);
+        roster.add(Node::new(listed, None));
+        assert_eq!(
+            follow(&[a]),
+            (0, 0),
+            "a listed address is not a second worker"
+        );
+        assert_eq!(roster.current_count(), 1);
+        let other_port = BTreeSet::from(["127.0.0.1:2".parse().unwrap()]);
+        assert_eq!(
+            roster.follow_answer(&client, ("w.test", 2), &other_port),
+            (1, 0),
+            "the name with another port is another entry, leaving the first alone"
+        );
+        assert_eq!(roster.current_count(), 2);
         let reports: Vec<_> = roster
             .nodes()
             .iter()
             .map(|n| n.report.lock().unwrap().clone())
             .collect();
-        assert!(reports
+        assert!(reports[..2]
             .iter()
             .all(|r| r.dns_name.as_deref() == Some("w.test")));
+        assert_eq!(reports[2].dns_name, None);
         assert_eq!(reports[1].address, "127.0.0.2:1");
         roster.stop_all();
     }
