@@ -332,6 +332,8 @@ struct FollowedName {
     failing: bool,
     /// Whether the last answer was cut to `MAX_ADDRESSES_PER_NAME` (said once).
     capped: bool,
+    /// Whether the last answer had no address (said when it becomes so).
+    empty: bool,
 }
 
 /// The DNS names of a render, resolved once at the start and then every `every` (if not zero).
@@ -357,6 +359,7 @@ impl Discovery {
                     port: *port,
                     failing: false,
                     capped: false,
+                    empty: false,
                 }),
                 WorkerTarget::Address(_) => None,
             })
@@ -370,17 +373,21 @@ impl Discovery {
     }
 
     /// Resolves every name once; then, when re-resolution is on, keeps following them in a
-    /// task the roster owns. Resolved once only, a name that does not resolve fails the render.
+    /// task the roster owns. Resolved once only, a name that does not resolve, or resolves to
+    /// no address, fails the render.
     pub async fn start(mut self, roster: &Arc<Roster>) -> anyhow::Result<()> {
         if self.names.is_empty() {
             return Ok(());
         }
         let resolve_once = self.every.is_zero();
         for index in 0..self.names.len() {
-            if let Err(e) = self.round(index, roster).await {
-                if resolve_once {
-                    let name = &self.names[index];
-                    anyhow::bail!("cannot resolve worker name {}: {e}", name.host);
+            let found = self.round(index, roster).await;
+            if resolve_once {
+                let host = &self.names[index].host;
+                match found {
+                    Err(e) => anyhow::bail!("cannot resolve worker name {host}: {e}"),
+                    Ok(0) => anyhow::bail!("worker name {host} resolves to no address"),
+                    Ok(_) => {}
                 }
             }
         }
@@ -405,9 +412,9 @@ impl Discovery {
         Ok(())
     }
 
-    /// Resolves one name and makes the roster follow its answer; a failure keeps the last good
-    /// answer and is said once.
-    async fn round(&mut self, index: usize, roster: &Roster) -> Result<(), ResolveFailure> {
+    /// Resolves one name and makes the roster follow its answer; returns how many addresses it
+    /// has. A failure keeps the last good answer and is said once.
+    async fn round(&mut self, index: usize, roster: &Roster) -> Result<usize, ResolveFailure> {
         let name = &mut self.names[index];
         let shared = &roster.shared;
         let (answer, left_out) = match self.resolver.resolve(&name.host, name.port).await {
@@ -432,6 +439,10 @@ impl Discovery {
                 MAX_ADDRESSES_PER_NAME + left_out
             ));
         }
+        if answer.is_empty() && !std::mem::replace(&mut name.empty, true) {
+            shared.notice(format!("{} resolves to no address (yet)", name.host));
+        }
+        name.empty = answer.is_empty();
         let (joined, removed) =
             roster.follow_answer(&self.client, (&name.host, name.port), &answer);
         if joined + removed > 0 {
@@ -441,7 +452,7 @@ impl Discovery {
                 answer.len()
             ));
         }
-        Ok(())
+        Ok(answer.len())
     }
 }
 

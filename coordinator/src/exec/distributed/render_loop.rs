@@ -164,8 +164,11 @@ impl RenderLoop<'_> {
     }
 
     fn last_errors(&self) -> String {
-        self.roster
-            .nodes()
+        let nodes = self.roster.nodes();
+        if nodes.is_empty() {
+            return "no worker address found yet under the --workers names".into();
+        }
+        nodes
             .iter()
             .map(|n| {
                 let r = n.report.lock().unwrap();

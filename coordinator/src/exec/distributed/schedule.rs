@@ -108,6 +108,23 @@ impl Schedule {
                 }
                 state.holder[i] = holder;
                 state.handed.push(index);
+                // Requeued units are pushed again: now and then keep only the last place of
+                // each unit not yet done, so the list stays within twice the plan.
+                if state.handed.len() > 2 * self.units.len() {
+                    let mut kept = vec![false; self.units.len()];
+                    let mut handed: Vec<u32> = state
+                        .handed
+                        .iter()
+                        .rev()
+                        .copied()
+                        .filter(|&i| {
+                            let i = i as usize;
+                            !state.done[i] && !std::mem::replace(&mut kept[i], true)
+                        })
+                        .collect();
+                    handed.reverse();
+                    state.handed = handed;
+                }
                 return Some(self.units[i]);
             }
         }
@@ -332,6 +349,17 @@ mod tests {
         // A lost unit goes back to the queue and is handed out before any copy.
         s.requeue(&taken[0]);
         assert_eq!(s.take("b").unwrap().index, 0);
+    }
+
+    #[test]
+    fn a_unit_lost_again_and_again_keeps_the_bookkeeping_bounded() {
+        let s = schedule();
+        let unit = s.take("a").unwrap();
+        for _ in 0..10 * s.len() {
+            s.requeue(&unit);
+            assert_eq!(s.take("a").unwrap().index, unit.index);
+        }
+        assert!(s.state.lock().unwrap().handed.len() <= 2 * s.len());
     }
 
     #[test]
