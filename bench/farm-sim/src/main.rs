@@ -386,3 +386,32 @@ fn print_figures(
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn busy_share_counts_each_workers_covered_time_once() {
+        let t0 = Instant::now();
+        let at = |ms: u64| t0 + Duration::from_millis(ms);
+        let busy = |worker, start, end| Busy {
+            worker,
+            start: at(start),
+            end: at(end),
+            completed: true,
+        };
+        let log = [
+            // Worker 0: overlapping units covering the whole window and beyond.
+            busy(0, 0, 700),
+            busy(0, 500, 1200),
+            // Worker 1: half of the window.
+            busy(1, 900, 1400),
+            // Worker 2: nothing in the window.
+            busy(2, 0, 400),
+        ];
+        let share = busy_share(&log, 3, (at(600), at(1000)));
+        assert!((share - (1.0 + 0.25 + 0.0) / 3.0).abs() < 1e-9, "{share}");
+        assert_eq!(busy_share(&log, 3, (at(5), at(5))), 0.0);
+    }
+}
