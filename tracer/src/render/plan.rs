@@ -35,9 +35,9 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
     let fine_final_pass =
         u64::from(TILE_SIZE * TILE_SIZE) * u64::from(samples_per_unit) >= FINE_FINAL_PASS_SAMPLES;
     let mut units = Vec::new();
-    let mut start = 0;
+    let mut start = 0u32;
     while start < settings.spp {
-        let end = (start + samples_per_unit).min(settings.spp);
+        let end = start.saturating_add(samples_per_unit).min(settings.spp);
         let tile = if end == settings.spp && fine_final_pass {
             FINAL_PASS_TILE_SIZE
         } else {
@@ -46,11 +46,11 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
         for y0 in (0..settings.height).step_by(tile as usize) {
             for x0 in (0..settings.width).step_by(tile as usize) {
                 units.push(WorkUnit {
-                    index: units.len() as u32,
+                    index: u32::try_from(units.len()).unwrap_or(u32::MAX),
                     x0,
                     y0,
-                    x1: (x0 + tile).min(settings.width),
-                    y1: (y0 + tile).min(settings.height),
+                    x1: x0.saturating_add(tile).min(settings.width),
+                    y1: y0.saturating_add(tile).min(settings.height),
                     sample_start: start,
                     sample_end: end,
                 });
