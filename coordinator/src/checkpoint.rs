@@ -16,7 +16,7 @@ use prost::Message;
 use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
 use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
-use yat_tracer::render::{RenderSettings, WorkUnit};
+use yat_tracer::render::{RenderSettings, WorkUnit, PLAN_VERSION};
 
 const MAGIC: &[u8; 8] = b"YATRESUM";
 const FORMAT_VERSION: u32 = 1;
@@ -24,9 +24,10 @@ const IDENTITY_LEN: usize = 64;
 const DIGEST_LEN: usize = 64;
 const HEADER_LEN: usize = MAGIC.len() + 4 + IDENTITY_LEN + 3 * 4;
 
-/// What a checkpoint belongs to: the SHA-256 of the renderer's version and of the scene as a
-/// worker is asked to load it (every file by content hash, and the settings). Anything that
-/// changes the image changes it; threads, workers and output paths do not.
+/// What a checkpoint belongs to: the SHA-256 of the renderer's version, the unit plan's version
+/// and the scene as a worker is asked to load it (every file by content hash, and the
+/// settings). Anything that changes the image changes it; threads, workers and output paths
+/// do not.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RenderIdentity(String);
 
@@ -35,6 +36,7 @@ impl RenderIdentity {
         let mut digest = Sha256Stream::default();
         digest.update(b"yat render ");
         digest.update(env!("CARGO_PKG_VERSION").as_bytes());
+        digest.update(format!(" plan {PLAN_VERSION} ").as_bytes());
         digest.update(&load_request.encode_to_vec());
         Self(digest.finish_hex())
     }

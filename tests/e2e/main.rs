@@ -3,6 +3,7 @@
 
 mod architecture;
 mod check;
+mod discovery;
 mod distributed;
 mod resume;
 mod util;

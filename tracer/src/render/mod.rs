@@ -10,7 +10,7 @@ pub mod scene;
 pub mod settings;
 pub mod unit;
 
-pub use plan::{plan_units, PASSES, TILE_SIZE};
+pub use plan::{plan_units, PASSES, PLAN_VERSION, TILE_SIZE};
 pub use scene::{BuildError, RenderScene};
 pub use settings::{RenderOverrides, RenderSettings, SettingsError, DEFAULT_SPP};
 pub use unit::{UnitStats, WorkUnit};

@@ -10,24 +10,47 @@ pub const TILE_SIZE: u32 = 64;
 /// unit's work dwarfs its network round trip.
 pub const PASSES: u32 = 8;
 
+/// The last pass is cut into tiles of this side when its full-size units are long (see
+/// `FINE_FINAL_PASS_SAMPLES`).
+pub const FINAL_PASS_TILE_SIZE: u32 = TILE_SIZE / 2;
+
+/// A full-size unit of at least this many samples (about half a core-second at a couple of
+/// microseconds per sample) gets a finer last pass: the last units of a render then end close
+/// together, instead of a few long ones keeping a farm waiting while every other worker idles.
+/// Shorter units end close together anyway, and finer ones would only add round trips.
+pub const FINE_FINAL_PASS_SAMPLES: u64 = 1 << 18;
+
+/// Changes whenever the same settings would give another plan. A unit's buffer is summed in
+/// f32 before it reaches the exact film, so another plan gives slightly different image bits:
+/// a checkpoint of another plan must not be resumed (it is part of the render's identity).
+pub const PLAN_VERSION: u32 = 2;
+
 /// The unit plan: tiles of `TILE_SIZE` in scanline order, and `PASSES` sample ranges, ordered
-/// by sample range first so that any prefix of the plan covers the whole image. It depends on
-/// the settings only: a pixel's sum is added up unit by unit, so the same plan everywhere is
-/// what makes in-process and distributed images bit-identical.
+/// by sample range first so that any prefix of the plan covers the whole image; the last range
+/// in tiles of `FINAL_PASS_TILE_SIZE` when units are long. It depends on the settings only: a
+/// pixel's sum is added up unit by unit, so the same plan everywhere is what makes in-process
+/// and distributed images bit-identical.
 pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
     let samples_per_unit = settings.spp.div_ceil(PASSES).max(1);
+    let fine_final_pass =
+        u64::from(TILE_SIZE * TILE_SIZE) * u64::from(samples_per_unit) >= FINE_FINAL_PASS_SAMPLES;
     let mut units = Vec::new();
-    let mut start = 0;
+    let mut start = 0u32;
     while start < settings.spp {
-        let end = (start + samples_per_unit).min(settings.spp);
-        for y0 in (0..settings.height).step_by(TILE_SIZE as usize) {
-            for x0 in (0..settings.width).step_by(TILE_SIZE as usize) {
+        let end = start.saturating_add(samples_per_unit).min(settings.spp);
+        let tile = if end == settings.spp && fine_final_pass {
+            FINAL_PASS_TILE_SIZE
+        } else {
+            TILE_SIZE
+        };
+        for y0 in (0..settings.height).step_by(tile as usize) {
+            for x0 in (0..settings.width).step_by(tile as usize) {
                 units.push(WorkUnit {
-                    index: units.len() as u32,
+                    index: u32::try_from(units.len()).unwrap_or(u32::MAX),
                     x0,
                     y0,
-                    x1: (x0 + TILE_SIZE).min(settings.width),
-                    y1: (y0 + TILE_SIZE).min(settings.height),
+                    x1: x0.saturating_add(tile).min(settings.width),
+                    y1: y0.saturating_add(tile).min(settings.height),
                     sample_start: start,
                     sample_end: end,
                 });
@@ -36,4 +59,66 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
         start = end;
     }
     units
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desc::LatLongConvention;
+
+    fn settings(width: u32, height: u32, spp: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            spp,
+            max_depth: 4,
+            seed: 0,
+            latlong: LatLongConvention::Seed,
+        }
+    }
+
+    /// How many units hold each (pixel, sample index).
+    fn coverage(s: &RenderSettings, units: &[WorkUnit]) -> Vec<u32> {
+        let mut count = vec![0; (s.width * s.height * s.spp) as usize];
+        for u in units {
+            for y in u.y0..u.y1 {
+                for x in u.x0..u.x1 {
+                    for i in u.sample_start..u.sample_end {
+                        count[((y * s.width + x) * s.spp + i) as usize] += 1;
+                    }
+                }
+            }
+        }
+        count
+    }
+
+    #[test]
+    fn every_sample_of_every_pixel_is_in_one_unit_in_pass_order() {
+        for s in [
+            settings(130, 70, 16),
+            settings(100, 40, 1000),
+            settings(7, 5, 3),
+        ] {
+            let units = plan_units(&s);
+            assert!(coverage(&s, &units).iter().all(|&c| c == 1), "{s:?}");
+            assert!(units.iter().enumerate().all(|(i, u)| u.index == i as u32));
+            assert!(units
+                .windows(2)
+                .all(|w| w[0].sample_start <= w[1].sample_start));
+        }
+    }
+
+    #[test]
+    fn only_long_units_get_a_finer_last_pass() {
+        // 64x64 x 16 samples per pass = 65536 samples: short units, one tile size.
+        let short = plan_units(&settings(128, 96, 128));
+        assert_eq!(short.len(), 4 * PASSES as usize);
+        // 64x64 x 125 samples per pass: the last pass in 32-pixel tiles (4 x 3 of them).
+        let long = plan_units(&settings(128, 96, 1000));
+        assert_eq!(long.len(), 4 * (PASSES as usize - 1) + 12);
+        let last = long.last().unwrap();
+        assert_eq!((last.sample_start, last.sample_end), (875, 1000));
+        assert_eq!(last.x1 - last.x0, FINAL_PASS_TILE_SIZE);
+        assert!(long[..28].iter().all(|u| u.x1 - u.x0 == TILE_SIZE));
+    }
 }

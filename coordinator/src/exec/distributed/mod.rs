@@ -6,6 +6,7 @@
 pub mod config;
 
 mod client;
+mod discovery;
 mod local;
 mod node;
 mod render_loop;
@@ -26,6 +27,7 @@ use crate::job::{RenderJob, RenderOutcome};
 use crate::manifest::SceneManifest;
 use client::ClientConfig;
 use config::DistributedConfig;
+use discovery::{ClientTemplate, Discovery, Roster, WorkerTarget};
 use local::LocalWorker;
 use node::Node;
 use render_loop::RenderLoop;
@@ -41,15 +43,22 @@ pub fn render(
 ) -> anyhow::Result<RenderOutcome> {
     let cpu_start = process_cpu_time();
     let started = Instant::now();
+    let targets = config
+        .workers
+        .iter()
+        .map(|entry| WorkerTarget::parse(entry))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut nodes = Vec::new();
-    for address in &config.workers {
-        let client = ClientConfig {
-            address: address.trim().to_string(),
-            token: config.token.clone(),
-            tls: config.tls.clone(),
-        };
-        client.validate()?;
-        nodes.push(Node::new(client, None));
+    for target in &targets {
+        if let WorkerTarget::Address(address) = target {
+            let client = ClientConfig {
+                address: address.to_string(),
+                token: config.token.clone(),
+                tls: config.tls.clone(),
+            };
+            client.validate()?;
+            nodes.push(Node::new(client, None));
+        }
     }
     if config.local_workers > 0 {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -62,7 +71,6 @@ pub fn render(
             nodes.push(Node::new(client, Some(worker)));
         }
     }
-    let nodes: Vec<Arc<Node>> = nodes.into_iter().map(Arc::new).collect();
 
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -80,27 +88,44 @@ pub fn render(
         manifest,
         events,
     });
-    let render_loop = RenderLoop {
-        job,
-        units: &units,
-        nodes: &nodes,
-        shared: &shared,
-        timeout: config.timeout,
+    let roster = Arc::new(Roster::new(shared.clone()));
+    let client = ClientTemplate {
+        token: config.token.clone(),
+        tls: config.tls.clone(),
+        tls_domain_given: config.tls_domain_given,
     };
-    let outcome = runtime.block_on(render_loop.run(start, event_rx));
-    // Ends the node loops and closes connections; then `nodes` drops the local workers.
+    let outcome = runtime.block_on(async {
+        for node in nodes {
+            roster.add(node);
+        }
+        Discovery::new(&targets, client, config.resolve_every, config.dns_server)
+            .context("cannot set up DNS resolution")?
+            .start(&roster)
+            .await?;
+        let render_loop = RenderLoop {
+            job,
+            units: &units,
+            roster: &roster,
+            shared: &shared,
+            timeout: config.timeout,
+        };
+        render_loop.run(start, event_rx).await
+    });
+    // Ends the node loops and closes connections; then `roster` drops the local workers.
     drop(runtime);
 
-    let report = DistributedReport::new(
+    let mut report = DistributedReport::new(
         started.elapsed(),
         process_cpu_time().saturating_sub(cpu_start),
         shared.schedule.len(),
         outcome.as_ref().map_or(0, |o| o.stats.samples),
-        nodes
+        roster
+            .nodes()
             .iter()
             .map(|n| n.report.lock().unwrap().clone())
             .collect(),
     );
+    report.units_copied = shared.schedule.copies();
     if let Some(path) = &config.workers_json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("cannot write {}", path.display()))?;

@@ -10,6 +10,8 @@ use super::local::LocalWorker;
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct NodeReport {
     pub address: String,
+    /// The DNS name this worker was found under (`None` for a listed address).
+    pub dns_name: Option<String>,
     pub hostname: String,
     pub threads: u32,
     /// Units whose results were merged.
@@ -29,7 +31,7 @@ pub struct NodeReport {
     pub result_pixels: u64,
     #[serde(skip)]
     pub connected: bool,
-    /// Why this worker will not be used again, if so.
+    /// Why this worker is not used (any more), if so: refused, exited, removed from DNS.
     pub gone: Option<String>,
     pub last_error: Option<String>,
 }

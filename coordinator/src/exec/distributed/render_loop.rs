@@ -7,11 +7,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::bail;
 use tokio::sync::mpsc;
-use tokio::task::JoinSet;
 use yat_tracer::render::{UnitStats, WorkUnit};
 
-use super::node::Node;
-use super::session::run_node;
+use super::discovery::Roster;
 use super::shared::{Event, Shared};
 use crate::checkpoint::Checkpoint;
 use crate::exec::progress::Progress;
@@ -25,7 +23,7 @@ const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
 pub struct RenderLoop<'a> {
     pub job: &'a RenderJob,
     pub units: &'a [WorkUnit],
-    pub nodes: &'a [Arc<Node>],
+    pub roster: &'a Roster,
     pub shared: &'a Arc<Shared>,
     pub timeout: Option<Duration>,
 }
@@ -43,10 +41,6 @@ impl RenderLoop<'_> {
             checkpoint.done_samples(self.units),
             self.job.quiet,
         );
-        let mut tasks = JoinSet::new();
-        for node in self.nodes {
-            tasks.spawn(run_node(node.clone(), self.shared.clone()));
-        }
         let mut stats = UnitStats::default();
         let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
@@ -107,7 +101,7 @@ impl RenderLoop<'_> {
                 }
             }
         };
-        tasks.abort_all();
+        self.roster.stop_all();
         progress.finish();
         if let Err(why) = result {
             return Err(self.job.stopped(&checkpoint, self.units, why));
@@ -126,12 +120,13 @@ impl RenderLoop<'_> {
             checkpoint.done_count(),
             self.units.len(),
             self.alive(),
-            self.nodes.len()
+            self.roster.current_count()
         )
     }
 
     fn alive(&self) -> usize {
-        self.nodes
+        self.roster
+            .nodes()
             .iter()
             .filter(|n| n.report.lock().unwrap().connected)
             .count()
@@ -140,11 +135,13 @@ impl RenderLoop<'_> {
     /// Fails when no worker can come back, or when the wait has exceeded --timeout.
     fn check_workers_remain(&self, alone_since: Instant) -> anyhow::Result<()> {
         let reports: Vec<_> = self
-            .nodes
+            .roster
+            .nodes()
             .iter()
             .map(|n| n.report.lock().unwrap().clone())
             .collect();
-        if reports.iter().all(|r| r.gone.is_some()) {
+        // A followed DNS name may still bring workers: wait for them (or --timeout).
+        if reports.iter().all(|r| r.gone.is_some()) && !self.roster.may_grow() {
             let reasons: Vec<_> = reports
                 .iter()
                 .map(|r| format!("{}: {}", r.address, r.gone.as_deref().unwrap_or_default()))
@@ -167,7 +164,11 @@ impl RenderLoop<'_> {
     }
 
     fn last_errors(&self) -> String {
-        self.nodes
+        let nodes = self.roster.nodes();
+        if nodes.is_empty() {
+            return "no worker address found yet under the --workers names".into();
+        }
+        nodes
             .iter()
             .map(|n| {
                 let r = n.report.lock().unwrap();

@@ -13,6 +13,8 @@ pub struct DistributedReport {
     /// scene files, scheduling, merging, previews).
     pub coordinator_cpu_seconds: f64,
     pub units: usize,
+    /// End-game copies of units still out elsewhere (each rendered a unit a second time).
+    pub units_copied: u64,
     pub samples: u64,
     pub samples_per_second: f64,
     /// Result bytes received per pixel of every unit (16 = four f32 per pixel).
@@ -36,6 +38,7 @@ impl DistributedReport {
             wall_seconds,
             coordinator_cpu_seconds: cpu.as_secs_f64(),
             units,
+            units_copied: 0,
             samples,
             samples_per_second: samples as f64 / wall_seconds,
             result_bytes_per_unit_pixel: bytes as f64 / pixels.max(1) as f64,

@@ -1,7 +1,19 @@
-//! The shared queue of a distributed render: which units wait, which are done, and how long a
-//! unit may take before it is presumed lost.
+//! The shared queue of a distributed render: which units wait, which are out, which are done,
+//! and how long a unit may take before it is presumed lost.
+//!
+//! The end of a render is where a farm idles: once the queue is shorter than what is out, the
+//! last units sit in a few workers' queues while the others have nothing to do. So in that end
+//! game a session keeps one unit per worker thread instead of two (no unit waits behind
+//! another), and once nothing is pending a worker with a free thread gets a copy of a unit still
+//! out elsewhere, the most recently handed out first (the one likely to finish last). A unit's
+//! result is the same bytes wherever it is rendered and only the first is merged, so this
+//! changes how soon the image is done, never the image. (The plan helps too: when units are
+//! long its last pass comes in smaller tiles; see `plan_units`. docs/cluster.md has the
+//! farm simulation's figures.)
 
+use std::collections::hash_map::DefaultHasher;
 use std::collections::VecDeque;
+use std::hash::{Hash, Hasher};
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -21,6 +33,17 @@ struct QueueState {
     pending: VecDeque<u32>,
     done: Vec<bool>,
     done_count: usize,
+    /// Per unit, whether it is out at a worker (taken, neither done nor back in the queue).
+    out: Vec<bool>,
+    out_count: usize,
+    /// Units in the order they were handed out, newest last: end-game copies come from the back.
+    handed: Vec<u32>,
+    /// Per unit: who it was first handed to (a hash of the worker's address), and whether a
+    /// copy was handed out too (one copy: enough to race a slow worker and fill idle threads
+    /// at the end, measured with bench/farm-sim; more only render the same unit again).
+    holder: Vec<u64>,
+    copied: Vec<bool>,
+    copies: u64,
 }
 
 impl Schedule {
@@ -33,6 +56,12 @@ impl Schedule {
                 .collect(),
             done_count: done.iter().filter(|&&d| d).count(),
             done,
+            out: vec![false; units.len()],
+            out_count: 0,
+            handed: Vec::new(),
+            holder: vec![0; units.len()],
+            copied: vec![false; units.len()],
+            copies: 0,
         };
         Self {
             units,
@@ -55,21 +84,72 @@ impl Schedule {
         state.done_count == self.units.len()
     }
 
-    /// The next unit to render, if any waits.
-    pub fn take(&self) -> Option<WorkUnit> {
+    /// How many units a session that normally keeps `limit` in flight (two per worker thread)
+    /// may hold now: one per thread in the end game, when fewer units wait than are out.
+    pub fn in_flight_limit(&self, limit: usize) -> usize {
+        let state = self.state.lock().unwrap();
+        if state.pending.len() < state.out_count {
+            limit.div_ceil(2)
+        } else {
+            limit
+        }
+    }
+
+    /// The next unit for the worker at `holder` (its address): the next one waiting, or once
+    /// none waits, a copy of the newest unit out at another worker that has no copy yet.
+    pub fn take(&self, holder: &str) -> Option<WorkUnit> {
+        let holder = holder_key(holder);
         let mut state = self.state.lock().unwrap();
         while let Some(index) = state.pending.pop_front() {
-            if !state.done[index as usize] {
-                return Some(self.units[index as usize]);
+            let i = index as usize;
+            if !state.done[i] {
+                if !std::mem::replace(&mut state.out[i], true) {
+                    state.out_count += 1;
+                }
+                state.holder[i] = holder;
+                state.handed.push(index);
+                // Requeued units are pushed again: now and then keep only the last place of
+                // each unit not yet done, so the list stays within twice the plan.
+                if state.handed.len() > 2 * self.units.len() {
+                    let mut kept = vec![false; self.units.len()];
+                    let mut handed: Vec<u32> = state
+                        .handed
+                        .iter()
+                        .rev()
+                        .copied()
+                        .filter(|&i| {
+                            let i = i as usize;
+                            !state.done[i] && !std::mem::replace(&mut kept[i], true)
+                        })
+                        .collect();
+                    handed.reverse();
+                    state.handed = handed;
+                }
+                return Some(self.units[i]);
             }
         }
-        None
+        // The end game. Done units at the back will never be copied: drop them as we go.
+        while state.handed.last().is_some_and(|&i| state.done[i as usize]) {
+            state.handed.pop();
+        }
+        let state = &mut *state;
+        let index = state.handed.iter().rev().copied().find(|&i| {
+            let i = i as usize;
+            !state.done[i] && state.out[i] && !state.copied[i] && state.holder[i] != holder
+        })?;
+        state.copied[index as usize] = true;
+        state.copies += 1;
+        Some(self.units[index as usize])
     }
 
     /// Puts a unit a worker failed to return back in front of the queue.
     pub fn requeue(&self, unit: &WorkUnit) {
         let mut state = self.state.lock().unwrap();
-        if !state.done[unit.index as usize] && !state.pending.contains(&unit.index) {
+        let i = unit.index as usize;
+        if !state.done[i] && !state.pending.contains(&unit.index) {
+            if std::mem::take(&mut state.out[i]) {
+                state.out_count -= 1;
+            }
             state.pending.push_front(unit.index);
             drop(state);
             self.changed.send_modify(|v| *v += 1);
@@ -79,9 +159,13 @@ impl Schedule {
     /// Marks a unit done; true the first time only, so a late duplicate is not merged twice.
     pub fn complete(&self, unit: &WorkUnit) -> bool {
         let mut state = self.state.lock().unwrap();
-        let first = !std::mem::replace(&mut state.done[unit.index as usize], true);
+        let i = unit.index as usize;
+        let first = !std::mem::replace(&mut state.done[i], true);
         if first {
             state.done_count += 1;
+            if std::mem::take(&mut state.out[i]) {
+                state.out_count -= 1;
+            }
             if state.done_count == self.units.len() {
                 drop(state);
                 self.changed.send_modify(|v| *v += 1);
@@ -90,10 +174,21 @@ impl Schedule {
         first
     }
 
+    /// End-game copies handed out (each renders a unit a second time).
+    pub fn copies(&self) -> u64 {
+        self.state.lock().unwrap().copies
+    }
+
     /// A receiver that sees a change when a unit is requeued or the render ends.
     pub fn watch(&self) -> watch::Receiver<u64> {
         self.changed.subscribe()
     }
+}
+
+fn holder_key(address: &str) -> u64 {
+    let mut hasher = DefaultHasher::new();
+    address.hash(&mut hasher);
+    hasher.finish()
 }
 
 /// How long a unit may be in flight before it is presumed lost and handed to another worker:
@@ -152,7 +247,9 @@ mod tests {
     #[test]
     fn a_resumed_schedule_hands_out_only_what_is_missing() {
         let s = Schedule::new(plan(), |u| u.index % 4 != 1);
-        let taken: Vec<u32> = std::iter::from_fn(|| s.take()).map(|u| u.index).collect();
+        let taken: Vec<u32> = std::iter::from_fn(|| s.take("a"))
+            .map(|u| u.index)
+            .collect();
         assert_eq!(
             taken,
             (0..s.len() as u32)
@@ -165,7 +262,7 @@ mod tests {
         }
         assert!(s.is_finished());
         let all_done = Schedule::new(plan(), |_| true);
-        assert!(all_done.is_finished() && all_done.take().is_none());
+        assert!(all_done.is_finished() && all_done.take("a").is_none());
     }
 
     #[test]
@@ -173,15 +270,19 @@ mod tests {
         let s = schedule();
         let n = s.len();
         assert!(n > 6);
-        let a = s.take().unwrap();
-        let b = s.take().unwrap();
+        let a = s.take("a").unwrap();
+        let b = s.take("a").unwrap();
         assert_eq!((a.index, b.index), (0, 1));
         s.requeue(&b);
         s.requeue(&b);
-        assert_eq!(s.take().unwrap().index, 1, "requeued units go first, once");
-        assert_eq!(s.take().unwrap().index, 2);
+        assert_eq!(
+            s.take("a").unwrap().index,
+            1,
+            "requeued units go first, once"
+        );
+        assert_eq!(s.take("a").unwrap().index, 2);
         let mut seen = 3;
-        while let Some(u) = s.take() {
+        while let Some(u) = s.take("a") {
             assert_eq!(u.index, seen);
             seen += 1;
         }
@@ -192,21 +293,73 @@ mod tests {
     fn a_result_counts_once_and_done_units_are_not_requeued() {
         let s = schedule();
         let mut rx = s.watch();
-        let units: Vec<_> = std::iter::from_fn(|| s.take()).collect();
+        let units: Vec<_> = std::iter::from_fn(|| s.take("a")).collect();
         assert!(s.complete(&units[0]));
         assert!(!s.complete(&units[0]), "a late duplicate is refused");
         s.requeue(&units[0]);
-        assert!(s.take().is_none(), "a done unit is not handed out again");
+        assert!(s.take("a").is_none(), "a done unit is not handed out again");
         s.requeue(&units[1]);
         assert!(rx.has_changed().unwrap());
         rx.mark_unchanged();
-        assert_eq!(s.take().unwrap().index, 1);
+        assert_eq!(s.take("a").unwrap().index, 1);
         for u in &units[1..] {
             assert!(!s.is_finished());
             assert!(s.complete(u));
         }
         assert!(s.is_finished());
         assert!(rx.has_changed().unwrap(), "the end wakes idle workers");
+    }
+
+    #[test]
+    fn the_end_game_copies_the_newest_unit_out_elsewhere_once() {
+        let s = schedule();
+        let n = s.len() as u32;
+        assert_eq!(s.in_flight_limit(8), 8);
+        let taken: Vec<_> = (0..n - 2).map(|_| s.take("a").unwrap()).collect();
+        assert_eq!(
+            s.in_flight_limit(8),
+            4,
+            "2 pending < {} out: one per thread",
+            n - 2
+        );
+        assert_eq!(s.take("b").unwrap().index, n - 2);
+        assert_eq!(s.take("b").unwrap().index, n - 1);
+        assert!(s.complete(&taken[n as usize - 3]));
+        // Nothing waits: copies of units out at another worker, newest first, once each.
+        assert_eq!(
+            s.take("b").unwrap().index,
+            n - 4,
+            "the done unit is skipped"
+        );
+        assert_eq!(s.take("a").unwrap().index, n - 1, "a copy of b's newest");
+        assert_eq!(s.take("b").unwrap().index, n - 5);
+        assert_eq!(s.copies(), 3);
+        let mut copied = vec![n - 4, n - 1, n - 5];
+        copied.extend(std::iter::from_fn(|| s.take("c")).map(|u| u.index));
+        let copies = copied.len();
+        copied.sort();
+        copied.dedup();
+        assert_eq!(copied.len(), copies, "no unit is copied twice");
+        assert_eq!(s.copies(), copies as u64);
+        assert!(s.complete(&taken[n as usize - 4]));
+        assert!(
+            !s.complete(&taken[n as usize - 4]),
+            "the copy's result is not merged twice"
+        );
+        // A lost unit goes back to the queue and is handed out before any copy.
+        s.requeue(&taken[0]);
+        assert_eq!(s.take("b").unwrap().index, 0);
+    }
+
+    #[test]
+    fn a_unit_lost_again_and_again_keeps_the_bookkeeping_bounded() {
+        let s = schedule();
+        let unit = s.take("a").unwrap();
+        for _ in 0..10 * s.len() {
+            s.requeue(&unit);
+            assert_eq!(s.take("a").unwrap().index, unit.index);
+        }
+        assert!(s.state.lock().unwrap().handed.len() <= 2 * s.len());
     }
 
     #[test]

@@ -217,8 +217,10 @@ async fn render_units(
         if schedule.is_finished() {
             return Ok(());
         }
-        while calls.len() < limit {
-            let Some(unit) = schedule.take() else { break };
+        while calls.len() < schedule.in_flight_limit(limit) {
+            let Some(unit) = schedule.take(node.address()) else {
+                break;
+            };
             held.units.insert(unit.index, unit);
             let request = pb::RenderUnitRequest {
                 scene_id: scene_id.to_string(),
