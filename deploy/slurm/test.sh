@@ -1,0 +1,348 @@
+#!/bin/bash
+# Tests yat-render.sbatch on a real Slurm: a one-node cluster (munged, slurmctld, slurmd) started
+# on this machine under a temporary folder, nothing read from or written to /etc.
+#
+#   1. a render submitted with sbatch equals an in-process render of the same settings, byte for
+#      byte;
+#   2. a longer render cancelled (scancel) once its checkpoint exists, then submitted again,
+#      resumes from the checkpoint and still equals the in-process render byte for byte;
+#   3. the same render given the time-limit warning (USR1 to the batch shell) saves, requeues
+#      itself, resumes in the requeued run and equals the in-process render byte for byte.
+#
+# Needs root (it installs Debian's slurm-wlm and munge when missing, and runs the daemons):
+# without root it says so and exits 77, the usual "skipped" code. Exits 0 when every check
+# passed, 1 when one failed (the job logs and the daemons' logs are printed).
+#
+# Environment: YAT_BIN (the yat binary; default: cargo build -p yat, debug), YAT_SEED_SCENES
+# (the seed project's scenes; default ../shared/seed-project/scenes beside the repository,
+# else the repository's own scenes/cornell), YAT_SLURM_TEST_KEEP=1 keeps the temporary folder.
+set -euo pipefail
+
+readonly SKIPPED=77
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+batch_script=$here/yat-render.sbatch
+
+now_ms() { date +%s%3N; }
+test_start=$(now_ms)
+# Progress goes to stderr, so that functions can return values on stdout.
+say() { printf '[%6.1fs] %s\n' "$((($(now_ms) - test_start)))e-3" "$*" >&2; }
+
+# Timing of the steps: `step NAME` starts one, `step_done` prints how long it took.
+step() {
+    step_name=$1
+    step_start=$(now_ms)
+    say "$step_name ..."
+}
+step_done() { say "$step_name: done in $(seconds_since "$step_start") s${1:+ ($1)}"; }
+seconds_since() { printf '%.1f' "$((($(now_ms) - $1)))e-3"; }
+
+if ((EUID != 0)); then
+    echo "skipped: needs root (installs slurm-wlm and munge, runs munged, slurmctld and slurmd)"
+    exit "$SKIPPED"
+fi
+
+passed=0
+tmp=
+jobs_submitted=()
+daemons=()
+
+show_logs() {
+    [[ -n $tmp && -d $tmp ]] || return 0
+    local file
+    for file in "$tmp"/jobs/*.log "$tmp"/log/*; do
+        [[ -s $file ]] || continue
+        echo "----- last lines of $file"
+        tail -n 40 "$file"
+    done
+}
+
+fail() {
+    say "FAIL: $*"
+    show_logs
+    echo "slurm: $passed passed, 1 failed"
+    exit 1
+}
+
+pass() {
+    passed=$((passed + 1))
+    say "PASS: $*"
+}
+
+cleanup() {
+    local status=$?
+    trap - EXIT
+    if ((${#jobs_submitted[@]})) && [[ -n ${SLURM_CONF:-} ]]; then
+        scancel "${jobs_submitted[@]}" 2>/dev/null || true
+        for job in "${jobs_submitted[@]}"; do
+            wait_job_end "$job" 30 >/dev/null 2>&1 || true
+        done
+    fi
+    # Only the daemons this script started, by their process ids.
+    local pid
+    for pid in "${daemons[@]}"; do
+        kill -TERM "$pid" 2>/dev/null || true
+    done
+    for pid in "${daemons[@]}"; do
+        timeout 15 tail --pid="$pid" -f /dev/null 2>/dev/null || kill -KILL "$pid" 2>/dev/null || true
+    done
+    if [[ -n $tmp ]]; then
+        if [[ ${YAT_SLURM_TEST_KEEP:-} == 1 ]]; then
+            say "kept $tmp"
+        else
+            rm -rf "$tmp"
+        fi
+    fi
+    exit "$status"
+}
+trap cleanup EXIT
+trap 'fail "interrupted"' INT TERM
+
+# ---------------------------------------------------------------------------------- tools
+step "Slurm and munge"
+missing=()
+for tool in munged munge slurmctld slurmd sbatch srun scontrol scancel sinfo; do
+    command -v "$tool" >/dev/null || missing+=("$tool")
+done
+if ((${#missing[@]})); then
+    say "missing ${missing[*]}: installing slurm-wlm and munge"
+    export DEBIAN_FRONTEND=noninteractive
+    timeout 600 apt-get update -q >/dev/null || fail "apt-get update failed"
+    timeout 900 apt-get install -y -q --no-install-recommends slurm-wlm munge >/dev/null ||
+        fail "apt-get install slurm-wlm munge failed"
+fi
+step_done "$(slurmd -V), $(munged -V 2>&1 | head -n 1)"
+
+step "the yat binary"
+if [[ -n ${YAT_BIN:-} ]]; then
+    yat=$YAT_BIN
+else
+    (cd "$repo" && cargo build -q -p yat --locked) || fail "cargo build -p yat failed"
+    yat=${CARGO_TARGET_DIR:-$repo/target}/debug/yat
+fi
+yat=$(realpath "$yat")
+[[ -x $yat ]] || fail "no yat binary at $yat"
+step_done "$yat"
+
+seed_scenes=${YAT_SEED_SCENES:-$repo/../shared/seed-project/scenes}
+scene=$seed_scenes/CornellBox/cornell-box.lxs
+if [[ ! -r $scene ]]; then
+    say "no seed scenes at $seed_scenes: using the repository's own Cornell box"
+    scene=$repo/scenes/cornell/cornell-box.lxs
+fi
+scene=$(realpath "$scene")
+
+# ---------------------------------------------------------------------------------- cluster
+step "a one-node Slurm cluster"
+tmp=$(mktemp -d /tmp/yat-slurm-test.XXXXXX)
+# munged wants every folder above its socket searchable by all, and its key private.
+chmod 755 "$tmp"
+mkdir -p "$tmp"/{munge,run,log,state,spool,jobs,work}
+chmod 700 "$tmp/munge"
+chmod 755 "$tmp/run"
+head -c 1024 /dev/urandom >"$tmp/munge/munge.key"
+chmod 600 "$tmp/munge/munge.key"
+
+# A port nothing on this machine listens on (no connection is accepted there).
+free_port() {
+    local port
+    for _ in $(seq 100); do
+        port=$((20000 + RANDOM % 40000))
+        if ! (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
+            echo "$port"
+            return 0
+        fi
+    done
+    fail "no free TCP port found"
+}
+ctld_port=$(free_port)
+slurmd_port=$(free_port)
+worker_port=$(free_port)
+
+host=$(hostname -s)
+# This node as slurmd sees it: its real CPUs, sockets, cores and memory.
+node_line=$(slurmd -C | head -n 1)
+[[ $node_line == NodeName=$host\ * ]] || fail "slurmd -C says '$node_line', not NodeName=$host"
+# cred_expire=10: a requeued job waits cred_expire + 1 seconds before it may start again
+# (default 120). proctrack/linuxproc and task/none: no cgroups needed.
+cat >"$tmp/slurm.conf" <<EOF
+ClusterName=yattest
+SlurmctldHost=$host
+SlurmctldPort=$ctld_port
+SlurmdPort=$slurmd_port
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+AuthInfo=socket=$tmp/run/munge.sock,cred_expire=10
+StateSaveLocation=$tmp/state
+SlurmdSpoolDir=$tmp/spool
+SlurmctldPidFile=$tmp/run/slurmctld.pid
+SlurmdPidFile=$tmp/run/slurmd.pid
+SlurmctldLogFile=$tmp/log/slurmctld.log
+SlurmdLogFile=$tmp/log/slurmd.log
+SlurmdDebug=info
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+MpiDefault=none
+ReturnToService=2
+MailProg=/bin/true
+JobCompType=jobcomp/none
+AccountingStorageType=accounting_storage/none
+JobAcctGatherType=jobacct_gather/none
+KillWait=10
+$node_line State=UNKNOWN
+PartitionName=yat Nodes=$host Default=YES MaxTime=INFINITE State=UP
+EOF
+
+# The clients (sbatch, squeue, scontrol, and srun inside the jobs) find the cluster here; no
+# variable of an enclosing Slurm job may leak in.
+unset "${!SLURM_@}"
+export SLURM_CONF=$tmp/slurm.conf
+
+munged -F --key-file="$tmp/munge/munge.key" --socket="$tmp/run/munge.sock" \
+    --pid-file="$tmp/run/munged.pid" --seed-file="$tmp/munge/munged.seed" \
+    --log-file="$tmp/log/munged.log" >"$tmp/log/munged.out" 2>&1 &
+daemons+=($!)
+timeout 20 bash -c "until munge -n -S '$tmp/run/munge.sock' >/dev/null 2>&1; do sleep 0.1; done" ||
+    fail "munged did not start"
+slurmctld -D -f "$tmp/slurm.conf" >"$tmp/log/slurmctld.out" 2>&1 &
+daemons+=($!)
+slurmd -D -f "$tmp/slurm.conf" >"$tmp/log/slurmd.out" 2>&1 &
+daemons+=($!)
+timeout 60 bash -c "until [[ \$(sinfo -h -n '$host' -o %t 2>/dev/null) == idle ]]; do sleep 0.2; done" ||
+    fail "node $host did not become idle: $(sinfo -N 2>&1)"
+step_done "$node_line"
+
+# ---------------------------------------------------------------------------------- helpers
+# Submits the batch script for a render of the scene to OUTPUT ($1); sets `job` to its id.
+submit() {
+    job=$(cd "$tmp/work" && sbatch --parsable --nodes=1 --exclusive --output="$tmp/jobs/job-%j.log" \
+        "$batch_script" "$scene" "$@") || fail "sbatch failed"
+    job=${job%%;*}
+    jobs_submitted+=("$job")
+}
+
+job_field() { scontrol show job -o "$1" 2>/dev/null | grep -o "\b$2=[^ ]*" | cut -d= -f2; }
+
+# Waits (at most $2 seconds) until job $1 has ended; prints its final state.
+wait_job_end() {
+    local deadline=$((SECONDS + $2)) state
+    while ((SECONDS < deadline)); do
+        state=$(job_field "$1" JobState)
+        case $state in
+        COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | PREEMPTED | OUT_OF_MEMORY | BOOT_FAIL | DEADLINE)
+            echo "$state"
+            return 0
+            ;;
+        esac
+        sleep 0.2
+    done
+    return 1
+}
+
+# Waits (at most $2 seconds) until file $1 exists.
+wait_file() {
+    timeout "$2" bash -c "until [[ -e '$1' ]]; do sleep 0.1; done"
+}
+
+# In-process reference render to $1; sets `render_time` to how long it took.
+reference() {
+    local out=$1 start
+    shift
+    start=$(now_ms)
+    "$yat" render "$scene" -o "$out" --quiet --checkpoint-every 0 --preview-every 0 "$@" ||
+        fail "in-process render failed"
+    render_time=$(seconds_since "$start")
+}
+
+expect_same_image() {
+    cmp "$1" "$2" || fail "$1 differs from the in-process render $2"
+}
+
+# ---------------------------------------------------------------------------------- 1. render
+export YAT_BIN=$yat YAT_PORT=$worker_port YAT_TIMEOUT=60
+small=(--resolution 192x108 --spp 16 --seed 0)
+
+step "in-process render, ${small[*]}"
+reference "$tmp/small-ref.png" "${small[@]}"
+small_time=$render_time
+step_done "render $small_time s"
+
+step "sbatch render, ${small[*]}"
+submitted=$(now_ms)
+submit "$tmp/small.png" "${small[@]}"
+state=$(wait_job_end "$job" 300) || fail "job $job did not end within 300 s"
+sbatch_time=$(seconds_since "$submitted")
+[[ $state == COMPLETED ]] || fail "job $job ended $state"
+expect_same_image "$tmp/small.png" "$tmp/small-ref.png"
+step_done "submit to end $sbatch_time s, in-process $small_time s"
+pass "the sbatch render equals the in-process render byte for byte"
+
+# ---------------------------------------------------------------------------------- 2. resume
+long=(--resolution 384x216 --spp 128 --seed 0)
+export YAT_CHECKPOINT_EVERY=1
+
+step "in-process render, ${long[*]}"
+reference "$tmp/long-ref.png" "${long[@]}"
+long_time=$render_time
+step_done "render $long_time s"
+
+# Waits until job $1 runs and its checkpoint $2 exists, then waits $3 seconds more.
+wait_checkpoint() {
+    wait_file "$2" 120 || fail "job $1 wrote no checkpoint $2 within 120 s ($(job_field "$1" JobState))"
+    sleep "$3"
+    [[ $(job_field "$1" JobState) == RUNNING ]] ||
+        fail "job $1 is $(job_field "$1" JobState) before it could be stopped: make the render longer"
+}
+
+# Sets `resumed` to the "N of M units" of job log $1's resume message, checked to be a true
+# part of the render.
+expect_resumed() {
+    local line done_units all_units
+    line=$(grep -o 'resuming from .*: [0-9]* of [0-9]* units' "$1") ||
+        fail "$1 does not say it resumed"
+    read -r done_units all_units < <(sed 's/.*: \([0-9]*\) of \([0-9]*\) units/\1 \2/' <<<"$line")
+    ((done_units > 0 && done_units < all_units)) ||
+        fail "resumed with $done_units of $all_units units done: not a partial render"
+    resumed="$done_units of $all_units units"
+}
+
+step "sbatch render cancelled half way, then submitted again"
+submit "$tmp/long.png" "${long[@]}"
+wait_checkpoint "$job" "$tmp/long.resume" 2
+scancel "$job"
+state=$(wait_job_end "$job" 60) || fail "cancelled job $job did not end within 60 s"
+[[ $state == CANCELLED ]] || fail "cancelled job $job ended $state"
+[[ -e $tmp/long.resume && ! -e $tmp/long.png ]] ||
+    fail "the cancelled job left no checkpoint, or an image"
+grep -q "interrupted: .* kept in" "$tmp/jobs/job-$job.log" ||
+    fail "job $job's coordinator did not save on SIGTERM"
+submit "$tmp/long.png" "${long[@]}"
+state=$(wait_job_end "$job" 300) || fail "resubmitted job $job did not end within 300 s"
+[[ $state == COMPLETED ]] || fail "resubmitted job $job ended $state"
+expect_resumed "$tmp/jobs/job-$job.log"
+expect_same_image "$tmp/long.png" "$tmp/long-ref.png"
+[[ ! -e $tmp/long.resume ]] || fail "the checkpoint outlived the finished render"
+step_done "resumed with $resumed"
+pass "a cancelled and resubmitted render resumes and equals the in-process render byte for byte"
+
+# ---------------------------------------------------------------------------------- 3. requeue
+step "sbatch render given the time-limit warning, requeued by itself"
+submit "$tmp/requeued.png" "${long[@]}"
+wait_checkpoint "$job" "$tmp/requeued.resume" 2
+# What --signal=B:USR1@120 sends before the time limit: USR1 to the batch shell alone.
+scancel --batch --signal=USR1 "$job"
+timeout 60 bash -c "until [[ \$(scontrol show job -o $job | grep -o 'Restarts=[0-9]*') == Restarts=1 ]]; do sleep 0.2; done" ||
+    fail "job $job was not requeued within 60 s"
+state=$(wait_job_end "$job" 600) || fail "requeued job $job did not end within 600 s"
+[[ $state == COMPLETED ]] || fail "requeued job $job ended $state"
+expect_resumed "$tmp/jobs/job-$job.log"
+expect_same_image "$tmp/requeued.png" "$tmp/long-ref.png"
+step_done "resumed with $resumed"
+pass "a render requeued at the time-limit warning resumes and equals the in-process render"
+
+say "all done in $(seconds_since "$test_start") s"
+echo "slurm: $passed passed, 0 failed"
