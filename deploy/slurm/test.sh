@@ -26,7 +26,7 @@ batch_script=$here/yat-render.sbatch
 now_ms() { date +%s%3N; }
 test_start=$(now_ms)
 # Progress goes to stderr, so that functions can return values on stdout.
-say() { printf '[%6.1fs] %s\n' "$((($(now_ms) - test_start)))e-3" "$*" >&2; }
+say() { printf '[%6.1fs] %s\n' "$(($(now_ms) - test_start))e-3" "$*" >&2; }
 
 # Timing of the steps: `step NAME` starts one, `step_done` prints how long it took.
 step() {
@@ -35,7 +35,7 @@ step() {
     say "$step_name ..."
 }
 step_done() { say "$step_name: done in $(seconds_since "$step_start") s${1:+ ($1)}"; }
-seconds_since() { printf '%.1f' "$((($(now_ms) - $1)))e-3"; }
+seconds_since() { printf '%.1f' "$(($(now_ms) - $1))e-3"; }
 
 if ((EUID != 0)); then
     echo "skipped: needs root (installs slurm-wlm and munge, runs munged, slurmctld and slurmd)"
@@ -304,7 +304,9 @@ expect_resumed() {
     local line done_units all_units
     line=$(grep -o 'resuming from .*: [0-9]* of [0-9]* units' "$1") ||
         fail "$1 does not say it resumed"
-    read -r done_units all_units < <(sed 's/.*: \([0-9]*\) of \([0-9]*\) units/\1 \2/' <<<"$line")
+    [[ $line =~ ([0-9]+)\ of\ ([0-9]+)\ units$ ]]
+    done_units=${BASH_REMATCH[1]}
+    all_units=${BASH_REMATCH[2]}
     ((done_units > 0 && done_units < all_units)) ||
         fail "resumed with $done_units of $all_units units done: not a partial render"
     resumed="$done_units of $all_units units"
