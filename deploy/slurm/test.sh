@@ -133,7 +133,7 @@ fi
 scene=$(realpath "$scene")
 
 # ---------------------------------------------------------------------------------- cluster
-step "a one-node Slurm cluster"
+step "a Slurm cluster: this host, and a second slurmd on it for two-node jobs"
 tmp=$(mktemp -d /tmp/yat-slurm-test.XXXXXX)
 # munged wants every folder above its socket searchable by all, and its key private.
 chmod 755 "$tmp"
@@ -157,30 +157,32 @@ free_port() {
 }
 ctld_port=$(free_port)
 slurmd_port=$(free_port)
+second_slurmd_port=$(free_port)
 worker_port=$(free_port)
 
 host=$(hostname -s)
 # This node as slurmd sees it: its real CPUs, sockets, cores and memory.
 node_line=$(slurmd -C | head -n 1)
 [[ $node_line == NodeName=$host\ * ]] || fail "slurmd -C says '$node_line', not NodeName=$host"
+# Node `$host` is this machine as it is; node `yatsecond`, a second slurmd on the same host
+# (its own port, reached at 127.0.0.1), makes the two-node partition `two`.
 # cred_expire=10: a requeued job waits cred_expire + 1 seconds before it may start again
 # (default 120). proctrack/linuxproc and task/none: no cgroups needed.
 cat >"$tmp/slurm.conf" <<EOF
 ClusterName=yattest
 SlurmctldHost=$host
 SlurmctldPort=$ctld_port
-SlurmdPort=$slurmd_port
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
 CredType=cred/munge
 AuthInfo=socket=$tmp/run/munge.sock,cred_expire=10
 StateSaveLocation=$tmp/state
-SlurmdSpoolDir=$tmp/spool
+SlurmdSpoolDir=$tmp/spool/%n
 SlurmctldPidFile=$tmp/run/slurmctld.pid
-SlurmdPidFile=$tmp/run/slurmd.pid
+SlurmdPidFile=$tmp/run/slurmd-%n.pid
 SlurmctldLogFile=$tmp/log/slurmctld.log
-SlurmdLogFile=$tmp/log/slurmd.log
+SlurmdLogFile=$tmp/log/slurmd-%n.log
 SlurmdDebug=info
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
@@ -193,8 +195,10 @@ JobCompType=jobcomp/none
 AccountingStorageType=accounting_storage/none
 JobAcctGatherType=jobacct_gather/none
 KillWait=10
-$node_line State=UNKNOWN
-PartitionName=yat Nodes=$host Default=YES MaxTime=INFINITE State=UP
+$node_line Port=$slurmd_port State=UNKNOWN
+NodeName=yatsecond NodeHostname=$host NodeAddr=127.0.0.1 Port=$second_slurmd_port CPUs=1 RealMemory=1024 State=UNKNOWN
+PartitionName=one Nodes=$host Default=YES MaxTime=INFINITE State=UP
+PartitionName=two Nodes=$host,yatsecond MaxTime=INFINITE State=UP
 EOF
 
 # The clients (sbatch, squeue, scontrol, and srun inside the jobs) find the cluster here; no
@@ -210,17 +214,21 @@ timeout 20 bash -c "until munge -n -S '$tmp/run/munge.sock' >/dev/null 2>&1; do 
     fail "munged did not start"
 slurmctld -D -f "$tmp/slurm.conf" >"$tmp/log/slurmctld.out" 2>&1 &
 daemons+=($!)
-slurmd -D -f "$tmp/slurm.conf" >"$tmp/log/slurmd.out" 2>&1 &
-daemons+=($!)
-timeout 60 bash -c "until [[ \$(sinfo -h -n '$host' -o %t 2>/dev/null) == idle ]]; do sleep 0.2; done" ||
-    fail "node $host did not become idle: $(sinfo -N 2>&1)"
+for node in "$host" yatsecond; do
+    slurmd -D -f "$tmp/slurm.conf" -N "$node" >"$tmp/log/slurmd-$node.out" 2>&1 &
+    daemons+=($!)
+done
+timeout 60 bash -c "until [[ \$(sinfo -h -N -t idle -o %N | sort -u | wc -l) == 2 ]]; do sleep 0.2; done" ||
+    fail "the nodes did not become idle: $(sinfo -N 2>&1)"
 step_done "$node_line"
 
 # ---------------------------------------------------------------------------------- helpers
-# Submits the batch script for a render of the scene to OUTPUT ($1); sets `job` to its id.
+# Submits the batch script for a render of the scene to OUTPUT ($1) with sbatch's options
+# `sbatch_options`; sets `job` to its id.
+sbatch_options=(--nodes=1 --exclusive)
 submit() {
-    job=$(cd "$tmp/work" && sbatch --parsable --nodes=1 --exclusive --output="$tmp/jobs/job-%j.log" \
-        "$batch_script" "$scene" "$@") || fail "sbatch failed"
+    job=$(cd "$tmp/work" && sbatch --parsable "${sbatch_options[@]}" \
+        --output="$tmp/jobs/job-%j.log" "$batch_script" "$scene" "$@") || fail "sbatch failed"
     job=${job%%;*}
     jobs_submitted+=("$job")
 }
@@ -264,6 +272,8 @@ expect_same_image() {
 
 # ---------------------------------------------------------------------------------- 1. render
 export YAT_BIN=$yat YAT_PORT=$worker_port YAT_TIMEOUT=60
+# Backtraces of the errors the jobs are expected to end with would drown their logs.
+unset RUST_BACKTRACE
 small=(--resolution 192x108 --spp 16 --seed 0)
 
 step "in-process render, ${small[*]}"
@@ -281,6 +291,30 @@ expect_same_image "$tmp/small.png" "$tmp/small-ref.png"
 step_done "submit to end $sbatch_time s, in-process $small_time s"
 pass "the sbatch render equals the in-process render byte for byte"
 
+step "sbatch render on two nodes, ${small[*]}"
+sbatch_options=(--partition=two --nodes=2)
+submit "$tmp/small-two.png" "${small[@]}"
+state=$(wait_job_end "$job" 300) || fail "job $job did not end within 300 s"
+[[ $state == COMPLETED ]] || fail "job $job ended $state"
+workers_used=$(grep -c '^worker .* ready' "$tmp/jobs/job-$job.log") || true
+((workers_used == 2)) || fail "job $job rendered on $workers_used workers, not 2"
+expect_same_image "$tmp/small-two.png" "$tmp/small-ref.png"
+sbatch_options=(--nodes=1 --exclusive)
+step_done
+pass "a two-node sbatch render (two workers) equals the in-process render byte for byte"
+
+step "sbatch render whose workers cannot start"
+# A cache folder inside a file: every worker exits at start. The job must fail soon after,
+# not wait for workers for YAT_TIMEOUT (600 s here).
+YAT_TIMEOUT=600 YAT_WORKER_FLAGS="--cache-dir $tmp/slurm.conf/cache" \
+    submit "$tmp/no-workers.png" "${small[@]}"
+state=$(wait_job_end "$job" 120) || fail "job $job without workers still runs after 120 s"
+[[ $state == FAILED ]] || fail "job $job without workers ended $state"
+grep -q "the workers' step ended before the render" "$tmp/jobs/job-$job.log" ||
+    fail "job $job does not say its workers ended"
+step_done
+pass "a job whose workers cannot start fails at once"
+
 # ---------------------------------------------------------------------------------- 2. resume
 long=(--resolution 384x216 --spp 128 --seed 0)
 export YAT_CHECKPOINT_EVERY=1
@@ -296,6 +330,21 @@ wait_checkpoint() {
     sleep "$3"
     [[ $(job_field "$1" JobState) == RUNNING ]] ||
         fail "job $1 is $(job_field "$1" JobState) before it could be stopped: make the render longer"
+}
+
+# The token of the running job's processes: the worker's and the coordinator's environments
+# hold the same fresh YAT_TOKEN, and neither command line shows it.
+expect_token_hidden() {
+    local worker coordinator tokens
+    worker=$(pgrep -f "^$yat worker --listen [^ ]*:$worker_port ") || fail "no worker process"
+    coordinator=$(pgrep -f "^$yat render $scene -o $1 ") || fail "no coordinator process"
+    tokens=$(for pid in $worker $coordinator; do
+        tr '\0' '\n' <"/proc/$pid/environ" | grep '^YAT_TOKEN='
+    done | sort -u)
+    [[ $tokens =~ ^YAT_TOKEN=[0-9a-f]{64}$ ]] ||
+        fail "the worker and the coordinator do not share one 256-bit YAT_TOKEN: '$tokens'"
+    ! grep -qa -e --token -e "${tokens#YAT_TOKEN=}" "/proc/$worker/cmdline" \
+        "/proc/$coordinator/cmdline" || fail "a command line shows the token"
 }
 
 # Sets `resumed` to the "N of M units" of job log $1's resume message, checked to be a true
@@ -315,6 +364,7 @@ expect_resumed() {
 step "sbatch render cancelled half way, then submitted again"
 submit "$tmp/long.png" "${long[@]}"
 wait_checkpoint "$job" "$tmp/long.resume" 2
+expect_token_hidden "$tmp/long.png"
 scancel "$job"
 state=$(wait_job_end "$job" 60) || fail "cancelled job $job did not end within 60 s"
 [[ $state == CANCELLED ]] || fail "cancelled job $job ended $state"
