@@ -274,7 +274,7 @@ expect_same_image() {
 export YAT_BIN=$yat YAT_PORT=$worker_port YAT_TIMEOUT=60
 # Backtraces of the errors the jobs are expected to end with would drown their logs.
 unset RUST_BACKTRACE
-small=(--resolution 192x108 --spp 16 --seed 0)
+small=(--resolution 384x216 --spp 32 --seed 0)
 
 step "in-process render, ${small[*]}"
 reference "$tmp/small-ref.png" "${small[@]}"
@@ -288,7 +288,8 @@ state=$(wait_job_end "$job" 300) || fail "job $job did not end within 300 s"
 sbatch_time=$(seconds_since "$submitted")
 [[ $state == COMPLETED ]] || fail "job $job ended $state"
 expect_same_image "$tmp/small.png" "$tmp/small-ref.png"
-step_done "submit to end $sbatch_time s, in-process $small_time s"
+job_render_time=$(grep -o 'render [0-9.]* s$' "$tmp/jobs/job-$job.log" | cut -d' ' -f2)
+step_done "submit to end $sbatch_time s, of which the coordinator's render $job_render_time s; in-process $small_time s"
 pass "the sbatch render equals the in-process render byte for byte"
 
 step "sbatch render on two nodes, ${small[*]}"
@@ -363,7 +364,7 @@ expect_resumed() {
 
 step "sbatch render cancelled half way, then submitted again"
 submit "$tmp/long.png" "${long[@]}"
-wait_checkpoint "$job" "$tmp/long.resume" 2
+wait_checkpoint "$job" "$tmp/long.resume" 0.5
 expect_token_hidden "$tmp/long.png"
 scancel "$job"
 state=$(wait_job_end "$job" 60) || fail "cancelled job $job did not end within 60 s"
@@ -384,7 +385,7 @@ pass "a cancelled and resubmitted render resumes and equals the in-process rende
 # ---------------------------------------------------------------------------------- 3. requeue
 step "sbatch render given the time-limit warning, requeued by itself"
 submit "$tmp/requeued.png" "${long[@]}"
-wait_checkpoint "$job" "$tmp/requeued.resume" 2
+wait_checkpoint "$job" "$tmp/requeued.resume" 0.5
 # What --signal=B:USR1@120 sends before the time limit: USR1 to the batch shell alone.
 scancel --batch --signal=USR1 "$job"
 timeout 60 bash -c "until [[ \$(scontrol show job -o $job | grep -o 'Restarts=[0-9]*') == Restarts=1 ]]; do sleep 0.2; done" ||
