@@ -1,12 +1,16 @@
 #!/bin/bash
-# Tests yat-render.sbatch on a real Slurm: a one-node cluster (munged, slurmctld, slurmd) started
-# on this machine under a temporary folder, nothing read from or written to /etc.
+# Tests yat-render.sbatch on a real Slurm: munged, slurmctld and two slurmd (this host as it is,
+# and a second node on the same host) started under a temporary folder, nothing read from or
+# written to /etc. See README.md ("Testing") for the configuration and why.
 #
 #   1. a render submitted with sbatch equals an in-process render of the same settings, byte for
 #      byte;
-#   2. a longer render cancelled (scancel) once its checkpoint exists, then submitted again,
-#      resumes from the checkpoint and still equals the in-process render byte for byte;
-#   3. the same render given the time-limit warning (USR1 to the batch shell) saves, requeues
+#   2. so does the same render on two nodes (two workers);
+#   3. a job whose workers cannot start fails at once, saying so;
+#   4. a longer render cancelled (scancel) once its checkpoint exists, then submitted again,
+#      resumes from the checkpoint and still equals the in-process render byte for byte; the
+#      job's token is in its processes' environment, on no command line;
+#   5. the same render given the time-limit warning (USR1 to the batch shell) saves, requeues
 #      itself, resumes in the requeued run and equals the in-process render byte for byte.
 #
 # Needs root (it installs Debian's slurm-wlm and munge when missing, and runs the daemons):
@@ -107,9 +111,14 @@ done
 if ((${#missing[@]})); then
     say "missing ${missing[*]}: installing slurm-wlm and munge"
     export DEBIAN_FRONTEND=noninteractive
-    timeout 600 apt-get update -q >/dev/null || fail "apt-get update failed"
-    timeout 900 apt-get install -y -q --no-install-recommends slurm-wlm munge >/dev/null ||
-        fail "apt-get install slurm-wlm munge failed"
+    apt_log=$(mktemp /tmp/yat-slurm-test-apt.XXXXXX)
+    if ! { timeout 600 apt-get update -q &&
+        timeout 900 apt-get install -y -q --no-install-recommends slurm-wlm munge; } >"$apt_log" 2>&1; then
+        tail -n 30 "$apt_log"
+        rm -f "$apt_log"
+        fail "apt-get could not install slurm-wlm and munge"
+    fi
+    rm -f "$apt_log"
 fi
 step_done "$(slurmd -V), $(munged -V 2>&1 | head -n 1)"
 
