@@ -176,7 +176,8 @@ node_line=$(slurmd -C | head -n 1)
 # Node `$host` is this machine as it is; node `yatsecond`, a second slurmd on the same host
 # (its own port, reached at 127.0.0.1), makes the two-node partition `two`.
 # cred_expire=10: a requeued job waits cred_expire + 1 seconds before it may start again
-# (default 120). proctrack/linuxproc and task/none: no cgroups needed.
+# (default 120), and sched_interval=1 starts it within a second of that (default: the next
+# full scheduling pass, up to 60 s later). proctrack/linuxproc and task/none: no cgroups.
 cat >"$tmp/slurm.conf" <<EOF
 ClusterName=yattest
 SlurmctldHost=$host
@@ -204,6 +205,7 @@ JobCompType=jobcomp/none
 AccountingStorageType=accounting_storage/none
 JobAcctGatherType=jobacct_gather/none
 KillWait=10
+SchedulerParameters=sched_interval=1
 $node_line Port=$slurmd_port State=UNKNOWN
 NodeName=yatsecond NodeHostname=$host NodeAddr=127.0.0.1 Port=$second_slurmd_port CPUs=1 RealMemory=1024 State=UNKNOWN
 PartitionName=one Nodes=$host Default=YES MaxTime=INFINITE State=UP
