@@ -105,7 +105,7 @@ pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<Work
 pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
     let mut backoff = MIN_BACKOFF;
     let mut bad_in_a_row = 0;
-    let mut finished = shared.schedule.watch();
+    let mut changed = shared.schedule.watch();
     while !shared.schedule.is_finished() {
         if let Some(status) = node.local.as_ref().and_then(|l| l.exit_status()) {
             retire(
@@ -128,10 +128,13 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
                 retire(&node, &shared, reason);
                 return;
             }
-            Err(SessionError::Draining(what)) => shared.notice(format!(
-                "worker {} draining ({what}); its units go back to the queue",
-                node.address()
-            )),
+            Err(SessionError::Draining(what)) => {
+                shared.notice(format!(
+                    "worker {} draining ({what}); its units go back to the queue",
+                    node.address()
+                ));
+                node.update(|r| r.last_error = Some(format!("draining ({what})")));
+            }
             Err(SessionError::BadReply(error)) => {
                 bad_in_a_row += 1;
                 node.update(|r| {
@@ -163,7 +166,9 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
         }
         tokio::select! {
             _ = tokio::time::sleep(backoff) => {}
-            _ = finished.changed() => {}
+            // Only the end cuts the wait short: a requeue (this worker's own units going back
+            // included) must not, or a worker failing fast would be retried at once.
+            _ = changed.wait_for(|_| shared.schedule.is_finished()) => {}
         }
         backoff = (backoff * 2).min(MAX_BACKOFF);
     }
