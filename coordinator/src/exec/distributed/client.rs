@@ -193,12 +193,16 @@ impl WorkerClient {
 }
 
 /// What a failed call means: a drain; a refused token (for good); a lost connection (no
-/// fault of the worker's); any other status, the deadline included, is a bad reply.
+/// fault of the worker's: a status our transport made from an error it carries as its source,
+/// or one of the codes that say so); any other status, the deadline included, is a bad reply.
 fn call_error(what: &str, status: Status) -> SessionError {
     if is_draining(&status) {
         return SessionError::Draining(format!("{what} refused"));
     }
     let described = format!("{what}: {}", describe_status(&status));
+    if std::error::Error::source(&status).is_some() {
+        return SessionError::Transient(described);
+    }
     match status.code() {
         Code::Unauthenticated => SessionError::Permanent(format!(
             "authentication failed (unauthenticated): {}",
@@ -288,6 +292,9 @@ mod tests {
                 "{code:?}"
             );
         }
+        let broken = std::io::Error::new(std::io::ErrorKind::BrokenPipe, "broken pipe");
+        let lost = call_error("unit 1", Status::from_error(Box::new(broken)));
+        assert!(matches!(lost, SessionError::Transient(m) if m.contains("broken pipe")));
         let drain = call_error("unit 2", yat_proto::drain::draining_status("unit 2"));
         assert!(matches!(drain, SessionError::Draining(m) if m.contains("unit 2")));
     }
