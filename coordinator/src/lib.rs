@@ -13,5 +13,6 @@ pub mod interim;
 pub mod job;
 pub mod manifest;
 pub mod render_report;
+pub mod sanitize;
 pub mod scene;
 pub mod shutdown;

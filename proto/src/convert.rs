@@ -3,7 +3,7 @@
 
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
-use yat_tracer::film::SampleBuffer;
+use yat_tracer::film::{SampleBuffer, MAX_SUM};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::pb;
@@ -13,6 +13,11 @@ pub const BYTES_PER_PIXEL: usize = 16;
 
 /// Largest unit a worker renders: its reply stays at 4 MiB, under every message limit.
 pub const MAX_UNIT_PIXELS: u64 = 1 << 18;
+
+/// More rays than any camera sample traces: a path has at most MAX_DEPTH (4096) scattering
+/// vertices, each with one shadow ray and at most 64 pass-through vertices before it, about
+/// 2^18 rays. A unit's ray count above this many per sample is a lie.
+pub const MAX_RAYS_PER_SAMPLE: u64 = 1 << 20;
 
 #[derive(Debug, thiserror::Error)]
 pub enum WireError {
@@ -28,6 +33,17 @@ pub enum WireError {
         got: usize,
         expected: usize,
     },
+    #[error("asked for unit {asked}, got unit {got}")]
+    OtherUnit { asked: u32, got: u32 },
+    #[error("unit {index}: pixel {pixel} holds {value}, which {reason}")]
+    PixelValue {
+        index: u32,
+        pixel: usize,
+        value: f32,
+        reason: &'static str,
+    },
+    #[error("unit {index}: {reason}")]
+    Stats { index: u32, reason: String },
 }
 
 impl From<&RenderSettings> for pb::RenderSettings {
@@ -155,7 +171,12 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
     out.freeze()
 }
 
-/// Reads a sample buffer of `unit` back from its wire form; the length must match the tile.
+/// Reads a sample buffer of `unit` back from its wire form, checking what an honest render can
+/// produce: the length of the tile; finite values; sums the film can hold (under
+/// [`MAX_SUM`], so one value cannot saturate it); weight sums of at most the unit's samples per
+/// pixel in magnitude (each sample weighs +1 or -1, see `filter.rs`). Radiance has no bound
+/// short of the film's: a bright but finite sum is indistinguishable from a firefly. Negative
+/// sums are honest (filters with negative lobes give samples the weight -1).
 pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireError> {
     let expected = unit.pixel_count() * BYTES_PER_PIXEL;
     if bytes.len() != expected {
@@ -165,14 +186,77 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
             expected,
         });
     }
+    let max_weight = (unit.sample_end - unit.sample_start) as f32;
     let mut rgb = Vec::with_capacity(unit.pixel_count());
     let mut weight = Vec::with_capacity(unit.pixel_count());
-    for px in bytes.chunks_exact(BYTES_PER_PIXEL) {
-        let f = |i: usize| f32::from_le_bytes(px[4 * i..4 * i + 4].try_into().unwrap());
-        rgb.push([f(0), f(1), f(2)]);
-        weight.push(f(3));
+    for (pixel, px) in bytes.chunks_exact(BYTES_PER_PIXEL).enumerate() {
+        let values: [f32; 4] =
+            std::array::from_fn(|i| f32::from_le_bytes(px[4 * i..4 * i + 4].try_into().unwrap()));
+        let refuse = |value: f32, reason| WireError::PixelValue {
+            index: unit.index,
+            pixel,
+            value,
+            reason,
+        };
+        for &value in &values {
+            if !value.is_finite() {
+                return Err(refuse(value, "is not finite"));
+            }
+            if value.abs() >= MAX_SUM {
+                return Err(refuse(value, "exceeds what the film holds"));
+            }
+        }
+        if values[3].abs() > max_weight {
+            return Err(refuse(
+                values[3],
+                "exceeds the unit's samples per pixel as a weight sum",
+            ));
+        }
+        rgb.push([values[0], values[1], values[2]]);
+        weight.push(values[3]);
     }
     Ok(SampleBuffer { unit, rgb, weight })
+}
+
+/// A worker's reply to `unit`, checked: the unit's own index, a sample buffer that
+/// [`decode_pixels`] accepts, and counters an honest render of the unit gives (exactly its
+/// samples, no more dropped than taken, rays within [`MAX_RAYS_PER_SAMPLE`] per sample).
+pub fn result_from_wire(
+    unit: WorkUnit,
+    reply: &pb::RenderUnitReply,
+) -> Result<(SampleBuffer, UnitStats), WireError> {
+    if reply.index != unit.index {
+        return Err(WireError::OtherUnit {
+            asked: unit.index,
+            got: reply.index,
+        });
+    }
+    let buffer = decode_pixels(unit, &reply.pixels)?;
+    let stats = UnitStats::from(reply.stats.unwrap_or_default());
+    let samples = unit.sample_count();
+    let wrong = |reason: String| WireError::Stats {
+        index: unit.index,
+        reason,
+    };
+    if stats.samples != samples {
+        return Err(wrong(format!(
+            "{} samples reported, the unit has {samples}",
+            stats.samples
+        )));
+    }
+    if stats.dropped > samples {
+        return Err(wrong(format!(
+            "{} of {samples} samples reported dropped",
+            stats.dropped
+        )));
+    }
+    if stats.rays > samples.saturating_mul(MAX_RAYS_PER_SAMPLE) {
+        return Err(wrong(format!(
+            "{} rays reported for {samples} samples",
+            stats.rays
+        )));
+    }
+    Ok((buffer, stats))
 }
 
 #[cfg(test)]
@@ -269,5 +353,121 @@ mod tests {
         };
         assert_eq!(bits(&back), bits(&buffer));
         assert!(decode_pixels(unit, &bytes[1..]).is_err());
+    }
+
+    /// A 2x1 tile of 4 samples per pixel whose second pixel's values are `values`, encoded.
+    fn reply_with(values: [f32; 4]) -> (WorkUnit, pb::RenderUnitReply) {
+        let unit = WorkUnit {
+            index: 5,
+            x0: 0,
+            y0: 0,
+            x1: 2,
+            y1: 1,
+            sample_start: 4,
+            sample_end: 8,
+        };
+        let buffer = SampleBuffer {
+            unit,
+            rgb: vec![[0.5, 0.25, 0.0], [values[0], values[1], values[2]]],
+            weight: vec![4.0, values[3]],
+        };
+        let reply = pb::RenderUnitReply {
+            index: unit.index,
+            pixels: encode_pixels(&buffer),
+            stats: Some(pb::UnitStats {
+                samples: 8,
+                rays: 40,
+                dropped: 0,
+            }),
+            render_seconds: 0.1,
+        };
+        (unit, reply)
+    }
+
+    #[test]
+    fn honest_results_pass_including_negative_lobes_and_bright_pixels() {
+        for values in [
+            [1.0, 2.0, 3.0, 4.0],
+            [-0.5, -0.1, 0.0, -2.0],
+            [0.0, 0.0, 0.0, -4.0],
+            [1e9, 3e10, 0.0, 1.0],
+            [-0.0, f32::MIN_POSITIVE, 0.0, 0.0],
+        ] {
+            let (unit, reply) = reply_with(values);
+            let (buffer, stats) = result_from_wire(unit, &reply).unwrap();
+            assert_eq!(buffer.rgb[1], [values[0], values[1], values[2]]);
+            assert_eq!(buffer.weight[1], values[3]);
+            assert_eq!(stats.samples, 8);
+        }
+    }
+
+    #[test]
+    fn non_finite_huge_or_impossible_values_are_refused() {
+        for values in [
+            [f32::NAN, 0.0, 0.0, 1.0],
+            [0.0, f32::INFINITY, 0.0, 1.0],
+            [0.0, 0.0, f32::NEG_INFINITY, 1.0],
+            [0.0, 0.0, 0.0, f32::NAN],
+            [f32::MAX, 0.0, 0.0, 1.0],
+            [0.0, -1e12, 0.0, 1.0],
+            [MAX_SUM, 0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0, 5.0],
+            [1.0, 1.0, 1.0, -4.5],
+            [1.0, 1.0, 1.0, 1e30],
+        ] {
+            let (unit, reply) = reply_with(values);
+            let error = result_from_wire(unit, &reply).unwrap_err();
+            assert!(
+                matches!(
+                    error,
+                    WireError::PixelValue {
+                        index: 5,
+                        pixel: 1,
+                        ..
+                    }
+                ),
+                "{values:?}: {error}"
+            );
+        }
+    }
+
+    #[test]
+    fn another_units_reply_or_false_counters_are_refused() {
+        let (unit, reply) = reply_with([0.0; 4]);
+        let other = pb::RenderUnitReply {
+            index: 6,
+            ..reply.clone()
+        };
+        assert!(matches!(
+            result_from_wire(unit, &other),
+            Err(WireError::OtherUnit { asked: 5, got: 6 })
+        ));
+        let short = pb::RenderUnitReply {
+            pixels: reply.pixels.slice(..16),
+            ..reply.clone()
+        };
+        assert!(matches!(
+            result_from_wire(unit, &short),
+            Err(WireError::PixelsLength { .. })
+        ));
+        for (samples, rays, dropped) in [(7, 40, 0), (9, 40, 0), (8, 40, 9), (8, u64::MAX, 0)] {
+            let lying = pb::RenderUnitReply {
+                stats: Some(pb::UnitStats {
+                    samples,
+                    rays,
+                    dropped,
+                }),
+                ..reply.clone()
+            };
+            assert!(
+                matches!(result_from_wire(unit, &lying), Err(WireError::Stats { .. })),
+                "{samples} {rays} {dropped}"
+            );
+        }
+        let without_stats = pb::RenderUnitReply {
+            stats: None,
+            ..reply
+        };
+        assert!(result_from_wire(unit, &without_stats).is_err());
     }
 }

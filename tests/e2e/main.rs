@@ -5,6 +5,7 @@ mod architecture;
 mod check;
 mod discovery;
 mod distributed;
+mod hostile_worker;
 mod resume;
 mod util;
 #[path = "../fixtures/workspace.rs"]

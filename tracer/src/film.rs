@@ -186,6 +186,10 @@ impl SampleBuffer {
 /// Fixed-point scale of the film's sums: 2^-24 resolution, and room for sums up to 5e11.
 const FIXED_ONE: f64 = (1u64 << 24) as f64;
 
+/// The largest magnitude a sum can have in the film (2^39, about 5.5e11): a value beyond it
+/// would saturate the fixed-point sums, so no honest sample buffer holds one.
+pub const MAX_SUM: f32 = (i64::MAX as f64 / FIXED_ONE) as f32;
+
 fn to_fixed(v: f32) -> i64 {
     // Truncation is as deterministic as rounding and compiles to one instruction (rounding calls
     // libm, which dominated the coordinator's merge time). `as` saturates and maps NaN to 0, so

@@ -30,7 +30,8 @@ pub struct DistributedArgs {
     pub token: TokenFlag,
     #[command(flatten)]
     pub tls: ClientTlsFlags,
-    /// Give up when no worker has been connected for this many seconds [default: wait].
+    /// Give up when no unit's result has been merged for this many seconds, whether no worker
+    /// is connected or the connected ones return nothing usable [default: wait].
     #[arg(long, value_name = "SECONDS")]
     pub timeout: Option<f64>,
     /// Write each worker's figures (units, failures, bytes) and the coordinator's CPU time as

@@ -9,9 +9,11 @@ use tonic::service::interceptor::InterceptedService;
 use tonic::transport::{Channel, ClientTlsConfig, Endpoint};
 use tonic::{Code, Request, Status};
 use yat_proto::auth::AttachToken;
+use yat_proto::drain::is_draining;
 use yat_proto::{pb, RenderNodeClient, BLOB_CHUNK_BYTES, DEFAULT_MAX_MESSAGE_BYTES};
 
 use super::session_error::SessionError;
+use crate::sanitize::peer_text;
 
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 /// Deadline of the small calls (handshake, blob queries, stats).
@@ -21,6 +23,11 @@ const LOAD_TIMEOUT: Duration = Duration::from_secs(600);
 /// Upload deadline: a base plus this much time per MiB (a slow 1 MiB/s link still makes it).
 const UPLOAD_TIMEOUT_BASE: Duration = Duration::from_secs(30);
 const UPLOAD_TIMEOUT_PER_MIB: Duration = Duration::from_secs(1);
+/// Smallest blob chunk sent, whatever message limit a worker advertises (the handshake refuses
+/// a worker whose limit is below twice this).
+pub const MIN_CHUNK_BYTES: usize = 64 << 10;
+/// Characters of a worker's error message kept for the terminal and the report.
+const MAX_MESSAGE_CHARS: usize = 300;
 
 /// How to reach one worker.
 pub struct ClientConfig {
@@ -57,7 +64,6 @@ impl ClientConfig {
 #[derive(Clone)]
 pub struct WorkerClient {
     inner: RenderNodeClient<InterceptedService<Channel, AttachToken>>,
-    address: String,
 }
 
 impl WorkerClient {
@@ -73,10 +79,7 @@ impl WorkerClient {
         let inner = RenderNodeClient::with_interceptor(channel, token)
             .max_decoding_message_size(DEFAULT_MAX_MESSAGE_BYTES)
             .max_encoding_message_size(DEFAULT_MAX_MESSAGE_BYTES);
-        Ok(Self {
-            inner,
-            address: config.address.clone(),
-        })
+        Ok(Self { inner })
     }
 
     /// A worker of another protocol version refuses for good.
@@ -90,8 +93,8 @@ impl WorkerClient {
         )
         .await
         .map_err(|status| match status.code() {
-            Code::FailedPrecondition => SessionError::Permanent(status.message().to_string()),
-            _ => transient("handshake", status),
+            Code::FailedPrecondition => SessionError::Permanent(worker_message(&status)),
+            _ => call_error("handshake", status),
         })
     }
 
@@ -105,7 +108,7 @@ impl WorkerClient {
             self.inner.has_blobs(request(query, CALL_TIMEOUT)),
         )
         .await
-        .map_err(|s| transient("blob query", s))?;
+        .map_err(|s| call_error("blob query", s))?;
         Ok(reply.missing)
     }
 
@@ -118,7 +121,8 @@ impl WorkerClient {
         bytes: &Bytes,
         max_message_bytes: u64,
     ) -> Result<u64, SessionError> {
-        let chunk_bytes = BLOB_CHUNK_BYTES.min(max_message_bytes as usize / 2).max(1);
+        let half_limit = usize::try_from(max_message_bytes / 2).unwrap_or(usize::MAX);
+        let chunk_bytes = BLOB_CHUNK_BYTES.min(half_limit).max(MIN_CHUNK_BYTES);
         let chunks: Vec<pb::BlobChunk> = (0..bytes.len().div_ceil(chunk_bytes).max(1))
             .map(|i| {
                 let range = i * chunk_bytes..((i + 1) * chunk_bytes).min(bytes.len());
@@ -143,13 +147,15 @@ impl WorkerClient {
         )
         .await
         .map_err(|status| match status.code() {
-            Code::ResourceExhausted => SessionError::Permanent(status.message().to_string()),
-            _ => transient("upload", status),
+            Code::ResourceExhausted => SessionError::Permanent(worker_message(&status)),
+            _ => call_error("upload", status),
         })?;
         Ok(sent)
     }
 
-    /// A scene the worker cannot parse or build fails the whole render: no worker can.
+    /// A worker that cannot parse or build the scene (INVALID_ARGUMENT, INTERNAL, OUT_OF_RANGE
+    /// and the like: errors that would repeat) is the odd one out, since this coordinator parsed
+    /// it: that worker is refused for this render, the render goes on with the others.
     pub async fn load_scene(
         &mut self,
         load: pb::LoadSceneRequest,
@@ -160,12 +166,16 @@ impl WorkerClient {
         )
         .await
         .map_err(|status| match status.code() {
-            Code::InvalidArgument => SessionError::Fatal(anyhow::anyhow!(
-                "worker {} cannot load the scene: {}",
-                self.address,
-                status.message()
+            Code::InvalidArgument
+            | Code::Internal
+            | Code::OutOfRange
+            | Code::Unimplemented
+            | Code::Unknown
+            | Code::DataLoss => SessionError::Permanent(format!(
+                "cannot load the scene: {}",
+                describe_status(&status)
             )),
-            _ => transient("scene load", status),
+            _ => call_error("scene load", status),
         })
     }
 
@@ -178,27 +188,43 @@ impl WorkerClient {
         let index = unit.unit.as_ref().map_or(0, |u| u.index);
         with_deadline(deadline, self.inner.render_unit(request(unit, deadline)))
             .await
-            .map_err(|status| transient(&format!("unit {index}"), status))
+            .map_err(|status| call_error(&format!("unit {index}"), status))
     }
 }
 
-/// A failed call: worth another session later, unless the worker refused our token.
-fn transient(what: &str, status: Status) -> SessionError {
+/// What a failed call means: a drain; a refused token (for good); a lost connection (no
+/// fault of the worker's: a status our transport made from an error it carries as its source,
+/// or one of the codes that say so); any other status, the deadline included, is a bad reply.
+fn call_error(what: &str, status: Status) -> SessionError {
+    if is_draining(&status) {
+        return SessionError::Draining(format!("{what} refused"));
+    }
+    let described = format!("{what}: {}", describe_status(&status));
+    if std::error::Error::source(&status).is_some() {
+        return SessionError::Transient(described);
+    }
     match status.code() {
         Code::Unauthenticated => SessionError::Permanent(format!(
             "authentication failed (unauthenticated): {}",
-            status.message()
+            worker_message(&status)
         )),
-        _ => SessionError::Transient(format!("{what}: {}", describe_status(&status))),
+        Code::Unavailable | Code::Cancelled | Code::Aborted => SessionError::Transient(described),
+        _ => SessionError::BadReply(described),
     }
 }
 
+/// The status's code and message, its causes after it, safe to print.
 fn describe_status(status: &Status) -> String {
-    let text = format!("{:?}: {}", status.code(), status.message());
+    let text = format!("{:?}: {}", status.code(), worker_message(status));
     match std::error::Error::source(status) {
         Some(cause) => format!("{text}: {}", error_chain(cause)),
         None => text,
     }
+}
+
+/// The message a worker (or the transport) put in a status, safe to print.
+fn worker_message(status: &Status) -> String {
+    peer_text(status.message(), MAX_MESSAGE_CHARS)
 }
 
 /// The call's reply, or DEADLINE_EXCEEDED when it takes longer than `deadline` (the request's
@@ -223,7 +249,7 @@ fn request<T>(message: T, deadline: Duration) -> Request<T> {
 }
 
 /// An error and its causes on one line (tonic's transport errors hide the useful part in
-/// their sources).
+/// their sources), safe to print (a peer's bytes may be quoted in them).
 fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
     let mut text = e.to_string();
     let mut source = e.source();
@@ -236,7 +262,7 @@ fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
         }
         source = cause.source();
     }
-    text
+    peer_text(&text, MAX_MESSAGE_CHARS)
 }
 
 #[cfg(test)]
@@ -245,9 +271,46 @@ mod tests {
 
     #[test]
     fn an_authentication_failure_is_permanent_and_says_so() {
-        let refused = transient("handshake", Status::unauthenticated("wrong token"));
+        let refused = call_error("handshake", Status::unauthenticated("wrong token"));
         assert!(matches!(refused, SessionError::Permanent(m) if m.contains("authentication")));
-        let lost = transient("unit 3", Status::unavailable("connection reset"));
+        let lost = call_error("unit 3", Status::unavailable("connection reset"));
         assert!(matches!(lost, SessionError::Transient(m) if m.contains("unit 3")));
+    }
+
+    #[test]
+    fn errors_the_worker_answers_are_bad_replies_and_a_drain_is_none() {
+        for status in [
+            Status::internal("boom"),
+            Status::out_of_range("x"),
+            Status::invalid_argument("x"),
+            Status::not_found("scene"),
+            Status::deadline_exceeded("no answer within 2.0 s"),
+        ] {
+            let code = status.code();
+            assert!(
+                matches!(call_error("unit 1", status), SessionError::BadReply(m) if m.contains("unit 1")),
+                "{code:?}"
+            );
+        }
+        let broken = std::io::Error::new(std::io::ErrorKind::BrokenPipe, "broken pipe");
+        let lost = call_error("unit 1", Status::from_error(Box::new(broken)));
+        assert!(matches!(lost, SessionError::Transient(m) if m.contains("broken pipe")));
+        let drain = call_error("unit 2", yat_proto::drain::draining_status("unit 2"));
+        assert!(matches!(drain, SessionError::Draining(m) if m.contains("unit 2")));
+    }
+
+    #[test]
+    fn a_workers_message_reaches_the_terminal_without_escapes() {
+        let hostile = Status::internal(format!("\x1b]0;pwn\x07\x1b[2J{}", "x".repeat(10_000)));
+        let SessionError::BadReply(text) = call_error("unit 1", hostile) else {
+            panic!("an error status is a bad reply");
+        };
+        assert!(!text.contains('\x1b') && !text.contains('\x07'), "{text:?}");
+        assert!(text.contains("]0;pwn"));
+        assert!(
+            text.chars().count() < MAX_MESSAGE_CHARS + 50,
+            "{}",
+            text.len()
+        );
     }
 }

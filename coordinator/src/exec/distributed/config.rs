@@ -24,7 +24,7 @@ pub struct DistributedConfig {
     /// Whether `--tls-domain` was given; otherwise a worker found under a DNS name must present
     /// a certificate for that name.
     pub tls_domain_given: bool,
-    /// Give up when no worker has been connected this long [default: wait].
+    /// Give up when no unit has been merged this long [default: wait].
     pub timeout: Option<Duration>,
     /// Presume a unit lost after this long instead of adapting to the slowest unit (tests).
     pub unit_deadline: Option<Duration>,

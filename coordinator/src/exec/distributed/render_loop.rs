@@ -44,6 +44,7 @@ impl RenderLoop<'_> {
         let mut stats = UnitStats::default();
         let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
+        let mut last_merged = Instant::now();
         let mut waiting_noticed = Instant::now();
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         let result = loop {
@@ -57,11 +58,11 @@ impl RenderLoop<'_> {
                             break Err(e.into());
                         }
                         stats += unit_stats;
+                        last_merged = Instant::now();
                         progress.add_samples(unit_stats.samples);
                         progress.set_status(self.status(&checkpoint));
                     }
                     Event::Notice(line) => progress.say(&line),
-                    Event::Fatal(e) => break Err(e),
                 },
                 _ = tick.tick() => {
                     if self.job.interrupt.is_set() {
@@ -78,14 +79,14 @@ impl RenderLoop<'_> {
                             progress.say(&format!("{e:#}"));
                         }
                     }
+                    if let Err(e) = self.check_workers_remain(last_merged) {
+                        break Err(e);
+                    }
                     if self.alive() > 0 {
                         alone_since = None;
                         continue;
                     }
                     let since = *alone_since.get_or_insert_with(Instant::now);
-                    if let Err(e) = self.check_workers_remain(since) {
-                        break Err(e);
-                    }
                     if since.elapsed() >= WAITING_NOTICE_EVERY
                         && waiting_noticed.elapsed() >= WAITING_NOTICE_EVERY
                     {
@@ -132,8 +133,8 @@ impl RenderLoop<'_> {
             .count()
     }
 
-    /// Fails when no worker can come back, or when the wait has exceeded --timeout.
-    fn check_workers_remain(&self, alone_since: Instant) -> anyhow::Result<()> {
+    /// Fails when no worker can come back, or when no unit was merged for --timeout.
+    fn check_workers_remain(&self, last_merged: Instant) -> anyhow::Result<()> {
         let reports: Vec<_> = self
             .roster
             .nodes()
@@ -152,9 +153,13 @@ impl RenderLoop<'_> {
             );
         }
         if let Some(timeout) = self.timeout {
-            if alone_since.elapsed() >= timeout {
+            if last_merged.elapsed() >= timeout {
+                let connected = match self.alive() {
+                    0 => "no worker connected".to_string(),
+                    n => format!("{n} connected but not returning results"),
+                };
                 bail!(
-                    "no worker connected for {:.0} s (--timeout); last errors: {}",
+                    "no unit merged for {:.1} s (--timeout), {connected}; workers: {}",
                     timeout.as_secs_f64(),
                     self.last_errors()
                 );
@@ -176,7 +181,11 @@ impl RenderLoop<'_> {
                     .gone
                     .as_deref()
                     .or(r.last_error.as_deref())
-                    .unwrap_or("connecting");
+                    .unwrap_or(if r.connected {
+                        "connected"
+                    } else {
+                        "connecting"
+                    });
                 format!("{}: {why}", r.address)
             })
             .collect::<Vec<_>>()

@@ -192,7 +192,7 @@ fn holder_key(address: &str) -> u64 {
 }
 
 /// How long a unit may be in flight before it is presumed lost and handed to another worker:
-/// `max(floor, factor x the slowest unit seen)`, or a fixed value (tests).
+/// `max(floor, factor x the slowest unit seen)` up to a ceiling, or a fixed value (tests).
 pub struct UnitDeadline {
     fixed: Option<Duration>,
     slowest: Mutex<Duration>,
@@ -202,6 +202,9 @@ pub struct UnitDeadline {
 const DEADLINE_FLOOR: Duration = Duration::from_secs(30);
 /// A unit is presumed lost after this many times the slowest unit seen.
 const DEADLINE_FACTOR: u32 = 4;
+/// Nor later than this: a worker slow to the edge of each deadline would otherwise raise it
+/// fourfold every time.
+const DEADLINE_CEILING: Duration = Duration::from_secs(600);
 
 impl UnitDeadline {
     pub fn new(fixed: Option<Duration>) -> Self {
@@ -218,8 +221,10 @@ impl UnitDeadline {
     }
 
     pub fn current(&self) -> Duration {
-        self.fixed
-            .unwrap_or_else(|| DEADLINE_FLOOR.max(*self.slowest.lock().unwrap() * DEADLINE_FACTOR))
+        self.fixed.unwrap_or_else(|| {
+            let adaptive = self.slowest.lock().unwrap().saturating_mul(DEADLINE_FACTOR);
+            adaptive.clamp(DEADLINE_FLOOR, DEADLINE_CEILING)
+        })
     }
 }
 
@@ -371,6 +376,12 @@ mod tests {
         d.observe(Duration::from_secs(20));
         d.observe(Duration::from_secs(1));
         assert_eq!(d.current(), Duration::from_secs(80));
+        d.observe(Duration::from_secs(3600));
+        assert_eq!(
+            d.current(),
+            DEADLINE_CEILING,
+            "one slow unit cannot raise it further"
+        );
         let fixed = UnitDeadline::new(Some(Duration::from_millis(500)));
         fixed.observe(Duration::from_secs(20));
         assert_eq!(fixed.current(), Duration::from_millis(500));

@@ -9,60 +9,149 @@ use std::time::{Duration, Instant};
 
 use prost::Message;
 use tokio::task::JoinSet;
-use yat_proto::convert::decode_pixels;
+use yat_proto::convert::{result_from_wire, BYTES_PER_PIXEL};
 use yat_proto::{pb, PROTOCOL_VERSION};
-use yat_tracer::render::{UnitStats, WorkUnit};
+use yat_tracer::render::{WorkUnit, TILE_SIZE};
 
-use super::client::WorkerClient;
+use super::client::{WorkerClient, MIN_CHUNK_BYTES};
 use super::node::Node;
 use super::schedule::Schedule;
 use super::session_error::SessionError;
 use super::shared::{Event, Shared};
+use crate::sanitize::peer_text;
 
 const MIN_BACKOFF: Duration = Duration::from_millis(250);
 const MAX_BACKOFF: Duration = Duration::from_secs(5);
 /// Units in flight per worker thread: one rendering, one queued behind it, so a worker never
 /// idles for a round trip.
 const UNITS_IN_FLIGHT_PER_THREAD: u32 = 2;
+/// Units a session sends before the worker has returned one; each accepted result allows
+/// `UNITS_IN_FLIGHT_PER_THREAD` more, up to what its threads take. A worker that claims many
+/// threads and never answers holds only these.
+const FIRST_UNITS_IN_FLIGHT: usize = 2;
+/// The most threads a worker's claim is believed (2048 units in flight).
+pub const MAX_WORKER_THREADS: u32 = 1024;
+/// Bad replies in a row (across sessions, until a result is accepted) after which a worker is
+/// retired for this render.
+pub const MAX_BAD_REPLIES_IN_A_ROW: u32 = 3;
+/// Longest host or software name accepted from a worker: a longer one is a hostile worker's.
+const MAX_NAME_BYTES: usize = 1024;
+/// Characters of a worker's host or software name shown.
+const MAX_NAME_CHARS: usize = 64;
+/// Longest scene id accepted: it goes back with every unit (honest ones are 64 hex digits).
+const MAX_SCENE_ID_BYTES: usize = 256;
+/// Bytes of a unit's reply besides its pixels: index, counters, seconds, framing.
+const REPLY_OVERHEAD_BYTES: u64 = 1024;
 
-/// The worker's reply to the handshake, checked: the same protocol version as ours.
-pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<(), String> {
+/// The smallest message limit a worker may advertise: two of the smallest blob chunk, and the
+/// reply to the largest unit of any plan.
+pub fn min_message_bytes() -> u64 {
+    let unit_reply = u64::from(TILE_SIZE * TILE_SIZE) * BYTES_PER_PIXEL as u64;
+    (2 * MIN_CHUNK_BYTES as u64).max(unit_reply + REPLY_OVERHEAD_BYTES)
+}
+
+/// A worker as its handshake describes it, checked, clamped and safe to print.
+#[derive(Debug)]
+pub struct WorkerInfo {
+    pub hostname: String,
+    pub software: String,
+    /// The threads it claims, at most [`MAX_WORKER_THREADS`].
+    pub threads: u32,
+    pub claimed_threads: u32,
+    pub max_message_bytes: u64,
+    pub max_blob_bytes: u64,
+}
+
+/// The worker's reply to the handshake, checked: the same protocol version as ours, at least
+/// one thread, names of a sane length, a message limit that fits a unit's reply.
+pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<WorkerInfo, String> {
+    if reply.hostname.len() > MAX_NAME_BYTES || reply.software.len() > MAX_NAME_BYTES {
+        return Err(format!(
+            "worker {address} sends a host or software name of {} bytes (at most {MAX_NAME_BYTES})",
+            reply.hostname.len().max(reply.software.len())
+        ));
+    }
+    let software = peer_text(&reply.software, MAX_NAME_CHARS);
     if reply.protocol_version != PROTOCOL_VERSION {
         return Err(format!(
-            "worker {address} ({}) speaks protocol version {}, this coordinator version {}",
-            reply.software, reply.protocol_version, PROTOCOL_VERSION
+            "worker {address} ({software}) speaks protocol version {}, this coordinator version {}",
+            reply.protocol_version, PROTOCOL_VERSION
         ));
     }
     if reply.threads == 0 {
         return Err(format!("worker {address} reports 0 threads"));
     }
-    Ok(())
+    if reply.max_message_bytes < min_message_bytes() {
+        return Err(format!(
+            "worker {address} accepts messages of {} bytes, {} needed",
+            reply.max_message_bytes,
+            min_message_bytes()
+        ));
+    }
+    Ok(WorkerInfo {
+        hostname: peer_text(&reply.hostname, MAX_NAME_CHARS),
+        software,
+        threads: reply.threads.min(MAX_WORKER_THREADS),
+        claimed_threads: reply.threads,
+        max_message_bytes: reply.max_message_bytes,
+        max_blob_bytes: reply.max_blob_bytes,
+    })
 }
 
 /// Serves the render with one worker until the schedule is finished or the worker is gone for
-/// good.
+/// good. The backoff between sessions and the count of bad replies are reset only by an
+/// accepted result, so a worker that fails fast is not retried fast, and one that never does
+/// better is retired.
 pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
     let mut backoff = MIN_BACKOFF;
-    let mut finished = shared.schedule.watch();
+    let mut bad_in_a_row = 0;
+    let mut changed = shared.schedule.watch();
     while !shared.schedule.is_finished() {
         if let Some(status) = node.local.as_ref().and_then(|l| l.exit_status()) {
-            let reason = format!("the local worker exited ({status})");
-            shared.notice(format!("worker {}: {reason}", node.address()));
-            node.update(|r| r.gone = Some(reason));
+            retire(
+                &node,
+                &shared,
+                format!("the local worker exited ({status})"),
+            );
             return;
         }
-        let outcome = session(&node, &shared).await;
+        let mut accepted = 0;
+        let outcome = session(&node, &shared, &mut accepted).await;
         let was_rendering = std::mem::take(&mut node.report.lock().unwrap().connected);
+        if accepted > 0 {
+            backoff = MIN_BACKOFF;
+            bad_in_a_row = 0;
+        }
         match outcome {
             Ok(()) => return,
-            Err(SessionError::Fatal(e)) => {
-                let _ = shared.events.send(Event::Fatal(e));
+            Err(SessionError::Permanent(reason)) => {
+                retire(&node, &shared, reason);
                 return;
             }
-            Err(SessionError::Permanent(reason)) => {
-                shared.notice(format!("worker {} refused: {reason}", node.address()));
-                node.update(|r| r.gone = Some(reason));
-                return;
+            Err(SessionError::Draining(what)) => {
+                shared.notice(format!(
+                    "worker {} draining ({what}); its units go back to the queue",
+                    node.address()
+                ));
+                node.update(|r| r.last_error = Some(format!("draining ({what})")));
+            }
+            Err(SessionError::BadReply(error)) => {
+                bad_in_a_row += 1;
+                node.update(|r| {
+                    r.failures += 1;
+                    r.last_error = Some(error.clone());
+                });
+                if bad_in_a_row >= MAX_BAD_REPLIES_IN_A_ROW {
+                    let reason = format!(
+                        "retired after {bad_in_a_row} bad replies in a row, the last: {error}"
+                    );
+                    retire(&node, &shared, reason);
+                    return;
+                }
+                shared.notice(format!(
+                    "worker {} answered badly ({error}); its units go back to the queue",
+                    node.address()
+                ));
             }
             Err(SessionError::Transient(error)) => {
                 if was_rendering {
@@ -70,20 +159,29 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
                         "worker {} lost ({error}); its units go back to the queue",
                         node.address()
                     ));
-                    backoff = MIN_BACKOFF;
+                    node.update(|r| r.failures += 1);
                 }
                 node.update(|r| r.last_error = Some(error));
             }
         }
         tokio::select! {
             _ = tokio::time::sleep(backoff) => {}
-            _ = finished.changed() => {}
+            // Only the end cuts the wait short: a requeue (this worker's own units going back
+            // included) must not, or a worker failing fast would be retried at once.
+            _ = changed.wait_for(|_| shared.schedule.is_finished()) => {}
         }
         backoff = (backoff * 2).min(MAX_BACKOFF);
     }
 }
 
-async fn session(node: &Node, shared: &Shared) -> Result<(), SessionError> {
+/// This worker will not be used again in this render, for `reason`.
+fn retire(node: &Node, shared: &Shared, reason: String) {
+    shared.notice(format!("worker {} refused: {reason}", node.address()));
+    node.update(|r| r.gone = Some(reason));
+}
+
+/// One session; `accepted` counts the results it accepted.
+async fn session(node: &Node, shared: &Shared, accepted: &mut usize) -> Result<(), SessionError> {
     let address = node.address();
     let mut client = WorkerClient::connect(&node.config).await?;
 
@@ -96,33 +194,45 @@ async fn session(node: &Node, shared: &Shared) -> Result<(), SessionError> {
         ),
     };
     let reply = client.handshake(hello).await?;
-    check_handshake(address, &reply).map_err(SessionError::Permanent)?;
+    let worker = check_handshake(address, &reply).map_err(SessionError::Permanent)?;
     node.update(|r| {
-        r.hostname = reply.hostname.clone();
-        r.threads = reply.threads;
+        r.hostname = worker.hostname.clone();
+        r.threads = worker.threads;
     });
 
-    upload_missing_blobs(&mut client, node, shared, &reply).await?;
+    upload_missing_blobs(&mut client, node, shared, &worker).await?;
     let load = shared.load_request.clone();
     let sent = load.encoded_len() as u64;
     let loaded = client.load_scene(load).await?;
+    if loaded.scene_id.is_empty() || loaded.scene_id.len() > MAX_SCENE_ID_BYTES {
+        return Err(SessionError::Permanent(format!(
+            "a scene id of {} bytes (1 to {MAX_SCENE_ID_BYTES} expected)",
+            loaded.scene_id.len()
+        )));
+    }
     node.update(|r| {
         r.bytes_sent += sent;
         r.bytes_received += loaded.encoded_len() as u64;
         r.connected = true;
     });
     shared.notice(format!(
-        "worker {address} ({}, {} threads) ready{}",
-        reply.hostname,
-        reply.threads,
+        "worker {address} ({}, {}, {} threads{}) ready{}",
+        worker.hostname,
+        worker.software,
+        worker.threads,
+        if worker.claimed_threads > worker.threads {
+            format!(" of {} claimed", worker.claimed_threads)
+        } else {
+            String::new()
+        },
         if loaded.build_seconds > 0.0 {
             format!(", scene built in {:.2} s", loaded.build_seconds)
         } else {
             String::new()
         }
     ));
-    let in_flight = reply.threads.saturating_mul(UNITS_IN_FLIGHT_PER_THREAD);
-    render_units(client, node, shared, &loaded.scene_id, in_flight as usize).await
+    let in_flight = (worker.threads * UNITS_IN_FLIGHT_PER_THREAD) as usize;
+    render_units(client, node, shared, &loaded.scene_id, in_flight, accepted).await
 }
 
 /// Asks which blobs the worker lacks and uploads those.
@@ -130,7 +240,7 @@ async fn upload_missing_blobs(
     client: &mut WorkerClient,
     node: &Node,
     shared: &Shared,
-    worker: &pb::HandshakeReply,
+    worker: &WorkerInfo,
 ) -> Result<(), SessionError> {
     let blobs = &shared.manifest.blobs;
     let query = pb::HasBlobsRequest {
@@ -139,8 +249,9 @@ async fn upload_missing_blobs(
     node.update(|r| r.bytes_sent += query.encoded_len() as u64);
     for hash in client.missing_blobs(query).await? {
         let bytes = blobs.get(&hash).ok_or_else(|| {
-            SessionError::Transient(format!(
-                "the worker asked for blob {hash}, which is not ours"
+            SessionError::BadReply(format!(
+                "the worker asked for blob {}, which is not ours",
+                peer_text(&hash, MAX_NAME_CHARS)
             ))
         })?;
         if bytes.len() as u64 > worker.max_blob_bytes {
@@ -196,13 +307,16 @@ async fn render_one(
     (unit, reply.map(|r| (r, started.elapsed())))
 }
 
-/// Pulls units while fewer than `limit` are in flight, until the render is finished.
+/// Pulls units while fewer than allowed are in flight (`FIRST_UNITS_IN_FLIGHT`, more with each
+/// accepted result, at most `max_in_flight`), until the render is finished; `accepted` counts
+/// the results accepted.
 async fn render_units(
     client: WorkerClient,
     node: &Node,
     shared: &Shared,
     scene_id: &str,
-    limit: usize,
+    max_in_flight: usize,
+    accepted: &mut usize,
 ) -> Result<(), SessionError> {
     let schedule = &shared.schedule;
     let mut changed = schedule.watch();
@@ -217,6 +331,9 @@ async fn render_units(
         if schedule.is_finished() {
             return Ok(());
         }
+        let limit = max_in_flight.min(
+            FIRST_UNITS_IN_FLIGHT.saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
+        );
         while calls.len() < schedule.in_flight_limit(limit) {
             let Some(unit) = schedule.take(node.address()) else {
                 break;
@@ -244,15 +361,10 @@ async fn render_units(
                 let (unit, outcome) = joined
                     .expect("calls is not empty")
                     .map_err(|e| SessionError::Transient(format!("unit task: {e}")))?;
+                // Kept in `held` until accepted: an error returns it to the queue.
+                accept(node, shared, unit, outcome?)?;
                 held.units.remove(&unit.index);
-                let outcome = outcome.inspect_err(|_| {
-                    held.units.insert(unit.index, unit);
-                    node.update(|r| r.failures += 1);
-                })?;
-                accept(node, shared, unit, outcome).inspect_err(|_| {
-                    held.units.insert(unit.index, unit);
-                    node.update(|r| r.failures += 1);
-                })?;
+                *accepted += 1;
             }
             _ = changed.changed() => {}
         }
@@ -267,16 +379,9 @@ fn accept(
     (reply, took): (pb::RenderUnitReply, Duration),
 ) -> Result<(), SessionError> {
     let received = reply.encoded_len() as u64;
-    if reply.index != unit.index {
-        return Err(SessionError::Transient(format!(
-            "asked for unit {}, got unit {}",
-            unit.index, reply.index
-        )));
-    }
-    let buffer =
-        decode_pixels(unit, &reply.pixels).map_err(|e| SessionError::Transient(e.to_string()))?;
+    let (buffer, stats) =
+        result_from_wire(unit, &reply).map_err(|e| SessionError::BadReply(e.to_string()))?;
     shared.deadline.observe(took);
-    let stats = UnitStats::from(reply.stats.unwrap_or_default());
     let first = shared.schedule.complete(&unit);
     node.update(|r| {
         r.bytes_received += received;
@@ -297,18 +402,84 @@ fn accept(
 mod tests {
     use super::*;
 
-    #[test]
-    fn another_protocol_version_is_refused_naming_both() {
-        let mut reply = pb::HandshakeReply {
+    fn honest() -> pb::HandshakeReply {
+        pb::HandshakeReply {
             protocol_version: PROTOCOL_VERSION,
             threads: 2,
+            hostname: "node-1".into(),
             software: "yat 9.9".into(),
-            ..Default::default()
-        };
+            max_message_bytes: 8 << 20,
+            max_blob_bytes: 1 << 30,
+            features: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn another_protocol_version_is_refused_naming_both() {
+        let mut reply = honest();
         assert!(check_handshake("h:1", &reply).is_ok());
         reply.protocol_version = PROTOCOL_VERSION + 1;
         let message = check_handshake("h:1", &reply).unwrap_err();
         assert!(message.contains(&format!("version {}", PROTOCOL_VERSION + 1)));
         assert!(message.contains(&format!("version {PROTOCOL_VERSION}")));
+    }
+
+    #[test]
+    fn a_workers_claims_are_clamped_or_refused() {
+        let many = pb::HandshakeReply {
+            threads: 1_000_000,
+            ..honest()
+        };
+        let info = check_handshake("h:1", &many).unwrap();
+        assert_eq!(
+            (info.threads, info.claimed_threads),
+            (MAX_WORKER_THREADS, 1_000_000)
+        );
+        for bad in [
+            pb::HandshakeReply {
+                threads: 0,
+                ..honest()
+            },
+            pb::HandshakeReply {
+                max_message_bytes: 1,
+                ..honest()
+            },
+            pb::HandshakeReply {
+                max_message_bytes: 64 << 10,
+                ..honest()
+            },
+            pb::HandshakeReply {
+                hostname: "h".repeat(MAX_NAME_BYTES + 1),
+                ..honest()
+            },
+            pb::HandshakeReply {
+                software: "s".repeat(1 << 20),
+                ..honest()
+            },
+        ] {
+            assert!(check_handshake("h:1", &bad).is_err(), "{bad:?}");
+        }
+        // The smallest limit that holds a 64x64 tile's reply and two 64 KiB chunks passes.
+        let tight = pb::HandshakeReply {
+            max_message_bytes: min_message_bytes(),
+            ..honest()
+        };
+        assert!(check_handshake("h:1", &tight).is_ok());
+        assert!(min_message_bytes() >= 16 * 64 * 64 && min_message_bytes() >= 128 << 10);
+    }
+
+    #[test]
+    fn a_workers_names_are_made_safe_and_short() {
+        let hostile = pb::HandshakeReply {
+            hostname: format!("\x1b]0;pwn\x07{}", "n".repeat(500)),
+            software: "\x1b[2Jyat".into(),
+            ..honest()
+        };
+        let info = check_handshake("h:1", &hostile).unwrap();
+        for name in [&info.hostname, &info.software] {
+            assert!(!name.chars().any(char::is_control), "{name:?}");
+            assert!(name.chars().count() <= MAX_NAME_CHARS);
+        }
+        assert!(info.software.ends_with("[2Jyat"));
     }
 }

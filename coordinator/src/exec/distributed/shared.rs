@@ -18,8 +18,6 @@ pub enum Event {
     },
     /// A message for the terminal.
     Notice(String),
-    /// The render cannot succeed (e.g. the scene does not build).
-    Fatal(anyhow::Error),
 }
 
 /// What every node loop shares.
