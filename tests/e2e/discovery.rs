@@ -192,7 +192,7 @@ fn workers_join_and_leave_as_the_name_resolves() {
     let removed = Instant::now();
     let status = coordinator.wait().unwrap();
     assert!(status.success(), "coordinator failed: {status}");
-    // A unit presumed lost waits 30 s (the deadline floor): A's units came back at once.
+    // A unit presumed lost waits 30 s (the deadline floor): A finished what it held at once.
     assert!(
         removed.elapsed() < Duration::from_secs(25),
         "the render waited {:.1} s after A left",
@@ -217,7 +217,9 @@ fn workers_join_and_leave_as_the_name_resolves() {
         assert_eq!(w["dns_name"], "workers.yat.test", "{report:#}");
     }
     assert_eq!(a["gone"], "removed from DNS", "{report:#}");
-    assert!(a["units_requeued"].as_u64().unwrap() >= 1, "{report:#}");
+    // A was still up (as a draining pod is): it finished the units it held instead of
+    // throwing them back.
+    assert_eq!(a["units_requeued"], 0, "{report:#}");
     assert!(a["units"].as_u64().unwrap() >= 3, "{report:#}");
     assert!(
         b["units"].as_u64().unwrap() >= 1,

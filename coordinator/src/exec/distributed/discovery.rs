@@ -3,8 +3,11 @@
 //! resolves to is a worker: a Kubernetes headless Service, a round-robin record). Names are
 //! resolved again every `--resolve-every` seconds: an address new in the answer joins the
 //! running render as a node with its own session loop, an address no longer in the answer
-//! leaves it (its session is aborted, so the units it held go back to the queue at once) and is
-//! reported as removed from DNS, and an address that comes back is a worker again. A name that
+//! leaves it and is reported as removed from DNS, and an address that comes back is a worker
+//! again. A leaving worker takes no more units but may finish the ones it holds, for up to the
+//! unit deadline: a Kubernetes pod leaves its Service's answer the moment it is deleted, while
+//! its drain is still finishing those units; after the deadline its session is aborted and what
+//! it still holds goes back to the queue. A name that
 //! fails to resolve keeps its last good answer. Which worker renders which unit never changes
 //! the image, so none of this touches the bit-identical promise.
 
@@ -16,6 +19,7 @@ use std::time::Duration;
 use hickory_resolver::config::{NameServerConfigGroup, ResolverConfig, ResolverOpts};
 use hickory_resolver::name_server::TokioConnectionProvider;
 use hickory_resolver::{Name, ResolveError, TokioResolver};
+use tokio::sync::watch;
 use tokio::task::JoinHandle;
 use tonic::transport::ClientTlsConfig;
 
@@ -192,7 +196,16 @@ struct Member {
     entry: Option<String>,
     address: Option<SocketAddr>,
     task: Option<JoinHandle<()>>,
+    /// Tells the task to leave: no more units, finish the ones held.
+    leave: watch::Sender<bool>,
     removed: bool,
+}
+
+/// Starts serving `node` in a task of its own; the sender asks it to leave.
+fn spawn_session(node: &Arc<Node>, shared: &Arc<Shared>) -> (JoinHandle<()>, watch::Sender<bool>) {
+    let (leave, asked) = watch::channel(false);
+    let task = tokio::spawn(run_node(node.clone(), shared.clone(), asked));
+    (task, leave)
 }
 
 /// The workers of a render, each served by its own session loop (`run_node`). It only grows:
@@ -216,12 +229,13 @@ impl Roster {
     /// Adds a listed or local worker and starts serving it (inside the runtime).
     pub fn add(&self, node: Node) {
         let node = Arc::new(node);
-        let task = tokio::spawn(run_node(node.clone(), self.shared.clone()));
+        let (task, leave) = spawn_session(&node, &self.shared);
         self.members.lock().unwrap().push(Member {
             node,
             entry: None,
             address: None,
             task: Some(task),
+            leave,
             removed: false,
         });
     }
@@ -272,9 +286,16 @@ impl Roster {
             let in_answer = member.address.is_some_and(|a| answer.contains(&a));
             if !in_answer && !member.removed {
                 member.removed = true;
-                // Dropping the session's future gives the units it held back to the queue.
+                member.leave.send_replace(true);
+                // Past the deadline, aborting the session gives what it still holds back to the
+                // queue.
                 if let Some(task) = member.task.take() {
-                    task.abort();
+                    let grace = self.shared.deadline.current();
+                    let session = task.abort_handle();
+                    tokio::spawn(async move {
+                        tokio::time::sleep(grace).await;
+                        session.abort();
+                    });
                 }
                 member.node.update(|r| {
                     r.connected = false;
@@ -301,8 +322,10 @@ impl Roster {
                 Some(member) if member.removed => {
                     member.removed = false;
                     member.node.update(|r| r.gone = None);
-                    let task = tokio::spawn(run_node(member.node.clone(), self.shared.clone()));
+                    // A new session; the old one, if still finishing its units, ends by itself.
+                    let (task, leave) = spawn_session(&member.node, &self.shared);
                     member.task = Some(task);
+                    member.leave = leave;
                     joined += 1;
                     continue;
                 }
@@ -310,12 +333,13 @@ impl Roster {
                 None => Arc::new(Node::new(client.for_address(host, address), None)),
             };
             node.update(|r| r.dns_name = Some(host.to_string()));
-            let task = tokio::spawn(run_node(node.clone(), self.shared.clone()));
+            let (task, leave) = spawn_session(&node, &self.shared);
             members.push(Member {
                 node,
                 entry: Some(entry.clone()),
                 address: Some(address),
                 task: Some(task),
+                leave,
                 removed: false,
             });
             joined += 1;

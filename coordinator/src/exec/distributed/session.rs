@@ -1,13 +1,15 @@
 //! The steps of a render on one worker: a loop that connects (again and again, with backoff),
 //! shakes hands, uploads what the worker lacks, loads the scene, and then pulls units from the
 //! shared schedule with a bounded number in flight. Whatever goes wrong, the units it held go
-//! back to the queue.
+//! back to the queue. A worker asked to leave (its address gone from DNS: a pod deleted, a node
+//! scaled away) takes no more units and finishes the ones it holds, which its drain allows.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use prost::Message;
+use tokio::sync::watch;
 use tokio::task::JoinSet;
 use yat_proto::convert::{result_from_wire, BYTES_PER_PIXEL};
 use yat_proto::{pb, PROTOCOL_VERSION};
@@ -98,15 +100,15 @@ pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<Work
     })
 }
 
-/// Serves the render with one worker until the schedule is finished or the worker is gone for
-/// good. The backoff between sessions and the count of bad replies are reset only by an
-/// accepted result, so a worker that fails fast is not retried fast, and one that never does
-/// better is retired.
-pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
+/// Serves the render with one worker until the schedule is finished, the worker is gone for
+/// good, or `leave` turns true (then the units in flight are finished first). The backoff
+/// between sessions and the count of bad replies are reset only by an accepted result, so a
+/// worker that fails fast is not retried fast, and one that never does better is retired.
+pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Receiver<bool>) {
     let mut backoff = MIN_BACKOFF;
     let mut bad_in_a_row = 0;
     let mut changed = shared.schedule.watch();
-    while !shared.schedule.is_finished() {
+    while !shared.schedule.is_finished() && !*leave.borrow() {
         if let Some(status) = node.local.as_ref().and_then(|l| l.exit_status()) {
             retire(
                 &node,
@@ -116,7 +118,7 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
             return;
         }
         let mut accepted = 0;
-        let outcome = session(&node, &shared, &mut accepted).await;
+        let outcome = session(&node, &shared, &mut accepted, &mut leave).await;
         let was_rendering = std::mem::take(&mut node.report.lock().unwrap().connected);
         if accepted > 0 {
             backoff = MIN_BACKOFF;
@@ -169,6 +171,8 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>) {
             // Only the end cuts the wait short: a requeue (this worker's own units going back
             // included) must not, or a worker failing fast would be retried at once.
             _ = changed.wait_for(|_| shared.schedule.is_finished()) => {}
+            // Asked to leave (or the roster is gone): nothing is held between sessions.
+            _ = leave.wait_for(|&leaving| leaving) => return,
         }
         backoff = (backoff * 2).min(MAX_BACKOFF);
     }
@@ -181,7 +185,12 @@ fn retire(node: &Node, shared: &Shared, reason: String) {
 }
 
 /// One session; `accepted` counts the results it accepted.
-async fn session(node: &Node, shared: &Shared, accepted: &mut usize) -> Result<(), SessionError> {
+async fn session(
+    node: &Node,
+    shared: &Shared,
+    accepted: &mut usize,
+    leave: &mut watch::Receiver<bool>,
+) -> Result<(), SessionError> {
     let address = node.address();
     let mut client = WorkerClient::connect(&node.config).await?;
 
@@ -232,7 +241,13 @@ async fn session(node: &Node, shared: &Shared, accepted: &mut usize) -> Result<(
         }
     ));
     let in_flight = (worker.threads * UNITS_IN_FLIGHT_PER_THREAD) as usize;
-    render_units(client, node, shared, &loaded.scene_id, in_flight, accepted).await
+    let units = UnitLoop {
+        node,
+        shared,
+        scene_id: &loaded.scene_id,
+        max_in_flight: in_flight,
+    };
+    units.run(client, accepted, leave).await
 }
 
 /// Asks which blobs the worker lacks and uploads those.
@@ -307,66 +322,92 @@ async fn render_one(
     (unit, reply.map(|r| (r, started.elapsed())))
 }
 
-/// Pulls units while fewer than allowed are in flight (`FIRST_UNITS_IN_FLIGHT`, more with each
-/// accepted result, at most `max_in_flight`), until the render is finished; `accepted` counts
-/// the results accepted.
-async fn render_units(
-    client: WorkerClient,
-    node: &Node,
-    shared: &Shared,
-    scene_id: &str,
+/// A session's unit loop: the worker, the render, the scene id it loaded and the most units
+/// it may hold.
+struct UnitLoop<'a> {
+    node: &'a Node,
+    shared: &'a Shared,
+    scene_id: &'a str,
     max_in_flight: usize,
-    accepted: &mut usize,
-) -> Result<(), SessionError> {
-    let schedule = &shared.schedule;
-    let mut changed = schedule.watch();
-    let mut held = HeldUnits {
-        schedule,
-        units: HashMap::new(),
-        node,
-    };
-    // Dropped (aborting the calls) before `held` gives their units back.
-    let mut calls = JoinSet::new();
-    loop {
-        if schedule.is_finished() {
-            return Ok(());
-        }
-        let limit = max_in_flight.min(
-            FIRST_UNITS_IN_FLIGHT.saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
-        );
-        while calls.len() < schedule.in_flight_limit(limit) {
-            let Some(unit) = schedule.take(node.address()) else {
-                break;
-            };
-            held.units.insert(unit.index, unit);
-            let request = pb::RenderUnitRequest {
-                scene_id: scene_id.to_string(),
-                unit: Some((&unit).into()),
-            };
-            node.update(|r| r.bytes_sent += request.encoded_len() as u64);
-            calls.spawn(render_one(
-                client.clone(),
-                request,
-                unit,
-                shared.deadline.current(),
-            ));
-        }
-        if calls.is_empty() {
-            // Nothing to take: wait for a requeued unit or the end.
-            let _ = changed.changed().await;
-            continue;
-        }
-        tokio::select! {
-            joined = calls.join_next() => {
-                let (unit, outcome) = joined
-                    .expect("calls is not empty")
-                    .map_err(|e| SessionError::Transient(format!("unit task: {e}")))?;
-                // Kept in `held` until accepted: an error returns it to the queue.
-                accept(node, shared, unit, outcome?)?;
-                held.units.remove(&unit.index);
-                *accepted += 1;
+}
+
+impl UnitLoop<'_> {
+    /// Pulls units while fewer than allowed are in flight (`FIRST_UNITS_IN_FLIGHT`, more with
+    /// each accepted result, at most `max_in_flight`), until the render is finished, or until
+    /// `leave` turns true and the units in flight are in; `accepted` counts the results
+    /// accepted.
+    async fn run(
+        self,
+        client: WorkerClient,
+        accepted: &mut usize,
+        leave: &mut watch::Receiver<bool>,
+    ) -> Result<(), SessionError> {
+        let UnitLoop {
+            node,
+            shared,
+            scene_id,
+            max_in_flight,
+        } = self;
+        let schedule = &shared.schedule;
+        let mut changed = schedule.watch();
+        let mut held = HeldUnits {
+            schedule,
+            units: HashMap::new(),
+            node,
+        };
+        // Dropped (aborting the calls) before `held` gives their units back.
+        let mut calls = JoinSet::new();
+        loop {
+            if schedule.is_finished() {
+                return Ok(());
             }
-            _ = changed.changed() => {}
+            // A roster that dropped its sender will never say: as good as asked to leave.
+            let leaving = *leave.borrow() || leave.has_changed().is_err();
+            let limit = max_in_flight.min(
+                FIRST_UNITS_IN_FLIGHT
+                    .saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
+            );
+            while !leaving && calls.len() < schedule.in_flight_limit(limit) {
+                let Some(unit) = schedule.take(node.address()) else {
+                    break;
+                };
+                held.units.insert(unit.index, unit);
+                let request = pb::RenderUnitRequest {
+                    scene_id: scene_id.to_string(),
+                    unit: Some((&unit).into()),
+                };
+                node.update(|r| r.bytes_sent += request.encoded_len() as u64);
+                calls.spawn(render_one(
+                    client.clone(),
+                    request,
+                    unit,
+                    shared.deadline.current(),
+                ));
+            }
+            if calls.is_empty() {
+                if leaving {
+                    return Ok(());
+                }
+                // Nothing to take: wait for a requeued unit, the end, or the request to leave.
+                tokio::select! {
+                    _ = changed.changed() => {}
+                    _ = leave.changed() => {}
+                }
+                continue;
+            }
+            tokio::select! {
+                joined = calls.join_next() => {
+                    let (unit, outcome) = joined
+                        .expect("calls is not empty")
+                        .map_err(|e| SessionError::Transient(format!("unit task: {e}")))?;
+                    // Kept in `held` until accepted: an error returns it to the queue.
+                    accept(node, shared, unit, outcome?)?;
+                    held.units.remove(&unit.index);
+                    *accepted += 1;
+                }
+                _ = changed.changed() => {}
+                _ = leave.changed(), if !leaving => {}
+            }
         }
     }
 }
