@@ -1,0 +1,127 @@
+//! `yat-fuzz`: runs a fuzz target for a number of inputs and reports inputs/s and the panics
+//! found; exits non-zero if any input panicked.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::{Args, Parser, Subcommand};
+use yat_fuzz::campaign::{self, Report, Settings, Target};
+use yat_fuzz::parser_target::{Case, ParserTarget, SeedFolders};
+use yat_fuzz::wire_target::{Session, WireTarget};
+use yat_fuzz::workspace::{seed_scenes, workspace_root};
+
+#[derive(Parser)]
+#[command(
+    name = "yat-fuzz",
+    about = "Mutation fuzzer for YAT's scene parser and wire message handlers",
+    long_about = "Mutation fuzzer for YAT's scene parser and wire message handlers. Runs a \
+                  target for --inputs inputs, prints inputs run, inputs/s and each distinct \
+                  panic (its location, message and the minimized input saved in --crashes), \
+                  and exits with status 1 if any input panicked."
+)]
+struct Cli {
+    #[command(subcommand)]
+    target: TargetCommand,
+}
+
+#[derive(Subcommand)]
+enum TargetCommand {
+    /// .lxs scenes (with includes, PLY meshes, images) mutated, parsed, built, one unit rendered.
+    Parser {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Seed project scene folder searched for more .lxs seeds (default: $YAT_SEED_SCENES,
+        /// else <workspace>/../shared/seed-project/scenes, skipped when absent).
+        #[arg(long)]
+        seed_scenes: Option<PathBuf>,
+    },
+    /// Protobuf messages of render.proto and gRPC metadata, mutated and handled as each end does.
+    Wire {
+        #[command(flatten)]
+        run: RunArgs,
+    },
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// Inputs to run.
+    #[arg(long, default_value_t = 100_000)]
+    inputs: u64,
+    /// Seed of the random mutations: the same seed and inputs give the same run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Folder for the inputs that panicked or ran slow (default: <workspace>/fuzz/crashes).
+    #[arg(long)]
+    crashes: Option<PathBuf>,
+    /// An input running longer than this many seconds is counted and saved as slow.
+    #[arg(long, default_value_t = 2.0)]
+    slow_seconds: f64,
+    /// Print progress every this many inputs (0: never).
+    #[arg(long, default_value_t = 50_000)]
+    progress: u64,
+    /// Run this saved input once, without catching its panic (shows the backtrace).
+    #[arg(long)]
+    replay: Option<PathBuf>,
+}
+
+fn main() -> anyhow::Result<ExitCode> {
+    let cli = Cli::parse();
+    let report = match cli.target {
+        TargetCommand::Parser { run, seed_scenes: dir } => {
+            let root = workspace_root();
+            let mut folders = SeedFolders {
+                scenes: vec![root.join("scenes")],
+                snippets: Some(root.join("fuzz/corpus")),
+            };
+            folders.scenes.extend(dir.or_else(seed_scenes));
+            let mut target = ParserTarget::new(&folders).context("loading the parser seeds")?;
+            eprintln!("parser: {} seed scenes", target.seed_count());
+            if let Some(path) = &run.replay {
+                let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+                let case = Case::decode(&bytes).context("not a saved parser case")?;
+                println!("{:?}", target.execute(&case));
+                return Ok(ExitCode::SUCCESS);
+            }
+            campaign::run(&mut target, &run.settings())
+        }
+        TargetCommand::Wire { run } => {
+            let mut target = WireTarget::new();
+            if let Some(path) = &run.replay {
+                let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+                let session = Session::decode(&bytes).context("not a saved wire session")?;
+                println!("{:?}", target.execute(&session));
+                return Ok(ExitCode::SUCCESS);
+            }
+            campaign::run(&mut target, &run.settings())
+        }
+    };
+    Ok(finish(&report))
+}
+
+impl RunArgs {
+    fn settings(&self) -> Settings {
+        Settings {
+            inputs: self.inputs,
+            seed: self.seed,
+            crash_dir: Some(
+                self.crashes
+                    .clone()
+                    .unwrap_or_else(|| workspace_root().join("fuzz/crashes")),
+            ),
+            slow: Duration::from_secs_f64(self.slow_seconds),
+            progress_every: self.progress,
+        }
+    }
+}
+
+fn finish(report: &Report) -> ExitCode {
+    print!("{report}");
+    if report.findings.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        println!("{} distinct panics found", report.findings.len());
+        ExitCode::FAILURE
+    }
+}
