@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use fastrand::Rng;
@@ -62,6 +62,8 @@ pub struct Report {
     pub target: &'static str,
     pub inputs: u64,
     pub elapsed: Duration,
+    /// Inputs that got past the first check (a scene that parsed), without a panic.
+    pub accepted: u64,
     /// Distinct panics, by location.
     pub findings: Vec<Finding>,
     /// Inputs that ran longer than the slow bound, and the longest one.
@@ -122,6 +124,8 @@ pub struct Settings {
     pub slow: Duration,
     /// Print progress every this many inputs (0: never).
     pub progress_every: u64,
+    /// Time spent minimizing each new panic's input.
+    pub minimize_for: Duration,
 }
 
 /// The panic the hook saw last: location and message. A panic inside a rayon task is
@@ -131,29 +135,64 @@ static LAST_PANIC: Mutex<Option<(String, String)>> = Mutex::new(None);
 /// One campaign at a time in a process: the panic hook and [`LAST_PANIC`] are global.
 static CAMPAIGN: Mutex<()> = Mutex::new(());
 
+/// While alive, panics are recorded in [`LAST_PANIC`] instead of printed; only one exists at a
+/// time in a process.
+struct PanicCapture {
+    _only_one: MutexGuard<'static, ()>,
+}
+
+impl PanicCapture {
+    fn install() -> Self {
+        let only_one = CAMPAIGN.lock().unwrap_or_else(|e| e.into_inner());
+        panic::set_hook(Box::new(|info| {
+            let location = info
+                .location()
+                .map(|l| format!("{}:{}:{}", l.file(), l.line(), l.column()))
+                .unwrap_or_else(|| "unknown".into());
+            let message = if let Some(s) = info.payload().downcast_ref::<&str>() {
+                s.to_string()
+            } else if let Some(s) = info.payload().downcast_ref::<String>() {
+                s.clone()
+            } else {
+                "(non-text panic payload)".into()
+            };
+            *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()) = Some((location, message));
+        }));
+        Self {
+            _only_one: only_one,
+        }
+    }
+}
+
+impl Drop for PanicCapture {
+    fn drop(&mut self) {
+        // Back to the default hook, which prints panics.
+        drop(panic::take_hook());
+    }
+}
+
+/// Runs one saved input; if it panics, returns where and what with the input minimized for up
+/// to `minimize_for`.
+pub fn replay<T: Target>(
+    target: &T,
+    input: T::Input,
+    minimize_for: Duration,
+) -> Result<Outcome, (String, String, T::Input)> {
+    let _capture = PanicCapture::install();
+    run_one(target, &input).map_err(|(location, message)| {
+        let small = minimize(target, input, &location, minimize_for);
+        (location, message, small)
+    })
+}
+
 /// Runs `settings.inputs` inputs of `target` and reports what happened.
 pub fn run<T: Target>(target: &mut T, settings: &Settings) -> Report {
-    let _only_campaign = CAMPAIGN.lock().unwrap_or_else(|e| e.into_inner());
-    let previous_hook = panic::take_hook();
-    panic::set_hook(Box::new(|info| {
-        let location = info
-            .location()
-            .map(|l| format!("{}:{}:{}", l.file(), l.line(), l.column()))
-            .unwrap_or_else(|| "unknown".into());
-        let message = if let Some(s) = info.payload().downcast_ref::<&str>() {
-            s.to_string()
-        } else if let Some(s) = info.payload().downcast_ref::<String>() {
-            s.clone()
-        } else {
-            "(non-text panic payload)".into()
-        };
-        *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()) = Some((location, message));
-    }));
-
+    let capture = PanicCapture::install();
     let mut rng = Rng::with_seed(settings.seed);
     let mut findings: Vec<Finding> = Vec::new();
     let mut by_location: HashMap<String, usize> = HashMap::new();
     let (mut slow_inputs, mut slowest) = (0u64, Duration::ZERO);
+    let mut accepted = 0u64;
     let started = Instant::now();
     for n in 0..settings.inputs {
         let input = target.generate(&mut rng);
@@ -169,11 +208,14 @@ pub fn run<T: Target>(target: &mut T, settings: &Settings) -> Report {
             }
         }
         match result {
-            Ok(outcome) => target.learn(input, outcome),
+            Ok(outcome) => {
+                accepted += u64::from(outcome.parsed);
+                target.learn(input, outcome);
+            }
             Err((location, message)) => match by_location.get(&location) {
                 Some(&i) => findings[i].hits += 1,
                 None => {
-                    let small = minimize(target, input, &location);
+                    let small = minimize(target, input, &location, settings.minimize_for);
                     let saved = settings.crash_dir.as_ref().and_then(|dir| {
                         let name = format!("{}-crash-{}", target.name(), findings.len() + 1);
                         save(target, &small, dir, &name)
@@ -202,11 +244,12 @@ pub fn run<T: Target>(target: &mut T, settings: &Settings) -> Report {
         }
     }
     let elapsed = started.elapsed();
-    panic::set_hook(previous_hook);
+    drop(capture);
     Report {
         target: target.name(),
         inputs: settings.inputs,
         elapsed,
+        accepted,
         findings,
         slow_inputs,
         slowest,
@@ -226,8 +269,13 @@ fn run_one<T: Target>(target: &T, input: &T::Input) -> Result<Outcome, (String, 
 }
 
 /// Greedily takes smaller variants of `input` that still panic at `location`.
-fn minimize<T: Target>(target: &T, mut input: T::Input, location: &str) -> T::Input {
-    let deadline = Instant::now() + Duration::from_secs(20);
+fn minimize<T: Target>(
+    target: &T,
+    mut input: T::Input,
+    location: &str,
+    minimize_for: Duration,
+) -> T::Input {
+    let deadline = Instant::now() + minimize_for;
     'shrinking: while Instant::now() < deadline {
         for candidate in target.shrink(&input) {
             if Instant::now() > deadline {

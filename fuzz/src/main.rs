@@ -1,7 +1,7 @@
 //! `yat-fuzz`: runs a fuzz target for a number of inputs and reports inputs/s and the panics
 //! found; exits non-zero if any input panicked.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -61,7 +61,11 @@ struct RunArgs {
     /// Print progress every this many inputs (0: never).
     #[arg(long, default_value_t = 50_000)]
     progress: u64,
-    /// Run this saved input once, without catching its panic (shows the backtrace).
+    /// Seconds spent minimizing the input of each new panic.
+    #[arg(long, default_value_t = 20.0)]
+    minimize_seconds: f64,
+    /// Run this saved input once instead; if it panics, print where and save it minimized
+    /// beside it (<name>-min.case or .session).
     #[arg(long)]
     replay: Option<PathBuf>,
 }
@@ -69,7 +73,10 @@ struct RunArgs {
 fn main() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     let report = match cli.target {
-        TargetCommand::Parser { run, seed_scenes: dir } => {
+        TargetCommand::Parser {
+            run,
+            seed_scenes: dir,
+        } => {
             let root = workspace_root();
             let mut folders = SeedFolders {
                 scenes: vec![root.join("scenes")],
@@ -79,20 +86,18 @@ fn main() -> anyhow::Result<ExitCode> {
             let mut target = ParserTarget::new(&folders).context("loading the parser seeds")?;
             eprintln!("parser: {} seed scenes", target.seed_count());
             if let Some(path) = &run.replay {
-                let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+                let bytes = read(path)?;
                 let case = Case::decode(&bytes).context("not a saved parser case")?;
-                println!("{:?}", target.execute(&case));
-                return Ok(ExitCode::SUCCESS);
+                return replay(&target, case, path, &run);
             }
             campaign::run(&mut target, &run.settings())
         }
         TargetCommand::Wire { run } => {
             let mut target = WireTarget::new();
             if let Some(path) = &run.replay {
-                let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+                let bytes = read(path)?;
                 let session = Session::decode(&bytes).context("not a saved wire session")?;
-                println!("{:?}", target.execute(&session));
-                return Ok(ExitCode::SUCCESS);
+                return replay(&target, session, path, &run);
             }
             campaign::run(&mut target, &run.settings())
         }
@@ -112,6 +117,34 @@ impl RunArgs {
             ),
             slow: Duration::from_secs_f64(self.slow_seconds),
             progress_every: self.progress,
+            minimize_for: Duration::from_secs_f64(self.minimize_seconds),
+        }
+    }
+}
+
+fn read(path: &Path) -> anyhow::Result<Vec<u8>> {
+    std::fs::read(path).with_context(|| format!("reading {}", path.display()))
+}
+
+/// Runs one saved input; a panicking one is minimized and saved beside it as `<name>-min`.
+fn replay<T: Target>(
+    target: &T,
+    input: T::Input,
+    path: &Path,
+    run: &RunArgs,
+) -> anyhow::Result<ExitCode> {
+    let minimize_for = Duration::from_secs_f64(run.minimize_seconds);
+    match campaign::replay(target, input, minimize_for) {
+        Ok(outcome) => {
+            println!("no panic ({} outcome features)", outcome.features.len());
+            Ok(ExitCode::SUCCESS)
+        }
+        Err((location, message, small)) => {
+            let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+            let saved = target.save(&small, &path.with_file_name(format!("{stem}-min")))?;
+            println!("panic at {location}: {message}");
+            println!("minimized input: {}", saved.display());
+            Ok(ExitCode::FAILURE)
         }
     }
 }

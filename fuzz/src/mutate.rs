@@ -169,8 +169,11 @@ impl Mutator {
                 .as_bytes()
                 .to_vec(),
             TokenChoice::Str => {
-                let quoted: Vec<&Vec<u8>> =
-                    self.dictionary.iter().filter(|w| w.first() == Some(&b'"')).collect();
+                let quoted: Vec<&Vec<u8>> = self
+                    .dictionary
+                    .iter()
+                    .filter(|w| w.first() == Some(&b'"'))
+                    .collect();
                 match quoted.len() {
                     0 => self.word(rng).to_vec(),
                     n => quoted[rng.usize(0..n)].clone(),
@@ -195,7 +198,11 @@ fn range(rng: &mut Rng, len: usize) -> Span {
     }
     let start = rng.usize(0..len);
     // Mostly short ranges, sometimes long ones.
-    let max = if rng.u8(0..8) == 0 { len - start } else { (len - start).min(16) };
+    let max = if rng.u8(0..8) == 0 {
+        len - start
+    } else {
+        (len - start).min(16)
+    };
     start..start + rng.usize(1..=max)
 }
 

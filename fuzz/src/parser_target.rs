@@ -10,8 +10,8 @@
 //! missing ones get a stand-in. Every input also carries the stand-in meshes and images of
 //! [`crate::stand_ins`], so mutations that name them reach the PLY reader and image decoders.
 
-use std::collections::hash_map::DefaultHasher;
 use std::cell::Cell;
+use std::collections::hash_map::DefaultHasher;
 use std::collections::HashSet;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -72,35 +72,137 @@ const UNIT: WorkUnit = WorkUnit {
 /// Words the mutator inserts: statement keywords, type names, parameter declarations, the
 /// input's file names, and PLY header lines.
 const DICTIONARY: &[&str] = &[
-    "Identity", "Translate 1 2 3", "Scale 0 0 0", "Rotate 90 0 0 1", "LookAt", "Transform",
-    "ConcatTransform", "CoordinateSystem \"a\"", "CoordSysTransform \"a\"", "MotionBegin [0 1]",
-    "MotionEnd", "AttributeBegin", "AttributeEnd", "TransformBegin", "TransformEnd",
-    "WorldBegin", "WorldEnd", "Include", "Camera", "Film", "PixelFilter", "Sampler",
-    "SurfaceIntegrator", "Accelerator", "Renderer", "VolumeIntegrator", "Volume", "Exterior",
-    "Texture", "Material", "MakeNamedMaterial", "NamedMaterial", "LightSource",
-    "AreaLightSource", "Shape", "ReverseOrientation", "ObjectBegin \"o\"", "ObjectEnd",
-    "ObjectInstance \"o\"", "\"matte\"", "\"glossy\"", "\"glass\"", "\"metal\"", "\"mix\"",
-    "\"null\"", "\"mirror\"", "\"mattetranslucent\"", "\"roughglass\"", "\"metal2\"",
-    "\"imagemap\"", "\"checkerboard\"", "\"constant\"", "\"scale\"", "\"blackbody\"",
-    "\"fresnel\"", "\"color\"", "\"float\"", "\"point\"", "\"spot\"", "\"distant\"",
-    "\"infinite\"", "\"area\"", "\"sphere\"", "\"disk\"", "\"cylinder\"", "\"plane\"",
-    "\"trianglemesh\"", "\"plymesh\"", "\"perspective\"", "\"orthographic\"", "\"fisheye\"",
-    "\"fleximage\"", "\"mitchell\"", "\"gaussian\"", "\"sinc\"", "\"path\"",
-    "\"float radius\"", "\"integer indices\"", "\"point P\"", "\"normal N\"", "\"float uv\"",
-    "\"color Kd\"", "\"texture Kd\"", "\"float fov\"", "\"integer xresolution\"",
-    "\"integer yresolution\"", "\"string filename\"", "\"string mapname\"",
-    "\"string mapping\"", "\"float screenwindow\"", "\"integer dimension\"",
-    "\"string namedmaterial1\"", "\"texture amount\"", "\"bool architectural\"",
-    "\"integer maxdepth\"", "\"integer pixelsamples\"", "\"float coneangle\"",
-    "\"color L\"", "\"float gain\"", "\"float power\"", "\"spectrum Kd\"", "\"vector v1\"",
-    "\"integer quadindices\"", "\"string type\"", "\"float uroughness\"",
-    "\"string wrap\"", "\"float gamma\"", "\"float temperature\"", "\"string name\"",
-    "\"bool\"", "\"true\"", "\"false\"",
-    "\"mesh.ply\"", "\"mesh-bin.ply\"", "\"tex.png\"", "\"tex.jpg\"", "\"tex.exr\"",
-    "\"env.hdr\"", "\"inc.lxo\"", "\"main.lxs\"", "\"\"", "\"../../etc/passwd\"", "\"/\"",
-    "element vertex 4294967295", "element face 1000000000", "property float x",
-    "property list uchar int vertex_indices", "property list uint uint vertex_indices",
-    "format binary_big_endian 1.0", "format ascii 1.0", "end_header",
+    "Identity",
+    "Translate 1 2 3",
+    "Scale 0 0 0",
+    "Rotate 90 0 0 1",
+    "LookAt",
+    "Transform",
+    "ConcatTransform",
+    "CoordinateSystem \"a\"",
+    "CoordSysTransform \"a\"",
+    "MotionBegin [0 1]",
+    "MotionEnd",
+    "AttributeBegin",
+    "AttributeEnd",
+    "TransformBegin",
+    "TransformEnd",
+    "WorldBegin",
+    "WorldEnd",
+    "Include",
+    "Camera",
+    "Film",
+    "PixelFilter",
+    "Sampler",
+    "SurfaceIntegrator",
+    "Accelerator",
+    "Renderer",
+    "VolumeIntegrator",
+    "Volume",
+    "Exterior",
+    "Texture",
+    "Material",
+    "MakeNamedMaterial",
+    "NamedMaterial",
+    "LightSource",
+    "AreaLightSource",
+    "Shape",
+    "ReverseOrientation",
+    "ObjectBegin \"o\"",
+    "ObjectEnd",
+    "ObjectInstance \"o\"",
+    "\"matte\"",
+    "\"glossy\"",
+    "\"glass\"",
+    "\"metal\"",
+    "\"mix\"",
+    "\"null\"",
+    "\"mirror\"",
+    "\"mattetranslucent\"",
+    "\"roughglass\"",
+    "\"metal2\"",
+    "\"imagemap\"",
+    "\"checkerboard\"",
+    "\"constant\"",
+    "\"scale\"",
+    "\"blackbody\"",
+    "\"fresnel\"",
+    "\"color\"",
+    "\"float\"",
+    "\"point\"",
+    "\"spot\"",
+    "\"distant\"",
+    "\"infinite\"",
+    "\"area\"",
+    "\"sphere\"",
+    "\"disk\"",
+    "\"cylinder\"",
+    "\"plane\"",
+    "\"trianglemesh\"",
+    "\"plymesh\"",
+    "\"perspective\"",
+    "\"orthographic\"",
+    "\"fisheye\"",
+    "\"fleximage\"",
+    "\"mitchell\"",
+    "\"gaussian\"",
+    "\"sinc\"",
+    "\"path\"",
+    "\"float radius\"",
+    "\"integer indices\"",
+    "\"point P\"",
+    "\"normal N\"",
+    "\"float uv\"",
+    "\"color Kd\"",
+    "\"texture Kd\"",
+    "\"float fov\"",
+    "\"integer xresolution\"",
+    "\"integer yresolution\"",
+    "\"string filename\"",
+    "\"string mapname\"",
+    "\"string mapping\"",
+    "\"float screenwindow\"",
+    "\"integer dimension\"",
+    "\"string namedmaterial1\"",
+    "\"texture amount\"",
+    "\"bool architectural\"",
+    "\"integer maxdepth\"",
+    "\"integer pixelsamples\"",
+    "\"float coneangle\"",
+    "\"color L\"",
+    "\"float gain\"",
+    "\"float power\"",
+    "\"spectrum Kd\"",
+    "\"vector v1\"",
+    "\"integer quadindices\"",
+    "\"string type\"",
+    "\"float uroughness\"",
+    "\"string wrap\"",
+    "\"float gamma\"",
+    "\"float temperature\"",
+    "\"string name\"",
+    "\"bool\"",
+    "\"true\"",
+    "\"false\"",
+    "\"mesh.ply\"",
+    "\"mesh-bin.ply\"",
+    "\"tex.png\"",
+    "\"tex.jpg\"",
+    "\"tex.exr\"",
+    "\"env.hdr\"",
+    "\"inc.lxo\"",
+    "\"main.lxs\"",
+    "\"\"",
+    "\"../../etc/passwd\"",
+    "\"/\"",
+    "element vertex 4294967295",
+    "element face 1000000000",
+    "property float x",
+    "property list uchar int vertex_indices",
+    "property list uint uint vertex_indices",
+    "format binary_big_endian 1.0",
+    "format ascii 1.0",
+    "end_header",
 ];
 
 /// A scene input: the main file first, then every other file it may reference.
@@ -124,7 +226,10 @@ impl Case {
             .filter(|&i| !self.is_binary(i))
             .map(|i| &self.files[i].1[..])
             .collect();
-        let named = |name: &[u8]| text.iter().any(|t| t.windows(name.len()).any(|w| w == name));
+        let named = |name: &[u8]| {
+            text.iter()
+                .any(|t| t.windows(name.len()).any(|w| w == name))
+        };
         (0..self.files.len())
             .filter(|&i| i == 0 || named(self.files[i].0.as_bytes()))
             .collect()
@@ -146,7 +251,9 @@ impl Case {
         let mut files = Vec::new();
         while !data.is_empty() {
             let end = data.iter().position(|&b| b == b'\n')?;
-            let header = std::str::from_utf8(&data[..end]).ok()?.strip_prefix("=== ")?;
+            let header = std::str::from_utf8(&data[..end])
+                .ok()?
+                .strip_prefix("=== ")?;
             let (name, len) = header.rsplit_once(' ')?;
             let len: usize = len.parse().ok()?;
             let body = data.get(end + 1..end + 1 + len)?;
@@ -206,7 +313,11 @@ impl ParserTarget {
             }
         }
         for dir in &folders.scenes {
-            seeds.extend(files_in(dir)?.into_iter().filter(|p| p.extension().is_some_and(|e| e == "lxs")));
+            seeds.extend(
+                files_in(dir)?
+                    .into_iter()
+                    .filter(|p| p.extension().is_some_and(|e| e == "lxs")),
+            );
         }
         seeds.sort();
         let mut corpus = Vec::with_capacity(seeds.len());
@@ -256,8 +367,16 @@ impl Target for ParserTarget {
         // A file the scene uses: the main file, or one its text names (an include, a mesh,
         // an image); scene text three times as often as meshes and images.
         let used = case.used_files();
-        let text: Vec<usize> = used.iter().copied().filter(|&i| !case.is_binary(i)).collect();
-        let binary: Vec<usize> = used.iter().copied().filter(|&i| case.is_binary(i)).collect();
+        let text: Vec<usize> = used
+            .iter()
+            .copied()
+            .filter(|&i| !case.is_binary(i))
+            .collect();
+        let binary: Vec<usize> = used
+            .iter()
+            .copied()
+            .filter(|&i| case.is_binary(i))
+            .collect();
         let target = if binary.is_empty() || rng.u8(0..4) > 0 {
             text[rng.usize(0..text.len())]
         } else {
@@ -304,7 +423,10 @@ impl Target for ParserTarget {
         // The exporter's path: analytic shapes as triangles.
         for shape in desc.shapes.iter().take(MAX_TESSELLATED_SHAPES) {
             if let Some(mesh) = tessellate(&shape.geometry, TESSELLATION_SEGMENTS) {
-                features.push(skeleton_hash("tessellated", &format!("{}", mesh.indices.is_empty())));
+                features.push(skeleton_hash(
+                    "tessellated",
+                    &format!("{}", mesh.indices.is_empty()),
+                ));
             }
         }
         if is_too_big_to_build(&desc) {
@@ -452,7 +574,13 @@ fn skeleton_hash(kind: &str, message: &str) -> u64 {
 /// Ranges of whole lines to try deleting: halves, quarters, ... down to single lines.
 fn line_chunks(bytes: &[u8]) -> Vec<std::ops::Range<usize>> {
     let mut starts: Vec<usize> = std::iter::once(0)
-        .chain(bytes.iter().enumerate().filter(|(_, &b)| b == b'\n').map(|(i, _)| i + 1))
+        .chain(
+            bytes
+                .iter()
+                .enumerate()
+                .filter(|(_, &b)| b == b'\n')
+                .map(|(i, _)| i + 1),
+        )
         .filter(|&s| s < bytes.len())
         .collect();
     starts.push(bytes.len());
@@ -556,9 +684,9 @@ impl AssetSource for RecordingSource {
 /// starting with a capital letter).
 fn cut_at_statement(text: &[u8], max: usize) -> &[u8] {
     let limit = max.min(text.len());
-    let cut = (1..limit)
+    let cut = (1..=limit)
         .rev()
-        .find(|&i| text[i - 1] == b'\n' && text[i].is_ascii_uppercase())
+        .find(|&i| text[i - 1] == b'\n' && text.get(i).is_some_and(u8::is_ascii_uppercase))
         .unwrap_or(0);
     &text[..cut]
 }
@@ -583,7 +711,10 @@ mod tests {
     #[test]
     fn scene_text_is_cut_before_a_statement() {
         let text = b"Shape \"x\"\n  \"point P\" [1 2 3]\nShape \"y\"\n 4 5\n";
-        assert_eq!(cut_at_statement(text, 30), b"Shape \"x\"\n  \"point P\" [1 2 3]\n");
+        assert_eq!(
+            cut_at_statement(text, 30),
+            b"Shape \"x\"\n  \"point P\" [1 2 3]\n"
+        );
         assert_eq!(cut_at_statement(text, 5), b"");
     }
 

@@ -85,7 +85,12 @@ property int vertex2
 end_header
 "
     .to_vec();
-    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] {
+    for p in [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ] {
         for v in p {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -110,8 +115,10 @@ fn image_bytes(format: ImageFormat) -> Vec<u8> {
             Rgb32FImage::from_fn(4, 4, |x, y| image::Rgb([x as f32, y as f32 * 0.5, 2.0]))
                 .write_to(&mut out, format)
         }
-        _ => RgbImage::from_fn(4, 4, |x, y| image::Rgb([(x * 60) as u8, (y * 60) as u8, 128]))
-            .write_to(&mut out, format),
+        _ => RgbImage::from_fn(4, 4, |x, y| {
+            image::Rgb([(x * 60) as u8, (y * 60) as u8, 128])
+        })
+        .write_to(&mut out, format),
     };
     written.expect("encoding a 4x4 image in memory cannot fail");
     out.into_inner()

@@ -142,7 +142,10 @@ impl WireTarget {
         Self {
             paths: RefCell::default(),
             corpus: seed_sessions(),
-            mutator: Mutator::new(MAX_FRAME_BYTES, &["Bearer ", "Bearer s3cret-token", "14", "yat-draining"]),
+            mutator: Mutator::new(
+                MAX_FRAME_BYTES,
+                &["Bearer ", "Bearer s3cret-token", "14", "yat-draining"],
+            ),
         }
     }
 }
@@ -244,10 +247,17 @@ impl Target for WireTarget {
     fn progress(&self) -> String {
         let paths = self.paths.borrow();
         let frames: u64 = paths.values().sum();
-        let decoded: u64 = paths.iter().filter(|(p, _)| *p % 16 > 0).map(|(_, n)| n).sum();
+        let decoded: u64 = paths
+            .iter()
+            .filter(|(p, _)| *p % 16 > 0)
+            .map(|(_, n)| n)
+            .sum();
         let merged = paths
             .iter()
-            .filter(|(p, _)| **p >= Kind::RenderUnitReply as u64 * 16 + 7 && **p < Kind::RenderUnitReply as u64 * 16 + 16)
+            .filter(|(p, _)| {
+                **p >= Kind::RenderUnitReply as u64 * 16 + 7
+                    && **p < Kind::RenderUnitReply as u64 * 16 + 16
+            })
             .map(|(_, n)| n)
             .sum::<u64>();
         format!(
@@ -331,7 +341,9 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
             let Ok(buffer) = decode_pixels(unit, &reply.pixels) else {
                 return 3;
             };
-            let Some(film) = &mut state.film else { return 4 };
+            let Some(film) = &mut state.film else {
+                return 4;
+            };
             if film.add(&buffer).is_err() {
                 return 5;
             }
@@ -517,12 +529,18 @@ fn mutate_protobuf(rng: &mut Rng, data: &mut Vec<u8>, depth: u32) {
         match (field, rng.u8(0..6)) {
             (Field::Varint(_), _) => {
                 write_varint(&mut out, number << 3);
-                write_varint(&mut out, EXTREME_VARINTS[rng.usize(0..EXTREME_VARINTS.len())]);
+                write_varint(
+                    &mut out,
+                    EXTREME_VARINTS[rng.usize(0..EXTREME_VARINTS.len())],
+                );
             }
             (Field::Bytes(inner), 0) => {
                 // A length beyond the data.
                 write_varint(&mut out, (number << 3) | 2);
-                write_varint(&mut out, inner.len() as u64 + rng.u64(1..=u64::from(u32::MAX)));
+                write_varint(
+                    &mut out,
+                    inner.len() as u64 + rng.u64(1..=u64::from(u32::MAX)),
+                );
                 out.extend_from_slice(inner);
             }
             (Field::Bytes(inner), 1) => {
@@ -556,7 +574,10 @@ fn mutate_protobuf(rng: &mut Rng, data: &mut Vec<u8>, depth: u32) {
                     }
                 } else {
                     write_varint(&mut out, number << 3);
-                    write_varint(&mut out, EXTREME_VARINTS[rng.usize(0..EXTREME_VARINTS.len())]);
+                    write_varint(
+                        &mut out,
+                        EXTREME_VARINTS[rng.usize(0..EXTREME_VARINTS.len())],
+                    );
                 }
                 let _ = field;
             }
@@ -588,7 +609,11 @@ fn write_field(out: &mut Vec<u8>, number: u64, wire_type: u64, field: &Field<'_>
 fn seed_sessions() -> Vec<Session> {
     let frame = |kind, bytes: Vec<u8>| Frame { kind, bytes };
     let mut sessions = Vec::new();
-    for (width, height, spp, tile) in [(100, 50, 16, (64, 0, 100, 50)), (8, 8, 1, (0, 0, 8, 8)), (65_536, 4096, 1 << 24, (0, 0, 64, 64))] {
+    for (width, height, spp, tile) in [
+        (100, 50, 16, (64, 0, 100, 50)),
+        (8, 8, 1, (0, 0, 8, 8)),
+        (65_536, 4096, 1 << 24, (0, 0, 64, 64)),
+    ] {
         let settings = pb::RenderSettings {
             width,
             height,
@@ -724,7 +749,10 @@ fn seed_sessions() -> Vec<Session> {
             ),
             frame(Kind::Authorization, format!("Bearer {TOKEN}").into_bytes()),
             frame(Kind::Authorization, b"Bearer wrong".to_vec()),
-            frame(Kind::StatusTrailers, b"14\0worker draining: unit 3 refused\x001".to_vec()),
+            frame(
+                Kind::StatusTrailers,
+                b"14\0worker draining: unit 3 refused\x001".to_vec(),
+            ),
             frame(Kind::StatusTrailers, b"13\0internal%20error".to_vec()),
         ],
     });
@@ -745,10 +773,16 @@ mod tests {
         let reply = Kind::RenderUnitReply as u64 * 16;
         assert!(first.contains(&(load + 4)), "{first:?}");
         assert!(first.contains(&(unit + 3)), "{first:?}");
-        assert!(first.contains(&(reply + 8)) || first.contains(&(reply + 7)), "{first:?}");
+        assert!(
+            first.contains(&(reply + 8)) || first.contains(&(reply + 7)),
+            "{first:?}"
+        );
         let last = target.execute(target.corpus.last().unwrap()).features;
         let auth = Kind::Authorization as u64 * 16;
-        assert!(last.contains(&(auth + 2)) && last.contains(&(auth + 1)), "{last:?}");
+        assert!(
+            last.contains(&(auth + 2)) && last.contains(&(auth + 1)),
+            "{last:?}"
+        );
         let trailers = Kind::StatusTrailers as u64 * 16;
         assert!(last.contains(&(trailers + 8)), "a drain is seen: {last:?}");
     }
@@ -778,7 +812,9 @@ mod tests {
         for _ in 0..100 {
             let mut m = bytes.clone();
             mutate_protobuf(&mut rng, &mut m, 0);
-            differ += usize::from(pb::WorkUnit::decode(&m[..]).ok() != pb::WorkUnit::decode(&bytes[..]).ok());
+            differ += usize::from(
+                pb::WorkUnit::decode(&m[..]).ok() != pb::WorkUnit::decode(&bytes[..]).ok(),
+            );
         }
         assert!(differ > 80, "{differ} of 100 mutations changed the message");
     }
