@@ -562,7 +562,7 @@ fn mutate_protobuf(rng: &mut Rng, data: &mut Vec<u8>, depth: u32) {
                 mutate_protobuf(rng, &mut content, depth + 1);
                 write_field(&mut out, *number, 2, &Field::Bytes(&content));
             }
-            (field, _) => {
+            _ => {
                 // A fixed field made NaN, infinite or huge; or a wire type the field does not have.
                 if rng.bool() {
                     write_varint(&mut out, (number << 3) | wire_type);
@@ -579,7 +579,6 @@ fn mutate_protobuf(rng: &mut Rng, data: &mut Vec<u8>, depth: u32) {
                         EXTREME_VARINTS[rng.usize(0..EXTREME_VARINTS.len())],
                     );
                 }
-                let _ = field;
             }
         }
     }
