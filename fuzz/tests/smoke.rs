@@ -10,10 +10,9 @@ use yat_fuzz::workspace::workspace_root;
 
 const INPUTS: u64 = 2_000;
 
-/// Where the panics still open are: the BVH build (obvhs) on huge world coordinates, whose fix
-/// is the geometry's world-range check (another branch). Their minimized inputs are ignored
-/// tests in `tracer/tests/integration/fuzz_regressions.rs`; when that fix is merged, un-ignore
-/// them and make this filter empty.
+/// Where the panics still open are: the BVH build (obvhs) on huge world coordinates, to be fixed
+/// in the geometry. Their minimized inputs are ignored tests in
+/// `tracer/tests/integration/fuzz_regressions.rs`; once they all pass, empty this filter.
 const OPEN_PANICS_IN: &[&str] = &["/obvhs-"];
 
 fn settings() -> Settings {
