@@ -1,0 +1,168 @@
+//! Inputs the fuzzer (`fuzz/`, `yat-fuzz parser`) found panicking, minimized, run the way the
+//! fuzzer runs them: parsed from memory, built, and one small unit rendered. Each must end in a
+//! value (a scene, or an error), never a panic.
+//!
+//! Every panic found so far is in the BVH build (obvhs) on huge world coordinates: the fix
+//! belongs to the geometry (`tracer/src/geometry`), not to the parser, so these tests are
+//! ignored until it is merged. The world-range check of the `files` branch (coordinates beyond
+//! 1e15 skipped, as of its commit 0de038a) makes five of them pass. The two marked "debug"
+//! and "still open" panic only with debug assertions (obvhs's own tree checks, as in
+//! `cargo test`) on coordinates near 2^31, inside that range; release builds do not panic on
+//! them.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Arc;
+
+use yat_tracer::assets::MemorySource;
+use yat_tracer::desc::LatLongConvention;
+use yat_tracer::parse::parse_scene;
+use yat_tracer::render::{RenderScene, RenderSettings, WorkUnit};
+
+/// Parses `main` (with `includes`), builds it and renders one 8x8 unit at 2 samples per pixel;
+/// fails the test with the panic's message if any step panics.
+fn parse_build_render(main: &str, includes: &[(&str, &str)]) {
+    let mut source = MemorySource::new();
+    source.insert("main.lxs", Arc::from(main.as_bytes()));
+    for (name, text) in includes {
+        source.insert(*name, Arc::from(text.as_bytes()));
+    }
+    let settings = RenderSettings {
+        width: 8,
+        height: 8,
+        spp: 2,
+        max_depth: 4,
+        seed: 1,
+        latlong: LatLongConvention::LuxRender,
+    };
+    let unit = WorkUnit {
+        index: 0,
+        x0: 0,
+        y0: 0,
+        x1: 8,
+        y1: 8,
+        sample_start: 0,
+        sample_end: 2,
+    };
+    let run = catch_unwind(AssertUnwindSafe(|| {
+        let Ok(desc) = parse_scene("main.lxs", &source) else {
+            return;
+        };
+        if let Ok(scene) = RenderScene::build(&desc, &source, &settings) {
+            let (buffer, _) = scene.render_unit(&unit);
+            assert_eq!(buffer.weight.len(), 64);
+        }
+    }));
+    if let Err(panic) = run {
+        let message = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("(no message)");
+        panic!("the input panicked: {message}");
+    }
+}
+
+#[test]
+#[ignore = "panics in the BVH build until the geometry's world-range check is merged"]
+fn a_sphere_of_radius_1e38_in_an_include() {
+    parse_build_render(
+        "WorldBegin\nInclude \"objects.lxo\"\n",
+        &[(
+            "objects.lxo",
+            "Shape \"sphere\" \"float radius\" 1e38\nShape \"sphere\" \"float radius\" 0.5\n",
+        )],
+    );
+}
+
+#[test]
+#[ignore = "panics in the BVH build until the geometry's world-range check is merged"]
+fn a_sphere_of_radius_3e38_alone() {
+    parse_build_render(
+        "WorldBegin\nShape \"sphere\" \"float radius\" [3e38]\n",
+        &[],
+    );
+}
+
+#[test]
+#[ignore = "panics in the BVH build until the geometry's world-range check is merged"]
+fn a_disk_of_radius_3e38() {
+    parse_build_render(
+        "WorldBegin\nShape \"disk\" \"float radius\" 3e38\nShape \"sphere\" \"float radius\" 0.5\n",
+        &[],
+    );
+}
+
+#[test]
+#[ignore = "panics in the BVH build until the geometry's world-range check is merged"]
+fn an_object_instanced_at_3e38() {
+    parse_build_render(
+        "WorldBegin
+ObjectBegin \"ball\"
+  Shape \"disk\" \"float radius\" [1] \"float innerradius\" [0.2] \"float height\" [0.1] \"float phimax\" [270]
+ObjectEnd
+Translate 2 3e38 0
+ObjectInstance \"ball\"
+",
+        &[],
+    );
+}
+
+/// Debug, still open: a cube with one corner at x = -2^31 - 1.
+#[test]
+#[ignore = "still open: obvhs debug assertions on coordinates near 2^31 (inside the world range)"]
+fn a_cube_corner_at_minus_2_pow_31() {
+    parse_build_render(
+        "WorldBegin\nInclude \"cube.lxo\"\n",
+        &[(
+            "cube.lxo",
+            "Transform [0.5 0 0 0 0 0.5 0 0 0 0 1 0 -1 -2.18370795249939 1 1]
+Shape \"mesh\"
+  \"integer triindices\" [0 1 2 0 2 3 4 5 6 4 6 7 8 9 10 8 10 11 12 13 14 12 14 15 16 17 18 16 18 19 20 21 22 20 22 23]
+  \"point P\" [-1 1 -1 -1 -1 -1 -2147483649 -1 1 -1 1 1 -1 1 1 1 1 1 1 1 -1 -1 1 -1 1 1 1 1 -1 1 1 -1
+    -1 1 1 -1 -1 -1 -1 1 -1 -1 1 -1 1 -1 -1 1 -1 -1 -1 -1 1 -1 1 1 -1 1 -1 -1 1 -1 1 1 1 1 -1 1 1 -1 -1 1]
+",
+        )],
+    );
+}
+
+/// Debug, still open: spheres of radius 0.45 and 360 beside a quad with a corner at z = -2^31.
+#[test]
+#[ignore = "still open: obvhs debug assertions on coordinates near 2^31 (inside the world range)"]
+fn a_quad_corner_at_minus_2_pow_31_beside_spheres() {
+    parse_build_render(
+        "WorldBegin
+NamedMaterial \"roughglass\"  Translate -0.6 0 0.45 Shape \"sphere\" \"float radius\" 0.45
+NamedMaterial \"gold\"        Translate  0.6 0 0.45 Shape \"sphere\" \"float radius\" 0.45
+NamedMaterial \"copperish\"   Translate  1.8 0 0.45 Shape \"sphere\" \"float radius\" 0.45
+AttributeBegin NamedMaterial \"mix\" Translate 3.0 0 0.45 Shape \"sphere\" \"float radius\" 360 AttributeEnd
+Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]
+  \"point P\" [-3 -2 6  -3 2 6  3 2 6  3 -2 -2147483648]
+",
+        &[],
+    );
+}
+
+/// Debug: instances 2^64 and 2^31 away from the origin, seen from a mirrored camera.
+#[test]
+#[ignore = "panics in the BVH build until the geometry's world-range check is merged"]
+fn instances_at_2_pow_64_and_2_pow_31() {
+    parse_build_render(
+        "Scale -1 1 1
+LookAt 0 10 100  0 -1 0  0 1 0
+Camera \"perspective\" \"float fov\" [30]
+WorldBegin
+CoordSysTransform \"camera\"
+ObjectBegin \"ball\"
+  Shape \"sphere\" \"float radius\" [0.5]
+  Shape \"disk\" \"float radius\" [1] \"float innerradius\" [0.2] \"float height\" [0.1] \"float phimax\" [270]
+ObjectEnd
+AttributeBegin
+  Translate 18446744073709551616 0 0
+  ObjectInstance \"ball\"
+AttributeEnd
+Translate -2 2147483647 0
+ObjectInstance \"ball\"
+",
+        &[],
+    );
+}
