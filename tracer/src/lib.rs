@@ -18,6 +18,7 @@
 extern crate self as yat_tracer;
 
 pub mod assets;
+pub mod budget;
 pub mod bxdf;
 pub mod camera;
 pub mod desc;

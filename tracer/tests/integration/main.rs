@@ -2,6 +2,9 @@
 //! malformed input, whole renders with numbers, and the seed scenes when they are present.
 
 mod geometry_on_scenes;
+#[path = "../../../tests/fixtures/hostile.rs"]
+mod hostile;
+mod hostile_scenes;
 mod parse_conventions;
 mod parse_errors;
 mod render;
