@@ -21,7 +21,8 @@ pub const DEFAULT_MAX_INCLUDE_VISITS: u64 = 10_000;
 /// every instance, when the command line does not say: 2^26, some 16 GiB of built geometry.
 pub const DEFAULT_MAX_PRIMITIVES: u64 = 1 << 26;
 /// Texels of the distinct image files decoded when the command line does not say: 2^29, for
-/// example two 16k x 16k environment maps.
+/// example eight 8k x 8k maps (1.5 GiB as 8-bit RGB). One image is also held to the `image`
+/// crate's own decoding limit of 512 MiB.
 pub const DEFAULT_MAX_TEXELS: u64 = 1 << 29;
 
 /// What a scene may cost to parse and build; every figure counts the whole scene.

@@ -182,9 +182,9 @@ impl<'s> Builder<'s> {
     pub(super) fn spend(&mut self, limit: Limit, amount: u64, pos: &Pos) -> Result<(), ParseError> {
         self.spent
             .spend(self.guard.budget, limit, amount)
-            .map_err(|source| ParseError::OverBudget {
+            .map_err(|exceeded| ParseError::OverBudget {
                 pos: pos.clone(),
-                source,
+                exceeded,
             })
     }
 
@@ -200,10 +200,7 @@ impl<'s> Builder<'s> {
         while let Some((keyword, pos)) = r.keyword()? {
             self.guard
                 .check_cancel()
-                .map_err(|source| ParseError::Cancelled {
-                    pos: pos.clone(),
-                    source,
-                })?;
+                .map_err(|_| ParseError::Cancelled { pos: pos.clone() })?;
             self.statement(keyword, &pos, &mut r)?;
         }
         self.include_stack.pop();

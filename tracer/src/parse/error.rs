@@ -31,11 +31,14 @@ pub enum ParseError {
         message: String,
     },
     /// The statement at `pos` took the scene over its build budget.
-    #[error("{pos}: {source}")]
-    OverBudget { pos: SourcePos, source: OverBudget },
+    #[error("{pos}: {exceeded}")]
+    OverBudget {
+        pos: SourcePos,
+        exceeded: OverBudget,
+    },
     /// The parse was abandoned through its cancel flag (at the statement at `pos`).
-    #[error("{pos}: {source}")]
-    Cancelled { pos: SourcePos, source: Cancelled },
+    #[error("{pos}: {}", Cancelled)]
+    Cancelled { pos: SourcePos },
     /// A PLY file is malformed.
     #[error("{pos}: PLY file \"{path}\": {message}")]
     Ply {
