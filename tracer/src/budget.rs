@@ -5,7 +5,8 @@
 //! times...), an image whose header claims 60000 x 60000 texels. Every node checks the same
 //! [`BuildBudget`] while it parses and builds, and stops with an error naming the limit, the
 //! figure reached and the statement (file:line:col) that reached it. The defaults leave room for
-//! every scene the project renders (the largest, CaptainFalcon, uses a few percent of each).
+//! every scene the project renders (CaptainFalcon: 10 107 triangles, 2.2 million texels, 1.3 MB
+//! of scene text, well under one percent of each).
 //!
 //! [`BuildGuard`] adds a cancel flag checked at the same points, so a worker whose coordinator
 //! went away can abandon a build.
