@@ -2,8 +2,8 @@
 //!
 //! A scene file of a few kilobytes can describe gigabytes: an object instanced a million times,
 //! an Include fan-out (a file including another ten times, which includes another ten
-//! times...), an image whose header claims 60000 x 60000 texels. Every node checks the same
-//! [`BuildBudget`] while it parses and builds, and stops with an error naming the limit, the
+//! times...), an image whose header claims 60000 x 60000 texels. Every node checks its own
+//! [`BuildBudget`] (set by its flags) while it parses and builds, and stops with an error naming the limit, the
 //! figure reached and the statement (file:line:col) that reached it. The defaults leave room for
 //! every scene the project renders (CaptainFalcon: 10 107 triangles, 2.2 million texels, 1.3 MB
 //! of scene text, well under one percent of each).
