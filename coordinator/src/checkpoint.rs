@@ -6,17 +6,23 @@
 //! File layout (little-endian): magic, format version, render identity (64 hex bytes), width,
 //! height, unit count, a bit per unit of the plan, the film's four i64 sums per pixel, and the
 //! SHA-256 of everything before it.
+//!
+//! The file is only written through an exclusive temporary file renamed over it, and only read
+//! when it is a regular file of exactly the size this render's checkpoint has
+//! ([`crate::replace_file`]): a symlink, a FIFO or a device put in its place is neither followed
+//! nor read.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::Context;
 use prost::Message;
 use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
 use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
 use yat_tracer::render::{RenderSettings, WorkUnit, PLAN_VERSION};
+
+use crate::replace_file::{read_regular_file, ReadFileError, StagedFile};
 
 const MAGIC: &[u8; 8] = b"YATRESUM";
 const FORMAT_VERSION: u32 = 1;
@@ -146,6 +152,12 @@ impl Checkpoint {
         out.out.write_all(digest.as_bytes())
     }
 
+    /// The size of the file of a checkpoint with these settings and this many units.
+    fn file_len(settings: &RenderSettings, unit_count: usize) -> u64 {
+        let pixels = u64::from(settings.width) * u64::from(settings.height);
+        (HEADER_LEN + DIGEST_LEN) as u64 + (unit_count as u64).div_ceil(8) + pixels * 32
+    }
+
     /// Reads a checkpoint of the render `identity` with these settings and this many units.
     fn decode(
         bytes: &[u8],
@@ -214,7 +226,7 @@ pub enum CheckpointError {
     #[error("of another render (the scene's files, the settings or the yat version differ)")]
     OtherRender,
     #[error(transparent)]
-    Io(#[from] std::io::Error),
+    File(#[from] ReadFileError),
 }
 
 /// Where and how often a render keeps its checkpoint: `<output stem>.resume` beside the image.
@@ -247,10 +259,9 @@ impl CheckpointFile {
         settings: &RenderSettings,
         unit_count: usize,
     ) -> Result<Option<Checkpoint>, CheckpointError> {
-        let bytes = match std::fs::read(&self.path) {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => return Err(e.into()),
+        let expected = Checkpoint::file_len(settings, unit_count);
+        let Some(bytes) = read_regular_file(&self.path, expected)? else {
+            return Ok(None);
         };
         Checkpoint::decode(&bytes, &self.identity, settings, unit_count).map(Some)
     }
@@ -290,42 +301,13 @@ impl CheckpointFile {
 
     /// The first half of [`CheckpointFile::save`], the one that reads the checkpoint: its bytes
     /// written to a temporary file beside the real one (fast: they go to the page cache).
-    pub fn stage(&self, checkpoint: &Checkpoint) -> anyhow::Result<StagedCheckpoint> {
-        let temporary = self.path.with_extension("resume.partial");
-        let write = || -> std::io::Result<std::fs::File> {
-            let mut out = std::io::BufWriter::new(std::fs::File::create(&temporary)?);
-            checkpoint.encode_to(&self.identity, &mut out)?;
-            out.into_inner().map_err(|e| e.into_error())
-        };
-        let file = write()
-            .with_context(|| format!("cannot save the checkpoint {}", temporary.display()))?;
-        Ok(StagedCheckpoint {
-            file,
-            temporary,
-            path: self.path.clone(),
-        })
+    pub fn stage(&self, checkpoint: &Checkpoint) -> anyhow::Result<StagedFile> {
+        StagedFile::write(&self.path, |out| checkpoint.encode_to(&self.identity, out))
     }
 
     /// Removes the checkpoint once the final image is written.
     pub fn remove(&self) {
         let _ = std::fs::remove_file(&self.path);
-    }
-}
-
-/// A checkpoint written but not yet in place.
-pub struct StagedCheckpoint {
-    file: std::fs::File,
-    temporary: PathBuf,
-    path: PathBuf,
-}
-
-impl StagedCheckpoint {
-    /// Syncs the new checkpoint to disk and puts it in place of the previous one.
-    pub fn commit(self) -> anyhow::Result<()> {
-        self.file
-            .sync_all()
-            .and_then(|()| std::fs::rename(&self.temporary, &self.path))
-            .with_context(|| format!("cannot save the checkpoint {}", self.path.display()))
     }
 }
 
@@ -464,7 +446,11 @@ mod tests {
         file.save(&checkpoint).unwrap();
         let loaded = file.resume(&settings(), &units, true);
         assert_eq!(loaded.film().sums(), checkpoint.film().sums());
-        assert!(!dir.path().join("out.resume.partial").exists());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "only the checkpoint, no temporary file"
+        );
 
         let stranger = CheckpointFile::beside(&output, identity("b.lxs"), Duration::ZERO);
         assert_eq!(stranger.resume(&settings(), &units, true).done_count(), 0);

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use yat_tracer::desc::FilmDesc;
 
-use crate::checkpoint::{Checkpoint, CheckpointFile, StagedCheckpoint};
+use crate::checkpoint::{Checkpoint, CheckpointFile};
+use crate::replace_file::StagedFile;
 
 /// The tone-mapped image so far, rewritten every so often next to the output.
 pub struct PreviewFile {
@@ -111,21 +112,25 @@ impl InterimOutputs {
 /// Interim outputs staged, to be finished without holding up the render.
 pub struct StagedOutputs {
     preview: Option<(PathBuf, image::RgbImage)>,
-    checkpoint: Option<anyhow::Result<StagedCheckpoint>>,
+    checkpoint: Option<anyhow::Result<StagedFile>>,
 }
 
 impl StagedOutputs {
-    /// Encodes the preview PNG and syncs the checkpoint to disk; what failed is returned, for the
-    /// render to report and go on.
+    /// Encodes the preview PNG and syncs the checkpoint to disk, each through a temporary file
+    /// renamed over the last one; what failed is returned, for the render to report and go on.
     pub fn finish(self) -> Vec<anyhow::Error> {
         let preview = self.preview.map(|(path, image)| {
-            image
-                .save_with_format(&path, image::ImageFormat::Png)
-                .map_err(|e| anyhow::anyhow!("cannot write the preview {}: {e}", path.display()))
+            StagedFile::write(&path, |out| {
+                image
+                    .write_to(out, image::ImageFormat::Png)
+                    .map_err(std::io::Error::other)
+            })
+            .and_then(StagedFile::commit)
+            .map_err(|e| e.context(format!("cannot write the preview {}", path.display())))
         });
         let checkpoint = self
             .checkpoint
-            .map(|staged| staged.and_then(StagedCheckpoint::commit));
+            .map(|staged| staged.and_then(StagedFile::commit));
         [preview, checkpoint]
             .into_iter()
             .flatten()

@@ -1,7 +1,7 @@
 //! A render job: the scene, the settings that decide the image, and the outputs (the final
 //! image, the interim preview and checkpoint); and what rendering it yields, whoever renders it.
 
-use std::path::PathBuf;
+use std::path::{Component, Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
@@ -26,6 +26,48 @@ pub struct RenderJob {
     pub interim: InterimOutputs,
     /// Set by Ctrl-C or SIGTERM when checkpoints are on: the render stops, saved.
     pub interrupt: Interrupt,
+}
+
+/// The endings of the files a render writes beside its output `X.png`: `X.preview.png`,
+/// `X.resume`, `X.exr`. An output named so would be overwritten by, or overwrite, the side file
+/// of another output (or its own: `-o x.resume` is its own checkpoint).
+const SIDE_FILE_ENDINGS: [&str; 3] = [".preview.png", ".resume", ".exr"];
+
+/// Refuses an output path that collides with the side files of a render.
+pub fn check_output_path(output_png: &Path) -> anyhow::Result<()> {
+    let name = output_png
+        .file_name()
+        .map(|n| n.to_string_lossy())
+        .with_context(|| format!("the output {} names no file", output_png.display()))?;
+    if let Some(ending) = SIDE_FILE_ENDINGS.iter().find(|e| name.ends_with(*e)) {
+        anyhow::bail!(
+            "the output {} ends in \"{ending}\", the name a render gives the preview, the \
+             checkpoint or the EXR it writes beside its image: choose a name ending in .png",
+            output_png.display()
+        );
+    }
+    Ok(())
+}
+
+/// The output a scene's `Film "string filename"` asks for when `-o` is absent: its file name
+/// plus `.png`, in the current folder. A scene is not trusted to choose a folder: a filename
+/// with one (`../../x`, `/etc/x`) keeps only its last part, with the warning returned.
+pub fn film_output_path(filename: &str) -> anyhow::Result<(PathBuf, Option<String>)> {
+    let path = Path::new(filename);
+    let Some(Component::Normal(name)) = path.components().next_back() else {
+        anyhow::bail!(
+            "the scene's Film filename \"{filename}\" names no file: give the output with -o"
+        );
+    };
+    let output = PathBuf::from(format!("{}.png", name.to_string_lossy()));
+    let warning = (path.components().count() > 1).then(|| {
+        format!(
+            "the scene's Film filename \"{filename}\" names a folder; a scene may only write to \
+             the current folder: writing {} (-o chooses another path)",
+            output.display()
+        )
+    });
+    Ok((output, warning))
 }
 
 /// The merged result of a render.
@@ -93,5 +135,38 @@ impl RenderJob {
         }
         self.interim.remove();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_named_like_side_files_are_refused() {
+        for bad in ["x.resume", "a/x.preview.png", "x.exr", "/tmp/y.resume"] {
+            let err = check_output_path(Path::new(bad)).unwrap_err().to_string();
+            assert!(err.contains("choose a name"), "{bad}: {err}");
+        }
+        for good in ["x.png", "dir/x.png", "x", "resume.png", "x.preview"] {
+            check_output_path(Path::new(good)).unwrap();
+        }
+        assert!(check_output_path(Path::new("/")).is_err());
+    }
+
+    #[test]
+    fn a_film_filename_is_confined_to_the_current_folder() {
+        assert_eq!(
+            film_output_path("render").unwrap(),
+            (PathBuf::from("render.png"), None)
+        );
+        for hostile in ["../../x", "/etc/x", "a/b/x", "./x/"] {
+            let (path, warning) = film_output_path(hostile).unwrap();
+            assert_eq!(path, PathBuf::from("x.png"), "{hostile}");
+            assert!(warning.unwrap().contains("current folder"), "{hostile}");
+        }
+        for nothing in ["", "..", "/", "a/.."] {
+            assert!(film_output_path(nothing).is_err(), "{nothing:?}");
+        }
     }
 }

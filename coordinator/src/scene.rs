@@ -1,13 +1,16 @@
 //! Loading a scene, the same way for every subcommand: the main file's folder as the source of
-//! the files it references, the parse, its warnings, and errors that name the file.
+//! the files it references, the parse under the build budget, its warnings, and errors that
+//! name the file; and building it for an in-process render under the same budget.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use yat_tracer::assets::FsSource;
+use yat_tracer::budget::{BuildBudget, BuildGuard};
 use yat_tracer::desc::SceneDesc;
-use yat_tracer::parse::parse_scene;
+use yat_tracer::parse::parse_scene_guarded;
+use yat_tracer::render::{RenderScene, RenderSettings};
 
 /// A scene file parsed, with where its files come from.
 pub struct ParsedScene {
@@ -19,6 +22,8 @@ pub struct ParsedScene {
     pub source: FsSource,
     pub desc: SceneDesc,
     pub parse_time: Duration,
+    /// What the scene may cost to parse and build here.
+    pub budget: BuildBudget,
 }
 
 /// What loading does with the parser's warnings.
@@ -31,7 +36,17 @@ pub enum Warnings {
 }
 
 impl ParsedScene {
+    /// Loads the scene under the default build budget.
     pub fn load(path: &Path, warnings: Warnings) -> anyhow::Result<Self> {
+        Self::load_within(path, warnings, BuildBudget::default())
+    }
+
+    /// Loads the scene, refusing it once it exceeds `budget`.
+    pub fn load_within(
+        path: &Path,
+        warnings: Warnings,
+        budget: BuildBudget,
+    ) -> anyhow::Result<Self> {
         let main_name = path
             .file_name()
             .and_then(|n| n.to_str())
@@ -39,7 +54,11 @@ impl ParsedScene {
             .to_string();
         let source = FsSource::for_main_file(path);
         let started = Instant::now();
-        let desc = parse_scene(&main_name, &source)
+        let guard = BuildGuard {
+            budget: &budget,
+            ..BuildGuard::default()
+        };
+        let desc = parse_scene_guarded(&main_name, &source, guard)
             .with_context(|| format!("cannot load scene {}", path.display()))?;
         let parse_time = started.elapsed();
         if warnings == Warnings::Print {
@@ -53,6 +72,17 @@ impl ParsedScene {
             source,
             desc,
             parse_time,
+            budget,
         })
+    }
+
+    /// Builds the scene for an in-process render, under the budget it was parsed with.
+    pub fn build(&self, settings: &RenderSettings) -> anyhow::Result<RenderScene> {
+        let guard = BuildGuard {
+            budget: &self.budget,
+            ..BuildGuard::default()
+        };
+        RenderScene::build_guarded(&self.desc, &self.source, settings, guard)
+            .with_context(|| format!("cannot build {}", self.path.display()))
     }
 }

@@ -5,6 +5,9 @@ mod architecture;
 mod check;
 mod discovery;
 mod distributed;
+mod files;
+#[path = "../fixtures/hostile.rs"]
+mod hostile;
 mod hostile_worker;
 mod resume;
 mod util;

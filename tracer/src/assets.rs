@@ -23,8 +23,23 @@ pub struct AssetRef {
     pub kind: AssetKind,
 }
 
+/// The largest file a scene may reference: the largest blob a worker accepts by default.
+pub const MAX_FILE_BYTES: u64 = 2 << 30;
+
 #[derive(Debug, thiserror::Error)]
 pub enum AssetError {
+    /// A FIFO, a device or a folder where a file was expected: reading it could block or
+    /// never end.
+    #[error("\"{written}\" ({tried}) is not a regular file")]
+    NotAFile { written: String, tried: String },
+    #[error(
+        "\"{written}\" ({tried}) holds {bytes} bytes, more than the limit of {MAX_FILE_BYTES}"
+    )]
+    TooLarge {
+        written: String,
+        tried: String,
+        bytes: u64,
+    },
     #[error("file not found: \"{written}\" (tried {tried})")]
     NotFound { written: String, tried: String },
     #[error("cannot read \"{written}\" ({tried}): {source}")]
@@ -65,20 +80,46 @@ impl FsSource {
 
 impl AssetSource for FsSource {
     fn read(&self, written: &str) -> Result<Arc<[u8]>, AssetError> {
+        use std::io::Read;
         let path = self.resolve(written);
         let tried = path.display().to_string();
-        match std::fs::read(&path) {
-            Ok(bytes) => Ok(bytes.into()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(AssetError::NotFound {
+        let io = |source: std::io::Error| match source.kind() {
+            std::io::ErrorKind::NotFound => AssetError::NotFound {
                 written: written.to_string(),
-                tried,
-            }),
-            Err(source) => Err(AssetError::Io {
+                tried: tried.clone(),
+            },
+            _ => AssetError::Io {
                 written: written.to_string(),
-                tried,
+                tried: tried.clone(),
                 source,
-            }),
-        }
+            },
+        };
+        // The kind is checked before opening (opening a FIFO blocks until a writer comes) and
+        // again on the open file; the read stops at the limit whatever the size said.
+        let is_file = |metadata: std::fs::Metadata| {
+            if !metadata.is_file() {
+                return Err(AssetError::NotAFile {
+                    written: written.to_string(),
+                    tried: tried.clone(),
+                });
+            }
+            if metadata.len() > MAX_FILE_BYTES {
+                return Err(AssetError::TooLarge {
+                    written: written.to_string(),
+                    tried: tried.clone(),
+                    bytes: metadata.len(),
+                });
+            }
+            Ok(metadata.len())
+        };
+        is_file(std::fs::metadata(&path).map_err(io)?)?;
+        let file = std::fs::File::open(&path).map_err(io)?;
+        let len = is_file(file.metadata().map_err(io)?)?;
+        let mut bytes = Vec::with_capacity(len as usize);
+        file.take(MAX_FILE_BYTES)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        Ok(bytes.into())
     }
 }
 

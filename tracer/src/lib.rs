@@ -8,6 +8,9 @@
 //! [`render::RenderScene::render_unit`] (per sample: [`sampler`], [`filter`], [`camera`], then
 //! [`integrator::trace_path`]) -> [`film::SampleBuffer`]s merged into a [`film::Film`].
 //!
+//! Parse and build are bounded by a [`budget::BuildBudget`] and can be abandoned through a
+//! cancel flag ([`budget::BuildGuard`]).
+//!
 //! Leaves the layers above share: [`render::unit`] (work units, which the film's buffers are
 //! keyed by), [`render::settings`], [`geometry::SurfaceHit`]; the path tracer sees the built
 //! scene only through [`integrator::PathScene`].
@@ -18,6 +21,7 @@
 extern crate self as yat_tracer;
 
 pub mod assets;
+pub mod budget;
 pub mod bxdf;
 pub mod camera;
 pub mod desc;

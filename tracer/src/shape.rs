@@ -94,6 +94,15 @@ impl Geometry {
         }
     }
 
+    /// The primitives the shape places in the world, what the build budget counts: its
+    /// triangles, or one.
+    pub fn primitive_count(&self) -> u64 {
+        match self {
+            Geometry::Mesh(mesh) => mesh.indices.len() as u64,
+            _ => 1,
+        }
+    }
+
     /// A sphere's z range: zmin and zmax in order, clamped to [-|radius|, |radius|]. None for
     /// other shapes. The renderer, the area of an emitting sphere and the tessellation
     /// ([`crate::mesh::tessellate`]) all use this range.

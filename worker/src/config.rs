@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use tonic::transport::Identity;
+use yat_tracer::budget::BuildBudget;
 
 pub struct WorkerConfig {
     /// Units rendered at the same time (at least one).
@@ -18,6 +19,8 @@ pub struct WorkerConfig {
     pub token: Option<String>,
     /// Serve TLS with this certificate and key.
     pub tls: Option<Identity>,
+    /// What a scene may cost to parse and build (bytes, Include visits, primitives, texels).
+    pub build_budget: BuildBudget,
     /// Testing aid: a pause before each unit, to make a worker slow on purpose.
     pub throttle: Duration,
 }

@@ -10,6 +10,7 @@ use prost::Message;
 use yat_proto::convert::{unit_from_wire, WireError};
 use yat_proto::hash::{is_sha256_hex, sha256_hex};
 use yat_proto::{pb, DEFAULT_MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
+use yat_tracer::budget::BuildBudget;
 use yat_tracer::render::RenderSettings;
 
 use crate::blobs::BlobStore;
@@ -47,6 +48,8 @@ pub struct Node {
     pool: RenderPool,
     /// Test hook: a pause before each unit, to make a worker slow on purpose.
     throttle: Duration,
+    /// What a scene may cost to parse and build.
+    build_budget: BuildBudget,
     counters: Counters,
     started: Instant,
 }
@@ -77,6 +80,7 @@ impl Node {
             scenes: SceneCache::new(SCENE_CACHE_CAPACITY),
             pool: RenderPool::new(threads)?,
             throttle: config.throttle,
+            build_budget: config.build_budget,
             counters: Counters::default(),
             started: Instant::now(),
         })
@@ -162,13 +166,8 @@ impl Node {
         let started = Instant::now();
         let assets = request.assets;
         let blobs = self.blobs.clone();
-        let build = || async move {
-            tokio::task::spawn_blocking(move || {
-                LoadedScene::build(&blobs, &main, &assets, settings)
-            })
-            .await
-            .map_err(NodeError::BuildTask)?
-        };
+        let build =
+            || LoadedScene::build_blocking(blobs, main, assets, settings, self.build_budget);
         let (loaded, built) = self.scenes.get_or_build(&scene_id, build).await?;
         Ok(pb::LoadSceneReply {
             scene_id,

@@ -19,6 +19,7 @@ fn config() -> WorkerConfig {
         token: None,
         tls: None,
         throttle: Duration::ZERO,
+        build_budget: yat_tracer::budget::BuildBudget::default(),
     }
 }
 

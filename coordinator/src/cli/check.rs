@@ -8,16 +8,19 @@ use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
 
+use super::budget::BudgetArgs;
 use crate::scene::{ParsedScene, Warnings};
 
 #[derive(clap::Args)]
 pub struct CheckArgs {
     /// The main .lxs file.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub budget: BudgetArgs,
 }
 
 pub fn run(args: CheckArgs) -> anyhow::Result<()> {
-    let scene = ParsedScene::load(&args.scene, Warnings::Keep)?;
+    let scene = ParsedScene::load_within(&args.scene, Warnings::Keep, args.budget.budget())?;
     print!(
         "{}",
         summary(

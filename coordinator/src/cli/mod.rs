@@ -1,5 +1,6 @@
 //! The `yat` subcommands: each maps its flags onto the library's plain types and runs.
 
+pub mod budget;
 pub mod check;
 pub mod distributed;
 pub mod export;

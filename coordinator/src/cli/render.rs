@@ -8,13 +8,14 @@ use anyhow::Context;
 use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
+use super::budget::BudgetArgs;
 use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
 use crate::checkpoint::{CheckpointFile, RenderIdentity};
 use crate::exec::{distributed, in_process};
 use crate::interim::{InterimOutputs, PreviewFile};
-use crate::job::RenderJob;
+use crate::job::{check_output_path, film_output_path, RenderJob};
 use crate::manifest::SceneManifest;
 use crate::render_report::RenderReport;
 use crate::scene::{ParsedScene, Warnings};
@@ -24,7 +25,9 @@ use crate::shutdown::Interrupt;
 pub struct RenderArgs {
     /// The main .lxs file.
     pub scene: PathBuf,
-    /// Output PNG (default: the Film's filename plus .png, in the current folder).
+    /// Output PNG (default: the Film's filename plus .png, in the current folder; a folder in
+    /// the Film's filename is dropped). Its side files go beside it: X.preview.png, X.resume and
+    /// X.exr, so an output named like one of those is refused.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Also write linear radiance as OpenEXR next to the PNG.
@@ -62,6 +65,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
     pub preview_every: f64,
     #[command(flatten)]
+    pub budget: BudgetArgs,
+    #[command(flatten)]
     pub distributed: DistributedArgs,
 }
 
@@ -81,13 +86,14 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let scene = ParsedScene::load(
+    let scene = ParsedScene::load_within(
         &args.scene,
         if args.quiet {
             Warnings::Keep
         } else {
             Warnings::Print
         },
+        args.budget.budget(),
     )?;
     let overrides = RenderOverrides {
         spp: args.spp,
@@ -100,10 +106,17 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     settings
         .check()
         .with_context(|| format!("cannot render {}", args.scene.display()))?;
-    let output_png = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}.png", scene.desc.film.filename)));
+    let output_png = match &args.output {
+        Some(output) => output.clone(),
+        None => {
+            let (output, warning) = film_output_path(&scene.desc.film.filename)?;
+            if let Some(warning) = warning {
+                eprintln!("warning: {warning}");
+            }
+            output
+        }
+    };
+    check_output_path(&output_png)?;
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
     let preview_every = seconds("preview-every", args.preview_every)?;
     let workers = args.distributed.config()?;

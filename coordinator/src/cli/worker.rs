@@ -8,6 +8,8 @@ use std::time::Duration;
 use yat_proto::flags::{ServerTlsFlags, TokenFlag};
 use yat_worker::{Worker, WorkerConfig};
 
+use super::budget::BudgetArgs;
+
 const MIB: u64 = 1 << 20;
 
 #[derive(clap::Args, Debug)]
@@ -32,6 +34,8 @@ pub struct WorkerArgs {
     /// Scene files kept in memory, in MiB (least recently used dropped first).
     #[arg(long, default_value_t = 4096)]
     pub memory_cache_mib: u64,
+    #[command(flatten)]
+    pub budget: BudgetArgs,
     /// Exit when standard input closes: a parent that dies takes its workers with it.
     #[arg(long)]
     pub exit_with_stdin: bool,
@@ -51,6 +55,7 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         token: args.token.token,
         tls: args.tls.identity()?,
         throttle: Duration::from_millis(args.throttle_ms),
+        build_budget: args.budget.budget(),
     };
     let without_token = config.token.is_none();
     // Fails here, before the address is announced, when the cache folder is unusable.

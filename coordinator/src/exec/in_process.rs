@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use rayon::prelude::*;
-use yat_tracer::render::{plan_units, RenderScene, UnitStats, WorkUnit};
+use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
 
 use super::progress::Progress;
 use crate::checkpoint::Checkpoint;
@@ -24,8 +24,7 @@ struct InProcessState {
 /// Renders `job` on `threads` threads (default: all cores).
 pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderOutcome> {
     let build_start = Instant::now();
-    let scene = RenderScene::build(&job.scene.desc, &job.scene.source, &job.settings)
-        .with_context(|| format!("cannot build {}", job.scene.path.display()))?;
+    let scene = job.scene.build(&job.settings)?;
     let build = SceneBuild {
         time: build_start.elapsed(),
         triangles: scene.triangle_count(),

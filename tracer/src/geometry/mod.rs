@@ -11,6 +11,7 @@ mod analytic;
 mod hit;
 mod plane;
 mod triangle;
+mod world_range;
 
 #[cfg(test)]
 pub(crate) mod tests;
@@ -31,10 +32,12 @@ use crate::shape::ShapeDesc;
 pub use analytic::AnalyticShape;
 pub use hit::{SurfaceHit, SurfaceSample};
 pub use triangle::TriangleSurface;
+pub use world_range::MAX_WORLD_COORD;
 
 use analytic::QuadricHit;
 use plane::InfinitePlane;
 use triangle::{TriangleEdges, WorldMesh};
+use world_range::within_world;
 
 /// A BVH primitive: what the traversal reads, and where its shading data lives.
 #[derive(Clone, Copy, Debug)]
@@ -112,7 +115,8 @@ impl SceneGeometry {
                     if issues.bad_triangles > 0 || issues.dropped_normals || issues.dropped_uvs {
                         tracing::warn!(
                             "shape \"{}\": {} triangles skipped (index out of range, zero \
-                             area or non-finite), normals dropped: {}, uvs dropped: {}",
+                             area, or beyond {MAX_WORLD_COORD:e} in world space), normals \
+                             dropped: {}, uvs dropped: {}",
                             shape.name,
                             issues.bad_triangles,
                             issues.dropped_normals,
@@ -136,6 +140,17 @@ impl SceneGeometry {
                     None => tracing::warn!("shape \"{}\": degenerate plane skipped", shape.name),
                 },
                 quadric => match AnalyticShape::new(index, quadric, m, ro) {
+                    Some(s)
+                        if !s.world_bounds().valid()
+                            || !within_world(s.world_bounds().min.into())
+                            || !within_world(s.world_bounds().max.into()) =>
+                    {
+                        tracing::warn!(
+                            "shape \"{}\": skipped, it reaches beyond {MAX_WORLD_COORD:e} in \
+                             world space",
+                            shape.name
+                        )
+                    }
                     Some(s) => {
                         let a = analytic.len() as u32;
                         aabbs.push(s.world_bounds());

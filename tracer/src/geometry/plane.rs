@@ -30,7 +30,11 @@ impl InfinitePlane {
         let object_to_world = Affine3A::from_mat4(*object_to_world);
         let linear = Mat3::from(object_to_world.matrix3);
         let det = linear.determinant();
-        (det != 0.0 && det.is_finite() && object_to_world.is_finite()).then_some(())?;
+        (det != 0.0
+            && det.is_finite()
+            && object_to_world.is_finite()
+            && super::world_range::within_world(object_to_world.translation.into()))
+        .then_some(())?;
         let orientation = if reverse_orientation { -1.0 } else { 1.0 };
         let n = (linear.inverse().transpose() * normal).try_normalize()? * orientation;
         Some(Self {

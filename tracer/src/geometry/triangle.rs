@@ -62,7 +62,8 @@ pub(crate) struct WorldMesh {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
     uvs: Option<Vec<Vec2>>,
-    /// Only the triangles that can be hit: indices in range, finite, non-zero area.
+    /// Only the triangles that can be hit: indices in range, inside the world's range
+    /// ([`super::world_range::MAX_WORLD_COORD`]), non-zero area.
     indices: Vec<[u32; 3]>,
     /// -1 when ReverseOrientation or a handedness-swapping transform (but not both) turns the
     /// front side against the winding order.
@@ -121,7 +122,10 @@ impl WorldMesh {
             .filter(|tri| {
                 let valid = tri.iter().all(|&i| (i as usize) < positions.len()) && {
                     let [p0, p1, p2] = tri.map(|i| positions[i as usize]);
-                    (p1 - p0).cross(p2 - p0).normalize_or_zero() != Vec3::ZERO
+                    [p0, p1, p2]
+                        .iter()
+                        .all(|p| super::world_range::within_world(*p))
+                        && (p1 - p0).cross(p2 - p0).normalize_or_zero() != Vec3::ZERO
                 };
                 issues.bad_triangles += usize::from(!valid);
                 valid

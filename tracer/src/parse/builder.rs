@@ -14,6 +14,7 @@ use super::params::ParamList;
 use super::reader::Reader;
 use crate::assets::AssetSource;
 use crate::assets::{AssetKind, AssetRef};
+use crate::budget::{BudgetMeter, BuildGuard, Limit};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::SourcePos as Pos;
 use crate::diag::Warning;
@@ -82,6 +83,8 @@ pub struct PendingShape {
 
 pub struct Builder<'s> {
     pub(super) source: &'s dyn AssetSource,
+    guard: BuildGuard<'s>,
+    spent: BudgetMeter,
     /// The main file's name, for diagnostics about the scene as a whole.
     main: String,
     include_stack: Vec<String>,
@@ -141,9 +144,11 @@ fn is_exporter_param(name: &str) -> bool {
 }
 
 impl<'s> Builder<'s> {
-    pub fn new(source: &'s dyn AssetSource) -> Self {
+    pub fn new(source: &'s dyn AssetSource, guard: BuildGuard<'s>) -> Self {
         Self {
             source,
+            guard,
+            spent: BudgetMeter::default(),
             main: String::new(),
             include_stack: Vec::new(),
             ctm: Mat4::IDENTITY,
@@ -171,6 +176,19 @@ impl<'s> Builder<'s> {
     }
 
     // -----------------------------------------------------------------------------------------
+    // Budget
+
+    /// Adds to a figure of the build budget what the statement at `pos` costs.
+    pub(super) fn spend(&mut self, limit: Limit, amount: u64, pos: &Pos) -> Result<(), ParseError> {
+        self.spent
+            .spend(self.guard.budget, limit, amount)
+            .map_err(|exceeded| ParseError::OverBudget {
+                pos: pos.clone(),
+                exceeded,
+            })
+    }
+
+    // -----------------------------------------------------------------------------------------
     // Files and statements
 
     pub fn run_file(&mut self, name: &str, text: &[u8]) -> Result<(), ParseError> {
@@ -180,6 +198,9 @@ impl<'s> Builder<'s> {
         self.include_stack.push(name.to_string());
         let mut r = Reader::new(name, text);
         while let Some((keyword, pos)) = r.keyword()? {
+            self.guard
+                .check_cancel()
+                .map_err(|_| ParseError::Cancelled { pos: pos.clone() })?;
             self.statement(keyword, &pos, &mut r)?;
         }
         self.include_stack.pop();
@@ -204,7 +225,9 @@ impl<'s> Builder<'s> {
                 ),
             });
         }
+        self.spend(Limit::IncludeVisits, 1, pos)?;
         let bytes = self.read_asset(&path, AssetKind::Include, pos)?;
+        self.spend(Limit::ParsedBytes, bytes.len() as u64, pos)?;
         self.run_file(&path, &bytes)
     }
 
@@ -219,14 +242,14 @@ impl<'s> Builder<'s> {
             return Ok(());
         }
         match keyword {
-            "Identity" => self.transform(Mat4::IDENTITY, false),
+            "Identity" => self.transform(Mat4::IDENTITY, false, pos)?,
             "Translate" => {
                 let v = r.numbers::<3>("Translate")?;
-                self.transform(Mat4::from_translation(Vec3::from_array(v)), true);
+                self.transform(Mat4::from_translation(Vec3::from_array(v)), true, pos)?;
             }
             "Scale" => {
                 let v = r.numbers::<3>("Scale")?;
-                self.transform(Mat4::from_scale(Vec3::from_array(v)), true);
+                self.transform(Mat4::from_scale(Vec3::from_array(v)), true, pos)?;
             }
             "Rotate" => {
                 let [angle, x, y, z] = r.numbers::<4>("Rotate")?;
@@ -238,7 +261,7 @@ impl<'s> Builder<'s> {
                     });
                 }
                 let m = Mat4::from_axis_angle(axis.normalize(), angle.to_radians());
-                self.transform(m, true);
+                self.transform(m, true, pos)?;
             }
             "LookAt" => {
                 let v = r.numbers::<9>("LookAt")?;
@@ -251,11 +274,11 @@ impl<'s> Builder<'s> {
                     pos: pos.clone(),
                     message: "LookAt: the eye and target coincide, or the up vector is parallel to the viewing direction".into(),
                 })?;
-                self.transform(m, true);
+                self.transform(m, true, pos)?;
             }
             "Transform" | "ConcatTransform" => {
                 let v = r.numbers::<16>(keyword)?;
-                self.transform(Mat4::from_cols_array(&v), keyword == "ConcatTransform");
+                self.transform(Mat4::from_cols_array(&v), keyword == "ConcatTransform", pos)?;
             }
             "CoordinateSystem" => {
                 let name = r.string("a coordinate system name")?;
@@ -444,7 +467,7 @@ impl<'s> Builder<'s> {
                     Some(shapes) => {
                         let shapes = shapes.clone();
                         for s in shapes {
-                            self.emit_shape(s, self.ctm);
+                            self.emit_shape(s, self.ctm, pos)?;
                         }
                     }
                     None => self.warn(pos, format!("ObjectInstance: no object named \"{name}\"")),
@@ -459,15 +482,26 @@ impl<'s> Builder<'s> {
     // Transforms and blocks
 
     /// Applies a transform statement: post-multiplies (`concat`) or replaces the current
-    /// matrix. Inside a motion block only the first transform counts.
-    fn transform(&mut self, m: Mat4, concat: bool) {
+    /// matrix. Inside a motion block only the first transform counts. A product that overflows
+    /// (`Scale 1e30` twice) is refused: nothing placed under it could be rendered.
+    fn transform(&mut self, m: Mat4, concat: bool, pos: &Pos) -> Result<(), ParseError> {
         if let Some(applied) = self.motion {
             if applied {
-                return;
+                return Ok(());
             }
             self.motion = Some(true);
         }
-        self.ctm = if concat { self.ctm * m } else { m };
+        let ctm = if concat { self.ctm * m } else { m };
+        if !ctm.is_finite() {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: "the transform overflows: the current matrix would hold a value beyond \
+                          the range of 32-bit floats"
+                    .into(),
+            });
+        }
+        self.ctm = ctm;
+        Ok(())
     }
 
     fn push(&mut self, kind: FrameKind, pos: &Pos) {
@@ -586,18 +620,34 @@ impl<'s> Builder<'s> {
         };
         match &mut self.current_object {
             Some((_, shapes)) => shapes.push(shape),
-            None => self.emit_shape(shape, Mat4::IDENTITY),
+            None => self.emit_shape(shape, Mat4::IDENTITY, pos)?,
         }
         Ok(())
     }
 
-    /// Places a shape in the world (`instance` is the ObjectInstance transform) and sets its
-    /// area light's radiance from its world-space area.
-    fn emit_shape(&mut self, shape: PendingShape, instance: Mat4) {
+    /// Places a shape in the world (`instance` is the ObjectInstance transform; `pos` the
+    /// statement that places it) and sets its area light's radiance from its world-space area.
+    fn emit_shape(
+        &mut self,
+        shape: PendingShape,
+        instance: Mat4,
+        pos: &Pos,
+    ) -> Result<(), ParseError> {
+        let primitives = shape.desc.geometry.primitive_count();
+        self.spend(Limit::Primitives, primitives, pos)?;
         let mut desc = shape.desc;
         desc.object_to_world = instance * desc.object_to_world;
+        if !desc.object_to_world.is_finite() {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: "the object's transform times the instance's overflows the range of \
+                          32-bit floats"
+                    .into(),
+            });
+        }
         desc.area_light = shape.emitter.map(|e| e.desc(desc.world_area()));
         self.shapes.push(desc);
+        Ok(())
     }
 
     // -----------------------------------------------------------------------------------------
@@ -726,6 +776,7 @@ impl ParseContext for Builder<'_> {
             return Ok(m.clone());
         }
         let bytes = self.read_asset(path, AssetKind::Ply, pos)?;
+        self.spend(Limit::ParsedBytes, bytes.len() as u64, pos)?;
         let mesh = ply::read_valid_mesh(&bytes).map_err(|message| ParseError::Ply {
             pos: pos.clone(),
             path: path.to_string(),
@@ -760,16 +811,17 @@ impl ParseContext for Builder<'_> {
         if already {
             return Ok(());
         }
-        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+        let (width, height) = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
             .with_guessed_format()
             .map_err(|e| e.to_string())
             .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
-            .map(|_| ())
             .map_err(|message| ParseError::Image {
                 pos: pos.clone(),
                 path: path.to_string(),
                 message,
-            })
+            })?;
+        // Counted from the header, before anything is decoded.
+        self.spend(Limit::Texels, u64::from(width) * u64::from(height), pos)
     }
 }
 

@@ -1,6 +1,7 @@
 //! The parser's error: what is wrong and where, file:line:column first.
 
 use crate::assets::AssetError;
+use crate::budget::{Cancelled, OverBudget};
 use crate::diag::SourcePos;
 
 #[derive(Debug, thiserror::Error)]
@@ -29,6 +30,15 @@ pub enum ParseError {
         path: String,
         message: String,
     },
+    /// The statement at `pos` took the scene over its build budget.
+    #[error("{pos}: {exceeded}")]
+    OverBudget {
+        pos: SourcePos,
+        exceeded: OverBudget,
+    },
+    /// The parse was abandoned through its cancel flag (at the statement at `pos`).
+    #[error("{pos}: {}", Cancelled)]
+    Cancelled { pos: SourcePos },
     /// A PLY file is malformed.
     #[error("{pos}: PLY file \"{path}\": {message}")]
     Ply {
@@ -47,6 +57,8 @@ impl ParseError {
             | ParseError::Invalid { pos, .. }
             | ParseError::Asset { pos, .. }
             | ParseError::Image { pos, .. }
+            | ParseError::OverBudget { pos, .. }
+            | ParseError::Cancelled { pos, .. }
             | ParseError::Ply { pos, .. } => pos,
         }
     }

@@ -28,6 +28,7 @@ pub(crate) mod params;
 mod reader;
 
 use crate::assets::AssetSource;
+use crate::budget::{BuildGuard, Limit};
 use crate::desc::SceneDesc;
 use crate::diag::SourcePos;
 
@@ -37,13 +38,29 @@ pub use error::ParseError;
 pub use crate::spectra::{blackbody_rgb, metal_preset};
 
 /// Parses the main scene file `main` (its name as given to `source`) and every file it
-/// includes, and builds the scene description. Warnings go into `SceneDesc::warnings`.
+/// includes, and builds the scene description, under the default build budget. Warnings go
+/// into `SceneDesc::warnings`.
 pub fn parse_scene(main: &str, source: &dyn AssetSource) -> Result<SceneDesc, ParseError> {
+    parse_scene_guarded(main, source, BuildGuard::default())
+}
+
+/// [`parse_scene`] under `guard`: its budget is checked as the scene is read, its cancel flag
+/// at every statement.
+pub fn parse_scene_guarded(
+    main: &str,
+    source: &dyn AssetSource,
+    guard: BuildGuard,
+) -> Result<SceneDesc, ParseError> {
     let bytes = source.read(main).map_err(|error| ParseError::Asset {
         pos: SourcePos::new(main, 0, 0),
         error,
     })?;
-    let mut b = builder::Builder::new(source);
+    let mut b = builder::Builder::new(source, guard);
+    b.spend(
+        Limit::ParsedBytes,
+        bytes.len() as u64,
+        &SourcePos::new(main, 0, 0),
+    )?;
     b.run_file(main, &bytes)?;
     b.finish()
 }

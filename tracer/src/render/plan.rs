@@ -108,6 +108,32 @@ mod tests {
         }
     }
 
+    /// Every sample of every pixel once at the largest settings `check` accepts.
+    #[test]
+    fn the_plan_covers_every_sample_at_the_limits() {
+        use crate::render::settings::{MAX_SIDE, MAX_SPP};
+        for s in [
+            settings(64, 64, MAX_SPP),
+            settings(MAX_SIDE, 1, 7),
+            settings(1, MAX_SIDE, MAX_SPP),
+        ] {
+            s.check().unwrap();
+            let units = plan_units(&s);
+            let samples: u64 = units.iter().map(WorkUnit::sample_count).sum();
+            let pixels = u64::from(s.width) * u64::from(s.height);
+            assert_eq!(samples, pixels * u64::from(s.spp), "{s:?}");
+            assert!(units.iter().enumerate().all(|(i, u)| u.index as usize == i));
+        }
+    }
+
+    /// An spp `check` refuses still plans without overflowing: the last pass ends at u32::MAX.
+    #[test]
+    fn an_unchecked_spp_does_not_overflow() {
+        let units = plan_units(&settings(1, 1, u32::MAX));
+        assert_eq!(units.len(), PASSES as usize);
+        assert_eq!(units.last().unwrap().sample_end, u32::MAX);
+    }
+
     #[test]
     fn only_long_units_get_a_finer_last_pass() {
         // 64x64 x 16 samples per pass = 65536 samples: short units, one tile size.

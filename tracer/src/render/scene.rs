@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::assets::AssetSource;
+use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::SceneDesc;
 use crate::film::SampleBuffer;
@@ -25,6 +26,10 @@ pub enum BuildError {
     Texture(#[from] crate::texture::TextureError),
     #[error(transparent)]
     Light(#[from] crate::lights::LightError),
+    #[error(transparent)]
+    OverBudget(#[from] OverBudget),
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
 }
 
 /// The scene ready to render: world-space geometry and BVH, textures, materials, lights.
@@ -42,12 +47,30 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
+    /// Builds the scene under the default budget.
     pub fn build(
         desc: &SceneDesc,
         source: &dyn AssetSource,
         settings: &RenderSettings,
     ) -> Result<Self, BuildError> {
+        Self::build_guarded(desc, source, settings, BuildGuard::default())
+    }
+
+    /// Builds the scene under `guard`: the primitives are counted against the budget before
+    /// anything is allocated for them (a description that came from the parser was counted
+    /// there already, statement by statement), and the cancel flag is checked between the
+    /// stages. Images are decoded under the `image` crate's allocation limit.
+    pub fn build_guarded(
+        desc: &SceneDesc,
+        source: &dyn AssetSource,
+        settings: &RenderSettings,
+        guard: BuildGuard,
+    ) -> Result<Self, BuildError> {
+        let primitives = desc.shapes.iter().map(|s| s.geometry.primitive_count());
+        BudgetMeter::default().spend(guard.budget, Limit::Primitives, primitives.sum())?;
+        guard.check_cancel()?;
         let geometry = SceneGeometry::build(&desc.shapes);
+        guard.check_cancel()?;
         let shapes = desc.shapes.iter();
         let area_lights = shapes.map(|s| (s.name.as_str(), s.area_light.as_ref()));
         let lights = Lights::build(
@@ -57,10 +80,13 @@ impl RenderScene {
             source,
             settings.latlong,
         )?;
+        guard.check_cancel()?;
+        let textures = Textures::new(&desc.textures, source)?;
+        guard.check_cancel()?;
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: FilterSampler::new(&desc.filter),
-            textures: Textures::new(&desc.textures, source)?,
+            textures,
             materials: Materials::new(desc.materials.clone()),
             geometry,
             lights,

@@ -3,6 +3,9 @@
 
 mod fuzz_regressions;
 mod geometry_on_scenes;
+#[path = "../../../tests/fixtures/hostile.rs"]
+mod hostile;
+mod hostile_scenes;
 mod parse_conventions;
 mod parse_errors;
 mod render;

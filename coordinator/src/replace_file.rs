@@ -1,0 +1,196 @@
+//! Files the coordinator rewrites while a render runs (the checkpoint, the preview) go through
+//! a temporary file created exclusively beside them and then renamed over them: a crash leaves
+//! the previous file whole, and a symlink or a FIFO planted at either name is never followed
+//! (the rename replaces the link itself; `O_EXCL | O_NOFOLLOW` refuses an existing name).
+
+use std::fs::File;
+use std::hash::{BuildHasher, Hasher};
+use std::io::{Read, Write};
+use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+
+/// Attempts at a fresh temporary name before giving up (each collision is a file someone put
+/// there under a name that was random).
+const NAME_ATTEMPTS: u32 = 8;
+
+/// A temporary file beside its destination, created exclusively with mode 0600.
+pub struct StagedFile {
+    file: File,
+    temporary: PathBuf,
+    path: PathBuf,
+    committed: bool,
+}
+
+/// A name no one could have predicted: `.NAME.RANDOM.tmp` beside `path`.
+fn temporary_name(path: &Path) -> PathBuf {
+    let mut random = std::collections::hash_map::RandomState::new().build_hasher();
+    random.write_u128(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos()),
+    );
+    random.write_u32(std::process::id());
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    path.with_file_name(format!(".{name}.{:016x}.tmp", random.finish()))
+}
+
+impl StagedFile {
+    /// Creates the temporary file for `path` and fills it with `write`.
+    pub fn write(
+        path: &Path,
+        write: impl FnOnce(&mut std::io::BufWriter<&File>) -> std::io::Result<()>,
+    ) -> anyhow::Result<Self> {
+        let mut attempt = 0;
+        let (file, temporary) = loop {
+            let temporary = temporary_name(path);
+            let created = File::options()
+                .write(true)
+                .create_new(true)
+                .mode(0o600)
+                .custom_flags(libc::O_NOFOLLOW)
+                .open(&temporary);
+            match created {
+                Ok(file) => break (file, temporary),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    attempt += 1;
+                    if attempt == NAME_ATTEMPTS {
+                        return Err(e).with_context(|| {
+                            format!("cannot create a temporary file beside {}", path.display())
+                        });
+                    }
+                }
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot write {}", temporary.display()))
+                }
+            }
+        };
+        let staged = Self {
+            file,
+            temporary,
+            path: path.to_path_buf(),
+            committed: false,
+        };
+        let mut out = std::io::BufWriter::new(&staged.file);
+        write(&mut out)
+            .and_then(|()| out.flush())
+            .with_context(|| format!("cannot write {}", staged.temporary.display()))?;
+        drop(out);
+        Ok(staged)
+    }
+
+    /// Syncs the file to disk and renames it over the destination.
+    pub fn commit(mut self) -> anyhow::Result<()> {
+        self.file
+            .sync_all()
+            .and_then(|()| std::fs::rename(&self.temporary, &self.path))
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for StagedFile {
+    /// A staged file never committed is removed.
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.temporary);
+        }
+    }
+}
+
+/// Why a file is not read.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadFileError {
+    #[error("not a regular file (a link, a FIFO, a device or a folder)")]
+    NotAFile,
+    #[error("{found} bytes long where {expected} were expected")]
+    WrongSize { found: u64, expected: u64 },
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
+/// Reads `path` only if it is a regular file (not through a symlink) of exactly `expected`
+/// bytes: a FIFO does not block (`O_NONBLOCK`), a device or a huge file is not read.
+/// `Ok(None)` when there is no file.
+pub fn read_regular_file(path: &Path, expected: u64) -> Result<Option<Vec<u8>>, ReadFileError> {
+    let file = File::options()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(path);
+    let file = match file {
+        Ok(file) => file,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        // O_NOFOLLOW on a symlink.
+        Err(e) if e.raw_os_error() == Some(libc::ELOOP) => return Err(ReadFileError::NotAFile),
+        Err(e) => return Err(e.into()),
+    };
+    let metadata = file.metadata()?;
+    if !metadata.is_file() {
+        return Err(ReadFileError::NotAFile);
+    }
+    if metadata.size() != expected {
+        return Err(ReadFileError::WrongSize {
+            found: metadata.size(),
+            expected,
+        });
+    }
+    let mut bytes = Vec::with_capacity(expected as usize);
+    file.take(expected).read_to_end(&mut bytes)?;
+    Ok(Some(bytes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_staged_file_replaces_a_planted_symlink_not_its_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("target");
+        std::fs::write(&target, b"precious").unwrap();
+        let path = dir.path().join("out.resume");
+        std::os::unix::fs::symlink(&target, &path).unwrap();
+        let staged = StagedFile::write(&path, |out| out.write_all(b"new")).unwrap();
+        let mode = std::fs::metadata(&staged.temporary).unwrap().mode();
+        assert_eq!(mode & 0o777, 0o600);
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"precious");
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert!(!std::fs::symlink_metadata(&path).unwrap().is_symlink());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            2,
+            "no temporary left"
+        );
+    }
+
+    #[test]
+    fn only_a_regular_file_of_the_expected_size_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("f");
+        assert!(read_regular_file(&file, 3).unwrap().is_none());
+        std::fs::write(&file, b"abc").unwrap();
+        assert_eq!(read_regular_file(&file, 3).unwrap().unwrap(), b"abc");
+        assert!(matches!(
+            read_regular_file(&file, 4),
+            Err(ReadFileError::WrongSize {
+                found: 3,
+                expected: 4
+            })
+        ));
+        let link = dir.path().join("link");
+        std::os::unix::fs::symlink(&file, &link).unwrap();
+        assert!(matches!(
+            read_regular_file(&link, 3),
+            Err(ReadFileError::NotAFile)
+        ));
+        assert!(matches!(
+            read_regular_file(Path::new("/dev/zero"), 3),
+            Err(ReadFileError::NotAFile)
+        ));
+    }
+}
