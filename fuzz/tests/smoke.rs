@@ -10,11 +10,6 @@ use yat_fuzz::workspace::workspace_root;
 
 const INPUTS: u64 = 2_000;
 
-/// Where the panics still open are: the BVH build (obvhs) on huge world coordinates, to be fixed
-/// in the geometry. Their minimized inputs are ignored tests in
-/// `tracer/tests/integration/fuzz_regressions.rs`; once they all pass, empty this filter.
-const OPEN_PANICS_IN: &[&str] = &["/obvhs-"];
-
 fn settings() -> Settings {
     Settings {
         inputs: INPUTS,
@@ -39,12 +34,7 @@ fn parser_inputs_never_panic() {
     let report = campaign::run(&mut target, &settings());
     print!("{report}");
     assert_eq!(report.inputs, INPUTS);
-    let new: Vec<_> = report
-        .findings
-        .iter()
-        .filter(|f| !OPEN_PANICS_IN.iter().any(|open| f.location.contains(open)))
-        .collect();
-    assert!(new.is_empty(), "panics not yet known: {new:#?}");
+    assert!(report.findings.is_empty(), "panics: {:#?}", report.findings);
     // A good share of the inputs get past the parser, so the build and render are fuzzed too.
     assert!(report.accepted * 3 >= INPUTS, "{report}");
 }
