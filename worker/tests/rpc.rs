@@ -12,13 +12,9 @@ use yat_worker::{serve, WorkerConfig};
 /// One render thread, no token, no TLS, and a 1000-byte blob limit.
 fn config() -> WorkerConfig {
     WorkerConfig {
-        threads: 1,
-        cache_dir: None,
         memory_cache_bytes: 1 << 20,
         max_blob_bytes: 1000,
-        token: None,
-        tls: None,
-        throttle: Duration::ZERO,
+        ..WorkerConfig::default()
     }
 }
 

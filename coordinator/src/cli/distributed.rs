@@ -41,7 +41,7 @@ impl DistributedArgs {
         Ok(Some(DistributedConfig {
             workers: self.workers.clone(),
             local_workers: self.local_workers,
-            token: self.token.token.clone(),
+            token: self.token.resolve()?,
             tls: self.tls.config()?,
             timeout: self.timeout.map(|t| seconds("timeout", t)).transpose()?,
             unit_deadline: self
