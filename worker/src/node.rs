@@ -55,11 +55,15 @@ pub struct Node {
 impl Node {
     pub fn new(config: &WorkerConfig) -> Result<Self, ServeError> {
         let threads = config.threads.max(1);
-        let blobs = BlobStore::new(config.memory_cache_bytes, config.cache_dir.as_deref())
-            .map_err(|e| match &config.cache_dir {
-                Some(dir) => ServeError::CacheFolder(dir.clone(), e),
-                None => ServeError::Cache(e),
-            })?;
+        let blobs = BlobStore::new(
+            config.memory_cache_bytes,
+            config.cache_dir.as_deref(),
+            config.cache_dir_bytes,
+        )
+        .map_err(|e| match &config.cache_dir {
+            Some(dir) => ServeError::CacheFolder(dir.clone(), e),
+            None => ServeError::Cache(e),
+        })?;
         let mut features = Vec::new();
         if config.cache_dir.is_some() {
             features.push("disk-cache".to_string());
@@ -168,8 +172,7 @@ impl Node {
         let blobs = self.blobs.clone();
         tokio::task::spawn_blocking(move || blobs.insert(&hash, data.into()))
             .await
-            .map_err(NodeError::BlobTask)?
-            .map_err(NodeError::BlobCache)?;
+            .map_err(NodeError::BlobTask)??;
         self.counters
             .blob_bytes_received
             .fetch_add(stored_bytes, Ordering::Relaxed);
