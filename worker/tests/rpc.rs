@@ -5,9 +5,13 @@ use std::time::Duration;
 
 use tokio::net::TcpListener;
 use tonic::Code;
+use yat_proto::drain::is_draining;
 use yat_proto::hash::sha256_hex;
 use yat_proto::{pb, RenderNodeClient, PROTOCOL_VERSION};
-use yat_worker::{serve, WorkerConfig};
+use yat_worker::{serve, ServeError, WorkerConfig};
+
+mod support;
+use support::*;
 
 /// One render thread, no token, no TLS, and a 1000-byte blob limit.
 fn config() -> WorkerConfig {
@@ -27,22 +31,6 @@ async fn worker() -> RenderNodeClient<tonic::transport::Channel> {
     RenderNodeClient::connect(format!("http://{address}"))
         .await
         .unwrap()
-}
-
-fn chunks(hash: &str, size: u64, parts: &[&'static [u8]]) -> Vec<pb::BlobChunk> {
-    parts
-        .iter()
-        .enumerate()
-        .map(|(i, data)| pb::BlobChunk {
-            sha256: if i == 0 {
-                hash.to_string()
-            } else {
-                String::new()
-            },
-            size: if i == 0 { size } else { 0 },
-            data: prost::bytes::Bytes::from_static(data),
-        })
-        .collect()
 }
 
 #[tokio::test]
@@ -190,4 +178,136 @@ async fn serve_returns_once_its_shutdown_resolves() {
         .expect("serve returned")
         .unwrap();
     assert!(served.is_ok(), "{served:?}");
+}
+
+#[tokio::test]
+async fn health_needs_no_token_and_a_drain_finishes_rendering_units_and_hands_back_the_rest() {
+    use tonic_health::pb::health_check_response::ServingStatus;
+    use tonic_health::pb::{health_client::HealthClient, HealthCheckRequest};
+    let mut worker = Served::start(WorkerConfig {
+        token: Some("t".into()),
+        throttle: Duration::from_millis(1500),
+        ..WorkerConfig::default()
+    })
+    .await;
+    let health = HealthClient::new(worker.channel());
+    let status = |service: &str| {
+        let mut health = health.clone();
+        let request = HealthCheckRequest {
+            service: service.to_string(),
+        };
+        async move { health.check(request).await.unwrap().into_inner().status() }
+    };
+    for service in ["", "yat.render.v1.RenderNode"] {
+        assert_eq!(status(service).await, ServingStatus::Serving, "{service:?}");
+    }
+    let unknown = HealthCheckRequest {
+        service: "other".into(),
+    };
+    let unknown = health.clone().check(unknown).await.unwrap_err();
+    assert_eq!(unknown.code(), Code::NotFound);
+    let denied = worker.client(None).stats(pb::StatsRequest {}).await;
+    assert_eq!(denied.unwrap_err().code(), Code::Unauthenticated);
+
+    let mut client = worker.client(Some("t"));
+    let scene = load_scene(&mut client, 4).await;
+    // One thread: unit 0 renders (its throttle pause counts), unit 1 waits for the thread.
+    let rendering = tokio::spawn({
+        let mut c = client.clone();
+        let request = unit(&scene, 0, 0..4);
+        async move { c.render_unit(request).await }
+    });
+    wait_until(Duration::from_secs(5), async || {
+        units_in_flight(&mut client).await == 1
+    })
+    .await;
+    let waiting = tokio::spawn({
+        let mut c = client.clone();
+        let request = unit(&scene, 1, 0..4);
+        async move { c.render_unit(request).await }
+    });
+    wait_until(Duration::from_secs(5), async || {
+        units_in_flight(&mut client).await == 2
+    })
+    .await;
+
+    let signalled = tokio::time::Instant::now();
+    worker.signal();
+    let handed_back = waiting.await.unwrap().unwrap_err();
+    assert!(is_draining(&handed_back), "{handed_back:?}");
+    assert!(
+        signalled.elapsed() < Duration::from_millis(1000),
+        "handed back at once"
+    );
+    for service in ["", "yat.render.v1.RenderNode"] {
+        assert_eq!(status(service).await, ServingStatus::NotServing);
+    }
+    let refused = client.render_unit(unit(&scene, 2, 0..4)).await.unwrap_err();
+    assert!(is_draining(&refused), "{refused:?}");
+    let upload = chunks(&"a".repeat(64), 1, &[b"x"]);
+    let refused = client
+        .put_blob(tokio_stream::iter(upload))
+        .await
+        .unwrap_err();
+    assert!(is_draining(&refused), "{refused:?}");
+
+    let finished = rendering.await.unwrap().unwrap().into_inner();
+    assert_eq!((finished.index, finished.pixels.len()), (0, 16 * 16 * 16));
+    let served = tokio::time::timeout(Duration::from_secs(10), worker.server)
+        .await
+        .expect("serve returned after the drain")
+        .unwrap();
+    assert!(served.is_ok(), "{served:?}");
+}
+
+#[tokio::test]
+async fn an_open_port_needs_a_token_or_client_certificates_or_insecure() {
+    let listener = TcpListener::bind("0.0.0.0:0").await.unwrap();
+    let refused = serve(listener, config(), std::future::ready(())).await;
+    let error = refused.unwrap_err();
+    assert!(matches!(error, ServeError::Exposed { .. }), "{error}");
+    for flag in ["--token-file", "--tls-client-ca", "--insecure"] {
+        assert!(error.to_string().contains(flag), "{error}");
+    }
+    for config in [
+        WorkerConfig {
+            insecure: true,
+            ..config()
+        },
+        WorkerConfig {
+            token: Some("t".into()),
+            ..config()
+        },
+    ] {
+        let listener = TcpListener::bind("0.0.0.0:0").await.unwrap();
+        let served = serve(listener, config, std::future::ready(())).await;
+        assert!(served.is_ok(), "{served:?}");
+    }
+}
+
+#[tokio::test]
+async fn units_beyond_the_queue_are_refused() {
+    let worker = Served::start(WorkerConfig {
+        max_queued_units: 1,
+        throttle: Duration::from_secs(2),
+        ..WorkerConfig::default()
+    })
+    .await;
+    let mut client = worker.client(None);
+    let scene = load_scene(&mut client, 1).await;
+    let mut calls = Vec::new();
+    for index in 0..2 {
+        let mut c = client.clone();
+        let request = unit(&scene, index, 0..1);
+        calls.push(tokio::spawn(async move { c.render_unit(request).await }));
+        wait_until(Duration::from_secs(5), async || {
+            units_in_flight(&mut client).await == u64::from(index) + 1
+        })
+        .await;
+    }
+    let refused = client.render_unit(unit(&scene, 2, 0..1)).await.unwrap_err();
+    assert_eq!(refused.code(), Code::ResourceExhausted, "{refused:?}");
+    for call in calls {
+        assert_eq!(call.await.unwrap().unwrap().into_inner().pixels.len(), 4096);
+    }
 }
