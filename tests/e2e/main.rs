@@ -4,6 +4,7 @@
 mod architecture;
 mod check;
 mod distributed;
+mod drain;
 mod resume;
 mod util;
 #[path = "../fixtures/workspace.rs"]
