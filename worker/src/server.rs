@@ -26,7 +26,7 @@ use crate::grpc::GrpcNode;
 use crate::node::Node;
 
 /// HTTP/2 pings to every peer, so a live peer's connection is never idle and a dead one is
-/// found.
+/// found: this often, or three times per connection idle limit if that is shorter.
 const KEEPALIVE_INTERVAL: Duration = Duration::from_secs(10);
 const KEEPALIVE_TIMEOUT: Duration = Duration::from_secs(20);
 
@@ -104,7 +104,7 @@ impl Worker {
         let service = InterceptedService::new(service, RequireToken::new(self.token.as_deref()));
         let network = &self.network;
         let mut server = Server::builder()
-            .http2_keepalive_interval(Some(KEEPALIVE_INTERVAL))
+            .http2_keepalive_interval(Some(KEEPALIVE_INTERVAL.min(network.connection_idle / 3)))
             .http2_keepalive_timeout(Some(KEEPALIVE_TIMEOUT))
             .max_concurrent_streams(network.max_streams_per_connection)
             .concurrency_limit_per_connection(network.max_streams_per_connection as usize)
