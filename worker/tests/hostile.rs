@@ -3,7 +3,6 @@
 //! bound, and an honest token holder is still served. The tests run one at a time, since they
 //! measure the process's memory.
 
-use std::sync::Mutex;
 use std::time::Duration;
 
 use tokio::io::AsyncReadExt;
@@ -17,7 +16,7 @@ mod support;
 use support::*;
 
 /// The tests measure the whole process: one at a time.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+static ONE_AT_A_TIME: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
 
 const TOKEN: &str = "honest";
 
@@ -49,7 +48,7 @@ async fn honest_unit_renders(worker: &Served, limit: Duration) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn unfinished_and_oversized_uploads_stay_within_the_upload_budget() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _one = ONE_AT_A_TIME.lock().await;
     const BUDGET: u64 = 32 * MIB;
     let worker = Served::start(WorkerConfig {
         upload_budget_bytes: BUDGET,
@@ -144,7 +143,7 @@ async fn unfinished_and_oversized_uploads_stay_within_the_upload_budget() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn idle_connections_and_streams_are_closed_and_an_honest_client_gets_in() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _one = ONE_AT_A_TIME.lock().await;
     let worker = Served::start(WorkerConfig {
         network: NetworkLimits {
             max_connections: 64,
@@ -214,7 +213,7 @@ async fn idle_connections_and_streams_are_closed_and_an_honest_client_gets_in() 
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_flood_of_huge_units_is_capped_and_abandoned_units_stop() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _one = ONE_AT_A_TIME.lock().await;
     let worker = Served::start(WorkerConfig {
         threads: 2,
         max_queued_units: 24,
@@ -305,7 +304,7 @@ async fn a_flood_of_huge_units_is_capped_and_abandoned_units_stop() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn strangers_and_failing_loads_do_not_disturb_running_units() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let _one = ONE_AT_A_TIME.lock().await;
     let worker = Served::start(hostile_config()).await;
     let mut client = worker.client(Some(TOKEN));
 
