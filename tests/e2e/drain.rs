@@ -104,3 +104,86 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
         "{log}"
     );
 }
+
+/// A lit sphere in one file, for a unit sent without a coordinator.
+const SPHERE: &[u8] = br#"Film "fleximage" "integer xresolution" [16] "integer yresolution" [16]
+LookAt 0 -3 0  0 0 0  0 0 1
+Camera "perspective" "float fov" [60]
+WorldBegin
+AttributeBegin
+  AreaLightSource "area" "color L" [1 1 1]
+  Shape "sphere" "float radius" 1
+AttributeEnd
+WorldEnd
+"#;
+
+/// Uploads [`SPHERE`] to the worker at `address`, loads it and asks for one unit, on
+/// `runtime`; the call stays pending until the worker answers or goes.
+fn send_one_unit(runtime: &tokio::runtime::Runtime, address: &str) {
+    use yat_proto::pb;
+    let address = format!("http://{address}");
+    runtime.spawn(async move {
+        let mut client = yat_proto::RenderNodeClient::connect(address).await.unwrap();
+        let sha256 = yat_proto::hash::sha256_hex(SPHERE);
+        let chunk = pb::BlobChunk {
+            sha256: sha256.clone(),
+            size: SPHERE.len() as u64,
+            data: SPHERE.to_vec().into(),
+        };
+        client.put_blob(tokio_stream::iter([chunk])).await.unwrap();
+        let load = pb::LoadSceneRequest {
+            main: Some(pb::SceneFile {
+                path: "sphere.lxs".into(),
+                sha256,
+            }),
+            assets: vec![],
+            settings: Some(pb::RenderSettings {
+                width: 16,
+                height: 16,
+                spp: 1,
+                max_depth: 2,
+                ..Default::default()
+            }),
+        };
+        let scene_id = client.load_scene(load).await.unwrap().into_inner().scene_id;
+        let unit = pb::WorkUnit {
+            index: 0,
+            x0: 0,
+            y0: 0,
+            x1: 16,
+            y1: 16,
+            sample_start: 0,
+            sample_end: 1,
+        };
+        let request = pb::RenderUnitRequest {
+            scene_id,
+            unit: Some(unit),
+        };
+        let _ = client.render_unit(request).await;
+    });
+}
+
+#[test]
+fn a_second_signal_stops_a_draining_worker_at_once() {
+    let mut worker = Worker::start(&["--throttle-ms", "10000"]);
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    send_one_unit(&runtime, &worker.address);
+    let polling = Instant::now();
+    while worker.stats(None).units_in_flight < 1 {
+        assert!(
+            polling.elapsed() < Duration::from_secs(30),
+            "no unit arrived"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    worker.signal("TERM");
+    assert!(
+        worker.wait_for_exit(Duration::from_millis(500)).is_none(),
+        "the first signal drains: a unit is still rendering"
+    );
+    worker.signal("TERM");
+    let status = worker
+        .wait_for_exit(Duration::from_secs(3))
+        .expect("the second signal stops the worker at once");
+    assert_eq!(status.code(), Some(130), "{status}");
+}

@@ -311,3 +311,61 @@ async fn units_beyond_the_queue_are_refused() {
         assert_eq!(call.await.unwrap().unwrap().into_inner().pixels.len(), 4096);
     }
 }
+
+#[tokio::test]
+async fn with_a_client_ca_only_clients_with_its_certificates_are_served() {
+    use rcgen::{BasicConstraints, CertificateParams, CertifiedIssuer, IsCa, KeyPair};
+    use tonic::transport::{Certificate, ClientTlsConfig, Endpoint, Identity};
+    let mut ca_params = CertificateParams::new(Vec::new()).unwrap();
+    ca_params.is_ca = IsCa::Ca(BasicConstraints::Unconstrained);
+    let ca = CertifiedIssuer::self_signed(ca_params, KeyPair::generate().unwrap()).unwrap();
+    let issue = |name: &str| {
+        let key = KeyPair::generate().unwrap();
+        let cert = CertificateParams::new(vec![name.to_string()])
+            .unwrap()
+            .signed_by(&key, &ca)
+            .unwrap();
+        Identity::from_pem(cert.pem(), key.serialize_pem())
+    };
+    // No token, on every address: client certificates satisfy the secure-by-default rule.
+    let listener = TcpListener::bind("0.0.0.0:0").await.unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let config = WorkerConfig {
+        tls: Some(issue("localhost")),
+        tls_client_ca: Some(Certificate::from_pem(ca.pem())),
+        ..config()
+    };
+    tokio::spawn(serve(listener, config, std::future::pending()));
+    let handshake = |identity: Option<Identity>| {
+        let mut tls = ClientTlsConfig::new()
+            .ca_certificate(Certificate::from_pem(ca.pem()))
+            .domain_name("localhost");
+        if let Some(identity) = identity {
+            tls = tls.identity(identity);
+        }
+        async move {
+            let channel = Endpoint::from_shared(format!("https://127.0.0.1:{port}"))
+                .unwrap()
+                .tls_config(tls)
+                .unwrap()
+                .connect()
+                .await;
+            let hello = pb::HandshakeRequest {
+                protocol_version: PROTOCOL_VERSION,
+                client: "test".into(),
+            };
+            match channel {
+                Ok(channel) => RenderNodeClient::new(channel)
+                    .handshake(hello)
+                    .await
+                    .map(drop),
+                Err(error) => Err(tonic::Status::unavailable(error.to_string())),
+            }
+        }
+    };
+    assert!(handshake(Some(issue("coordinator"))).await.is_ok());
+    assert!(
+        handshake(None).await.is_err(),
+        "a client without a certificate"
+    );
+}
