@@ -24,7 +24,8 @@ pub struct WorkerArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Keep received scene files in this folder too, so they survive a restart. It is
-    /// created private (0700); a folder others may write to is refused.
+    /// created private (0700); an existing folder others may use is made private, or refused
+    /// when it is another user's.
     #[arg(long)]
     pub cache_dir: Option<PathBuf>,
     /// Scene files kept in --cache-dir, in MiB (least recently used deleted first).
@@ -63,13 +64,13 @@ pub struct WorkerArgs {
     pub max_streams_per_connection: u32,
     /// Close a connection whose peer sends nothing for this many seconds (live peers answer
     /// the worker's pings every 10 s).
-    #[arg(long, default_value_t = defaults::CONNECTION_IDLE_SECONDS)]
+    #[arg(long, default_value_t = defaults::CONNECTION_IDLE_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
     pub connection_idle_seconds: u64,
     /// Fail an upload that sends no chunk for this many seconds.
-    #[arg(long, default_value_t = defaults::BLOB_IDLE_SECONDS)]
+    #[arg(long, default_value_t = defaults::BLOB_IDLE_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
     pub blob_idle_seconds: u64,
     /// Fail any request still running after this many seconds.
-    #[arg(long, default_value_t = defaults::REQUEST_TIMEOUT_SECONDS)]
+    #[arg(long, default_value_t = defaults::REQUEST_TIMEOUT_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
     pub request_timeout_seconds: u64,
     /// Exit when standard input closes: a parent that dies takes its workers with it.
     #[arg(long)]
