@@ -17,7 +17,7 @@ use crate::blobs::BlobStore;
 use crate::config::WorkerConfig;
 use crate::error::{NodeError, ServeError};
 use crate::loaded_scene::LoadedScene;
-use crate::pool::{DrainCounts, RenderPool};
+use crate::pool::{RenderPool, UnitCounts};
 use crate::scenes::SceneCache;
 use crate::upload::{BlobUpload, UploadBudget};
 
@@ -102,7 +102,7 @@ impl Node {
 
     /// Stops taking work: new blobs, scenes and units are refused from now on and units waiting
     /// for a render thread are handed back. Says how many units were rendering and waiting.
-    pub fn begin_drain(&self) -> DrainCounts {
+    pub fn begin_drain(&self) -> UnitCounts {
         let counts = self.pool.counts();
         self.draining.send_replace(true);
         counts

@@ -38,9 +38,10 @@ pub struct RenderedUnit {
     pub elapsed: Duration,
 }
 
-/// What a drain found: units it lets finish and units it hands back.
+/// Units on a render thread and units waiting for one (what a drain lets finish and hands
+/// back).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DrainCounts {
+pub struct UnitCounts {
     pub rendering: u64,
     pub waiting: u64,
 }
@@ -70,8 +71,8 @@ impl RenderPool {
     }
 
     /// Units waiting for a thread and units on one.
-    pub fn counts(&self) -> DrainCounts {
-        DrainCounts {
+    pub fn counts(&self) -> UnitCounts {
+        UnitCounts {
             rendering: *self.rendering.borrow(),
             waiting: self.waiting.load(Ordering::Relaxed),
         }
