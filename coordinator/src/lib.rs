@@ -8,6 +8,7 @@
 
 pub mod checkpoint;
 pub mod cli;
+pub mod cpus;
 pub mod exec;
 pub mod interim;
 pub mod job;

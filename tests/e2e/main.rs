@@ -5,6 +5,7 @@ mod architecture;
 mod check;
 mod discovery;
 mod distributed;
+mod drain;
 mod files;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;

@@ -143,7 +143,22 @@ impl Worker {
         self.child.wait().unwrap();
     }
 
-    /// Sends a signal with the `kill` command (STOP, CONT).
+    /// The exit status, once the process ends within `limit`.
+    pub fn wait_for_exit(
+        &mut self,
+        limit: std::time::Duration,
+    ) -> Option<std::process::ExitStatus> {
+        let started = std::time::Instant::now();
+        while started.elapsed() < limit {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return Some(status);
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        None
+    }
+
+    /// Sends a signal with the `kill` command (STOP, CONT, TERM).
     pub fn signal(&self, name: &str) {
         let status = Command::new("kill")
             .args([&format!("-{name}"), &self.pid().to_string()])

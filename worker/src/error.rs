@@ -1,6 +1,7 @@
 //! The worker's errors: a request's ([`NodeError`], which the gRPC layer maps to the status
 //! codes `render.proto` documents) and starting or running the server ([`ServeError`]).
 
+use std::net::SocketAddr;
 use std::path::PathBuf;
 
 use yat_proto::convert::WireError;
@@ -25,6 +26,13 @@ pub enum NodeError {
     EmptyBlobStream,
     #[error("a blob's first chunk must name its sha256 (64 lowercase hex digits)")]
     UnnamedBlob,
+    #[error(
+        "blob uploads in progress hold {held} bytes; {more} more would pass this worker's \
+         budget of {budget} bytes: try again later"
+    )]
+    UploadBudget { held: u64, more: u64, budget: u64 },
+    #[error("blob {hash}: no chunk for {seconds} s, upload abandoned")]
+    BlobStalled { hash: String, seconds: u64 },
     #[error("blob {hash} has {size} bytes; this worker accepts at most {max}")]
     BlobTooLarge { hash: String, size: u64, max: u64 },
     #[error("blob {hash}: more bytes than the declared {size}")]
@@ -39,6 +47,15 @@ pub enum NodeError {
     BlobHashMismatch { declared: String, actual: String },
     #[error("blob {sha256} (\"{path}\") is missing: upload it first")]
     BlobMissing { sha256: String, path: String },
+    #[error(
+        "cache full: blob {hash} has {size} bytes, more than the cache folder's budget of \
+         {budget} bytes"
+    )]
+    CacheFull {
+        hash: String,
+        size: u64,
+        budget: u64,
+    },
     #[error("blob cache: {0}")]
     BlobCache(#[source] std::io::Error),
     #[error("{path}: {source}")]
@@ -50,6 +67,14 @@ pub enum NodeError {
     SceneBuild { path: String, source: BuildError },
     #[error("scene {0} is not loaded here: load it again")]
     SceneNotLoaded(String),
+    #[error("{max} units are already waiting for a render thread: try again later")]
+    QueueFull { max: usize },
+    /// The worker is draining: the request was not worked on.
+    #[error("worker draining: {0} refused")]
+    Draining(String),
+    /// The caller stopped waiting; nobody reads this error.
+    #[error("unit {0} cancelled by its caller")]
+    UnitCancelled(u32),
     #[error("unit {0} panicked")]
     UnitPanicked(u32),
     #[error("render thread vanished")]
@@ -69,6 +94,14 @@ pub enum ServeError {
     CacheFolder(PathBuf, #[source] std::io::Error),
     #[error("cannot create the blob cache")]
     Cache(#[source] std::io::Error),
+    #[error(
+        "refusing to serve on {address} without a token or TLS client certificates: anyone \
+         who reaches this port could use this worker. Give --token-file PATH (or YAT_TOKEN), or \
+         --tls-cert, --tls-key and --tls-client-ca, or --insecure to serve anyway"
+    )]
+    Exposed { address: SocketAddr },
+    #[error("cannot read the listener's address")]
+    Listener(#[source] std::io::Error),
     #[error(transparent)]
     ThreadPool(#[from] rayon::ThreadPoolBuildError),
     #[error("invalid TLS certificate or key")]

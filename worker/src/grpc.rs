@@ -2,8 +2,10 @@
 //! codes `render.proto` documents. No logic lives here.
 
 use std::sync::Arc;
+use std::time::Duration;
 
 use tonic::{Request, Response, Status, Streaming};
+use yat_proto::drain::draining_status;
 use yat_proto::pb;
 
 use crate::error::NodeError;
@@ -11,11 +13,31 @@ use crate::node::Node;
 
 pub struct GrpcNode {
     node: Arc<Node>,
+    /// How long a PutBlob stream may go without a chunk.
+    blob_idle: Duration,
 }
 
 impl GrpcNode {
-    pub fn new(node: Arc<Node>) -> Self {
-        Self { node }
+    pub fn new(node: Arc<Node>, blob_idle: Duration) -> Self {
+        Self { node, blob_idle }
+    }
+}
+
+impl GrpcNode {
+    /// The next chunk of blob `hash`, failing the upload when none comes in time.
+    async fn next_chunk(
+        &self,
+        chunks: &mut Streaming<pb::BlobChunk>,
+        hash: &str,
+    ) -> Result<Option<pb::BlobChunk>, Status> {
+        match tokio::time::timeout(self.blob_idle, chunks.message()).await {
+            Ok(chunk) => chunk,
+            Err(_) => Err(NodeError::BlobStalled {
+                hash: hash.to_string(),
+                seconds: self.blob_idle.as_secs(),
+            }
+            .into()),
+        }
     }
 }
 
@@ -23,6 +45,7 @@ impl From<NodeError> for Status {
     fn from(error: NodeError) -> Self {
         use NodeError::*;
         let code = match &error {
+            Draining(what) => return draining_status(what),
             ProtocolVersion { .. } | BlobMissing { .. } => tonic::Code::FailedPrecondition,
             Wire(_)
             | MalformedHash { .. }
@@ -33,7 +56,11 @@ impl From<NodeError> for Status {
             | BlobHashMismatch { .. }
             | SceneParse { .. }
             | SceneBuild { .. } => tonic::Code::InvalidArgument,
-            BlobTooLarge { .. } => tonic::Code::ResourceExhausted,
+            BlobTooLarge { .. } | UploadBudget { .. } | CacheFull { .. } | QueueFull { .. } => {
+                tonic::Code::ResourceExhausted
+            }
+            BlobStalled { .. } => tonic::Code::DeadlineExceeded,
+            UnitCancelled(_) => tonic::Code::Cancelled,
             SceneNotLoaded(_) => tonic::Code::NotFound,
             BlobCache(_) | UnitPanicked(_) | RenderThreadVanished | BlobTask(_) | BuildTask(_) => {
                 tonic::Code::Internal
@@ -64,10 +91,13 @@ impl pb::render_node_server::RenderNode for GrpcNode {
         request: Request<Streaming<pb::BlobChunk>>,
     ) -> Result<Response<pb::PutBlobReply>, Status> {
         let mut chunks = request.into_inner();
-        let first = chunks.message().await?.ok_or(NodeError::EmptyBlobStream)?;
+        let first = self
+            .next_chunk(&mut chunks, "(unnamed)")
+            .await?
+            .ok_or(NodeError::EmptyBlobStream)?;
         let mut upload = self.node.begin_blob(first.sha256, first.size)?;
         upload.push(&first.data)?;
-        while let Some(chunk) = chunks.message().await? {
+        while let Some(chunk) = self.next_chunk(&mut chunks, upload.hash()).await? {
             upload.push(&chunk.data)?;
         }
         Ok(Response::new(self.node.store_blob(upload).await?))

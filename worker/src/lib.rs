@@ -5,6 +5,7 @@
 
 mod blobs;
 mod config;
+mod connection;
 mod error;
 mod grpc;
 mod loaded_scene;
@@ -14,6 +15,6 @@ mod scenes;
 mod server;
 mod upload;
 
-pub use config::WorkerConfig;
+pub use config::{defaults, NetworkLimits, WorkerConfig, MIB};
 pub use error::{NodeError, ServeError};
 pub use server::{serve, Worker};

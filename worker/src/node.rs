@@ -4,9 +4,10 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use prost::Message;
+use tokio::sync::watch;
 use yat_proto::convert::{unit_from_wire, WireError};
 use yat_proto::hash::{is_sha256_hex, sha256_hex};
 use yat_proto::{pb, DEFAULT_MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
@@ -17,9 +18,9 @@ use crate::blobs::BlobStore;
 use crate::config::WorkerConfig;
 use crate::error::{NodeError, ServeError};
 use crate::loaded_scene::LoadedScene;
-use crate::pool::RenderPool;
+use crate::pool::{RenderPool, UnitCounts};
 use crate::scenes::SceneCache;
-use crate::upload::BlobUpload;
+use crate::upload::{BlobUpload, UploadBudget};
 
 /// Scenes a worker keeps built at once.
 const SCENE_CACHE_CAPACITY: usize = 4;
@@ -38,7 +39,6 @@ struct Counters {
     samples_done: AtomicU64,
     blob_bytes_received: AtomicU64,
     result_bytes_sent: AtomicU64,
-    units_in_flight: AtomicU64,
 }
 
 pub struct Node {
@@ -46,10 +46,11 @@ pub struct Node {
     blobs: Arc<BlobStore>,
     scenes: SceneCache<LoadedScene>,
     pool: RenderPool,
-    /// Test hook: a pause before each unit, to make a worker slow on purpose.
-    throttle: Duration,
     /// What a scene may cost to parse and build.
     build_budget: BuildBudget,
+    uploads: UploadBudget,
+    /// Set once at the shutdown signal: new work is refused, queued units handed back.
+    draining: watch::Sender<bool>,
     counters: Counters,
     started: Instant,
 }
@@ -57,11 +58,15 @@ pub struct Node {
 impl Node {
     pub fn new(config: &WorkerConfig) -> Result<Self, ServeError> {
         let threads = config.threads.max(1);
-        let blobs = BlobStore::new(config.memory_cache_bytes, config.cache_dir.as_deref())
-            .map_err(|e| match &config.cache_dir {
-                Some(dir) => ServeError::CacheFolder(dir.clone(), e),
-                None => ServeError::Cache(e),
-            })?;
+        let blobs = BlobStore::new(
+            config.memory_cache_bytes,
+            config.cache_dir.as_deref(),
+            config.cache_dir_bytes,
+        )
+        .map_err(|e| match &config.cache_dir {
+            Some(dir) => ServeError::CacheFolder(dir.clone(), e),
+            None => ServeError::Cache(e),
+        })?;
         let mut features = Vec::new();
         if config.cache_dir.is_some() {
             features.push("disk-cache".to_string());
@@ -69,18 +74,27 @@ impl Node {
         if config.tls.is_some() {
             features.push("tls".to_string());
         }
+        let draining = watch::Sender::new(false);
+        let pool = RenderPool::new(
+            threads,
+            config.max_queued_units,
+            draining.subscribe(),
+            config.throttle,
+        )?;
         Ok(Self {
             capabilities: Capabilities {
                 threads: threads as u32,
                 max_message_bytes: DEFAULT_MAX_MESSAGE_BYTES as u64,
-                max_blob_bytes: config.max_blob_bytes,
+                // A blob is held whole while it arrives, so it must fit the uploads' budget.
+                max_blob_bytes: config.max_blob_bytes.min(config.upload_budget_bytes),
                 features,
             },
             blobs: Arc::new(blobs),
             scenes: SceneCache::new(SCENE_CACHE_CAPACITY),
-            pool: RenderPool::new(threads)?,
-            throttle: config.throttle,
+            pool,
             build_budget: config.build_budget,
+            uploads: UploadBudget::new(config.upload_budget_bytes),
+            draining,
             counters: Counters::default(),
             started: Instant::now(),
         })
@@ -88,6 +102,26 @@ impl Node {
 
     pub fn capabilities(&self) -> &Capabilities {
         &self.capabilities
+    }
+
+    /// Stops taking work: new blobs, scenes and units are refused from now on and units waiting
+    /// for a render thread are handed back. Says how many units were rendering and waiting.
+    pub fn begin_drain(&self) -> UnitCounts {
+        let counts = self.pool.counts();
+        self.draining.send_replace(true);
+        counts
+    }
+
+    /// Resolves once no unit is rendering.
+    pub async fn idle(&self) {
+        self.pool.idle().await;
+    }
+
+    fn refuse_if_draining(&self, what: impl FnOnce() -> String) -> Result<(), NodeError> {
+        if *self.draining.borrow() {
+            return Err(NodeError::Draining(what()));
+        }
+        Ok(())
     }
 
     /// The worker's version and capabilities, for a client of the same protocol version.
@@ -126,7 +160,13 @@ impl Node {
 
     /// Starts receiving a blob, named and sized by its first chunk.
     pub fn begin_blob(&self, hash: String, size: u64) -> Result<BlobUpload, NodeError> {
-        BlobUpload::begin(hash, size, self.capabilities.max_blob_bytes)
+        self.refuse_if_draining(|| format!("blob {hash}"))?;
+        BlobUpload::begin(
+            hash,
+            size,
+            self.capabilities.max_blob_bytes,
+            self.uploads.clone(),
+        )
     }
 
     /// Stores a blob received whole and verified.
@@ -136,8 +176,7 @@ impl Node {
         let blobs = self.blobs.clone();
         tokio::task::spawn_blocking(move || blobs.insert(&hash, data.into()))
             .await
-            .map_err(NodeError::BlobTask)?
-            .map_err(NodeError::BlobCache)?;
+            .map_err(NodeError::BlobTask)??;
         self.counters
             .blob_bytes_received
             .fetch_add(stored_bytes, Ordering::Relaxed);
@@ -149,6 +188,7 @@ impl Node {
         &self,
         request: pb::LoadSceneRequest,
     ) -> Result<pb::LoadSceneReply, NodeError> {
+        self.refuse_if_draining(|| "scene load".to_string())?;
         // Protobuf encoding of the same message is the same bytes: the id names the files'
         // contents, their paths and the settings, identically on every worker.
         let scene_id = sha256_hex(&request.encode_to_vec());
@@ -186,16 +226,16 @@ impl Node {
         &self,
         request: pb::RenderUnitRequest,
     ) -> Result<pb::RenderUnitReply, NodeError> {
+        self.refuse_if_draining(|| {
+            let index = request.unit.as_ref().map_or(0, |u| u.index);
+            format!("unit {index}")
+        })?;
         let loaded = self
             .scenes
             .get(&request.scene_id)
             .ok_or(NodeError::SceneNotLoaded(request.scene_id))?;
         let unit = request.unit.as_ref().ok_or(WireError::Missing("unit"))?;
         let unit = unit_from_wire(unit, &loaded.settings)?;
-        let _in_flight = InFlight::enter(&self.counters.units_in_flight);
-        if !self.throttle.is_zero() {
-            tokio::time::sleep(self.throttle).await;
-        }
         let rendered = self.pool.render(loaded, unit).await?;
         let c = &self.counters;
         c.units_done.fetch_add(1, Ordering::Relaxed);
@@ -221,24 +261,11 @@ impl Node {
             result_bytes_sent: c.result_bytes_sent.load(Ordering::Relaxed),
             blobs_cached: self.blobs.len() as u64,
             scenes_cached: self.scenes.len() as u64,
-            units_in_flight: c.units_in_flight.load(Ordering::Relaxed),
+            units_in_flight: {
+                let units = self.pool.counts();
+                units.rendering + units.waiting
+            },
             uptime_seconds: self.started.elapsed().as_secs_f64(),
         }
-    }
-}
-
-/// Counts a unit as in flight until dropped, even when the coordinator gives up on it.
-struct InFlight<'a>(&'a AtomicU64);
-
-impl<'a> InFlight<'a> {
-    fn enter(counter: &'a AtomicU64) -> Self {
-        counter.fetch_add(1, Ordering::Relaxed);
-        Self(counter)
-    }
-}
-
-impl Drop for InFlight<'_> {
-    fn drop(&mut self) {
-        self.0.fetch_sub(1, Ordering::Relaxed);
     }
 }

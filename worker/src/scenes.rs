@@ -1,12 +1,14 @@
 //! Built scenes kept for later units and renders, keyed by scene id. Concurrent loads of the
-//! same scene build it once; the least recently used scene is dropped beyond the capacity (a
-//! coordinator that still needs it gets NOT_FOUND and loads it again).
+//! same scene build it once, and builds of different scenes run one at a time (a build can take
+//! a lot of memory). Beyond the capacity the least recently used scene is dropped once a new one
+//! is built (a coordinator that still needs it gets NOT_FOUND and loads it again), but never a
+//! scene that units are rendering or that is being built, and a failed build drops nothing.
 
 use std::collections::HashMap;
 use std::future::Future;
 use std::sync::{Arc, Mutex};
 
-use tokio::sync::OnceCell;
+use tokio::sync::{OnceCell, Semaphore};
 
 type Slot<T> = Arc<OnceCell<Arc<T>>>;
 
@@ -14,6 +16,7 @@ type Slot<T> = Arc<OnceCell<Arc<T>>>;
 pub struct SceneCache<T> {
     capacity: usize,
     slots: Mutex<Slots<T>>,
+    builds: Semaphore,
 }
 
 struct Slots<T> {
@@ -32,6 +35,12 @@ impl<T> Slots<T> {
     }
 }
 
+/// Whether a slot must stay: it is being built, or someone besides the cache holds its scene
+/// (a unit rendering it).
+fn pinned<T>(slot: &Slot<T>) -> bool {
+    slot.get().is_none_or(|scene| Arc::strong_count(scene) > 1)
+}
+
 impl<T> SceneCache<T> {
     pub fn new(capacity: usize) -> Self {
         Self {
@@ -40,6 +49,7 @@ impl<T> SceneCache<T> {
                 map: HashMap::new(),
                 clock: 0,
             }),
+            builds: Semaphore::new(1),
         }
     }
 
@@ -69,7 +79,6 @@ impl<T> SceneCache<T> {
                     let slot = Slot::<T>::default();
                     let clock = slots.clock;
                     slots.map.insert(id.to_string(), (slot.clone(), clock));
-                    self.evict(&mut slots, id);
                     slot
                 }
             }
@@ -77,22 +86,44 @@ impl<T> SceneCache<T> {
         let mut built = false;
         let scene = slot
             .get_or_try_init(|| async {
+                let _one_build_at_a_time = self.builds.acquire().await.expect("never closed");
                 built = true;
                 build().await.map(Arc::new)
             })
-            .await?;
-        Ok((scene.clone(), built))
+            .await;
+        let mut slots = self.slots.lock().unwrap();
+        match scene {
+            Ok(scene) => {
+                let scene = scene.clone();
+                self.evict(&mut slots, id);
+                Ok((scene, built))
+            }
+            Err(error) => {
+                let ours = slots
+                    .map
+                    .get(id)
+                    .is_some_and(|(s, _)| Arc::ptr_eq(s, &slot) && !s.initialized());
+                if ours {
+                    slots.map.remove(id);
+                }
+                Err(error)
+            }
+        }
     }
 
+    /// Drops the least recently used scenes that are not pinned until at most `capacity`
+    /// remain, or only pinned ones and `keep`.
     fn evict(&self, slots: &mut Slots<T>, keep: &str) {
         while slots.map.len() > self.capacity {
             let oldest = slots
                 .map
                 .iter()
-                .filter(|(id, _)| id.as_str() != keep)
+                .filter(|(id, (slot, _))| id.as_str() != keep && !pinned(slot))
                 .min_by_key(|(_, (_, used))| *used)
-                .map(|(id, _)| id.clone())
-                .expect("more than one scene");
+                .map(|(id, _)| id.clone());
+            let Some(oldest) = oldest else {
+                return;
+            };
             slots.map.remove(&oldest);
         }
     }
@@ -130,5 +161,63 @@ mod tests {
         assert!(cache.get("b").is_none(), "b was the least recently used");
         assert_eq!(cache.get("a").as_deref(), Some(&1));
         assert_eq!(cache.len(), 2);
+    }
+
+    #[tokio::test]
+    async fn scenes_in_use_stay_and_failed_builds_evict_nothing() {
+        let cache = SceneCache::<u32>::new(1);
+        let (a, _) = cache
+            .get_or_build("a", || async { Ok::<_, ()>(1) })
+            .await
+            .unwrap();
+        let failed: Result<_, &str> = cache.get_or_build("b", || async { Err("boom") }).await;
+        assert!(failed.is_err());
+        assert_eq!(
+            cache.get("a").as_deref(),
+            Some(&1),
+            "a failed build evicts nothing"
+        );
+        cache
+            .get_or_build("c", || async { Ok::<_, ()>(3) })
+            .await
+            .unwrap();
+        assert_eq!(
+            cache.get("a").as_deref(),
+            Some(&1),
+            "a scene a unit holds is not evicted"
+        );
+        drop(a);
+        cache
+            .get_or_build("d", || async { Ok::<_, ()>(4) })
+            .await
+            .unwrap();
+        assert!(cache.get("a").is_none() && cache.get("c").is_none());
+        assert_eq!(cache.len(), 1);
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn builds_run_one_at_a_time() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let cache = Arc::new(SceneCache::<usize>::new(8));
+        let (running, most) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+        let loads = (0..4).map(|i| {
+            let (cache, running, most) = (cache.clone(), running.clone(), most.clone());
+            tokio::spawn(async move {
+                cache
+                    .get_or_build(&i.to_string(), || async move {
+                        let now = running.fetch_add(1, Ordering::SeqCst) + 1;
+                        most.fetch_max(now, Ordering::SeqCst);
+                        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+                        running.fetch_sub(1, Ordering::SeqCst);
+                        Ok::<_, ()>(i)
+                    })
+                    .await
+            })
+        });
+        for load in loads.collect::<Vec<_>>() {
+            load.await.unwrap().unwrap();
+        }
+        assert_eq!(most.load(Ordering::SeqCst), 1);
+        assert_eq!(cache.len(), 4);
     }
 }

@@ -1,73 +1,169 @@
 //! Serving the node over gRPC on a listener the caller bound, until the caller's shutdown
-//! future resolves: the token check, TLS, message limits and keepalives around the service.
+//! future resolves and the node has drained: the token check, TLS, the health service, message
+//! and connection limits and keepalives around the service.
+//!
+//! The health service (`grpc.health.v1`, for `""` and `yat.render.v1.RenderNode`) is outside
+//! the token check: orchestrators' probes cannot send metadata, and it reveals nothing but
+//! SERVING or NOT_SERVING.
 
 use std::future::Future;
+use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
 use tonic::service::interceptor::InterceptedService;
-use tonic::transport::server::TcpIncoming;
-use tonic::transport::{Identity, Server, ServerTlsConfig};
+use tonic::transport::{Certificate, Identity, Server, ServerTlsConfig};
+use tonic_health::server::HealthReporter;
+use tonic_health::ServingStatus;
 use yat_proto::auth::RequireToken;
 use yat_proto::{RenderNodeServer, DEFAULT_MAX_MESSAGE_BYTES};
 
-use crate::config::WorkerConfig;
+use crate::config::{NetworkLimits, WorkerConfig};
+use crate::connection;
 use crate::error::ServeError;
 use crate::grpc::GrpcNode;
 use crate::node::Node;
 
+/// HTTP/2 pings to every peer, so a live peer's connection is never idle and a dead one is
+/// found: this often, or three times per connection idle limit if that is shorter.
+const KEEPALIVE_INTERVAL: Duration = Duration::from_secs(10);
+const KEEPALIVE_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// After the drain, how long the last replies get to leave before the server stops regardless
+/// of connections still open.
+const REPLY_GRACE: Duration = Duration::from_secs(2);
+
+type RenderService = RenderNodeServer<GrpcNode>;
+
 /// A worker ready to serve: its caches opened and its render threads started.
 pub struct Worker {
     node: Arc<Node>,
+    network: NetworkLimits,
+    drain: Duration,
     token: Option<String>,
     tls: Option<Identity>,
+    tls_client_ca: Option<Certificate>,
+    insecure: bool,
 }
 
 impl Worker {
     pub fn new(config: WorkerConfig) -> Result<Self, ServeError> {
         Ok(Self {
             node: Arc::new(Node::new(&config)?),
+            network: config.network,
+            drain: config.drain,
             token: config.token,
             tls: config.tls,
+            tls_client_ca: config.tls_client_ca,
+            insecure: config.insecure,
         })
     }
 
-    /// Serves coordinators on `listener` until `shutdown` resolves, then finishes the requests
-    /// under way and returns.
+    /// Refuses to serve beyond loopback when anyone reaching the port could use the worker: no
+    /// token, no TLS client certificates, and no `--insecure`.
+    pub fn check_exposure(&self, address: SocketAddr) -> Result<(), ServeError> {
+        let open = self.token.is_none() && self.tls_client_ca.is_none();
+        if open && !address.ip().is_loopback() && !self.insecure {
+            return Err(ServeError::Exposed { address });
+        }
+        Ok(())
+    }
+
+    /// Serves coordinators on `listener` until `shutdown` resolves, then drains: reports
+    /// NOT_SERVING, refuses new work, hands queued units back, lets units already rendering
+    /// finish for up to the drain period, and returns.
     pub async fn serve(
         self,
         listener: TcpListener,
         shutdown: impl Future<Output = ()>,
     ) -> Result<(), ServeError> {
+        let address = listener.local_addr().map_err(ServeError::Listener)?;
+        self.check_exposure(address)?;
         tracing::info!(
-            "{} thread(s){}{}",
+            "{} thread(s){}{}{}",
             self.node.capabilities().threads,
             if self.tls.is_some() { ", TLS" } else { "" },
+            if self.tls_client_ca.is_some() {
+                ", client certificates required"
+            } else {
+                ""
+            },
             if self.token.is_some() {
                 ", token required"
             } else {
                 ""
             }
         );
-        let service = RenderNodeServer::new(GrpcNode::new(self.node))
-            .max_decoding_message_size(DEFAULT_MAX_MESSAGE_BYTES)
-            .max_encoding_message_size(DEFAULT_MAX_MESSAGE_BYTES);
+        let (health, health_service) = tonic_health::server::health_reporter();
+        health.set_serving::<RenderService>().await;
+        let service =
+            RenderNodeServer::new(GrpcNode::new(self.node.clone(), self.network.blob_idle))
+                .max_decoding_message_size(DEFAULT_MAX_MESSAGE_BYTES)
+                .max_encoding_message_size(DEFAULT_MAX_MESSAGE_BYTES);
         let service = InterceptedService::new(service, RequireToken::new(self.token.as_deref()));
+        let network = &self.network;
         let mut server = Server::builder()
-            .http2_keepalive_interval(Some(Duration::from_secs(10)))
-            .http2_keepalive_timeout(Some(Duration::from_secs(20)));
+            .http2_keepalive_interval(Some(KEEPALIVE_INTERVAL.min(network.connection_idle / 3)))
+            .http2_keepalive_timeout(Some(KEEPALIVE_TIMEOUT))
+            .max_concurrent_streams(network.max_streams_per_connection)
+            .concurrency_limit_per_connection(network.max_streams_per_connection as usize)
+            .timeout(network.request_timeout);
         if let Some(identity) = self.tls {
-            server = server
-                .tls_config(ServerTlsConfig::new().identity(identity))
-                .map_err(ServeError::Tls)?;
+            let mut tls = ServerTlsConfig::new().identity(identity);
+            if let Some(ca) = self.tls_client_ca {
+                tls = tls.client_ca_root(ca);
+            }
+            server = server.tls_config(tls).map_err(ServeError::Tls)?;
         }
-        let incoming = TcpIncoming::from(listener).with_nodelay(Some(true));
-        server
+        let incoming =
+            connection::accept(listener, network.max_connections, network.connection_idle);
+        let (drained, drained_rx) = tokio::sync::oneshot::channel();
+        let node = self.node.clone();
+        let drain_period = self.drain;
+        let stop = async move {
+            shutdown.await;
+            drain(&node, &health, drain_period).await;
+            let _ = drained.send(());
+        };
+        let serving = server
+            .add_service(health_service)
             .add_service(service)
-            .serve_with_incoming_shutdown(incoming, shutdown)
-            .await
-            .map_err(ServeError::Server)
+            .serve_with_incoming_shutdown(incoming, stop);
+        let deadline = async {
+            if drained_rx.await.is_err() {
+                return std::future::pending().await;
+            }
+            tokio::time::sleep(REPLY_GRACE).await;
+        };
+        tokio::select! {
+            served = serving => served.map_err(ServeError::Server),
+            () = deadline => {
+                tracing::warn!("connections still open {REPLY_GRACE:?} after the drain; stopping");
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The steps of a drain, logged.
+async fn drain(node: &Node, health: &HealthReporter, period: Duration) {
+    health.set_not_serving::<RenderService>().await;
+    health
+        .set_service_status("", ServingStatus::NotServing)
+        .await;
+    let units = node.begin_drain();
+    tracing::info!(
+        "draining: {} units finishing, {} handed back",
+        units.rendering,
+        units.waiting
+    );
+    match tokio::time::timeout(period, node.idle()).await {
+        Ok(()) => tracing::info!("drained"),
+        Err(_) => tracing::warn!(
+            "drain: units still rendering after {} s; stopping anyway",
+            period.as_secs_f64()
+        ),
     }
 }
 

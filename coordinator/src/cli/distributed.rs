@@ -70,7 +70,7 @@ impl DistributedArgs {
             resolve_every: resolve_every(self.resolve_every)?,
             dns_server: self.dns_server,
             local_workers: self.local_workers,
-            token: self.token.token.clone(),
+            token: self.token.resolve()?,
             tls: self.tls.config()?,
             tls_domain_given: self.tls.tls_domain.is_some(),
             timeout: self.timeout.map(|t| seconds("timeout", t)).transpose()?,

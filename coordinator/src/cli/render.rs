@@ -39,7 +39,7 @@ pub struct RenderArgs {
     /// Maximum path depth (default: the scene's integrator depth).
     #[arg(long)]
     pub maxdepth: Option<u32>,
-    /// Render threads for an in-process render (default: all cores).
+    /// Render threads for an in-process render [default: the CPUs this process may use].
     #[arg(long)]
     pub threads: Option<usize>,
     /// Seed of the sampler: the same seed gives the same image.

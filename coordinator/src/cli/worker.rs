@@ -1,4 +1,5 @@
-//! `yat worker`: serve renders to coordinators on `--listen` until Ctrl-C or SIGTERM.
+//! `yat worker`: serve renders to coordinators on `--listen` until Ctrl-C or SIGTERM, then
+//! drain (a second signal stops at once).
 
 use std::io::Write;
 use std::net::SocketAddr;
@@ -6,34 +7,72 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use yat_proto::flags::{ServerTlsFlags, TokenFlag};
-use yat_worker::{Worker, WorkerConfig};
+use yat_worker::{defaults, NetworkLimits, Worker, WorkerConfig, MIB};
 
 use super::budget::BudgetArgs;
-
-const MIB: u64 = 1 << 20;
+use crate::cpus::threads_or_usable_cpus;
+use crate::shutdown::{signalled, INTERRUPTED_EXIT_CODE};
 
 #[derive(clap::Args, Debug)]
 pub struct WorkerArgs {
     /// Address to listen on, IP:PORT. Port 0 picks a free port; the first line printed on
-    /// stdout, `listening on IP:PORT`, names the real address.
+    /// stdout, `listening on IP:PORT`, names the real address. Beyond loopback the worker
+    /// needs a token or TLS client certificates, or --insecure.
     #[arg(long, default_value = "127.0.0.1:7878")]
     pub listen: SocketAddr,
-    /// Units rendered at the same time [default: the number of cores].
+    /// Units rendered at the same time [default: the CPUs this process may use, as its
+    /// affinity mask and cgroup quota allow].
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Keep received scene files in this folder too, so they survive a restart.
+    /// Keep received scene files in this folder too, so they survive a restart. It is
+    /// created private (0700); an existing folder others may use is made private, or refused
+    /// when it is another user's.
     #[arg(long)]
     pub cache_dir: Option<PathBuf>,
+    /// Scene files kept in --cache-dir, in MiB (least recently used deleted first).
+    #[arg(long, default_value_t = defaults::CACHE_DIR_MIB)]
+    pub cache_dir_mib: u64,
     #[command(flatten)]
     pub token: TokenFlag,
     #[command(flatten)]
     pub tls: ServerTlsFlags,
-    /// Largest scene file accepted, in MiB.
-    #[arg(long, default_value_t = 2048)]
+    /// Serve beyond loopback without a token or TLS client certificates: anyone who reaches
+    /// the port can use this worker.
+    #[arg(long)]
+    pub insecure: bool,
+    /// Largest scene file accepted, in MiB (at most --upload-budget-mib).
+    #[arg(long, default_value_t = defaults::MAX_BLOB_MIB)]
     pub max_blob_mib: u64,
     /// Scene files kept in memory, in MiB (least recently used dropped first).
-    #[arg(long, default_value_t = 4096)]
+    #[arg(long, default_value_t = defaults::MEMORY_CACHE_MIB)]
     pub memory_cache_mib: u64,
+    /// Memory all unfinished uploads may hold together, in MiB; an upload that would pass it
+    /// fails with RESOURCE_EXHAUSTED.
+    #[arg(long, default_value_t = defaults::UPLOAD_BUDGET_MIB)]
+    pub upload_budget_mib: u64,
+    /// Units waiting for a render thread at most; more fail with RESOURCE_EXHAUSTED
+    /// [default: 4 x threads + 16].
+    #[arg(long)]
+    pub max_queued_units: Option<usize>,
+    /// After SIGTERM or Ctrl-C, how long units already rendering may take to finish.
+    #[arg(long, default_value_t = defaults::DRAIN_SECONDS)]
+    pub drain_seconds: u64,
+    /// Connections served at once; more wait until one closes.
+    #[arg(long, default_value_t = defaults::MAX_CONNECTIONS)]
+    pub max_connections: usize,
+    /// Requests served at once on one connection.
+    #[arg(long, default_value_t = defaults::MAX_STREAMS_PER_CONNECTION)]
+    pub max_streams_per_connection: u32,
+    /// Close a connection whose peer sends nothing for this many seconds (live peers answer
+    /// the worker's pings every 10 s).
+    #[arg(long, default_value_t = defaults::CONNECTION_IDLE_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
+    pub connection_idle_seconds: u64,
+    /// Fail an upload that sends no chunk for this many seconds.
+    #[arg(long, default_value_t = defaults::BLOB_IDLE_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
+    pub blob_idle_seconds: u64,
+    /// Fail any request still running after this many seconds.
+    #[arg(long, default_value_t = defaults::REQUEST_TIMEOUT_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
+    pub request_timeout_seconds: u64,
     #[command(flatten)]
     pub budget: BudgetArgs,
     /// Exit when standard input closes: a parent that dies takes its workers with it.
@@ -45,24 +84,40 @@ pub struct WorkerArgs {
 }
 
 pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
+    let threads = threads_or_usable_cpus(args.threads, "worker");
     let config = WorkerConfig {
-        threads: args
-            .threads
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        threads,
         cache_dir: args.cache_dir,
-        memory_cache_bytes: args.memory_cache_mib * MIB,
-        max_blob_bytes: args.max_blob_mib * MIB,
-        token: args.token.token,
+        cache_dir_bytes: args.cache_dir_mib.saturating_mul(MIB),
+        memory_cache_bytes: args.memory_cache_mib.saturating_mul(MIB),
+        max_blob_bytes: args.max_blob_mib.saturating_mul(MIB),
+        upload_budget_bytes: args.upload_budget_mib.saturating_mul(MIB),
+        max_queued_units: args
+            .max_queued_units
+            .unwrap_or_else(|| defaults::max_queued_units(threads)),
+        drain: Duration::from_secs(args.drain_seconds),
+        network: NetworkLimits {
+            max_connections: args.max_connections,
+            max_streams_per_connection: args.max_streams_per_connection,
+            connection_idle: Duration::from_secs(args.connection_idle_seconds),
+            blob_idle: Duration::from_secs(args.blob_idle_seconds),
+            request_timeout: Duration::from_secs(args.request_timeout_seconds),
+        },
+        token: args.token.resolve()?,
         tls: args.tls.identity()?,
+        tls_client_ca: args.tls.client_ca()?,
+        insecure: args.insecure,
         throttle: Duration::from_millis(args.throttle_ms),
         build_budget: args.budget.budget(),
     };
-    let without_token = config.token.is_none();
+    let insecure = config.insecure;
     // Fails here, before the address is announced, when the cache folder is unusable.
     let worker = Worker::new(config)?;
-    if without_token && !args.listen.ip().is_loopback() {
+    worker.check_exposure(args.listen)?;
+    if insecure && !args.listen.ip().is_loopback() {
         tracing::warn!(
-            "listening on {} without --token: anyone who reaches this port can use this worker",
+            "--insecure: listening on {} without a token or client certificates; anyone who \
+             reaches this port can use this worker",
             args.listen
         );
     }
@@ -83,9 +138,20 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         writeln!(stdout, "listening on {}", listener.local_addr()?)?;
         stdout.flush()?;
         drop(stdout);
-        worker.serve(listener, crate::shutdown::signalled()).await?;
+        worker.serve(listener, first_signal()).await?;
         Ok(())
     })
+}
+
+/// Resolves at the first Ctrl-C or SIGTERM, the cue to drain, and makes the second one end the
+/// process at once.
+async fn first_signal() {
+    signalled().await;
+    tokio::spawn(async {
+        signalled().await;
+        tracing::warn!("second signal: stopping without finishing the drain");
+        std::process::exit(i32::from(INTERRUPTED_EXIT_CODE));
+    });
 }
 
 /// Watches stdin on a thread of its own and ends the process at end of file.

@@ -21,7 +21,7 @@ struct InProcessState {
     clock: InterimClock,
 }
 
-/// Renders `job` on `threads` threads (default: all cores).
+/// Renders `job` on `threads` threads (default: the CPUs this process may use).
 pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderOutcome> {
     let build_start = Instant::now();
     let scene = job.scene.build(&job.settings)?;
@@ -51,7 +51,10 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     let writing = Mutex::new(());
     let poisoned = || anyhow::anyhow!("a render thread panicked");
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
+        .num_threads(crate::cpus::threads_or_usable_cpus(
+            threads,
+            "in-process render",
+        ))
         .build()
         .context("cannot start the render threads")?;
     let result = pool.install(|| {

@@ -1,6 +1,8 @@
 //! The scene ready to render (world-space geometry and BVH, decoded textures, materials,
 //! light sampling tables) and rendering one unit into a sample buffer.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::{Vec2, Vec3};
 
 use crate::assets::AssetSource;
@@ -136,6 +138,18 @@ impl RenderScene {
     /// Renders one unit on the calling thread. Deterministic: the same unit gives the same
     /// buffer bytes on any machine and thread.
     pub fn render_unit(&self, unit: &WorkUnit) -> (SampleBuffer, UnitStats) {
+        self.render_unit_cancellable(unit, &AtomicBool::new(false))
+            .expect("never cancelled")
+    }
+
+    /// [`Self::render_unit`], giving up (`None`) soon after `cancel` is set: it is checked
+    /// before every sample, so a unit of many samples per pixel stops within one path's time.
+    /// A render server sets it when the unit's caller is gone.
+    pub fn render_unit_cancellable(
+        &self,
+        unit: &WorkUnit,
+        cancel: &AtomicBool,
+    ) -> Option<(SampleBuffer, UnitStats)> {
         let mut buffer = SampleBuffer::new(*unit);
         let mut stats = UnitStats::default();
         let tile_width = unit.x1 - unit.x0;
@@ -145,6 +159,9 @@ impl RenderScene {
                 let mut rgb = Vec3::ZERO;
                 let mut weight = 0.0f32;
                 for index in unit.sample_start..unit.sample_end {
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
                     let mut sampler =
                         PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed);
                     let (offset, w) = self.filter.sample(sampler.get_2d());
@@ -168,7 +185,7 @@ impl RenderScene {
                 buffer.weight[i] = weight;
             }
         }
-        (buffer, stats)
+        Some((buffer, stats))
     }
 }
 

@@ -61,7 +61,7 @@ pub fn render(
         }
     }
     if config.local_workers > 0 {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let cores = crate::cpus::threads_or_usable_cpus(None, "local workers");
         for worker in LocalWorker::spawn_all(config.local_workers, cores)? {
             let client = ClientConfig {
                 address: worker.address.clone(),

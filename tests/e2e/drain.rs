@@ -1,0 +1,189 @@
+//! A worker under an orchestrator (Kubernetes, Slurm): SIGTERM mid-render drains it without
+//! costing the render anything but time, and `--threads` defaults to the CPUs it was given.
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::util::*;
+
+#[test]
+fn a_worker_terminated_mid_render_drains_and_exits_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let reference = dir.path().join("in-process.png");
+    assert_success(&render(&scene, &reference, &["--threads", "2", "--quiet"]));
+    let expected = image_bytes(&reference);
+
+    let mut a = Worker::start(&["--throttle-ms", "150"]);
+    let b = Worker::start(&["--throttle-ms", "150"]);
+    let out = dir.path().join("drained.png");
+    let workers = format!("{},{}", a.address, b.address);
+    let started = Instant::now();
+    // No --unit-deadline: a unit lost in the drain would cost the default 30 s.
+    let mut coordinator = render_command(&scene, &out, &["--workers", &workers, "--quiet"])
+        .spawn()
+        .unwrap();
+    let polling = Instant::now();
+    while a.stats(None).units_done < 1 {
+        assert!(polling.elapsed() < Duration::from_secs(30), "worker a idle");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let in_flight = a.stats(None).units_in_flight;
+    a.signal("TERM");
+    let signalled = Instant::now();
+    let status = a
+        .wait_for_exit(Duration::from_secs(20 + 5))
+        .expect("the drained worker exits within --drain-seconds + 5 s");
+    assert!(status.success(), "{status}");
+    let drain = signalled.elapsed();
+    assert!(coordinator.wait().unwrap().success());
+    let elapsed = started.elapsed();
+    let (png, exr) = image_bytes(&out);
+    assert!(exr == expected.1, "EXR differs from in-process");
+    assert!(png == expected.0, "PNG differs from in-process");
+    assert!(
+        elapsed < Duration::from_secs(25),
+        "no unit waited for the 30 s deadline: {elapsed:?}"
+    );
+    eprintln!(
+        "drain: {in_flight} unit(s) in flight at SIGTERM, exit after {drain:?}, render {elapsed:?}"
+    );
+}
+
+#[test]
+fn threads_default_to_the_cpus_the_worker_may_use() {
+    if Command::new("taskset").arg("--version").output().is_err() {
+        eprintln!("skipped: `taskset` is not installed (util-linux)");
+        return;
+    }
+    let mut child = Command::new("taskset")
+        .args(["-c", "0", YAT, "worker", "--listen", "127.0.0.1:0"])
+        .env_remove("YAT_TOKEN")
+        .env("YAT_LOG", "info")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let address = line
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap()
+        .to_string();
+    let threads = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap()
+        .block_on(async move {
+            let mut client = yat_proto::RenderNodeClient::connect(format!("http://{address}"))
+                .await
+                .unwrap();
+            let hello = yat_proto::pb::HandshakeRequest {
+                protocol_version: yat_proto::PROTOCOL_VERSION,
+                client: "e2e".into(),
+            };
+            client.handshake(hello).await.unwrap().into_inner().threads
+        });
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let mut log = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut log)
+        .unwrap();
+    assert_eq!(threads, 1, "taskset -c 0 leaves one CPU");
+    assert!(
+        log.contains("1 thread(s), the CPUs this process may use"),
+        "{log}"
+    );
+}
+
+/// A lit sphere in one file, for a unit sent without a coordinator.
+const SPHERE: &[u8] = br#"Film "fleximage" "integer xresolution" [16] "integer yresolution" [16]
+LookAt 0 -3 0  0 0 0  0 0 1
+Camera "perspective" "float fov" [60]
+WorldBegin
+AttributeBegin
+  AreaLightSource "area" "color L" [1 1 1]
+  Shape "sphere" "float radius" 1
+AttributeEnd
+WorldEnd
+"#;
+
+/// Uploads [`SPHERE`] to the worker at `address`, loads it and asks for one unit, on
+/// `runtime`; the call stays pending until the worker answers or goes.
+fn send_one_unit(runtime: &tokio::runtime::Runtime, address: &str) {
+    use yat_proto::pb;
+    let address = format!("http://{address}");
+    runtime.spawn(async move {
+        let mut client = yat_proto::RenderNodeClient::connect(address).await.unwrap();
+        let sha256 = yat_proto::hash::sha256_hex(SPHERE);
+        let chunk = pb::BlobChunk {
+            sha256: sha256.clone(),
+            size: SPHERE.len() as u64,
+            data: SPHERE.to_vec().into(),
+        };
+        client.put_blob(tokio_stream::iter([chunk])).await.unwrap();
+        let load = pb::LoadSceneRequest {
+            main: Some(pb::SceneFile {
+                path: "sphere.lxs".into(),
+                sha256,
+            }),
+            assets: vec![],
+            settings: Some(pb::RenderSettings {
+                width: 16,
+                height: 16,
+                spp: 1,
+                max_depth: 2,
+                ..Default::default()
+            }),
+        };
+        let scene_id = client.load_scene(load).await.unwrap().into_inner().scene_id;
+        let unit = pb::WorkUnit {
+            index: 0,
+            x0: 0,
+            y0: 0,
+            x1: 16,
+            y1: 16,
+            sample_start: 0,
+            sample_end: 1,
+        };
+        let request = pb::RenderUnitRequest {
+            scene_id,
+            unit: Some(unit),
+        };
+        let _ = client.render_unit(request).await;
+    });
+}
+
+#[test]
+fn a_second_signal_stops_a_draining_worker_at_once() {
+    let mut worker = Worker::start(&["--throttle-ms", "10000"]);
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    send_one_unit(&runtime, &worker.address);
+    let polling = Instant::now();
+    while worker.stats(None).units_in_flight < 1 {
+        assert!(
+            polling.elapsed() < Duration::from_secs(30),
+            "no unit arrived"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    worker.signal("TERM");
+    assert!(
+        worker.wait_for_exit(Duration::from_millis(500)).is_none(),
+        "the first signal drains: a unit is still rendering"
+    );
+    worker.signal("TERM");
+    let status = worker
+        .wait_for_exit(Duration::from_secs(3))
+        .expect("the second signal stops the worker at once");
+    assert_eq!(status.code(), Some(130), "{status}");
+}
