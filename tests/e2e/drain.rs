@@ -18,18 +18,29 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let mut a = Worker::start(&["--throttle-ms", "150"]);
     let b = Worker::start(&["--throttle-ms", "150"]);
     let out = dir.path().join("drained.png");
+    let json = dir.path().join("workers.json");
     let workers = format!("{},{}", a.address, b.address);
     let started = Instant::now();
     // No --unit-deadline: a unit lost in the drain would cost the default 30 s.
-    let mut coordinator = render_command(&scene, &out, &["--workers", &workers, "--quiet"])
-        .spawn()
-        .unwrap();
+    let mut coordinator = render_command(
+        &scene,
+        &out,
+        &[
+            "--workers",
+            &workers,
+            "--quiet",
+            "--workers-json",
+            json.to_str().unwrap(),
+        ],
+    )
+    .spawn()
+    .unwrap();
     let polling = Instant::now();
     while a.stats(None).units_done < 1 {
         assert!(polling.elapsed() < Duration::from_secs(30), "worker a idle");
         std::thread::sleep(Duration::from_millis(10));
     }
-    let in_flight = a.stats(None).units_in_flight;
+    let before = a.stats(None);
     a.signal("TERM");
     let signalled = Instant::now();
     let status = a
@@ -46,8 +57,28 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
         elapsed < Duration::from_secs(25),
         "no unit waited for the 30 s deadline: {elapsed:?}"
     );
+    // The units a's threads were on (each pauses 150 ms first) were finished and merged, not
+    // thrown away with the session when a's queue was handed back.
+    let report = workers_report(&json);
+    let merged_by_a = report["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["address"] == a.address)
+        .unwrap()["units"]
+        .as_u64()
+        .unwrap();
+    assert!(
+        merged_by_a > before.units_done,
+        "a had {} unit(s) in flight and {} done at SIGTERM, and {merged_by_a} merged: {report:#}",
+        before.units_in_flight,
+        before.units_done
+    );
     eprintln!(
-        "drain: {in_flight} unit(s) in flight at SIGTERM, exit after {drain:?}, render {elapsed:?}"
+        "drain: {} unit(s) in flight at SIGTERM, {} more merged, exit after {drain:?}, render \
+         {elapsed:?}",
+        before.units_in_flight,
+        merged_by_a - before.units_done
     );
 }
 

@@ -334,8 +334,8 @@ struct UnitLoop<'a> {
 impl UnitLoop<'_> {
     /// Pulls units while fewer than allowed are in flight (`FIRST_UNITS_IN_FLIGHT`, more with
     /// each accepted result, at most `max_in_flight`), until the render is finished, or until
-    /// `leave` turns true and the units in flight are in; `accepted` counts the results
-    /// accepted.
+    /// `leave` turns true or the worker starts draining, and the units in flight are in;
+    /// `accepted` counts the results accepted.
     async fn run(
         self,
         client: WorkerClient,
@@ -357,12 +357,15 @@ impl UnitLoop<'_> {
         };
         // Dropped (aborting the calls) before `held` gives their units back.
         let mut calls = JoinSet::new();
+        // Set by the first call a draining worker refused: the units it is still rendering
+        // come back as results, so the session takes no more and ends when they are in.
+        let mut draining: Option<String> = None;
         loop {
             if schedule.is_finished() {
                 return Ok(());
             }
             // A roster that dropped its sender will never say: as good as asked to leave.
-            let leaving = *leave.borrow() || leave.has_changed().is_err();
+            let leaving = *leave.borrow() || leave.has_changed().is_err() || draining.is_some();
             let limit = max_in_flight.min(
                 FIRST_UNITS_IN_FLIGHT
                     .saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
@@ -385,6 +388,9 @@ impl UnitLoop<'_> {
                 ));
             }
             if calls.is_empty() {
+                if let Some(what) = draining {
+                    return Err(SessionError::Draining(what));
+                }
                 if leaving {
                     return Ok(());
                 }
@@ -400,8 +406,19 @@ impl UnitLoop<'_> {
                     let (unit, outcome) = joined
                         .expect("calls is not empty")
                         .map_err(|e| SessionError::Transient(format!("unit task: {e}")))?;
+                    let outcome = match outcome {
+                        // Refused without being worked on: back to the queue at once.
+                        Err(SessionError::Draining(what)) => {
+                            held.units.remove(&unit.index);
+                            schedule.requeue(&unit);
+                            node.update(|r| r.units_requeued += 1);
+                            draining.get_or_insert(what);
+                            continue;
+                        }
+                        outcome => outcome?,
+                    };
                     // Kept in `held` until accepted: an error returns it to the queue.
-                    accept(node, shared, unit, outcome?)?;
+                    accept(node, shared, unit, outcome)?;
                     held.units.remove(&unit.index);
                     *accepted += 1;
                 }
