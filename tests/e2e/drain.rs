@@ -36,11 +36,16 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     .spawn()
     .unwrap();
     let polling = Instant::now();
-    while a.stats(None).units_done < 1 {
+    // Signalled once a has returned a unit and is on another (its 2 threads pause 150 ms per
+    // unit, so one in flight is on a thread, not queued).
+    let before = loop {
+        let stats = a.stats(None);
+        if stats.units_done >= 1 && stats.units_in_flight >= 1 {
+            break stats;
+        }
         assert!(polling.elapsed() < Duration::from_secs(30), "worker a idle");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let before = a.stats(None);
+        std::thread::sleep(Duration::from_millis(5));
+    };
     a.signal("TERM");
     let signalled = Instant::now();
     let status = a
