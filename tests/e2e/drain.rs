@@ -5,6 +5,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::lit_sphere::LIT_SPHERE;
 use crate::util::*;
 
 #[test]
@@ -141,30 +142,18 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
     );
 }
 
-/// A lit sphere in one file, for a unit sent without a coordinator.
-const SPHERE: &[u8] = br#"Film "fleximage" "integer xresolution" [16] "integer yresolution" [16]
-LookAt 0 -3 0  0 0 0  0 0 1
-Camera "perspective" "float fov" [60]
-WorldBegin
-AttributeBegin
-  AreaLightSource "area" "color L" [1 1 1]
-  Shape "sphere" "float radius" 1
-AttributeEnd
-WorldEnd
-"#;
-
-/// Uploads [`SPHERE`] to the worker at `address`, loads it and asks for one unit, on
+/// Uploads [`LIT_SPHERE`] to the worker at `address`, loads it and asks for one unit, on
 /// `runtime`; the call stays pending until the worker answers or goes.
 fn send_one_unit(runtime: &tokio::runtime::Runtime, address: &str) {
     use yat_proto::pb;
     let address = format!("http://{address}");
     runtime.spawn(async move {
         let mut client = yat_proto::RenderNodeClient::connect(address).await.unwrap();
-        let sha256 = yat_proto::hash::sha256_hex(SPHERE);
+        let sha256 = yat_proto::hash::sha256_hex(LIT_SPHERE);
         let chunk = pb::BlobChunk {
             sha256: sha256.clone(),
-            size: SPHERE.len() as u64,
-            data: SPHERE.to_vec().into(),
+            size: LIT_SPHERE.len() as u64,
+            data: LIT_SPHERE.to_vec().into(),
         };
         client.put_blob(tokio_stream::iter([chunk])).await.unwrap();
         let load = pb::LoadSceneRequest {

@@ -10,6 +10,8 @@ mod files;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;
 mod hostile_worker;
+#[path = "../fixtures/lit_sphere.rs"]
+mod lit_sphere;
 mod resume;
 mod util;
 #[path = "../fixtures/workspace.rs"]

@@ -57,17 +57,9 @@ impl Served {
     }
 }
 
-/// A lit sphere seen by a camera: the smallest scene that renders something.
-pub const SCENE: &[u8] = br#"Film "fleximage" "integer xresolution" [16] "integer yresolution" [16]
-LookAt 0 -3 0  0 0 0  0 0 1
-Camera "perspective" "float fov" [60]
-WorldBegin
-AttributeBegin
-  AreaLightSource "area" "color L" [1 1 1]
-  Shape "sphere" "float radius" 1
-AttributeEnd
-WorldEnd
-"#;
+#[path = "../../../tests/fixtures/lit_sphere.rs"]
+mod lit_sphere;
+pub use lit_sphere::LIT_SPHERE as SCENE;
 
 /// Chunks of one blob: the first names it.
 pub fn chunks(hash: &str, size: u64, parts: &[&'static [u8]]) -> Vec<pb::BlobChunk> {
