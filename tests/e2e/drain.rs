@@ -17,7 +17,8 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let expected = image_bytes(&reference);
 
     let mut a = Worker::start(&["--throttle-ms", "150"]);
-    let b = Worker::start(&["--throttle-ms", "150"]);
+    // b is the slower: a's units are its own, not end-game copies of b's, when it is signalled.
+    let b = Worker::start(&["--throttle-ms", "300"]);
     let out = dir.path().join("drained.png");
     let json = dir.path().join("workers.json");
     let workers = format!("{},{}", a.address, b.address);

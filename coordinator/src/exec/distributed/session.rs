@@ -27,10 +27,12 @@ const MAX_BACKOFF: Duration = Duration::from_secs(5);
 /// Units in flight per worker thread: one rendering, one queued behind it, so a worker never
 /// idles for a round trip.
 const UNITS_IN_FLIGHT_PER_THREAD: u32 = 2;
-/// Units a session sends before the worker has returned one; each accepted result allows
-/// `UNITS_IN_FLIGHT_PER_THREAD` more, up to what its threads take. A worker that claims many
-/// threads and never answers holds only these.
-const FIRST_UNITS_IN_FLIGHT: usize = 2;
+/// Units a session sends before the worker has returned one: one per thread it claims, at most
+/// this many; each accepted result allows `UNITS_IN_FLIGHT_PER_THREAD` more, up to what its
+/// threads take. A worker that claims many threads and never answers holds only these (and
+/// the end game hands copies of them to the others), while an honest one has every thread busy
+/// from its first unit on.
+pub const MAX_UNITS_BEFORE_A_RESULT: usize = 64;
 /// The most threads a worker's claim is believed (2048 units in flight).
 pub const MAX_WORKER_THREADS: u32 = 1024;
 /// Bad replies in a row (across sessions, until a result is accepted) after which a worker is
@@ -241,10 +243,12 @@ async fn session(
         }
     ));
     let in_flight = (worker.threads * UNITS_IN_FLIGHT_PER_THREAD) as usize;
+    let first_in_flight = (worker.threads as usize).min(MAX_UNITS_BEFORE_A_RESULT);
     let units = UnitLoop {
         node,
         shared,
         scene_id: &loaded.scene_id,
+        first_in_flight,
         max_in_flight: in_flight,
     };
     units.run(client, accepted, leave).await
@@ -328,11 +332,12 @@ struct UnitLoop<'a> {
     node: &'a Node,
     shared: &'a Shared,
     scene_id: &'a str,
+    first_in_flight: usize,
     max_in_flight: usize,
 }
 
 impl UnitLoop<'_> {
-    /// Pulls units while fewer than allowed are in flight (`FIRST_UNITS_IN_FLIGHT`, more with
+    /// Pulls units while fewer than allowed are in flight (`first_in_flight`, more with
     /// each accepted result, at most `max_in_flight`), until the render is finished, or until
     /// `leave` turns true or the worker starts draining, and the units in flight are in;
     /// `accepted` counts the results accepted.
@@ -346,6 +351,7 @@ impl UnitLoop<'_> {
             node,
             shared,
             scene_id,
+            first_in_flight,
             max_in_flight,
         } = self;
         let schedule = &shared.schedule;
@@ -367,8 +373,7 @@ impl UnitLoop<'_> {
             // A roster that dropped its sender will never say: as good as asked to leave.
             let leaving = *leave.borrow() || leave.has_changed().is_err() || draining.is_some();
             let limit = max_in_flight.min(
-                FIRST_UNITS_IN_FLIGHT
-                    .saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
+                first_in_flight.saturating_add(UNITS_IN_FLIGHT_PER_THREAD as usize * *accepted),
             );
             while !leaving && calls.len() < schedule.in_flight_limit(limit) {
                 let Some(unit) = schedule.take(node.address()) else {
