@@ -9,20 +9,21 @@
 //!
 //! The file is only written through an exclusive temporary file renamed over it, and only read
 //! when it is a regular file of exactly the size this render's checkpoint has
-//! ([`crate::replace_file`]): a symlink, a FIFO or a device put in its place is neither followed
+//! ([`yat_tracer::private_file`]): a symlink, a FIFO or a device put in its place is neither followed
 //! nor read.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use anyhow::Context;
 use prost::Message;
 use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
 use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
 use yat_tracer::render::{RenderSettings, WorkUnit, PLAN_VERSION};
 
-use crate::replace_file::{read_regular_file, ReadFileError, StagedFile};
+use yat_tracer::private_file::{read_regular_file, ReadFileError, StagedFile};
 
 const MAGIC: &[u8; 8] = b"YATRESUM";
 const FORMAT_VERSION: u32 = 1;
@@ -296,13 +297,23 @@ impl CheckpointFile {
 
     /// Writes the checkpoint atomically: a crash while saving leaves the previous one whole.
     pub fn save(&self, checkpoint: &Checkpoint) -> anyhow::Result<()> {
-        self.stage(checkpoint)?.commit()
+        Self::commit(self.stage(checkpoint)?)
+    }
+
+    /// The second half of [`CheckpointFile::save`]: syncs the staged file and renames it over
+    /// the checkpoint.
+    pub fn commit(staged: StagedFile) -> anyhow::Result<()> {
+        let path = staged.destination().to_path_buf();
+        staged
+            .commit()
+            .with_context(|| format!("cannot write {}", path.display()))
     }
 
     /// The first half of [`CheckpointFile::save`], the one that reads the checkpoint: its bytes
     /// written to a temporary file beside the real one (fast: they go to the page cache).
     pub fn stage(&self, checkpoint: &Checkpoint) -> anyhow::Result<StagedFile> {
         StagedFile::write(&self.path, |out| checkpoint.encode_to(&self.identity, out))
+            .with_context(|| format!("cannot write {}", self.path.display()))
     }
 
     /// Removes the checkpoint once the final image is written.

@@ -5,10 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use anyhow::Context;
 use yat_tracer::desc::FilmDesc;
+use yat_tracer::private_file::StagedFile;
 
 use crate::checkpoint::{Checkpoint, CheckpointFile};
-use crate::replace_file::StagedFile;
 
 /// The tone-mapped image so far, rewritten every so often next to the output.
 pub struct PreviewFile {
@@ -126,11 +127,11 @@ impl StagedOutputs {
                     .map_err(std::io::Error::other)
             })
             .and_then(StagedFile::commit)
-            .map_err(|e| e.context(format!("cannot write the preview {}", path.display())))
+            .with_context(|| format!("cannot write the preview {}", path.display()))
         });
         let checkpoint = self
             .checkpoint
-            .map(|staged| staged.and_then(StagedFile::commit));
+            .map(|staged| staged.and_then(CheckpointFile::commit));
         [preview, checkpoint]
             .into_iter()
             .flatten()

@@ -14,7 +14,6 @@ pub mod interim;
 pub mod job;
 pub mod manifest;
 pub mod render_report;
-pub mod replace_file;
 pub mod sanitize;
 pub mod scene;
 pub mod shutdown;

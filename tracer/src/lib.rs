@@ -37,6 +37,7 @@ pub mod math;
 pub mod mesh;
 pub mod param;
 pub mod parse;
+pub mod private_file;
 pub mod render;
 pub mod sampler;
 pub mod shape;

@@ -10,14 +10,13 @@
 //! name; anything else found there is ignored or dropped.
 
 use std::collections::HashMap;
-use std::fs::{File, OpenOptions};
-use std::hash::{BuildHasher, Hasher};
-use std::io::{Read, Write};
-use std::os::unix::fs::{DirBuilderExt, OpenOptionsExt, PermissionsExt};
+use std::io::Write;
+use std::os::unix::fs::{DirBuilderExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use yat_proto::hash::{is_sha256_hex, sha256_hex};
+use yat_tracer::private_file::{is_staged_name, read_regular_file, ReadFileError, StagedFile};
 
 use crate::error::NodeError;
 
@@ -186,9 +185,6 @@ impl DiskEntries {
     }
 }
 
-/// Prefix of temporary files; a digest never starts with a dot.
-const TEMP_PREFIX: &str = ".tmp-";
-
 impl DiskCache {
     fn open(dir: &Path, max_bytes: u64) -> std::io::Result<Self> {
         make_private_folder(dir)?;
@@ -206,7 +202,7 @@ impl DiskCache {
             };
             // Not followed: a symbolic link is not a regular file here.
             let metadata = entry.metadata()?;
-            if name.starts_with(TEMP_PREFIX) && metadata.is_file() {
+            if is_staged_name(&name) && metadata.is_file() {
                 // Left by a crash in the middle of a write.
                 std::fs::remove_file(entry.path())?;
             } else if is_sha256_hex(&name) && metadata.is_file() {
@@ -236,22 +232,22 @@ impl DiskCache {
         };
         let path = self.dir.join(hash);
         match read_regular_file(&path, size) {
-            Ok(bytes) if sha256_hex(&bytes) == hash => Ok(Some(bytes.into())),
-            Ok(_) => {
+            Ok(Some(bytes)) if sha256_hex(&bytes) == hash => Ok(Some(bytes.into())),
+            Ok(Some(_)) => {
                 tracing::warn!("cache file {} is corrupt; dropping it", path.display());
                 self.drop_entry(hash)?;
                 Ok(None)
             }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Ok(None) => {
                 self.entries.lock().unwrap().remove(hash);
                 Ok(None)
             }
-            Err(e) if e.kind() == std::io::ErrorKind::InvalidData => {
+            Err(ReadFileError::Io(e)) => Err(e),
+            Err(e) => {
                 tracing::warn!("cache file {}: {e}; dropping it", path.display());
                 self.drop_entry(hash)?;
                 Ok(None)
             }
-            Err(e) => Err(e),
         }
     }
 
@@ -298,19 +294,9 @@ impl DiskCache {
             });
         }
         self.evict_for(size).map_err(NodeError::BlobCache)?;
-        let tmp = self.dir.join(format!("{TEMP_PREFIX}{}", random_hex()));
-        let written = OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .mode(0o600)
-            .custom_flags(libc::O_NOFOLLOW)
-            .open(&tmp)
-            .and_then(|mut file| file.write_all(bytes))
-            .and_then(|()| std::fs::rename(&tmp, self.dir.join(hash)));
-        if let Err(e) = written {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(NodeError::BlobCache(e));
-        }
+        StagedFile::write(&self.dir.join(hash), |out| out.write_all(bytes))
+            .and_then(StagedFile::commit)
+            .map_err(NodeError::BlobCache)?;
         self.entries.lock().unwrap().add(hash, size);
         Ok(())
     }
@@ -336,45 +322,6 @@ fn make_private_folder(dir: &Path) -> std::io::Result<()> {
         })?;
     }
     Ok(())
-}
-
-/// The content of the regular file at `path`, which must have `size` bytes. A symbolic link,
-/// a folder, a device or a file of another size is `InvalidData`.
-fn read_regular_file(path: &Path, size: u64) -> std::io::Result<Vec<u8>> {
-    let file = OpenOptions::new()
-        .read(true)
-        // Non-blocking: opening a FIFO planted under a blob's name must not hang the worker.
-        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
-        .open(path)
-        .map_err(|e| match e.raw_os_error() {
-            Some(libc::ELOOP) => std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                "a symbolic link, not a file",
-            ),
-            _ => e,
-        })?;
-    let metadata = file.metadata()?;
-    if !metadata.is_file() || metadata.len() != size {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "not a regular file of the expected size",
-        ));
-    }
-    let mut bytes = Vec::with_capacity(size as usize);
-    File::take(file, size).read_to_end(&mut bytes)?;
-    Ok(bytes)
-}
-
-/// 128 random bits as hex, from the OS-seeded keys of std's hasher.
-fn random_hex() -> String {
-    let state = std::collections::hash_map::RandomState::new();
-    (0..2u64)
-        .map(|i| {
-            let mut h = state.build_hasher();
-            h.write_u64(i);
-            format!("{:016x}", h.finish())
-        })
-        .collect()
 }
 
 #[cfg(test)]
@@ -412,7 +359,11 @@ mod tests {
             store.insert(&b, bb).unwrap();
         }
         std::fs::write(dir.path().join(&b), b"tampered").unwrap();
+        // What a crash in the middle of a write leaves: gone when the cache opens.
+        let leftover = dir.path().join(format!(".{a}.0123456789abcdef.tmp"));
+        std::fs::write(&leftover, b"partial").unwrap();
         let store = BlobStore::new(1 << 20, Some(dir.path()), 1 << 20).unwrap();
+        assert!(!leftover.exists());
         assert!(store.contains(&a));
         assert_eq!(store.get(&a).unwrap().as_deref(), Some(&ba[..]));
         assert!(store.get(&b).unwrap().is_none());

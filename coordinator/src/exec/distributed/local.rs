@@ -2,13 +2,13 @@
 //! `yat worker` on a free loopback port. They are killed when dropped, and since each watches
 //! its stdin (a pipe from us) they also exit when the coordinator dies without dropping them.
 
-use std::hash::{BuildHasher, Hasher};
 use std::io::{BufRead, BufReader};
 use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Stdio};
 use std::sync::{mpsc, Mutex};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
+use yat_tracer::private_file::random_hex;
 
 /// How long a starting worker may take to print its address.
 const STARTUP_TIMEOUT: Duration = Duration::from_secs(30);
@@ -29,7 +29,7 @@ impl LocalWorker {
         let exe = std::env::current_exe().context("cannot find the yat executable")?;
         let threads = (cores / count).max(1);
         // Loopback ports are open to every local user: each render's workers get a fresh token.
-        let token = random_token();
+        let token = random_hex();
         (0..count)
             .map(|i| {
                 let mut child = Command::new(&exe)
@@ -99,16 +99,4 @@ impl Drop for LocalWorker {
         let _ = child.kill();
         let _ = child.wait();
     }
-}
-
-/// 128 random bits as hex, from the OS-seeded keys of std's hasher.
-fn random_token() -> String {
-    let state = std::collections::hash_map::RandomState::new();
-    (0..2)
-        .map(|i| {
-            let mut h = state.build_hasher();
-            h.write_u64(i ^ u64::from(std::process::id()));
-            format!("{:016x}", h.finish())
-        })
-        .collect()
 }

@@ -1,21 +1,41 @@
-//! Files the coordinator rewrites while a render runs (the checkpoint, the preview) go through
-//! a temporary file created exclusively beside them and then renamed over them: a crash leaves
-//! the previous file whole, and a symlink or a FIFO planted at either name is never followed
-//! (the rename replaces the link itself; `O_EXCL | O_NOFOLLOW` refuses an existing name).
+//! Files a node keeps for itself (a coordinator's checkpoint and preview, a worker's disk cache
+//! of scene files), safe from what another local user plants in their folder: they are written
+//! to a temporary file created exclusively beside the destination (mode 0600, `O_EXCL |
+//! O_NOFOLLOW`, a random name) and renamed over it, so a crash leaves the previous file whole
+//! and a symlink or a FIFO planted at the name is replaced, never followed; and they are read
+//! only from a regular file of the expected size, not through a link, without blocking on a
+//! FIFO.
 
 use std::fs::File;
 use std::hash::{BuildHasher, Hasher};
-use std::io::{Read, Write};
+use std::io::{BufWriter, Read, Write};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
-
-use anyhow::Context;
 
 /// Attempts at a fresh temporary name before giving up (each collision is a file someone put
 /// there under a name that was random).
 const NAME_ATTEMPTS: u32 = 8;
 
-/// A temporary file beside its destination, created exclusively with mode 0600.
+/// 128 random bits as hex, from the OS-seeded keys of std's hasher.
+pub fn random_hex() -> String {
+    let state = std::collections::hash_map::RandomState::new();
+    (0..2u64)
+        .map(|i| {
+            let mut h = state.build_hasher();
+            h.write_u64(i);
+            format!("{:016x}", h.finish())
+        })
+        .collect()
+}
+
+/// Whether `name` is one of [`StagedFile`]'s temporary names (`.NAME.RANDOM.tmp`): what a crash
+/// in the middle of a write leaves behind.
+pub fn is_staged_name(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(".tmp")
+}
+
+/// A temporary file beside its destination, created exclusively with mode 0600; removed unless
+/// committed.
 pub struct StagedFile {
     file: File,
     temporary: PathBuf,
@@ -23,30 +43,18 @@ pub struct StagedFile {
     committed: bool,
 }
 
-/// A name no one could have predicted: `.NAME.RANDOM.tmp` beside `path`.
-fn temporary_name(path: &Path) -> PathBuf {
-    let mut random = std::collections::hash_map::RandomState::new().build_hasher();
-    random.write_u128(
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos()),
-    );
-    random.write_u32(std::process::id());
-    let name = path
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    path.with_file_name(format!(".{name}.{:016x}.tmp", random.finish()))
-}
-
 impl StagedFile {
     /// Creates the temporary file for `path` and fills it with `write`.
     pub fn write(
         path: &Path,
-        write: impl FnOnce(&mut std::io::BufWriter<&File>) -> std::io::Result<()>,
-    ) -> anyhow::Result<Self> {
+        write: impl FnOnce(&mut BufWriter<&File>) -> std::io::Result<()>,
+    ) -> std::io::Result<Self> {
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         let mut attempt = 0;
         let (file, temporary) = loop {
-            let temporary = temporary_name(path);
+            let temporary = path.with_file_name(format!(".{name}.{}.tmp", random_hex()));
             let created = File::options()
                 .write(true)
                 .create_new(true)
@@ -58,14 +66,10 @@ impl StagedFile {
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                     attempt += 1;
                     if attempt == NAME_ATTEMPTS {
-                        return Err(e).with_context(|| {
-                            format!("cannot create a temporary file beside {}", path.display())
-                        });
+                        return Err(e);
                     }
                 }
-                Err(e) => {
-                    return Err(e).with_context(|| format!("cannot write {}", temporary.display()))
-                }
+                Err(e) => return Err(e),
             }
         };
         let staged = Self {
@@ -74,27 +78,28 @@ impl StagedFile {
             path: path.to_path_buf(),
             committed: false,
         };
-        let mut out = std::io::BufWriter::new(&staged.file);
-        write(&mut out)
-            .and_then(|()| out.flush())
-            .with_context(|| format!("cannot write {}", staged.temporary.display()))?;
+        let mut out = BufWriter::new(&staged.file);
+        write(&mut out)?;
+        out.flush()?;
         drop(out);
         Ok(staged)
     }
 
+    /// Where the file goes when committed.
+    pub fn destination(&self) -> &Path {
+        &self.path
+    }
+
     /// Syncs the file to disk and renames it over the destination.
-    pub fn commit(mut self) -> anyhow::Result<()> {
-        self.file
-            .sync_all()
-            .and_then(|()| std::fs::rename(&self.temporary, &self.path))
-            .with_context(|| format!("cannot write {}", self.path.display()))?;
+    pub fn commit(mut self) -> std::io::Result<()> {
+        self.file.sync_all()?;
+        std::fs::rename(&self.temporary, &self.path)?;
         self.committed = true;
         Ok(())
     }
 }
 
 impl Drop for StagedFile {
-    /// A staged file never committed is removed.
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_file(&self.temporary);
@@ -157,6 +162,8 @@ mod tests {
         let staged = StagedFile::write(&path, |out| out.write_all(b"new")).unwrap();
         let mode = std::fs::metadata(&staged.temporary).unwrap().mode();
         assert_eq!(mode & 0o777, 0o600);
+        let temporary_name = staged.temporary.file_name().unwrap().to_str().unwrap();
+        assert!(is_staged_name(temporary_name), "{temporary_name}");
         staged.commit().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"precious");
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
@@ -166,6 +173,9 @@ mod tests {
             2,
             "no temporary left"
         );
+        let abandoned = StagedFile::write(&dir.path().join("x"), |out| out.write_all(b"x"));
+        drop(abandoned);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 
     #[test]
@@ -192,5 +202,12 @@ mod tests {
             read_regular_file(Path::new("/dev/zero"), 3),
             Err(ReadFileError::NotAFile)
         ));
+    }
+
+    #[test]
+    fn random_names_differ() {
+        let names: std::collections::HashSet<String> = (0..64).map(|_| random_hex()).collect();
+        assert_eq!(names.len(), 64);
+        assert!(names.iter().all(|n| n.len() == 32));
     }
 }
