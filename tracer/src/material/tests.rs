@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 
 use super::*;
 use crate::desc::MaterialDesc;
+use glossy::CoatParams;
 use crate::geometry::SurfaceHit;
 use crate::param::{Fresnel, MaterialId, Tex};
 use crate::sampler::PixelSampler;
@@ -52,15 +53,21 @@ fn matte(kd: f32, sigma: f32) -> MaterialDesc {
     })
 }
 
-fn glossy(kd: f32, ks: f32, u: f32, v: f32, multibounce: bool) -> MaterialDesc {
-    MaterialDesc::Glossy(Glossy {
-        kd: c(kd),
+fn coat(ks: f32, u: f32, v: f32, multibounce: bool) -> CoatParams {
+    CoatParams {
         ks: c(ks),
         ka: c(0.0),
         depth: c(0.0),
         uroughness: c(u),
         vroughness: c(v),
         multibounce,
+    }
+}
+
+fn glossy(kd: f32, ks: f32, u: f32, v: f32, multibounce: bool) -> MaterialDesc {
+    MaterialDesc::Glossy(Glossy {
+        kd: c(kd),
+        coat: coat(ks, u, v, multibounce),
     })
 }
 
@@ -123,12 +130,11 @@ fn cases() -> Vec<(&'static str, MaterialDesc)> {
             "glossy absorbing",
             MaterialDesc::Glossy(Glossy {
                 kd: c(1.0),
-                ks: c(0.1),
-                ka: rgb(0.9, 0.3, 0.0),
-                depth: c(0.5),
-                uroughness: c(0.2),
-                vroughness: c(0.2),
-                multibounce: false,
+                coat: CoatParams {
+                    ka: rgb(0.9, 0.3, 0.0),
+                    depth: c(0.5),
+                    ..coat(0.1, 0.2, 0.2, false)
+                },
             }),
         ),
         ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) })),
