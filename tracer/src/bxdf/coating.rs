@@ -141,6 +141,9 @@ impl Coating {
         let p_coat = self.coat_probability(base, wo);
         if u_lobe < p_coat {
             let wi = match self.coat(wo).sample(up(wo), u_lobe / p_coat, u)? {
+                // A microfacet reflection that goes below the surface is lost (the coat's
+                // density counts it only above).
+                CoatSample::Glossy(wi) if wi.z <= 0.0 => return None,
                 CoatSample::Glossy(wi) => wi,
                 CoatSample::Specular { wi, f, probability } => {
                     let wi = if wo.z < 0.0 { flip_z(wi) } else { wi };

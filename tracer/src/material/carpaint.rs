@@ -154,15 +154,7 @@ impl CarPaint {
                     );
                 }
             }
-            let color = |c: [f32; 3]| Tex::color(Vec3::from_array(c));
-            return Ok(Self {
-                kd: color(p.kd),
-                ks: p.ks.map(color),
-                r: p.r.map(Tex::float),
-                m: p.m.map(Tex::float),
-                ka,
-                depth,
-            });
+            return Ok(Self::from_preset(p, ka, depth));
         }
         let d = &PRESETS[0];
         let mut color = |n: &str, c: [f32; 3]| -> Result<Tex, ParseError> {
@@ -187,6 +179,19 @@ impl CarPaint {
             ka,
             depth,
         })
+    }
+
+    /// Preset `p` with clear-layer absorption `ka` and thickness `depth`.
+    pub fn from_preset(p: &Preset, ka: Tex, depth: Tex) -> Self {
+        let color = |c: [f32; 3]| Tex::color(Vec3::from_array(c));
+        Self {
+            kd: color(p.kd),
+            ks: p.ks.map(color),
+            r: p.r.map(Tex::float),
+            m: p.m.map(Tex::float),
+            ka,
+            depth,
+        }
     }
 
     /// The base under the flakes.
