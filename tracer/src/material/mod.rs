@@ -25,6 +25,7 @@ pub mod mattetranslucent;
 pub mod metal;
 pub mod mirror;
 pub mod mix;
+pub mod nk;
 pub mod null;
 pub mod scatter;
 pub mod shinymetal;
