@@ -51,7 +51,11 @@ pub fn write(p: &mut Props, prefix: &str, m: &MaterialDesc) -> bool {
             set("ka", tex_value(ka, true));
             set("d", tex_value(depth, false));
         }
-        MaterialDesc::Velvet(Velvet { kd, p: coeffs, thickness }) => {
+        MaterialDesc::Velvet(Velvet {
+            kd,
+            p: coeffs,
+            thickness,
+        }) => {
             set("type", quoted("velvet"));
             set("kd", tex_value(kd, true));
             for (i, c) in coeffs.iter().enumerate() {
@@ -64,7 +68,12 @@ pub fn write(p: &mut Props, prefix: &str, m: &MaterialDesc) -> bool {
             set("base", quoted(&mat_name(*base)));
             write_coat(p, prefix, "", coat);
         }
-        MaterialDesc::GlossyTranslucent(GlossyTranslucent { kd, kt, front, back }) => {
+        MaterialDesc::GlossyTranslucent(GlossyTranslucent {
+            kd,
+            kt,
+            front,
+            back,
+        }) => {
             set("type", quoted("glossytranslucent"));
             set("kd", tex_value(kd, true));
             set("kt", tex_value(kt, true));

@@ -79,8 +79,7 @@ impl Coating {
             return Vec3::ZERO;
         }
         let (coat_o, coat_i) = (self.coat(wo), self.coat(wi));
-        let passed =
-            (Vec3::ONE - coat_o.fresnel(cos_o)) * (Vec3::ONE - coat_i.fresnel(cos_i));
+        let passed = (Vec3::ONE - coat_o.fresnel(cos_o)) * (Vec3::ONE - coat_i.fresnel(cos_i));
         if same_hemisphere(wo, wi) {
             let w = passed * coat_o.absorption(cos_o, cos_i);
             if self.diffuse_base {

@@ -282,7 +282,12 @@ impl Materials {
 
     /// The lobe and coat of material `id`: a glossycoating's coat over its base's lobe (whose
     /// own coat, if any, is dropped).
-    fn scattering(&self, id: MaterialId, eval: &TextureEval, u_mix: f32) -> (Bxdf, Option<Coating>) {
+    fn scattering(
+        &self,
+        id: MaterialId,
+        eval: &TextureEval,
+        u_mix: f32,
+    ) -> (Bxdf, Option<Coating>) {
         let Some((leaf, u)) = self.resolve(id, eval, u_mix) else {
             return (Matte::default_bxdf(), None);
         };

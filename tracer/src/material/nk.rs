@@ -85,7 +85,11 @@ fn samples(text: &str) -> Result<Vec<(f64, f64, f64)>, NkError> {
             if v.len() != 2 {
                 return Err(error(no, "expected \"n k\""));
             }
-            let t = if count > 1 { j as f64 / (count - 1) as f64 } else { 0.0 };
+            let t = if count > 1 {
+                j as f64 / (count - 1) as f64
+            } else {
+                0.0
+            };
             out.push((to_nm(start + (end - start) * t), v[0], v[1]));
         }
     } else {
@@ -107,7 +111,10 @@ fn samples(text: &str) -> Result<Vec<(f64, f64, f64)>, NkError> {
     {
         return Err(error(
             0,
-            format!("a sample ({:.1} nm, n {}, k {}) is out of range", bad.0, bad.1, bad.2),
+            format!(
+                "a sample ({:.1} nm, n {}, k {}) is out of range",
+                bad.0, bad.1, bad.2
+            ),
         ));
     }
     Ok(out)
@@ -125,14 +132,22 @@ fn at(samples: &[(f64, f64, f64)], nm: f64) -> (f64, f64) {
         return (s.1, s.2);
     }
     let (a, b) = (samples[i - 1], samples[i]);
-    let t = if b.0 > a.0 { (nm - a.0) / (b.0 - a.0) } else { 0.0 };
+    let t = if b.0 > a.0 {
+        (nm - a.0) / (b.0 - a.0)
+    } else {
+        0.0
+    };
     (a.1 + (b.1 - a.1) * t, a.2 + (b.2 - a.2) * t)
 }
 
 /// The (eta, k) per RGB channel of an `.nk` file's bytes.
 pub fn read(bytes: &[u8]) -> Result<(Vec3, Vec3), NkError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        let line = bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1;
         error(line, "not UTF-8 text")
     })?;
     let mut samples = samples(text)?;
@@ -152,27 +167,50 @@ mod tests {
 
     #[test]
     fn luxpop_file_is_interpolated_at_the_rgb_wavelengths() {
-        let text = "; gold-ish\n4000 1.5 1.9\n5000 0.9 1.8\n; mid comment\n6000 0.3 3.0\n7000 0.2 4.0\n";
+        let text =
+            "; gold-ish\n4000 1.5 1.9\n5000 0.9 1.8\n; mid comment\n6000 0.3 3.0\n7000 0.2 4.0\n";
         let (eta, k) = read(text.as_bytes()).unwrap();
         // 650 nm halfway between 600 and 700; 550 between 500 and 600; 450 between 400 and 500.
-        assert!((eta - Vec3::new(0.25, 0.6, 1.2)).abs().max_element() < 1e-6, "{eta}");
-        assert!((k - Vec3::new(3.5, 2.4, 1.85)).abs().max_element() < 1e-6, "{k}");
+        assert!(
+            (eta - Vec3::new(0.25, 0.6, 1.2)).abs().max_element() < 1e-6,
+            "{eta}"
+        );
+        assert!(
+            (k - Vec3::new(3.5, 2.4, 1.85)).abs().max_element() < 1e-6,
+            "{k}"
+        );
     }
 
     #[test]
     fn sopra_file_in_each_unit() {
         // nm: 3 samples 400, 550, 700.
         let (eta, k) = read(b"4 400 700 3\n1.0 2.0\n2.0 3.0\n3.0 4.0\n").unwrap();
-        assert!((eta - Vec3::new(2.666_666_7, 2.0, 1.333_333_4)).abs().max_element() < 1e-5);
-        assert!((k - Vec3::new(3.666_666_7, 3.0, 2.333_333_4)).abs().max_element() < 1e-5);
+        assert!(
+            (eta - Vec3::new(2.666_666_7, 2.0, 1.333_333_4))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
+        assert!(
+            (k - Vec3::new(3.666_666_7, 3.0, 2.333_333_4))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
         // eV: 1239.84/2.2542 = 550 nm exactly in the middle sample.
         let ev = 1239.841_984 / 550.0;
         let text = format!("1 {} {} 3\n5 5\n7 8\n9 9\n", ev - 0.5, ev + 0.5);
         let (eta, k) = read(text.as_bytes()).unwrap();
-        assert!((eta.y - 7.0).abs() < 1e-4 && (k.y - 8.0).abs() < 1e-4, "{eta} {k}");
+        assert!(
+            (eta.y - 7.0).abs() < 1e-4 && (k.y - 8.0).abs() < 1e-4,
+            "{eta} {k}"
+        );
         // Micrometres: 0.45 .. 0.65 in 3 steps.
         let (eta, _) = read(b"2 0.45 0.65 3\n1 0\n2 0\n3 0\n").unwrap();
-        assert!((eta - Vec3::new(3.0, 2.0, 1.0)).abs().max_element() < 1e-5, "{eta}");
+        assert!(
+            (eta - Vec3::new(3.0, 2.0, 1.0)).abs().max_element() < 1e-5,
+            "{eta}"
+        );
     }
 
     #[test]

@@ -9,11 +9,11 @@ use glam::{Vec2, Vec3};
 
 use super::*;
 use crate::desc::MaterialDesc;
-use glossy::CoatParams;
 use crate::geometry::SurfaceHit;
 use crate::param::{Fresnel, MaterialId, Tex};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
+use glossy::CoatParams;
 
 fn hit_with(ng: Vec3, ns: Vec3) -> SurfaceHit {
     SurfaceHit {
@@ -133,7 +133,12 @@ fn shinymetal(kr: f32, ks: f32, r: f32) -> MaterialDesc {
     })
 }
 
-fn glossytranslucent(kd: f32, kt: f32, front: CoatParams, back: Option<CoatParams>) -> MaterialDesc {
+fn glossytranslucent(
+    kd: f32,
+    kt: f32,
+    front: CoatParams,
+    back: Option<CoatParams>,
+) -> MaterialDesc {
     MaterialDesc::GlossyTranslucent(GlossyTranslucent {
         kd: c(kd),
         kt: c(kt),
@@ -180,17 +185,31 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
             })],
         ),
         ("velvet default", vec![velvet(0.3, [-2.0, 20.0, 2.0], 0.1)]),
-        ("velvet white thick", vec![velvet(1.0, [-2.0, 20.0, 2.0], 1.0)]),
+        (
+            "velvet white thick",
+            vec![velvet(1.0, [-2.0, 20.0, 2.0], 1.0)],
+        ),
         ("velvet isotropic", vec![velvet(1.0, [0.0, 0.0, 0.0], 1.0)]),
-        ("velvet p2 100", vec![velvet(1.0, [30.0, 100.0, -50.0], 1.0)]),
+        (
+            "velvet p2 100",
+            vec![velvet(1.0, [30.0, 100.0, -50.0], 1.0)],
+        ),
         ("scatter isotropic", vec![scatter(1.0, Vec3::ZERO)]),
-        ("scatter forward", vec![scatter(0.8, Vec3::new(0.6, 0.5, 0.7))]),
+        (
+            "scatter forward",
+            vec![scatter(0.8, Vec3::new(0.6, 0.5, 0.7))],
+        ),
         ("scatter backward", vec![scatter(1.0, Vec3::splat(-0.5))]),
         ("shinymetal glossy side", vec![shinymetal(0.3, 0.6, 0.2)]),
         ("shinymetal mirror side", vec![shinymetal(0.8, 0.2, 0.2)]),
         (
             "glossytranslucent",
-            vec![glossytranslucent(0.5, 1.0, coat(0.04, 0.2, 0.2, false), None)],
+            vec![glossytranslucent(
+                0.5,
+                1.0,
+                coat(0.04, 0.2, 0.2, false),
+                None,
+            )],
         ),
         (
             "glossytranslucent two coats",
@@ -203,7 +222,12 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
         ),
         (
             "glossytranslucent white",
-            vec![glossytranslucent(0.0, 1.0, coat(1.0, 0.4, 0.4, false), None)],
+            vec![glossytranslucent(
+                0.0,
+                1.0,
+                coat(1.0, 0.4, 0.4, false),
+                None,
+            )],
         ),
         (
             "glossycoating over matte",
@@ -215,7 +239,10 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
         ),
         (
             "glossycoating over mirror",
-            coated(coat(0.3, 0.4, 0.4, false), MaterialDesc::Mirror(Mirror { kr: c(1.0) })),
+            coated(
+                coat(0.3, 0.4, 0.4, false),
+                MaterialDesc::Mirror(Mirror { kr: c(1.0) }),
+            ),
         ),
         (
             "glossycoating smooth over mattetranslucent",
@@ -442,7 +469,11 @@ fn white_lambert_albedo_is_one_and_lossless_bsdfs_keep_all_energy() {
         ("lambert 0.5", matte(0.5, 0.0), 0.5),
         // A smooth coat over a white diffuse base loses nothing: what the coat does not
         // reflect, the base does.
-        ("glossy smooth coat white", glossy(1.0, 0.2, 0.0, 0.0, false), 1.0),
+        (
+            "glossy smooth coat white",
+            glossy(1.0, 0.2, 0.0, 0.0, false),
+            1.0,
+        ),
         (
             "glossytranslucent white smooth",
             glossytranslucent(0.0, 1.0, coat(0.1, 0.0, 0.0, false), None),
@@ -561,6 +592,62 @@ fn reciprocity() {
             }
         }
         assert!(checked > 1000, "{name}: only {checked} non-zero pairs");
+    }
+}
+
+#[test]
+fn extras_are_reciprocal() {
+    // scatter is left out: like a volume's scattering event it divides by cos_i alone.
+    let reciprocal = [
+        (
+            "carpaint polaris silber",
+            vec![carpaint_preset("polaris silber")],
+        ),
+        ("velvet", vec![velvet(0.8, [-2.0, 20.0, 2.0], 0.3)]),
+        (
+            "glossytranslucent two coats",
+            vec![glossytranslucent(
+                0.3,
+                0.9,
+                coat(0.3, 0.3, 0.3, false),
+                Some(coat(0.05, 0.6, 0.6, false)),
+            )],
+        ),
+        (
+            "glossycoating over gold",
+            coated(coat(0.1, 0.3, 0.3, false), gold(0.3, 0.3)),
+        ),
+        (
+            "glossycoating absorbing over matte",
+            coated(
+                CoatParams {
+                    ka: rgb(0.5, 0.2, 0.1),
+                    depth: c(0.4),
+                    ..coat(0.2, 0.4, 0.2, true)
+                },
+                matte(0.7, 0.0),
+            ),
+        ),
+    ];
+    for (name, materials) in reciprocal {
+        let bsdf = bsdf_of_set(materials);
+        let mut checked = 0;
+        for i in 0..4096 {
+            let mut s = sampler(0, 0, i, 4096, 5);
+            let a = uniform_sphere(s.get_2d());
+            let b = uniform_sphere(s.get_2d());
+            let (fab, fba) = (bsdf.eval(a, b), bsdf.eval(b, a));
+            let scale = fab.max_element().max(fba.max_element());
+            if scale > 0.0 {
+                checked += 1;
+                assert!(
+                    (fab - fba).abs().max_element() <= 1e-4 * scale,
+                    "{name}: f({a}, {b}) = {fab}, f({b}, {a}) = {fba}"
+                );
+            }
+        }
+        // Velvet is zero where its clamped phase function is, a good part of the sphere.
+        assert!(checked > 500, "{name}: only {checked} non-zero pairs");
     }
 }
 

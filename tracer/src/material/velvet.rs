@@ -61,6 +61,12 @@ impl Velvet {
     }
 
     pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kd, &self.p[0], &self.p[1], &self.p[2], &self.thickness])
+        texture_ids(&[
+            &self.kd,
+            &self.p[0],
+            &self.p[1],
+            &self.p[2],
+            &self.thickness,
+        ])
     }
 }

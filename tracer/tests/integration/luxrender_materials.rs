@@ -86,7 +86,10 @@ fn carpaint_presets_and_custom_layers() {
     assert_eq!(paint(0).kd, Tex::color(Vec3::new(0.012, 0.015, 0.016)));
     // An unknown preset warns and is ford f8, LuxRender's default.
     assert_eq!(paint(1), preset("ford f8"));
-    assert!(d.warnings.iter().any(|w| w.message.contains("no such paint")));
+    assert!(d
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("no such paint")));
     // No name: every missing layer parameter is ford f8's.
     assert_eq!(paint(2), preset("ford f8"));
     let custom = paint(3);
@@ -100,7 +103,10 @@ fn carpaint_presets_and_custom_layers() {
     );
     // With a preset, LuxRender ignores the layer parameters (a warning says so).
     assert_eq!(paint(4), preset("white"));
-    assert!(d.warnings.iter().any(|w| w.message.contains("\"Kd\" is ignored")));
+    assert!(d
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("\"Kd\" is ignored")));
     assert_eq!(carpaint::PRESETS.len(), 8);
 }
 
@@ -115,7 +121,10 @@ fn glossytranslucent_back_face_parameters() {
         panic!()
     };
     assert_eq!(front.ks, Tex::float(0.2));
-    assert!(back.is_none(), "onesided (the default) shares the front coat");
+    assert!(
+        back.is_none(),
+        "onesided (the default) shares the front coat"
+    );
     let MaterialDesc::GlossyTranslucent(GlossyTranslucent { back, .. }) = material(&d, 1) else {
         panic!()
     };
@@ -214,7 +223,10 @@ fn shinymetal_mixes_mirror_and_glossy_in_proportion() {
         })
         .count();
     // |Kr| / (|Kr| + |Ks|) of the hits are the mirror.
-    assert!((mirrors as f64 / f64::from(n) - 1.0 / 3.0).abs() < 1e-3, "{mirrors}");
+    assert!(
+        (mirrors as f64 / f64::from(n) - 1.0 / 3.0).abs() < 1e-3,
+        "{mirrors}"
+    );
 }
 
 #[test]
@@ -233,8 +245,14 @@ fn metal_reads_an_nk_file_and_names_the_line_of_a_bad_one() {
         panic!()
     };
     // 650, 550 and 450 nm between 400 nm (1, 2) and 700 nm (4, 5).
-    assert!((*eta - Vec3::new(3.5, 2.5, 1.5)).abs().max_element() < 1e-5, "{eta}");
-    assert!((*k - Vec3::new(4.5, 3.5, 2.5)).abs().max_element() < 1e-5, "{k}");
+    assert!(
+        (*eta - Vec3::new(3.5, 2.5, 1.5)).abs().max_element() < 1e-5,
+        "{eta}"
+    );
+    assert!(
+        (*k - Vec3::new(4.5, 3.5, 2.5)).abs().max_element() < 1e-5,
+        "{k}"
+    );
     assert!(d
         .assets
         .iter()
