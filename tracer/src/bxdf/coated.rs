@@ -212,7 +212,7 @@ impl Coat {
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<CoatSample> {
         let selections = self.lobes().iter().map(|l| l.selection(wo.z));
         let total: f32 = selections.clone().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return None;
         }
         let mut target = u_lobe * total;

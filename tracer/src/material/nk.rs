@@ -16,6 +16,9 @@ use glam::Vec3;
 
 /// Where the R, G and B channels sample a spectrum, in nm.
 pub const RGB_WAVELENGTHS: [f32; 3] = [650.0, 550.0, 450.0];
+/// Planck's constant times the speed of light in eV nm: a photon of E eV has wavelength
+/// HC / E nm.
+pub const HC_EV_NM: f64 = 1_239.841_984;
 /// The most samples a file may hold.
 pub const MAX_SAMPLES: usize = 100_000;
 
@@ -48,7 +51,7 @@ fn numbers(line: usize, text: &str) -> Result<Vec<f64>, NkError> {
 /// The SOPRA header's unit code as a conversion to nm.
 fn unit_to_nm(code: f64) -> Option<fn(f64) -> f64> {
     Some(match code as i64 {
-        1 if code == 1.0 => |ev| 1239.841_984 / ev,
+        1 if code == 1.0 => |ev| HC_EV_NM / ev,
         2 if code == 2.0 => |um| um * 1000.0,
         3 if code == 3.0 => |inv_cm| 1e7 / inv_cm,
         4 if code == 4.0 => |nm| nm,
@@ -198,7 +201,7 @@ mod tests {
                 < 1e-5
         );
         // eV: 1239.84/2.2542 = 550 nm exactly in the middle sample.
-        let ev = 1239.841_984 / 550.0;
+        let ev = HC_EV_NM / 550.0;
         let text = format!("1 {} {} 3\n5 5\n7 8\n9 9\n", ev - 0.5, ev + 0.5);
         let (eta, k) = read(text.as_bytes()).unwrap();
         assert!(
