@@ -13,6 +13,8 @@ pub enum AssetKind {
     Include,
     Ply,
     Image,
+    /// A metal's refractive-index data (`.nk`), which `Material "metal"` may name.
+    Nk,
 }
 
 /// A file the scene depends on, keyed by its path as written (relative to the main file's

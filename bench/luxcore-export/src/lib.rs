@@ -20,6 +20,7 @@ mod camera;
 mod error;
 mod lights;
 mod materials;
+mod materials_extra;
 mod options;
 mod ply;
 mod props;

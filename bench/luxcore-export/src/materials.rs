@@ -3,8 +3,10 @@
 
 use glam::Vec3;
 use yat_tracer::desc::{Fresnel, MaterialDesc, Tex};
+use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix};
 
+use crate::materials_extra;
 use crate::props::{mat_name, quoted, tex_value, v3, Props};
 
 /// Writes material `m` under `name`; `emission` is added for emitting shapes (a null material
@@ -23,12 +25,15 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
         }
         MaterialDesc::Glossy(Glossy {
             kd,
-            ks,
-            ka,
-            depth,
-            uroughness,
-            vroughness,
-            multibounce,
+            coat:
+                CoatParams {
+                    ks,
+                    ka,
+                    depth,
+                    uroughness,
+                    vroughness,
+                    multibounce,
+                },
         }) => {
             set("type", quoted("glossy2"));
             set("kd", tex_value(kd, true));
@@ -109,8 +114,13 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
             set("material2", quoted(&mat_name(*b)));
             set("amount", tex_value(amount, false));
         }
-        // Kinds with no parameters LuxCore needs (null) go by their name.
-        other => set("type", quoted(other.name())),
+        // The LuxRender 1.x extras; kinds with no parameters LuxCore needs (null) go by
+        // their name.
+        other => {
+            if !materials_extra::write(p, &prefix, other) {
+                p.set(format!("{prefix}.type"), quoted(other.name()));
+            }
+        }
     }
     if let Some(radiance) = emission {
         p.set(format!("{prefix}.emission"), v3(radiance));

@@ -169,3 +169,54 @@ fn uv_mapping_parameters_carry_over_and_metal2_gets_a_fresnel_texture() {
     assert_eq!(value(scn, &format!("{fresnel}.type")), "\"fresnelcolor\"");
     assert_eq!(floats(value(scn, &format!("{fresnel}.kr"))), [0.4; 3]);
 }
+
+#[test]
+fn luxrender_extras_map_to_luxcore_materials() {
+    let lux = export_world(
+        "Material \"carpaint\" \"string name\" \"blue\"\nShape \"sphere\"\n\
+         Material \"velvet\" \"float p2\" [10]\nShape \"sphere\"\n\
+         MakeNamedMaterial \"base\" \"string type\" \"matte\"\n\
+         MakeNamedMaterial \"c\" \"string type\" \"glossycoating\" \"string basematerial\" \"base\" \"float uroughness\" [0.3]\n\
+         NamedMaterial \"c\"\nShape \"sphere\"\n\
+         Material \"glossytranslucent\" \"bool onesided\" \"false\" \"color backface_Ks\" [0.2 0.2 0.2]\nShape \"sphere\"",
+    );
+    let scn = &lux.scene;
+    let key = |m: &str, k: &str| value(scn, &format!("scene.materials.{m}.{k}")).to_string();
+    let types: Vec<String> = scn
+        .lines()
+        .filter(|l| l.starts_with("scene.materials.") && l.contains(".type = "))
+        .map(|l| l.split(" = ").nth(1).unwrap().trim_matches('"').to_string())
+        .collect();
+    for t in [
+        "carpaint",
+        "velvet",
+        "glossycoating",
+        "glossytranslucent",
+        "matte",
+    ] {
+        assert!(types.iter().any(|x| x == t), "{t} missing from {types:?}");
+    }
+    let find = |ty: &str| {
+        scn.lines()
+            .find_map(|l| {
+                let rest = l.strip_prefix("scene.materials.")?;
+                let (name, v) = rest.split_once(".type = ")?;
+                (v.trim_matches('"') == ty).then(|| name.to_string())
+            })
+            .unwrap()
+    };
+    let paint = find("carpaint");
+    // The blue preset's base colour and third lobe.
+    assert_eq!(floats(&key(&paint, "kd")), [0.0079, 0.023, 0.1]);
+    assert_eq!(floats(&key(&paint, "m3")), [0.02]);
+    let velvet = find("velvet");
+    assert_eq!(floats(&key(&velvet, "p2")), [10.0]);
+    assert_eq!(floats(&key(&velvet, "thickness")), [0.1]);
+    let coating = find("glossycoating");
+    let base = key(&coating, "base");
+    assert_eq!(key(base.trim_matches('"'), "type"), "\"matte\"");
+    assert_eq!(floats(&key(&coating, "uroughness")), [0.3]);
+    let leaf = find("glossytranslucent");
+    assert_eq!(floats(&key(&leaf, "ks_bf")), [0.2; 3]);
+    assert_eq!(floats(&key(&leaf, "uroughness_bf")), [0.0]);
+}

@@ -182,6 +182,7 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         AssetKind::Include => "include",
         AssetKind::Ply => "ply",
         AssetKind::Image => "image",
+        AssetKind::Nk => "nk",
     }));
     let _ = writeln!(s, "assets       {} ({assets})", d.assets.len());
     let _ = writeln!(s, "parse time   {:.1} ms", seconds * 1e3);

@@ -1,8 +1,10 @@
 //! The BSDF at a surface point in world space: a local scattering function in the shading
-//! frame, guarded by the geometric normal against light leaks.
+//! frame, possibly under a glossy coating, guarded by the geometric normal against light
+//! leaks.
 
 use glam::{Vec2, Vec3};
 
+use super::coating::Coating;
 use super::sample::LocalSample;
 use super::Bxdf;
 use crate::math::Frame;
@@ -31,12 +33,18 @@ pub struct Bsdf {
     frame: Frame,
     ng: Vec3,
     bxdf: Bxdf,
+    coating: Option<Coating>,
 }
 
 impl Bsdf {
     /// `frame.n` is the shading normal; `ng` the geometric normal (either orientation).
-    pub(crate) fn new(frame: Frame, ng: Vec3, bxdf: Bxdf) -> Self {
-        Self { frame, ng, bxdf }
+    pub(crate) fn new(frame: Frame, ng: Vec3, bxdf: Bxdf, coating: Option<Coating>) -> Self {
+        Self {
+            frame,
+            ng,
+            bxdf,
+            coating,
+        }
     }
 
     /// True when the material is `null`: the ray continues straight through.
@@ -46,7 +54,10 @@ impl Bsdf {
 
     /// True when every lobe is specular (light sampling is useless here).
     pub fn is_specular(&self) -> bool {
-        self.bxdf.is_specular()
+        match &self.coating {
+            Some(c) => c.is_specular(&self.bxdf),
+            None => self.bxdf.is_specular(),
+        }
     }
 
     /// Whether the geometric and shading normals agree on which side `wi` is on relative
@@ -64,13 +75,19 @@ impl Bsdf {
         if !self.sides_agree(wo, wi, wo_local, wi_local) {
             return Vec3::ZERO;
         }
-        self.bxdf.f(wo_local, wi_local)
+        match &self.coating {
+            Some(c) => c.f(&self.bxdf, wo_local, wi_local),
+            None => self.bxdf.f(wo_local, wi_local),
+        }
     }
 
     /// Density with which `sample` picks wi (non-specular lobes only).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.bxdf
-            .pdf(self.frame.to_local(wo), self.frame.to_local(wi))
+        let (wo, wi) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        match &self.coating {
+            Some(c) => c.pdf(&self.bxdf, wo, wi),
+            None => self.bxdf.pdf(wo, wi),
+        }
     }
 
     /// Samples wi given wo; `u_lobe` picks a lobe, `u` the direction.
@@ -81,7 +98,10 @@ impl Bsdf {
             f,
             pdf,
             specular,
-        } = self.bxdf.sample(wo_local, u_lobe, u)?;
+        } = match &self.coating {
+            Some(c) => c.sample(&self.bxdf, wo_local, u_lobe, u),
+            None => self.bxdf.sample(wo_local, u_lobe, u),
+        }?;
         let wi = self.frame.to_world(wi_local).normalize();
         if !self.sides_agree(wo, wi, wo_local, wi_local) || f == Vec3::ZERO {
             return None;

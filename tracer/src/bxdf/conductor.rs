@@ -36,6 +36,11 @@ pub struct Conductor {
 }
 
 impl Conductor {
+    /// The reflectance at `cos`.
+    pub fn fresnel_at(&self, cos: f32) -> Vec3 {
+        self.fresnel.eval(cos)
+    }
+
     pub fn is_specular(&self) -> bool {
         self.distrib.is_none()
     }

@@ -5,10 +5,12 @@
 //!
 //! Files: [`sample`] (the shared [`LocalSample`]), [`local`] (local-frame helpers), [`fresnel`],
 //! [`microfacet`] (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the
-//! lobes [`diffuse`], [`conductor`], [`dielectric`], [`coated`], and [`bsdf`] (world frame).
+//! lobes [`diffuse`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`], the glossy
+//! [`coated`] layer and [`coating`] (a coat over any lobe), and [`bsdf`] (world frame).
 
 pub mod bsdf;
 pub mod coated;
+pub mod coating;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
@@ -17,16 +19,19 @@ pub mod ggx_albedo;
 pub mod local;
 pub mod microfacet;
 pub mod sample;
+pub mod scatter;
+pub mod velvet;
 
 use glam::{Vec2, Vec3};
 
 pub use sample::LocalSample;
 
-use coated::Coated;
 use conductor::Conductor;
 use dielectric::Dielectric;
 use diffuse::{DiffuseReflection, DiffuseTranslucent};
 use local::flip_z;
+use scatter::Scatter;
+use velvet::Velvet;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Bxdf {
@@ -36,7 +41,8 @@ pub enum Bxdf {
     Translucent(DiffuseTranslucent),
     Conductor(Conductor),
     Dielectric(Dielectric),
-    Coated(Coated),
+    Velvet(Velvet),
+    Scatter(Scatter),
 }
 
 impl Bxdf {
@@ -45,7 +51,21 @@ impl Bxdf {
             Bxdf::PassThrough => true,
             Bxdf::Conductor(c) => c.is_specular(),
             Bxdf::Dielectric(d) => d.is_specular(),
-            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Coated(_) => false,
+            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Velvet(_) | Bxdf::Scatter(_) => false,
+        }
+    }
+
+    /// Roughly what the lobe reflects and transmits of the light arriving at `cos_o`: what a
+    /// coat over it weighs it by when choosing which to sample.
+    pub fn albedo_hint(&self, cos_o: f32) -> Vec3 {
+        match self {
+            Bxdf::PassThrough => Vec3::ZERO,
+            Bxdf::Diffuse(d) => d.r,
+            Bxdf::Translucent(t) => t.r + t.t,
+            Bxdf::Conductor(c) => c.fresnel_at(cos_o),
+            Bxdf::Dielectric(d) => d.kr.max(d.kt),
+            Bxdf::Velvet(v) => v.albedo_hint(),
+            Bxdf::Scatter(s) => s.albedo_hint(),
         }
     }
 
@@ -67,7 +87,8 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.f(wo, wi),
             Bxdf::Conductor(c) => c.f(wo, wi),
             Bxdf::Dielectric(d) => d.f(wo, wi),
-            Bxdf::Coated(g) => g.f(wo, wi),
+            Bxdf::Velvet(v) => v.f(wo, wi),
+            Bxdf::Scatter(s) => s.f(wo, wi),
         }
     }
 
@@ -83,7 +104,8 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.pdf(wo, wi),
             Bxdf::Conductor(c) => c.pdf(wo, wi),
             Bxdf::Dielectric(d) => d.pdf(wo, wi),
-            Bxdf::Coated(g) => g.pdf(wo, wi),
+            Bxdf::Velvet(v) => v.pdf(wo, wi),
+            Bxdf::Scatter(s) => s.pdf(wo, wi),
         }
     }
 
@@ -96,7 +118,8 @@ impl Bxdf {
             Bxdf::Translucent(t) => t.sample(wo, u_lobe, u),
             Bxdf::Conductor(c) => c.sample(wo, u),
             Bxdf::Dielectric(d) => d.sample(wo, u_lobe, u),
-            Bxdf::Coated(g) => g.sample(wo, u_lobe, u),
+            Bxdf::Velvet(v) => v.sample(wo, u),
+            Bxdf::Scatter(s) => s.sample(wo, u),
         }?;
         Some(if mirrored {
             LocalSample {

@@ -1,5 +1,7 @@
-//! `Material "glossy"` and `"glossy2"` (LuxRender's Glossy2): a diffuse base under a glossy
-//! coat (the [`coated`](crate::bxdf::coated) lobe).
+//! `Material "glossy"` and `"glossy2"` (LuxRender's Glossy2): a Lambert base under a glossy
+//! coat (the [`coated`](crate::bxdf::coated) layer, put together by
+//! [`coating`](crate::bxdf::coating)). The coat's parameters are also glossycoating's and
+//! glossytranslucent's ([`CoatParams`]).
 //!
 //! ```text
 //! Material "glossy" "color Kd" [0.5 0.1 0.1] "color Ks" [0.04 0.04 0.04]
@@ -22,7 +24,9 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
-use crate::bxdf::coated::Coated;
+use crate::bxdf::coated::Coat;
+use crate::bxdf::coating::Coating;
+use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::{Tex, TextureId};
@@ -38,11 +42,11 @@ pub const DEFAULT_INDEX: f32 = 0.0;
 pub const DEFAULT_DEPTH: f32 = 0.0;
 pub const DEFAULT_ROUGHNESS: f32 = 0.1;
 
-/// Kd, Ks (already multiplied by ((i-1)/(i+1))^2 when index > 0), absorption Ka with depth d,
-/// anisotropic roughness.
+/// The Glossy2 coat's parameters, shared by glossy, glossycoating and glossytranslucent (whose
+/// back face reads them with the prefix `backface_`): Ks (already multiplied by
+/// ((i-1)/(i+1))^2 when index > 0), absorption Ka with depth d, anisotropic roughness.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Glossy {
-    pub kd: Tex,
+pub struct CoatParams {
     pub ks: Tex,
     pub ka: Tex,
     pub depth: Tex,
@@ -51,16 +55,21 @@ pub struct Glossy {
     pub multibounce: bool,
 }
 
-impl Glossy {
+impl CoatParams {
+    /// Reads `{prefix}Ks`, `{prefix}index`, `{prefix}Ka`, `{prefix}d`, `{prefix}uroughness`,
+    /// `{prefix}vroughness` and `{prefix}multibounce`, with Ks and the roughnesses defaulting
+    /// to `ks_default` and `roughness_default`.
     pub fn read(
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
+        prefix: &str,
+        ks_default: f32,
+        roughness_default: f32,
     ) -> Result<Self, ParseError> {
-        let kd = ctx.color_param(params, "Kd", DEFAULT_KD, true)?;
-        let ks = ctx.color_param(params, "Ks", DEFAULT_KS, false)?;
-        let ka = ctx.color_param(params, "Ka", DEFAULT_KA, true)?;
-        let index = ctx.float_param(params, "index", DEFAULT_INDEX)?;
+        let name = |n: &str| format!("{prefix}{n}");
+        let ks = ctx.color_param(params, &name("Ks"), ks_default, false)?;
+        let index = ctx.float_param(params, &name("index"), DEFAULT_INDEX)?;
         let ks = match index {
             Tex::Const(i) if i.x > 0.0 => {
                 let f = ((i.x - 1.0) / (i.x + 1.0)).powi(2);
@@ -74,8 +83,9 @@ impl Glossy {
                 ctx.warn(
                     pos,
                     format!(
-                        "{}: a textured \"index\" is not supported; Ks is used as given",
-                        params.statement
+                        "{}: a textured \"{}\" is not supported; Ks is used as given",
+                        params.statement,
+                        name("index")
                     ),
                 );
                 ks
@@ -85,19 +95,18 @@ impl Glossy {
             Tex::Const(c) => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
             t => t,
         };
-        ctx.unsupported_unless(params, "sigma", 0.0);
         Ok(Self {
-            kd,
             ks,
-            ka,
-            depth: ctx.float_param(params, "d", DEFAULT_DEPTH)?,
-            uroughness: ctx.float_param(params, "uroughness", DEFAULT_ROUGHNESS)?,
-            vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
-            multibounce: params.bool("multibounce", false)?,
+            ka: ctx.color_param(params, &name("Ka"), DEFAULT_KA, true)?,
+            depth: ctx.float_param(params, &name("d"), DEFAULT_DEPTH)?,
+            uroughness: ctx.float_param(params, &name("uroughness"), roughness_default)?,
+            vroughness: ctx.float_param(params, &name("vroughness"), roughness_default)?,
+            multibounce: params.bool(&name("multibounce"), false)?,
         })
     }
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    /// The coat at a hit.
+    pub fn coat(&self, eval: &TextureEval) -> Coat {
         let distrib = eval.roughness(self.uroughness, self.vroughness);
         let multibounce_alpha = match (self.multibounce, distrib) {
             (true, Some(_)) => {
@@ -106,24 +115,60 @@ impl Glossy {
             }
             _ => None,
         };
-        Bxdf::Coated(Coated {
-            kd: eval.color(self.kd),
-            ks: eval.color(self.ks),
-            ka: eval.color(self.ka),
-            depth: eval.float(self.depth).max(0.0),
+        Coat::single(
+            eval.color(self.ks),
             distrib,
+            eval.color(self.ka),
+            eval.float(self.depth),
             multibounce_alpha,
-        })
+        )
     }
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[
-            &self.kd,
+    pub fn textures(&self) -> Vec<&Tex> {
+        vec![
             &self.ks,
             &self.ka,
             &self.depth,
             &self.uroughness,
             &self.vroughness,
-        ])
+        ]
+    }
+}
+
+/// A Lambert base Kd under a [`CoatParams`] coat.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Glossy {
+    pub kd: Tex,
+    pub coat: CoatParams,
+}
+
+impl Glossy {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let kd = ctx.color_param(params, "Kd", DEFAULT_KD, true)?;
+        let coat = CoatParams::read(params, pos, ctx, "", DEFAULT_KS, DEFAULT_ROUGHNESS)?;
+        ctx.unsupported_unless(params, "sigma", 0.0);
+        Ok(Self { kd, coat })
+    }
+
+    /// The base under the coat.
+    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+        Bxdf::Diffuse(DiffuseReflection {
+            r: eval.color(self.kd),
+            roughness: OrenNayar::new(0.0),
+        })
+    }
+
+    pub fn coating(&self, eval: &TextureEval) -> Coating {
+        Coating::two_sided(self.coat.coat(eval), true)
+    }
+
+    pub fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd];
+        params.extend(self.coat.textures());
+        texture_ids(&params)
     }
 }

@@ -8,7 +8,7 @@
 //!
 //! | parameter | type | default |
 //! |---|---|---|
-//! | `name` (metal) | string, a built-in preset (`filename` takes precedence) | "aluminium" ([`DEFAULT_PRESET`]); an unknown name or .nk file warns and uses aluminium |
+//! | `name` (metal) | string, a built-in preset or an `.nk` data file ([`nk`]; `filename` takes precedence) | "aluminium" ([`DEFAULT_PRESET`]); an unknown name or unreadable file warns and uses aluminium, a malformed file is an error |
 //! | `fresnel` (metal2) | fresnel texture, float texture or float (an index), or color (normal-incidence reflectance) | index 5 ([`DEFAULT_METAL2_INDEX`]) |
 //! | `Kr` (metal2, without `fresnel`) | color texture: normal-incidence reflectance | - |
 //! | `uroughness`, `vroughness` | float textures | 0.1 ([`DEFAULT_ROUGHNESS`]) |
@@ -19,6 +19,8 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::nk;
+use crate::assets::AssetKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -51,7 +53,11 @@ impl Metal {
             Some(f) => f,
             None => params.string_or("name", DEFAULT_PRESET)?,
         };
-        let (eta, k) = ctx.metal_by_name(&name, pos);
+        let (eta, k) = if name.to_ascii_lowercase().ends_with(".nk") {
+            read_nk(&name, pos, ctx)?
+        } else {
+            ctx.metal_by_name(&name, pos)
+        };
         Ok(Self {
             fresnel: Fresnel::Conductor { eta, k },
             uroughness: ctx.float_param(params, "uroughness", DEFAULT_ROUGHNESS)?,
@@ -96,6 +102,33 @@ impl Metal {
         params.extend([&self.uroughness, &self.vroughness]);
         texture_ids(&params)
     }
+}
+
+/// The complex index of an `.nk` file. As in LuxRender, a file that cannot be read warns and
+/// gives aluminium; one that is malformed is an error naming the file and line.
+fn read_nk(
+    name: &str,
+    pos: &SourcePos,
+    ctx: &mut dyn ParseContext,
+) -> Result<(Vec3, Vec3), ParseError> {
+    let bytes = match ctx.read_asset(name, AssetKind::Nk, pos) {
+        Ok(bytes) => bytes,
+        Err(ParseError::Asset { error, .. }) => {
+            ctx.warn(
+                pos,
+                format!("metal data file \"{name}\" cannot be read ({error}); using aluminium"),
+            );
+            return Ok(ctx.metal_by_name(DEFAULT_PRESET, pos));
+        }
+        Err(e) => return Err(e),
+    };
+    nk::read(&bytes).map_err(|e| ParseError::Invalid {
+        pos: pos.clone(),
+        message: match e.line {
+            0 => format!("metal data file \"{name}\": {}", e.message),
+            line => format!("metal data file \"{name}\" line {line}: {}", e.message),
+        },
+    })
 }
 
 /// metal2's Fresnel term: `texture fresnel` (a fresnel texture, or a float texture giving an

@@ -2,24 +2,34 @@
 //! makes at a hit. One file per material, each with its `.lxs` syntax, parameters and
 //! defaults, its reading and its evaluation: [`matte`], [`glossy`] (glossy, glossy2),
 //! [`mirror`], [`glass`] (glass, roughglass, glass2), [`metal`] (metal, metal2),
-//! [`mattetranslucent`], [`null`], [`mix`]. They compose the lobes of [`crate::bxdf`];
-//! [`eval`] is what they see of the textures at a hit.
+//! [`mattetranslucent`], [`null`], [`mix`], [`carpaint`], [`velvet`], [`shinymetal`],
+//! [`glossycoating`], [`glossytranslucent`], [`layered`], [`scatter`]. They compose the lobes
+//! of [`crate::bxdf`]; [`eval`] is what they see of the textures at a hit.
 //!
 //! A material is resolved per hit into a [`Bsdf`]: textures are evaluated at the hit, `mix`
-//! materials are resolved stochastically, and the result is a plain value.
+//! and `layered` materials (and shinymetal's two lobes) are resolved stochastically, a
+//! glossycoating's base is resolved under its coat, and the result is a plain value.
 //!
 //! A new material is one new file plus one line in [`MaterialDesc::read`]'s name table (and
 //! one line in each `match` below).
 
+pub mod carpaint;
 pub mod eval;
 pub mod glass;
 pub mod glossy;
+pub mod glossycoating;
+pub mod glossytranslucent;
+pub mod layered;
 pub mod matte;
 pub mod mattetranslucent;
 pub mod metal;
 pub mod mirror;
 pub mod mix;
+pub mod nk;
 pub mod null;
+pub mod scatter;
+pub mod shinymetal;
+pub mod velvet;
 
 #[cfg(test)]
 mod tests;
@@ -27,15 +37,23 @@ mod tests;
 use glam::Vec3;
 
 pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
+pub use carpaint::CarPaint;
 pub use glass::Glass;
 pub use glossy::Glossy;
+pub use glossycoating::GlossyCoating;
+pub use glossytranslucent::GlossyTranslucent;
+pub use layered::Layered;
 pub use matte::Matte;
 pub use mattetranslucent::MatteTranslucent;
 pub use metal::Metal;
 pub use mirror::Mirror;
 pub use mix::Mix;
 pub use null::Null;
+pub use scatter::Scatter;
+pub use shinymetal::ShinyMetal;
+pub use velvet::Velvet;
 
+use crate::bxdf::coating::Coating;
 use crate::bxdf::{ggx_albedo, Bxdf};
 use crate::diag::SourcePos;
 use crate::geometry::SurfaceHit;
@@ -59,7 +77,17 @@ pub enum MaterialDesc {
     MatteTranslucent(MatteTranslucent),
     Null(Null),
     Mix(Mix),
+    CarPaint(CarPaint),
+    Velvet(Velvet),
+    ShinyMetal(ShinyMetal),
+    GlossyCoating(GlossyCoating),
+    GlossyTranslucent(GlossyTranslucent),
+    Layered(Layered),
+    Scatter(Scatter),
 }
+
+/// What a ray that no layer of a `layered` material catches meets.
+static PASS_THROUGH: MaterialDesc = MaterialDesc::Null(Null);
 
 impl MaterialDesc {
     /// Reads `Material "ty"` (or `MakeNamedMaterial` with `"string type" ["ty"]`): the table
@@ -84,6 +112,15 @@ impl MaterialDesc {
             "mattetranslucent" => Self::MatteTranslucent(MatteTranslucent::read(params, pos, ctx)?),
             "null" => Self::Null(Null),
             "mix" => Self::Mix(Mix::read(params, pos, ctx)?),
+            "carpaint" => Self::CarPaint(CarPaint::read(params, pos, ctx)?),
+            "velvet" => Self::Velvet(Velvet::read(params, pos, ctx)?),
+            "shinymetal" => Self::ShinyMetal(ShinyMetal::read(params, pos, ctx)?),
+            "glossycoating" => Self::GlossyCoating(GlossyCoating::read(params, pos, ctx)?),
+            "glossytranslucent" => {
+                Self::GlossyTranslucent(GlossyTranslucent::read(params, pos, ctx)?)
+            }
+            "layered" => Self::Layered(Layered::read(params, pos, ctx)?),
+            "scatter" => Self::Scatter(Scatter::read(params, pos, ctx)?),
             other => {
                 ctx.warn(pos, format!("material \"{other}\" is not supported; using matte (with its Kd when given)"));
                 let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
@@ -110,6 +147,13 @@ impl MaterialDesc {
             Self::MatteTranslucent(_) => "mattetranslucent",
             Self::Null(_) => "null",
             Self::Mix(_) => "mix",
+            Self::CarPaint(_) => "carpaint",
+            Self::Velvet(_) => "velvet",
+            Self::ShinyMetal(_) => "shinymetal",
+            Self::GlossyCoating(_) => "glossycoating",
+            Self::GlossyTranslucent(_) => "glossytranslucent",
+            Self::Layered(_) => "layered",
+            Self::Scatter(_) => "scatter",
         }
     }
 
@@ -124,20 +168,31 @@ impl MaterialDesc {
             Self::MatteTranslucent(m) => m.textures(),
             Self::Null(m) => m.textures(),
             Self::Mix(m) => m.textures(),
+            Self::CarPaint(m) => m.textures(),
+            Self::Velvet(m) => m.textures(),
+            Self::ShinyMetal(m) => m.textures(),
+            Self::GlossyCoating(m) => m.textures(),
+            Self::GlossyTranslucent(m) => m.textures(),
+            Self::Layered(m) => m.textures(),
+            Self::Scatter(m) => m.textures(),
         }
     }
 
-    /// The materials it refers to (those a `mix` chooses between).
+    /// The materials it refers to (those a `mix` or `layered` chooses between, a
+    /// glossycoating's base).
     pub fn materials(&self) -> Vec<MaterialId> {
         match self {
             Self::Mix(m) => m.materials(),
+            Self::Layered(m) => m.materials(),
+            Self::GlossyCoating(m) => vec![m.base],
             _ => Vec::new(),
         }
     }
 
-    /// The lobe of a leaf material at a hit (a `mix` resolved by [`Materials`] first; an
-    /// unresolved one shows the default matte).
-    fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    /// The lobe of a leaf material at a hit, under its coat if it has one (`mix`, `layered`
+    /// and glossycoating resolved by [`Materials`] first; an unresolved one shows the default
+    /// matte). `u` in [0, 1) chooses shinymetal's lobe.
+    fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
         match self {
             Self::Matte(m) => m.bxdf(eval),
             Self::Glossy(m) => m.bxdf(eval),
@@ -146,7 +201,34 @@ impl MaterialDesc {
             Self::Metal(m) => m.bxdf(eval),
             Self::MatteTranslucent(m) => m.bxdf(eval),
             Self::Null(m) => m.bxdf(),
-            Self::Mix(_) => Matte::default_bxdf(),
+            Self::CarPaint(m) => m.bxdf(eval),
+            Self::Velvet(m) => m.bxdf(eval),
+            Self::ShinyMetal(m) => m.bxdf(eval, u),
+            Self::GlossyTranslucent(m) => m.bxdf(eval),
+            Self::Scatter(m) => m.bxdf(eval),
+            Self::Mix(_) | Self::Layered(_) | Self::GlossyCoating(_) => Matte::default_bxdf(),
+        }
+    }
+
+    /// The coat over [`MaterialDesc::bxdf`], for the materials that have one.
+    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
+        match self {
+            Self::Glossy(m) => Some(m.coating(eval)),
+            Self::CarPaint(m) => Some(m.coating(eval)),
+            Self::GlossyTranslucent(m) => Some(m.coating(eval)),
+            _ => None,
+        }
+    }
+
+    /// Whether the material needs the multibounce albedo tables.
+    fn multibounce(&self) -> bool {
+        match self {
+            Self::Glossy(m) => m.coat.multibounce,
+            Self::GlossyCoating(m) => m.coat.multibounce,
+            Self::GlossyTranslucent(m) => {
+                m.front.multibounce || m.back.as_ref().is_some_and(|b| b.multibounce)
+            }
+            _ => false,
         }
     }
 }
@@ -158,36 +240,73 @@ pub struct Materials {
 impl Materials {
     /// The materials indexed by [`MaterialId`].
     pub fn new(materials: Vec<MaterialDesc>) -> Self {
-        let multibounce = materials.iter().any(|m| {
-            matches!(
-                m,
-                MaterialDesc::Glossy(Glossy {
-                    multibounce: true,
-                    ..
-                })
-            )
-        });
-        if multibounce {
+        if materials.iter().any(MaterialDesc::multibounce) {
             ggx_albedo::prepare();
         }
         Self { materials }
     }
 
-    /// Follows `mix` materials down to a leaf. At each level `u_mix` chooses a side against
-    /// the amount and is rescaled to [0, 1) within the chosen side (see [`Mix::choose`]).
-    fn resolve(&self, id: MaterialId, eval: &TextureEval, u_mix: f32) -> Option<&MaterialDesc> {
+    /// Follows `mix` and `layered` materials down to a leaf. At each level `u` chooses a side
+    /// (or layer) against the amounts and is rescaled to [0, 1) within the chosen one (see
+    /// [`Mix::choose`]); the leaf gets what is left of it.
+    fn resolve(
+        &self,
+        id: MaterialId,
+        eval: &TextureEval,
+        u_mix: f32,
+    ) -> Option<(&MaterialDesc, f32)> {
         let mut material = self.materials.get(id.0 as usize)?;
         let mut u = u_mix;
         // A well-formed scene cannot nest deeper than it has materials; more means a cycle.
         for _ in 0..=self.materials.len() {
-            let MaterialDesc::Mix(mix) = material else {
-                return Some(material);
+            let next = match material {
+                MaterialDesc::Mix(mix) => {
+                    let next;
+                    (next, u) = mix.choose(eval, u);
+                    next
+                }
+                MaterialDesc::Layered(layered) => {
+                    let next;
+                    (next, u) = layered.choose(eval, u);
+                    match next {
+                        Some(next) => next,
+                        None => return Some((&PASS_THROUGH, u)),
+                    }
+                }
+                _ => return Some((material, u)),
             };
-            let next;
-            (next, u) = mix.choose(eval, u);
             material = self.materials.get(next.0 as usize)?;
         }
-        Some(material)
+        None
+    }
+
+    /// The lobe and coat of material `id`: a glossycoating's coat over its base's lobe (whose
+    /// own coat, if any, is dropped).
+    fn scattering(
+        &self,
+        id: MaterialId,
+        eval: &TextureEval,
+        u_mix: f32,
+    ) -> (Bxdf, Option<Coating>) {
+        let Some((leaf, u)) = self.resolve(id, eval, u_mix) else {
+            return (Matte::default_bxdf(), None);
+        };
+        let MaterialDesc::GlossyCoating(coating) = leaf else {
+            return (leaf.bxdf(eval, u), leaf.coating(eval));
+        };
+        let (mut base, mut u) = (leaf, u);
+        for _ in 0..=self.materials.len() {
+            let MaterialDesc::GlossyCoating(g) = base else {
+                let bxdf = base.bxdf(eval, u);
+                let diffuse = matches!(bxdf, Bxdf::Diffuse(_) | Bxdf::Translucent(_));
+                return (bxdf, Some(coating.coating(eval, diffuse)));
+            };
+            let Some(next) = self.resolve(g.base, eval, u) else {
+                break;
+            };
+            (base, u) = next;
+        }
+        (Matte::default_bxdf(), None)
     }
 
     /// The BSDF of material `id` at `hit`, whose position in its shape's object space is
@@ -208,11 +327,13 @@ impl Materials {
                 uv: hit.uv,
             },
         };
-        let bxdf = match self.resolve(id, &eval, u_mix) {
-            Some(material) => material.bxdf(&eval),
-            // A dangling id or a mix cycle (resolve gives up on it).
-            None => Matte::default_bxdf(),
-        };
-        Bsdf::new(Frame::from_normal_tangent(hit.ns, hit.dpdu), hit.ng, bxdf)
+        // A dangling id or a mix cycle shows the default matte.
+        let (bxdf, coating) = self.scattering(id, &eval, u_mix);
+        Bsdf::new(
+            Frame::from_normal_tangent(hit.ns, hit.dpdu),
+            hit.ng,
+            bxdf,
+            coating,
+        )
     }
 }

@@ -90,15 +90,15 @@ pub trait ParseContext {
     }
 
     /// A named metal preset's complex index (eta, k), or aluminium with a warning (LuxRender's
-    /// fallback for an unknown name or an .nk data file). Used by the `fresnelname` texture
-    /// and the `metal` material.
+    /// fallback for an unknown name). Used by the `fresnelname` texture and the `metal`
+    /// material (which reads `.nk` data files itself).
     fn metal_by_name(&mut self, name: &str, pos: &SourcePos) -> (Vec3, Vec3) {
         if let Some(p) = metal_preset(name) {
             return p;
         }
         self.warn(
             pos,
-            format!("metal \"{name}\" is not a built-in preset (.nk data files are not read); using aluminium"),
+            format!("metal \"{name}\" is not a built-in preset or an .nk file; using aluminium"),
         );
         metal_preset("aluminium").expect("aluminium is a preset")
     }

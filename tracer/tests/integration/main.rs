@@ -6,6 +6,7 @@ mod geometry_on_scenes;
 #[path = "../../../tests/fixtures/hostile.rs"]
 mod hostile;
 mod hostile_scenes;
+mod luxrender_materials;
 mod parse_conventions;
 mod parse_errors;
 mod render;

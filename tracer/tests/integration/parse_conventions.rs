@@ -7,6 +7,7 @@ use glam::{Mat4, Vec3};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
 use yat_tracer::lights::{DistantLight, InfiniteLight, PointLight, SpotLight};
+use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
@@ -273,12 +274,15 @@ fn material_defaults_and_rules() {
     );
     let MaterialDesc::Glossy(Glossy {
         kd,
-        ks,
-        ka,
-        depth,
-        uroughness,
-        multibounce,
-        ..
+        coat:
+            CoatParams {
+                ks,
+                ka,
+                depth,
+                uroughness,
+                multibounce,
+                ..
+            },
     }) = mat(1)
     else {
         panic!()
@@ -297,7 +301,11 @@ fn material_defaults_and_rules() {
         (*ka, *depth, *uroughness, *multibounce),
         (Tex::float(0.0), Tex::float(0.0), Tex::float(0.1), false)
     );
-    let MaterialDesc::Glossy(Glossy { ks, kd, .. }) = mat(2) else {
+    let MaterialDesc::Glossy(Glossy {
+        kd,
+        coat: CoatParams { ks, .. },
+    }) = mat(2)
+    else {
         panic!()
     };
     assert_eq!(
