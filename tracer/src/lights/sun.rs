@@ -52,10 +52,9 @@ const SUN_DISTANCE_KM: f64 = 149_600_000.0;
 pub struct SunLight {
     /// Unit world direction towards the sun's centre.
     pub to_sun: Vec3,
-    /// Radiance of the disc (gain and relsize applied).
-    pub radiance: Vec3,
-    /// sin^2 of the cone's half-angle.
-    pub sin2_max: f32,
+    pub turbidity: f32,
+    pub relsize: f32,
+    pub gain: f32,
 }
 
 impl SunLight {
@@ -81,44 +80,52 @@ impl SunLight {
                 message: format!("LightSource \"sun\": \"relsize\" must be positive, got {relsize}"),
             });
         }
-        let spectrum = sun_rgb(to_sun.z.clamp(-1.0, 1.0).acos(), turbidity);
-        if spectrum == Vec3::ZERO {
+        let sun = Self {
+            to_sun,
+            turbidity,
+            relsize,
+            gain,
+        };
+        if sun.radiance() == Vec3::ZERO && gain != 0.0 {
             ctx.warn(
                 pos,
                 "LightSource \"sun\": the sun is below the horizon and gives no light".into(),
             );
         }
-        Ok(Self {
-            to_sun,
-            radiance: spectrum * (gain / (relsize * relsize)),
-            sin2_max: sin2_max(relsize),
-        })
+        Ok(sun)
+    }
+
+    /// The disc's radiance: gain / relsize^2 x the sun's at its elevation.
+    pub fn radiance(&self) -> Vec3 {
+        let theta = self.to_sun.normalize_or_zero().z.clamp(-1.0, 1.0).acos();
+        sun_rgb(theta, self.turbidity) * (self.gain / (self.relsize * self.relsize))
+    }
+
+    /// sin^2 of the disc's angular radius, at most 1 (LuxRender's cap: a larger sun is the
+    /// whole hemisphere).
+    pub fn sin2_max(&self) -> f32 {
+        let sin = f64::from(self.relsize) * SUN_RADIUS_KM / SUN_DISTANCE_KM;
+        sin.min(1.0).powi(2) as f32
     }
 
     /// The light to sample, if it emits.
     pub fn light(&self) -> Option<SunDisc> {
         let to_sun = self.to_sun.normalize_or_zero();
-        let sin2 = self.sin2_max.clamp(0.0, 1.0);
-        (emits(self.radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
+        let sin2 = self.sin2_max();
+        let radiance = self.radiance();
+        (emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
             // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
             let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
             SunDisc {
                 frame: Frame::from_normal(to_sun),
                 to_sun,
-                radiance: self.radiance,
+                radiance,
                 sin2_max: sin2,
                 one_minus_cos,
                 pdf: 1.0 / (TAU * one_minus_cos),
             }
         })
     }
-}
-
-/// sin^2 of the sun's angular radius times `relsize`, at most 1 (LuxRender's cap: a larger
-/// sun is the whole hemisphere).
-fn sin2_max(relsize: f32) -> f32 {
-    let sin = f64::from(relsize) * SUN_RADIUS_KM / SUN_DISTANCE_KM;
-    sin.min(1.0).powi(2) as f32
 }
 
 /// A sun ready to sample: a cone of directions of constant radiance.

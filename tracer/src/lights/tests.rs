@@ -597,12 +597,11 @@ fn no_lights_means_no_samples() {
 }
 
 fn sun(to_sun: Vec3, relsize: f32) -> SunLight {
-    // As `SunLight::read` does for a sun at this elevation, turbidity 2 and gain 1.
-    let sin = relsize * 695_500.0 / 149_600_000.0;
     SunLight {
         to_sun,
-        radiance: sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize),
-        sin2_max: sin * sin,
+        turbidity: 2.0,
+        relsize,
+        gain: 1.0,
     }
 }
 
@@ -624,7 +623,8 @@ fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
     let mut irradiances = Vec::new();
     for relsize in [1.0, 4.0] {
         let s = sun(to_sun, relsize);
-        let radiance = s.radiance;
+        let radiance = s.radiance();
+        assert_eq!(radiance, sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize));
         let (_, lights) = build(vec![], vec![LightDesc::Sun(s)]);
         // The cone's solid angle 2 pi (1 - cos theta_max), in f64.
         let sin2 = f64::from(relsize) * 695_500.0 / 149_600_000.0;
