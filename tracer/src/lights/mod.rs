@@ -31,6 +31,8 @@ mod sun;
 #[cfg(test)]
 mod tests;
 
+use std::f32::consts::PI;
+
 use glam::{Vec2, Vec3};
 
 use crate::assets::AssetSource;
@@ -150,36 +152,37 @@ enum Light {
 
 /// A light at infinity: one member of the environment mixture.
 enum AtInfinity {
-    /// An infinite light or a tabulated sky.
     Map(Environment),
+    /// A tabulated sky: a map whose power is weighed against the sun's.
+    Sky(Environment),
     Sun(SunDisc),
 }
 
 impl AtInfinity {
     fn radiance(&self, dir: Vec3) -> Vec3 {
         match self {
-            AtInfinity::Map(l) => l.radiance(dir),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance(dir),
             AtInfinity::Sun(l) => l.radiance(dir),
         }
     }
 
     fn pdf(&self, dir: Vec3) -> f32 {
         match self {
-            AtInfinity::Map(l) => l.pdf(dir),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.pdf(dir),
             AtInfinity::Sun(l) => l.pdf(dir),
         }
     }
 
     fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
         match self {
-            AtInfinity::Map(l) => l.radiance_and_pdf(dir),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance_and_pdf(dir),
             AtInfinity::Sun(l) => l.radiance_and_pdf(dir),
         }
     }
 
     fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
         match self {
-            AtInfinity::Map(l) => l.sample(u),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.sample(u),
             AtInfinity::Sun(l) => l.sample(u),
         }
     }
@@ -187,6 +190,10 @@ impl AtInfinity {
     fn power(&self, scene_radius: f32) -> f32 {
         match self {
             AtInfinity::Map(l) => l.power(scene_radius),
+            // The sun's power is the irradiance of a disk facing it; a disk facing a sky of
+            // mean radiance L receives about pi L, pi times what a map's estimate says.
+            // Weighed alike, sun and sky share light samples as they share the daylight.
+            AtInfinity::Sky(l) => PI * l.power(scene_radius),
             AtInfinity::Sun(l) => l.power(scene_radius),
         }
     }
@@ -252,7 +259,7 @@ impl Lights {
                     .light(source, latlong)?
                     .map(|l| Light::Infinite(AtInfinity::Map(l))),
                 LightDesc::Sun(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sun(l))),
-                LightDesc::Sky(l) => l.light().map(|l| Light::Infinite(AtInfinity::Map(l))),
+                LightDesc::Sky(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sky(l))),
             };
             lights.extend(light);
         }
