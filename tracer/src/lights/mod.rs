@@ -103,7 +103,9 @@ pub(crate) fn read(
 ) -> Result<Vec<LightDesc>, ParseError> {
     let sky = |hosek, ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
         let gain = params.float("gain", emission::DEFAULT_GAIN)?;
-        Ok(LightDesc::Sky(SkyLight::read(hosek, gain, params, pos, ctx)?))
+        Ok(LightDesc::Sky(SkyLight::read(
+            hosek, gain, params, pos, ctx,
+        )?))
     };
     let sun = |ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
         let gain = params.float("gain", emission::DEFAULT_GAIN)?;
@@ -118,9 +120,7 @@ pub(crate) fn read(
         _ => {
             let e = Emission::read(params, ctx)?;
             vec![match ty {
-                "point" | "goniometric" => {
-                    LightDesc::Point(PointLight::read(e, params, pos, ctx)?)
-                }
+                "point" | "goniometric" => LightDesc::Point(PointLight::read(e, params, pos, ctx)?),
                 "spot" => LightDesc::Spot(SpotLight::read(e, params, pos, ctx)?),
                 "distant" => LightDesc::Distant(DistantLight::read(e, params, pos, ctx)?),
                 "infinite" | "infinitesample" => {

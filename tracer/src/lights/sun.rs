@@ -77,7 +77,9 @@ impl SunLight {
         if !(relsize > 0.0 && relsize.is_finite()) {
             return Err(ParseError::Invalid {
                 pos: pos.clone(),
-                message: format!("LightSource \"sun\": \"relsize\" must be positive, got {relsize}"),
+                message: format!(
+                    "LightSource \"sun\": \"relsize\" must be positive, got {relsize}"
+                ),
             });
         }
         let sun = Self {
@@ -183,8 +185,7 @@ impl SunDisc {
             .normalize_or_zero();
         // Rounding can put a sample on the rim a hair outside what `contains` accepts; keep
         // the two consistent so MIS sees the same density from both sides.
-        self.contains(dir)
-            .then_some((dir, self.pdf, self.radiance))
+        self.contains(dir).then_some((dir, self.pdf, self.radiance))
     }
 
     /// The flux through a disk of the scene's size: pi R^2 x irradiance.
@@ -222,9 +223,9 @@ pub fn sun_rgb(theta: f32, turbidity: f32) -> Vec3 {
             let kg = lerp_table(&GAS_K, lambda);
             let gas = (-1.41 * kg * m / (1.0 + 118.93 * kg * m).powf(0.45)).exp();
             let kwa = lerp_table(&WATER_K, lambda);
-            let water =
-                (-0.2385 * kwa * WATER_CM * m / (1.0 + 20.07 * kwa * WATER_CM * m).powf(0.45))
-                    .exp();
+            let water = (-0.2385 * kwa * WATER_CM * m
+                / (1.0 + 20.07 * kwa * WATER_CM * m).powf(0.45))
+            .exp();
             solar(lambda) * rayleigh * aerosol * ozone * gas * water
         })
         .collect();
@@ -244,11 +245,10 @@ pub fn sun_rgb(theta: f32, turbidity: f32) -> Vec3 {
 /// zero outside.
 fn solar(lambda: f64) -> f64 {
     const SOLAR: [f64; 38] = [
-        16559.0, 16233.7, 21127.5, 25888.2, 25829.1, 24232.3, 26760.5, 29658.3, 30545.4,
-        30057.5, 30663.7, 28830.4, 28712.1, 27825.0, 27100.6, 27233.6, 26361.3, 25503.8,
-        25060.2, 25311.6, 25355.9, 25134.2, 24631.5, 24173.2, 23685.3, 23212.1, 22827.7,
-        22339.8, 21970.2, 21526.7, 21097.9, 20728.3, 20240.4, 19870.8, 19427.2, 19072.4,
-        18628.9, 18259.2,
+        16559.0, 16233.7, 21127.5, 25888.2, 25829.1, 24232.3, 26760.5, 29658.3, 30545.4, 30057.5,
+        30663.7, 28830.4, 28712.1, 27825.0, 27100.6, 27233.6, 26361.3, 25503.8, 25060.2, 25311.6,
+        25355.9, 25134.2, 24631.5, 24173.2, 23685.3, 23212.1, 22827.7, 22339.8, 21970.2, 21526.7,
+        21097.9, 20728.3, 20240.4, 19870.8, 19427.2, 19072.4, 18628.9, 18259.2,
     ];
     let x = (lambda - 380.0) / 10.0;
     if !(0.0..=37.0).contains(&x) {

@@ -624,7 +624,10 @@ fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
     for relsize in [1.0, 4.0] {
         let s = sun(to_sun, relsize);
         let radiance = s.radiance();
-        assert_eq!(radiance, sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize));
+        assert_eq!(
+            radiance,
+            sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize)
+        );
         let (_, lights) = build(vec![], vec![LightDesc::Sun(s)]);
         // The cone's solid angle 2 pi (1 - cos theta_max), in f64.
         let sin2 = f64::from(relsize) * 695_500.0 / 149_600_000.0;
@@ -665,7 +668,10 @@ fn sun_colour_and_brightness_follow_the_atmosphere() {
     let overhead = sun_rgb(0.0, 2.0);
     let y = luminance(overhead);
     assert!((1.0e9..1.7e9).contains(&y), "Y = {y}");
-    assert!(overhead.x > overhead.z && overhead.z / overhead.x > 0.7, "{overhead}");
+    assert!(
+        overhead.x > overhead.z && overhead.z / overhead.x > 0.7,
+        "{overhead}"
+    );
     // Near the horizon: dimmer and redder; more haze: dimmer.
     let low = sun_rgb(80f32.to_radians(), 2.0);
     assert!(luminance(low) < 0.6 * y, "{low}");
@@ -690,7 +696,10 @@ fn sky_radiance_matches_the_models_at_zenith_and_horizon() {
     let (_, lights) = build(vec![], vec![LightDesc::Sky(desc.clone())]);
     let zenith = luminance(lights.environment(Vec3::Z));
     let want = preetham_zenith_luminance(theta_s, 3.0);
-    assert!(rel_err(zenith, want) < 5e-3, "zenith {zenith}, model {want}");
+    assert!(
+        rel_err(zenith, want) < 5e-3,
+        "zenith {zenith}, model {want}"
+    );
     // The tabulated sky agrees with the model it was tabulated from, below the horizon too
     // (where it repeats the horizon).
     for (desc, tolerance) in [
@@ -722,7 +731,9 @@ fn sky_radiance_matches_the_models_at_zenith_and_horizon() {
         assert!(luminance(near_sun) > 2.0 * luminance(z), "{:?}", desc.model);
     }
     // Both models give a clear-day zenith of a few thousand cd/m^2 for the sun at 37 degrees.
-    let hosek = sky(SkyModel::Hosek, sundir, 3.0, Mat4::IDENTITY).model().unwrap();
+    let hosek = sky(SkyModel::Hosek, sundir, 3.0, Mat4::IDENTITY)
+        .model()
+        .unwrap();
     let y = luminance(hosek(Vec3::Z));
     assert!((1000.0..10_000.0).contains(&y), "Hosek zenith {y}");
 }

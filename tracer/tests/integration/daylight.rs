@@ -91,7 +91,8 @@ WorldEnd
         let expected = luminance(e_sun + e_sky) * 0.5 / std::f32::consts::PI;
         let film = render(&desc, &MemorySource::new(), 16);
         let pixels = film.radiance();
-        let mean = pixels.iter().map(|&p| f64::from(luminance(p))).sum::<f64>() / pixels.len() as f64;
+        let mean =
+            pixels.iter().map(|&p| f64::from(luminance(p))).sum::<f64>() / pixels.len() as f64;
         let err = (mean / f64::from(expected) - 1.0).abs();
         assert!(
             err < 0.02,
@@ -127,12 +128,20 @@ WorldEnd
         })
         .collect();
     let warm = blackbody_rgb(3000.0);
-    assert!((intensities[0] - 2.0 * warm).abs().max_element() < 1e-5, "{intensities:?}");
-    assert!((intensities[1] - 0.5 * warm).abs().max_element() < 1e-5, "{intensities:?}");
+    assert!(
+        (intensities[0] - 2.0 * warm).abs().max_element() < 1e-5,
+        "{intensities:?}"
+    );
+    assert!(
+        (intensities[1] - 0.5 * warm).abs().max_element() < 1e-5,
+        "{intensities:?}"
+    );
     // A checkerboard varies over a surface: the default colour, with a warning naming it.
     assert_eq!(intensities[2], Vec3::ONE);
     assert!(
-        desc.warnings.iter().any(|w| w.to_string().contains("\"img\"")),
+        desc.warnings
+            .iter()
+            .any(|w| w.to_string().contains("\"img\"")),
         "{:?}",
         desc.warnings
     );
@@ -144,7 +153,10 @@ fn the_daylight_scene_renders_lit() {
     let source = FsSource::for_main_file(Path::new(&path));
     let desc = parse_scene("daylight.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
-    assert!(matches!(desc.lights[..], [LightDesc::Sun(SunLight { .. }), LightDesc::Sky(_)]));
+    assert!(matches!(
+        desc.lights[..],
+        [LightDesc::Sun(SunLight { .. }), LightDesc::Sky(_)]
+    ));
     let settings = RenderSettings::resolve(
         &desc,
         &RenderOverrides {
@@ -165,5 +177,8 @@ fn the_daylight_scene_renders_lit() {
     // Through the file's own tone map the image is neither black nor blown out.
     let display = film.to_display(&desc.film);
     let mean_byte = display.pixels().map(|p| f64::from(p[1])).sum::<f64>() / (64.0 * 36.0);
-    assert!((40.0..220.0).contains(&mean_byte), "mean display value {mean_byte}");
+    assert!(
+        (40.0..220.0).contains(&mean_byte),
+        "mean display value {mean_byte}"
+    );
 }

@@ -566,7 +566,10 @@ fn lights_follow_luxrender_rules() {
     // sunsky is a sun and a sky; LuxRender's default sun points down and gives no light.
     let names: Vec<&str> = d.lights[4..].iter().map(|l| l.name()).collect();
     assert_eq!(names, ["sun", "sky", "sky"]);
-    assert!(!d.warnings.iter().any(|w| w.message.contains("not supported")));
+    assert!(!d
+        .warnings
+        .iter()
+        .any(|w| w.message.contains("not supported")));
     assert!(
         d.warnings
             .iter()

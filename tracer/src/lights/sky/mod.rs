@@ -150,7 +150,11 @@ impl SkyLight {
                 let model = &model;
                 (0..w).map(move |x| {
                     let (sin_phi, cos_phi) = ((x as f32 + 0.5) / w as f32 * TAU).sin_cos();
-                    model(Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta))
+                    model(Vec3::new(
+                        sin_theta * cos_phi,
+                        sin_theta * sin_phi,
+                        cos_theta,
+                    ))
                 })
             })
             .collect();
@@ -158,7 +162,10 @@ impl SkyLight {
             return None;
         }
         if Environment::is_singular(&self.light_to_world) {
-            tracing::warn!("{} light: singular transform, using the identity", self.name());
+            tracing::warn!(
+                "{} light: singular transform, using the identity",
+                self.name()
+            );
         }
         Some(Environment::new(
             Vec3::splat(self.gain),

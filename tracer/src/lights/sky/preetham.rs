@@ -114,7 +114,7 @@ impl Preetham {
         let gamma = dir.dot(self.sun).clamp(-1.0, 1.0).acos();
         let [lum, x, y] =
             std::array::from_fn(|i| self.zenith[i] * perez_f(&self.perez[i], theta, gamma));
-        if !(y > 0.0) || !lum.is_finite() {
+        if y <= 0.0 || !y.is_finite() || !lum.is_finite() {
             return Vec3::ZERO;
         }
         let (x, y, lum) = (f64::from(x), f64::from(y), f64::from(lum));
