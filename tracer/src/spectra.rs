@@ -1,8 +1,9 @@
 //! Spectral data reduced to RGB: LuxRender's built-in metal presets (complex index of
-//! refraction per channel) and blackbody colours. A leaf module: the texture and material
-//! readers use it; `crate::parse` re-exports both functions.
+//! refraction per channel), blackbody colours, and the conversion of an emitted spectrum to
+//! linear sRGB in LuxRender's absolute units (the sun light). A leaf module: the texture,
+//! material and light readers use it; `crate::parse` re-exports the first two functions.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::math::luminance;
 
@@ -35,17 +36,44 @@ pub fn blackbody_rgb(kelvin: f32) -> Vec3 {
         z += b * cz;
         lambda += 5.0;
     }
-    // XYZ -> linear sRGB (D65).
-    let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
-    let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
-    let bl = 0.0557 * x - 0.2040 * y + 1.0570 * z;
-    let rgb = Vec3::new(r as f32, g as f32, bl as f32).max(Vec3::ZERO);
+    let rgb = xyz_to_linear_srgb(DVec3::new(x, y, z)).max(Vec3::ZERO);
     let yl = luminance(rgb);
     if yl > 0.0 {
         rgb / yl
     } else {
         Vec3::ONE
     }
+}
+
+/// LuxRender 1.x's film integrates spectra over this range of wavelengths, in nm.
+const FILM_NM: (f64, f64) = (380.0, 720.0);
+
+/// Luminous efficacy of radiation at 555 nm, lm/W: LuxRender's scale from W/(m^2 sr nm) to
+/// the XYZ its film accumulates (so Y is in cd/m^2).
+const LUMENS_PER_WATT: f64 = 683.0;
+
+/// Linear sRGB of an emitted spectral radiance `spectrum(lambda_nm)` in W/(m^2 sr nm), in
+/// LuxRender's units: XYZ = 683 x the integral of spectrum x CIE 1931 over the film's
+/// wavelengths (1 nm steps), then the sRGB (D65) matrix. Y, and so the luminance of the
+/// result, is in cd/m^2, the scale on which an RGB light colour of 1 has luminance 1.
+pub fn emission_rgb(spectrum: impl Fn(f64) -> f64) -> Vec3 {
+    let mut xyz = DVec3::ZERO;
+    let mut lambda = FILM_NM.0;
+    while lambda <= FILM_NM.1 {
+        let (cx, cy, cz) = cie_1931(lambda);
+        xyz += spectrum(lambda) * DVec3::new(cx, cy, cz);
+        lambda += 1.0;
+    }
+    xyz_to_linear_srgb(xyz * LUMENS_PER_WATT)
+}
+
+/// CIE XYZ to linear sRGB (D65 white).
+pub fn xyz_to_linear_srgb(xyz: DVec3) -> Vec3 {
+    let (x, y, z) = (xyz.x, xyz.y, xyz.z);
+    let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
+    let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
+    let b = 0.0557 * x - 0.2040 * y + 1.0570 * z;
+    Vec3::new(r as f32, g as f32, b as f32)
 }
 
 /// Planck's law, spectral radiance up to a constant factor (normalised away by the caller).

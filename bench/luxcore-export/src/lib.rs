@@ -17,6 +17,7 @@
 
 mod bake;
 mod camera;
+mod daylight;
 mod error;
 mod lights;
 mod materials;

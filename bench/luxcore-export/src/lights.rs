@@ -1,5 +1,6 @@
-//! Lights (`scene.lights.light<N>`): point, spot, distant and infinite lights as LuxCore's;
-//! a kind with no LuxCore mapping is left out with a note naming it.
+//! Lights (`scene.lights.light<N>`): point, spot, distant and infinite lights as LuxCore's,
+//! sun and sky through [`crate::daylight`]; a kind with no LuxCore mapping is left out with a
+//! note naming it.
 
 use std::f32::consts::PI;
 use std::path::Path;
@@ -82,6 +83,8 @@ pub fn write_light(
             };
             set("transformation", matrix(&(*light_to_world * turn)));
         }
+        LightDesc::Sun(sun) => crate::daylight::write_sun(p, &prefix, sun, notes),
+        LightDesc::Sky(sky) => crate::daylight::write_sky(p, &prefix, sky, notes),
         // A kind added later that LuxCore has no mapping for yet.
         #[allow(unreachable_patterns)]
         other => notes.push(format!(

@@ -220,3 +220,39 @@ fn luxrender_extras_map_to_luxcore_materials() {
     assert_eq!(floats(&key(&leaf, "ks_bf")), [0.2; 3]);
     assert_eq!(floats(&key(&leaf, "uroughness_bf")), [0.0]);
 }
+
+#[test]
+fn sun_and_sky_become_luxcores_sun_and_sky2() {
+    let lux = export_world(
+        "AttributeBegin\nRotate 90 0 0 1\n\
+         LightSource \"sunsky2\" \"vector sundir\" [0 0.6 0.8] \"float turbidity\" [3] \"float relsize\" [2] \"float gain\" [0.5]\n\
+         AttributeEnd\nLightSource \"sky\" \"vector sundir\" [0 0 1]",
+    );
+    let scn = &lux.scene;
+    assert_eq!(value(scn, "scene.lights.light0.type"), "\"sun\"");
+    // The sun's direction is in world space (turned by the Rotate); the sky's stays in light
+    // space with the transformation beside it.
+    let dir = floats(value(scn, "scene.lights.light0.dir"));
+    assert!((dir[0] + 0.6).abs() < 1e-5 && dir[1].abs() < 1e-5 && (dir[2] - 0.8).abs() < 1e-5);
+    assert_eq!(floats(value(scn, "scene.lights.light0.turbidity")), [3.0]);
+    assert_eq!(floats(value(scn, "scene.lights.light0.relsize")), [2.0]);
+    assert_eq!(floats(value(scn, "scene.lights.light0.gain")), [0.5; 3]);
+    assert_eq!(value(scn, "scene.lights.light1.type"), "\"sky2\"");
+    assert_eq!(
+        floats(value(scn, "scene.lights.light1.dir")),
+        [0.0, 0.6, 0.8]
+    );
+    let m = floats(value(scn, "scene.lights.light1.transformation"));
+    assert!(
+        (m[1] - 1.0).abs() < 1e-5 && (m[4] + 1.0).abs() < 1e-5,
+        "{m:?}"
+    );
+    assert_eq!(floats(value(scn, "scene.lights.light1.gain")), [0.5; 3]);
+    // A Preetham sky has no LuxCore equivalent: sky2, with a note.
+    assert_eq!(value(scn, "scene.lights.light2.type"), "\"sky2\"");
+    assert!(
+        lux.notes.iter().any(|n| n.contains("Preetham")),
+        "{:?}",
+        lux.notes
+    );
+}

@@ -32,7 +32,7 @@ use crate::parse::params::ParamList;
 use crate::shape::AreaLightDesc;
 
 use super::distribution::Distribution1D;
-use super::emission::{normalised_gain, DEFAULT_GAIN, DEFAULT_L};
+use super::emission::{light_color, normalised_gain, DEFAULT_GAIN, DEFAULT_L};
 use super::sample::LightSample;
 
 /// `power`, watts.
@@ -65,7 +65,7 @@ impl AreaLightParams {
             );
         }
         Ok(Self {
-            l: params.color("L", DEFAULT_L)?,
+            l: light_color(params, "L", DEFAULT_L, ctx)?,
             gain: params.float("gain", DEFAULT_GAIN)?,
             power: params.float("power", DEFAULT_POWER)?,
             efficacy: params.float("efficacy", DEFAULT_EFFICACY)?,

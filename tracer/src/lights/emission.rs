@@ -2,11 +2,18 @@
 //! power/efficacy normalisation (when power x efficacy > 0, the gain is scaled so the light
 //! emits that many lumens), used by point, spot and area lights. A leaf: the light files
 //! import it, it imports none of them.
+//!
+//! `L` may name a texture, as in LuxRender (`"texture L" "name"`, or a colour parameter given
+//! a texture name). The light needs one colour: a texture that is the same everywhere
+//! (constant, blackbody, scale or mix of such) gives it; one that varies over a surface
+//! (an image, a checkerboard) is a warning and the default colour is used.
 
 use glam::Vec3;
 
+use crate::param::Tex;
+use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
-use crate::parse::params::ParamList;
+use crate::parse::params::{ParamList, TexValue};
 
 /// `L`: the emitted colour.
 pub const DEFAULT_L: Vec3 = Vec3::ONE;
@@ -22,12 +29,38 @@ pub struct Emission {
 }
 
 impl Emission {
-    pub(crate) fn read(params: &ParamList) -> Result<Self, ParseError> {
+    pub(crate) fn read(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
         Ok(Self {
-            l: params.color("L", DEFAULT_L)?,
+            l: light_color(params, "L", DEFAULT_L, ctx)?,
             gain: params.float("gain", DEFAULT_GAIN)?,
         })
     }
+}
+
+/// A light's colour parameter: a colour, or a texture with one value everywhere.
+pub(crate) fn light_color(
+    params: &ParamList,
+    name: &str,
+    default: Vec3,
+    ctx: &mut dyn ParseContext,
+) -> Result<Vec3, ParseError> {
+    let value = params.tex_color(name, default)?;
+    let (texture, pos) = match &value {
+        TexValue::Const(c) => return Ok(*c),
+        TexValue::Named { name, pos } => (name.clone(), pos.clone()),
+    };
+    Ok(match ctx.tex(value, true, default) {
+        Tex::Const(c) => c,
+        tex => ctx.uniform_texture(tex).unwrap_or_else(|| {
+            ctx.warn(
+                &pos,
+                format!(
+                    "light colour \"{name}\": texture \"{texture}\" varies over the surface, which a light colour does not model; using the default"
+                ),
+            );
+            default
+        }),
+    })
 }
 
 /// `gain x power x efficacy / denominator` when that factor is positive and finite

@@ -1,15 +1,17 @@
 //! Lights: what a `LightSource` statement describes ([`LightDesc`], one file per kind, read
 //! through the name table [`read`]), area lights on shapes ([`area`]), and the sampler the
 //! integrator asks ([`Lights`]): point, spot, distant, infinite (constant or LatLong map,
-//! importance-sampled by luminance) and area lights, and the choice of which light to sample.
+//! importance-sampled by luminance), sun (a small cone), sky (Preetham or Hosek-Wilkie,
+//! tabulated and sampled like a map) and area lights, and the choice of which light to sample.
 //!
-//! A light is chosen with probability proportional to an estimate of its power. The infinite
-//! lights act as one mixture: a direction sampled from any of them carries the sum of their
-//! radiance and the mixture's density, which is what `environment` and `pdf_environment`
-//! return for an escaping ray, so MIS sees the same numbers from both sides.
+//! A light is chosen with probability proportional to an estimate of its power. The lights at
+//! infinity (infinite, sky, sun) act as one mixture: a direction sampled from any of them
+//! carries the sum of their radiance and the mixture's density, which is what `environment`
+//! and `pdf_environment` return for an escaping ray, so MIS sees the same numbers from both
+//! sides.
 //!
-//! Files: one per kind (`point`, `spot`, `distant`, `infinite`, `area`), each with its
-//! statement, parameters and defaults, reading and sampling; the leaves they share:
+//! Files: one per kind (`point`, `spot`, `distant`, `infinite`, `sun`, `sky/`, `area`), each
+//! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables). A new kind is one new file, one line in
 //! [`read`] and one line in each `match` below.
@@ -22,10 +24,14 @@ mod error;
 mod infinite;
 mod point;
 mod sample;
+mod sky;
 mod spot;
+mod sun;
 
 #[cfg(test)]
 mod tests;
+
+use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
@@ -43,13 +49,16 @@ pub use error::LightError;
 pub use infinite::{EnvMapDesc, InfiniteLight, LatLongConvention};
 pub use point::PointLight;
 pub use sample::LightSample;
+pub use sky::{SkyLight, SkyModel};
 pub use spot::SpotLight;
+pub use sun::{sun_rgb, SunLight};
 
 use area::AreaLight;
 use distribution::Distribution1D;
 use emission::Emission;
 use infinite::Environment;
 use spot::SpotCone;
+use sun::SunDisc;
 
 /// A `LightSource` statement as described: plain data with LuxRender's defaults applied.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,6 +67,8 @@ pub enum LightDesc {
     Spot(SpotLight),
     Distant(DistantLight),
     Infinite(InfiniteLight),
+    Sun(SunLight),
+    Sky(SkyLight),
 }
 
 impl LightDesc {
@@ -68,6 +79,8 @@ impl LightDesc {
             LightDesc::Spot(_) => "spot",
             LightDesc::Distant(_) => "distant",
             LightDesc::Infinite(_) => "infinite",
+            LightDesc::Sun(_) => "sun",
+            LightDesc::Sky(l) => l.name(),
         }
     }
 
@@ -80,36 +93,47 @@ impl LightDesc {
     }
 }
 
-/// Reads `LightSource "ty"`: None for a type that is skipped (with a warning).
+/// Reads `LightSource "ty"`: the lights it makes (`sunsky` and `sunsky2` make a sun and a
+/// sky from the same parameters, as LuxRender does), none for an unknown type (a warning).
 pub(crate) fn read(
     ty: &str,
     params: &ParamList,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
-) -> Result<Option<LightDesc>, ParseError> {
-    let e = Emission::read(params)?;
-    Ok(Some(match ty {
-        "point" | "goniometric" => LightDesc::Point(PointLight::read(e, params, pos, ctx)?),
-        "spot" => LightDesc::Spot(SpotLight::read(e, params, pos, ctx)?),
-        "distant" => LightDesc::Distant(DistantLight::read(e, params, pos, ctx)?),
-        "infinite" | "infinitesample" => {
-            LightDesc::Infinite(InfiniteLight::read(e, params, pos, ctx)?)
+) -> Result<Vec<LightDesc>, ParseError> {
+    let sky = |hosek, ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
+        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
+        Ok(LightDesc::Sky(SkyLight::read(
+            hosek, gain, params, pos, ctx,
+        )?))
+    };
+    let sun = |ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
+        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
+        Ok(LightDesc::Sun(SunLight::read(gain, params, pos, ctx)?))
+    };
+    Ok(match ty {
+        "sun" => vec![sun(ctx)?],
+        "sky" => vec![sky(false, ctx)?],
+        "sky2" => vec![sky(true, ctx)?],
+        "sunsky" => vec![sun(ctx)?, sky(false, ctx)?],
+        "sunsky2" => vec![sun(ctx)?, sky(true, ctx)?],
+        _ => {
+            let e = Emission::read(params, ctx)?;
+            vec![match ty {
+                "point" | "goniometric" => LightDesc::Point(PointLight::read(e, params, pos, ctx)?),
+                "spot" => LightDesc::Spot(SpotLight::read(e, params, pos, ctx)?),
+                "distant" => LightDesc::Distant(DistantLight::read(e, params, pos, ctx)?),
+                "infinite" | "infinitesample" => {
+                    LightDesc::Infinite(InfiniteLight::read(e, params, pos, ctx)?)
+                }
+                other => {
+                    ignore_all(params);
+                    ctx.warn(pos, format!("unknown LightSource \"{other}\" skipped"));
+                    return Ok(Vec::new());
+                }
+            }]
         }
-        "sun" | "sky" | "sky2" | "sunsky" | "sunsky2" => {
-            ignore_all(params);
-            ctx.warn_once(
-                format!("light|{ty}"),
-                pos,
-                format!("LightSource \"{ty}\" is not supported; the light is skipped"),
-            );
-            return Ok(None);
-        }
-        other => {
-            ignore_all(params);
-            ctx.warn(pos, format!("unknown LightSource \"{other}\" skipped"));
-            return Ok(None);
-        }
-    }))
+    })
 }
 
 fn ignore_all(params: &ParamList) {
@@ -123,7 +147,56 @@ enum Light {
     Point(PointLight),
     Spot(SpotCone),
     Distant(DistantLight),
-    Infinite(Environment),
+    Infinite(AtInfinity),
+}
+
+/// A light at infinity: one member of the environment mixture.
+enum AtInfinity {
+    Map(Environment),
+    /// A tabulated sky: a map whose power is weighed against the sun's.
+    Sky(Environment),
+    Sun(SunDisc),
+}
+
+impl AtInfinity {
+    fn radiance(&self, dir: Vec3) -> Vec3 {
+        match self {
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance(dir),
+            AtInfinity::Sun(l) => l.radiance(dir),
+        }
+    }
+
+    fn pdf(&self, dir: Vec3) -> f32 {
+        match self {
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.pdf(dir),
+            AtInfinity::Sun(l) => l.pdf(dir),
+        }
+    }
+
+    fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+        match self {
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance_and_pdf(dir),
+            AtInfinity::Sun(l) => l.radiance_and_pdf(dir),
+        }
+    }
+
+    fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
+        match self {
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.sample(u),
+            AtInfinity::Sun(l) => l.sample(u),
+        }
+    }
+
+    fn power(&self, scene_radius: f32) -> f32 {
+        match self {
+            AtInfinity::Map(l) => l.power(scene_radius),
+            // The sun's power is the irradiance of a disk facing it; a disk facing a sky of
+            // mean radiance L receives about pi L, pi times what a map's estimate says.
+            // Weighed alike, sun and sky share light samples as they share the daylight.
+            AtInfinity::Sky(l) => PI * l.power(scene_radius),
+            AtInfinity::Sun(l) => l.power(scene_radius),
+        }
+    }
 }
 
 /// An infinite light never starves: it gets at least this fraction of the other lights' power
@@ -182,7 +255,11 @@ impl Lights {
                 LightDesc::Point(l) => l.light().map(Light::Point),
                 LightDesc::Spot(l) => l.light().map(Light::Spot),
                 LightDesc::Distant(l) => l.light().map(Light::Distant),
-                LightDesc::Infinite(l) => l.light(source, latlong)?.map(Light::Infinite),
+                LightDesc::Infinite(l) => l
+                    .light(source, latlong)?
+                    .map(|l| Light::Infinite(AtInfinity::Map(l))),
+                LightDesc::Sun(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sun(l))),
+                LightDesc::Sky(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sky(l))),
             };
             lights.extend(light);
         }
@@ -241,7 +318,7 @@ impl Lights {
 
     /// A direction sampled from one of the infinite lights (chosen with probability `pmf`),
     /// with the radiance and density of the whole mixture.
-    fn sample_environment(&self, light: &Environment, u: Vec2, pmf: f32) -> Option<LightSample> {
+    fn sample_environment(&self, light: &AtInfinity, u: Vec2, pmf: f32) -> Option<LightSample> {
         let (wi, pdf, li) = light.sample(u)?;
         // A lone infinite light is the whole mixture: its own density and radiance
         // serve, without looking the direction up again.
@@ -309,7 +386,7 @@ impl Lights {
             .fold((Vec3::ZERO, 0.0), |(r, p), (ri, pi)| (r + ri, p + pi))
     }
 
-    fn infinite_lights(&self) -> impl Iterator<Item = (usize, &Environment)> {
+    fn infinite_lights(&self) -> impl Iterator<Item = (usize, &AtInfinity)> {
         self.infinite
             .iter()
             .filter_map(|&i| match &self.lights[i as usize] {

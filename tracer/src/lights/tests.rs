@@ -8,7 +8,7 @@ use super::*;
 use crate::assets::MemorySource;
 use crate::desc::{AreaLightDesc, Geometry, SceneDesc, ShapeDesc};
 use crate::geometry::tests::{mesh, scene_desc, shape, sphere};
-use crate::math::{luminance, Ray};
+use crate::math::{luminance, Frame, Ray};
 
 fn build_with(
     shapes: Vec<ShapeDesc>,
@@ -594,4 +594,209 @@ fn no_lights_means_no_samples() {
         .is_none());
     assert_eq!(lights.environment(Vec3::Z), Vec3::ZERO);
     assert_eq!(lights.pdf_environment(Vec3::Z), 0.0);
+}
+
+fn sun(to_sun: Vec3, relsize: f32) -> SunLight {
+    SunLight {
+        to_sun,
+        turbidity: 2.0,
+        relsize,
+        gain: 1.0,
+    }
+}
+
+fn sky(model: SkyModel, sundir: Vec3, turbidity: f32, light_to_world: Mat4) -> SkyLight {
+    SkyLight {
+        model,
+        sundir: sundir.normalize(),
+        turbidity,
+        gain: 1.0,
+        light_to_world,
+    }
+}
+
+const PREETHAM: SkyModel = SkyModel::Preetham { consts: [1.0; 5] };
+
+#[test]
+fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
+    let to_sun = Vec3::new(0.3, -0.4, 0.8).normalize();
+    let mut irradiances = Vec::new();
+    for relsize in [1.0, 4.0] {
+        let s = sun(to_sun, relsize);
+        let radiance = s.radiance();
+        assert_eq!(
+            radiance,
+            sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize)
+        );
+        let (_, lights) = build(vec![], vec![LightDesc::Sun(s)]);
+        // The cone's solid angle 2 pi (1 - cos theta_max), in f64.
+        let sin2 = f64::from(relsize) * 695_500.0 / 149_600_000.0;
+        let sin2 = sin2 * sin2;
+        let solid_angle = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - sin2).sqrt());
+        let expected = radiance.as_dvec3() * solid_angle;
+        let e = irradiance(&lights, Vec3::ZERO, to_sun, 20_000, 31).as_dvec3();
+        for c in 0..3 {
+            assert!(
+                (e[c] / expected[c] - 1.0).abs() < 1e-3,
+                "relsize {relsize}: E = {e}, expected {expected}"
+            );
+        }
+        // Tilted 60 degrees away from the sun, cos 60 of it.
+        let tilted = Frame::from_normal(to_sun).to_world(Vec3::new(
+            60f32.to_radians().sin(),
+            0.0,
+            60f32.to_radians().cos(),
+        ));
+        let e60 = irradiance(&lights, Vec3::ZERO, tilted, 20_000, 32).as_dvec3();
+        assert!((e60.y / (0.5 * expected.y) - 1.0).abs() < 2e-3, "{e60}");
+        // An escaping ray into the disc sees the radiance, with the sampler's density.
+        assert_eq!(lights.environment(to_sun), radiance);
+        let pdf = lights.pdf_environment(to_sun);
+        assert!((f64::from(pdf) * solid_angle - 1.0).abs() < 1e-3, "{pdf}");
+        let off = Frame::from_normal(to_sun).to_world(Vec3::new(0.03, 0.0, 1.0).normalize());
+        assert_eq!(lights.environment(off), Vec3::ZERO);
+        irradiances.push(e);
+    }
+    // relsize spreads the same power over a larger disc.
+    assert!((irradiances[1].y / irradiances[0].y - 1.0).abs() < 2e-3);
+}
+
+#[test]
+fn sun_colour_and_brightness_follow_the_atmosphere() {
+    // Overhead at turbidity 2: about 1.3e9 cd/m^2 (the measured noon sun is 1.6e9 at sea
+    // level for a very clear sky), white with a warm tint.
+    let overhead = sun_rgb(0.0, 2.0);
+    let y = luminance(overhead);
+    assert!((1.0e9..1.7e9).contains(&y), "Y = {y}");
+    assert!(
+        overhead.x > overhead.z && overhead.z / overhead.x > 0.7,
+        "{overhead}"
+    );
+    // Near the horizon: dimmer and redder; more haze: dimmer.
+    let low = sun_rgb(80f32.to_radians(), 2.0);
+    assert!(luminance(low) < 0.6 * y, "{low}");
+    assert!(low.z / low.x < 0.8 * overhead.z / overhead.x, "{low}");
+    assert!(luminance(sun_rgb(0.0, 6.0)) < 0.8 * y);
+    // Below the horizon: nothing.
+    assert_eq!(sun_rgb(95f32.to_radians(), 2.0), Vec3::ZERO);
+}
+
+/// Zenith luminance of Preetham's model, cd/m^2.
+fn preetham_zenith_luminance(theta_s: f32, t: f32) -> f32 {
+    let chi = (4.0 / 9.0 - t / 120.0) * (PI - 2.0 * theta_s);
+    ((4.0453 * t - 4.9710) * chi.tan() - 0.2155 * t + 2.4192) * 1000.0
+}
+
+#[test]
+fn sky_radiance_matches_the_models_at_zenith_and_horizon() {
+    let sundir = Vec3::new(0.0, 0.6, 0.8);
+    let theta_s = sundir.normalize().z.acos();
+    // Preetham: the zenith luminance is the model's own formula.
+    let desc = sky(PREETHAM, sundir, 3.0, Mat4::IDENTITY);
+    let (_, lights) = build(vec![], vec![LightDesc::Sky(desc.clone())]);
+    let zenith = luminance(lights.environment(Vec3::Z));
+    let want = preetham_zenith_luminance(theta_s, 3.0);
+    assert!(
+        rel_err(zenith, want) < 5e-3,
+        "zenith {zenith}, model {want}"
+    );
+    // The tabulated sky agrees with the model it was tabulated from, below the horizon too
+    // (where it repeats the horizon).
+    for (desc, tolerance) in [
+        (desc, 0.01),
+        (sky(SkyModel::Hosek, sundir, 3.0, Mat4::IDENTITY), 0.01),
+    ] {
+        let model = desc.model().unwrap();
+        let (_, lights) = build(vec![], vec![LightDesc::Sky(desc.clone())]);
+        for dir in [
+            Vec3::Z,
+            Vec3::new(1.0, 0.0, 0.02).normalize(),
+            Vec3::new(-0.3, 0.5, 0.4).normalize(),
+        ] {
+            let (got, want) = (lights.environment(dir), model(dir));
+            assert!(
+                (got - want).abs().max_element() < tolerance * want.max_element(),
+                "{:?} at {dir}: {got} vs {want}",
+                desc.model
+            );
+        }
+        // Below the horizon the sky is lit (the horizon's zenith angle, the true angle to
+        // the sun), not black.
+        let below = model(Vec3::new(1.0, 0.0, -0.5).normalize());
+        assert!(below.min_element() > 0.0 && below.is_finite(), "{below}");
+        // A clear sky is blue overhead and brighter towards the sun.
+        let z = model(Vec3::Z);
+        assert!(z.z > z.x, "{:?}: zenith {z}", desc.model);
+        let near_sun = model((sundir.normalize() + Vec3::new(0.0, 0.0, 0.1)).normalize());
+        assert!(luminance(near_sun) > 2.0 * luminance(z), "{:?}", desc.model);
+    }
+    // Both models give a clear-day zenith of a few thousand cd/m^2 for the sun at 37 degrees.
+    let hosek = sky(SkyModel::Hosek, sundir, 3.0, Mat4::IDENTITY)
+        .model()
+        .unwrap();
+    let y = luminance(hosek(Vec3::Z));
+    assert!((1000.0..10_000.0).contains(&y), "Hosek zenith {y}");
+}
+
+#[test]
+fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
+    let rotation = Mat4::from_rotation_x(-PI / 2.0) * Mat4::from_rotation_z(0.7);
+    for desc in [
+        sky(SkyModel::Hosek, Vec3::new(0.2, 0.5, 0.3), 2.2, rotation),
+        sky(PREETHAM, Vec3::new(-0.4, 0.1, 0.9), 4.0, Mat4::IDENTITY),
+    ] {
+        let model = desc.model().unwrap();
+        let (_, lights) = build(vec![], vec![LightDesc::Sky(desc.clone())]);
+        let mut rng = fastrand::Rng::with_seed(77);
+        // The density over the sphere, by uniform directions: its mean x 4 pi is 1.
+        let n = 200_000;
+        let mut pdf_sum = 0.0f64;
+        for _ in 0..n {
+            let z = 1.0 - 2.0 * rng.f32();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = 2.0 * PI * rng.f32();
+            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            pdf_sum += f64::from(lights.pdf_environment(dir));
+        }
+        let total = pdf_sum / f64::from(n) * 4.0 * std::f64::consts::PI;
+        assert!((total - 1.0).abs() < 0.01, "{:?}: {total}", desc.model);
+        // Importance-sampled estimate of the integral of luminance over the sphere against
+        // a quadrature of the model itself; and each sample's density is what
+        // pdf_environment says.
+        let mut estimate = 0.0f64;
+        let mut mismatches = 0;
+        for _ in 0..n {
+            let s = lights
+                .sample(Vec3::ZERO, rng.f32(), Vec2::new(rng.f32(), rng.f32()))
+                .unwrap();
+            if rel_err(lights.pdf_environment(s.wi), s.pdf) >= 1e-3 {
+                mismatches += 1;
+            }
+            estimate += f64::from(luminance(s.li) / s.pdf);
+        }
+        assert!(mismatches * 1000 < n, "{mismatches} pdfs disagree");
+        let estimate = estimate / f64::from(n);
+        let (nt, np) = (400, 800);
+        let mut quadrature = 0.0f64;
+        for i in 0..nt {
+            let theta = (i as f64 + 0.5) / nt as f64 * std::f64::consts::PI;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) / np as f64 * std::f64::consts::TAU;
+                let d = Vec3::new(
+                    (theta.sin() * phi.cos()) as f32,
+                    (theta.sin() * phi.sin()) as f32,
+                    theta.cos() as f32,
+                );
+                quadrature += f64::from(luminance(model(d)))
+                    * theta.sin()
+                    * (std::f64::consts::PI / nt as f64)
+                    * (std::f64::consts::TAU / np as f64);
+            }
+        }
+        assert!(
+            (estimate / quadrature - 1.0).abs() < 0.01,
+            "{:?}: estimate {estimate}, quadrature {quadrature}",
+            desc.model
+        );
+    }
 }

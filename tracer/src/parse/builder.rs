@@ -423,9 +423,8 @@ impl<'s> Builder<'s> {
                 if self.current_object.is_some() {
                     self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined".into());
                 }
-                if let Some(light) = crate::lights::read(&ty, &params, pos, self)? {
-                    self.lights.push(light);
-                }
+                let lights = crate::lights::read(&ty, &params, pos, self)?;
+                self.lights.extend(lights);
                 self.warn_unused(&params);
             }
             "AreaLightSource" => {
@@ -714,6 +713,10 @@ impl ParseContext for Builder<'_> {
 
     fn texture_is_color(&self, id: TextureId) -> bool {
         self.textures[id.0 as usize].is_color
+    }
+
+    fn uniform_texture(&self, tex: Tex) -> Option<Vec3> {
+        texture::Textures::uniform_value(&self.textures, tex)
     }
 
     fn scaled_texture(&mut self, id: TextureId, factor: f32) -> TextureId {

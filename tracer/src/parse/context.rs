@@ -39,6 +39,10 @@ pub trait ParseContext {
     /// Whether texture `id` was declared "color" (else "float").
     fn texture_is_color(&self, id: TextureId) -> bool;
 
+    /// The value of a texture-or-constant that is the same at every point (a constant, a
+    /// blackbody, scale or mix of such), None if it varies over a surface.
+    fn uniform_texture(&self, tex: Tex) -> Option<Vec3>;
+
     /// A new texture: texture `id` times the constant `factor`.
     fn scaled_texture(&mut self, id: TextureId, factor: f32) -> TextureId;
 

@@ -290,6 +290,48 @@ impl Textures {
     fn image(&self, texture: &Texture) -> &RgbImage {
         &self.images[texture.image.expect("decoded in Textures::new")]
     }
+
+    /// The value of `tex` when it is the same at every point, from the descriptions alone:
+    /// constants (and blackbody, read as one) and scale or mix of such. What a light colour
+    /// given as a texture reads (LuxRender accepts a texture wherever a colour goes). None
+    /// for a texture that varies over a surface or reads a file.
+    pub fn uniform_value(descs: &[TextureDesc], tex: Tex) -> Option<Vec3> {
+        fn uniform(descs: &[TextureDesc], tex: Tex) -> bool {
+            let Tex::Texture(TextureId(id)) = tex else {
+                return true;
+            };
+            descs.get(id as usize).is_some_and(|d| {
+                matches!(
+                    d.kind,
+                    TextureKind::Constant(_) | TextureKind::Scale(_) | TextureKind::Mix(_)
+                ) && d.kind.references().into_iter().all(|r| match r {
+                    // Only earlier textures: rules out cycles.
+                    Tex::Texture(TextureId(used)) => used < id && uniform(descs, r),
+                    Tex::Const(_) => true,
+                })
+            })
+        }
+        if !uniform(descs, tex) {
+            return None;
+        }
+        // No texture reached reads a file, so none needs its image.
+        let textures = Self {
+            textures: descs
+                .iter()
+                .map(|d| Texture {
+                    kind: d.kind.clone(),
+                    is_color: d.is_color,
+                    image: None,
+                })
+                .collect(),
+            images: Vec::new(),
+        };
+        let origin = TexturePoint {
+            p: Vec3::ZERO,
+            uv: glam::Vec2::ZERO,
+        };
+        Some(textures.eval(tex, &origin))
+    }
 }
 
 impl TextureEval for Textures {

@@ -1,0 +1,177 @@
+//! The daylight skies: LuxRender 1.x's `sky` (Preetham, [`preetham`]) and `sky2`
+//! (Hosek-Wilkie, [`hosek`]). `sunsky` and `sunsky2` are a sun plus one of these, read from
+//! the same parameters.
+//!
+//! ```text
+//! LightSource "sky" "vector sundir" [0 0 1] "float turbidity" [2] "float gain" [1]
+//! LightSource "sky2" "vector sundir" [0 0 1] "float turbidity" [2] "float gain" [1]
+//! ```
+//!
+//! | parameter   | default | meaning                                                     |
+//! |-------------|---------|-------------------------------------------------------------|
+//! | `sundir`    | 0 0 1   | towards the sun, in light space (z up)                      |
+//! | `turbidity` | 2       | haze (`sky2` clamps it to [1, 10])                          |
+//! | `gain`      | 1       | multiplies the radiance                                     |
+//! | `nsamples`  | 1       | a sampling hint: read and ignored                           |
+//! | `aconst` ... `econst` | 1 | `sky` only: the Perez multipliers ([`preetham`])       |
+//!
+//! Units are LuxRender's (cd/m^2: a clear zenith is a few thousand). The sky is defined in
+//! light space (z up), mapped to the world by the current transform, and covers the whole
+//! sphere: below the horizon it repeats the horizon, as LuxRender's does.
+//!
+//! The model is tabulated once on a LatLong grid and served by the infinite light's map
+//! machinery: bilinear lookups, importance sampling by luminance x sin(theta).
+
+mod hosek;
+mod preetham;
+
+use std::f32::consts::{PI, TAU};
+
+use glam::{Mat4, Vec3};
+use rayon::prelude::*;
+
+use crate::diag::SourcePos;
+use crate::image_io::RgbImage;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+use super::emission::emits;
+use super::infinite::{Environment, LatLongConvention};
+
+pub use hosek::Hosek;
+pub use preetham::Preetham;
+
+/// `sundir`.
+pub const DEFAULT_SUNDIR: Vec3 = Vec3::Z;
+/// `turbidity`.
+pub const DEFAULT_TURBIDITY: f32 = 2.0;
+
+/// The tabulated grid: 0.35 degrees per texel, fine for the smooth sky and its circumsolar
+/// glow, and (with the distribution) a few MB.
+const TABLE_WIDTH: u32 = 1024;
+const TABLE_HEIGHT: u32 = 512;
+
+/// Which model, with its own parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SkyModel {
+    /// `sky`: Preetham, with the five Perez multipliers.
+    Preetham { consts: [f32; 5] },
+    /// `sky2`: Hosek-Wilkie.
+    Hosek,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkyLight {
+    pub model: SkyModel,
+    /// Unit light-space direction towards the sun.
+    pub sundir: Vec3,
+    pub turbidity: f32,
+    pub gain: f32,
+    /// Light space has z up; this maps it to world space.
+    pub light_to_world: Mat4,
+}
+
+impl SkyLight {
+    /// Reads `sky` (`hosek` false) or `sky2` (`hosek` true).
+    pub(crate) fn read(
+        hosek: bool,
+        gain: f32,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let name = if hosek { "sky2" } else { "sky" };
+        let Some(sundir) = params.vec3("sundir", DEFAULT_SUNDIR)?.try_normalize() else {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: format!("LightSource \"{name}\": \"sundir\" must not be zero"),
+            });
+        };
+        let turbidity = params.float("turbidity", DEFAULT_TURBIDITY)?;
+        params.ignore("nsamples");
+        let model = if hosek {
+            SkyModel::Hosek
+        } else {
+            SkyModel::Preetham {
+                consts: preetham::read_consts(params)?,
+            }
+        };
+        Ok(Self {
+            model,
+            sundir,
+            turbidity,
+            gain,
+            light_to_world: ctx.ctm(),
+        })
+    }
+
+    /// The LuxRender type name.
+    pub fn name(&self) -> &'static str {
+        match self.model {
+            SkyModel::Preetham { .. } => "sky",
+            SkyModel::Hosek => "sky2",
+        }
+    }
+
+    /// Radiance per unit gain from a unit light-space direction: the model itself, before
+    /// tabulation (None if the model refuses its parameters).
+    pub fn model(&self) -> Option<impl Fn(Vec3) -> Vec3 + Sync> {
+        enum Model {
+            Preetham(Preetham),
+            Hosek(Hosek),
+        }
+        let sun = self.sundir.normalize_or_zero();
+        let model = match &self.model {
+            SkyModel::Preetham { consts } => {
+                Model::Preetham(Preetham::new(sun, self.turbidity, *consts))
+            }
+            SkyModel::Hosek => Model::Hosek(Hosek::new(sun, self.turbidity)?),
+        };
+        Some(move |dir: Vec3| match &model {
+            Model::Preetham(m) => m.radiance(dir),
+            Model::Hosek(m) => m.radiance(dir),
+        })
+    }
+
+    /// The light to sample, if it emits: the model tabulated on a LatLong grid in
+    /// LuxRender's convention.
+    pub fn light(&self) -> Option<Environment> {
+        if !(self.gain > 0.0 && self.gain.is_finite()) {
+            return None;
+        }
+        let model = self.model()?;
+        let (w, h) = (TABLE_WIDTH, TABLE_HEIGHT);
+        // Texel centres; rows in parallel (each texel depends only on its direction).
+        let texels: Vec<Vec3> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let (sin_theta, cos_theta) = ((y as f32 + 0.5) / h as f32 * PI).sin_cos();
+                let model = &model;
+                (0..w).map(move |x| {
+                    let (sin_phi, cos_phi) = ((x as f32 + 0.5) / w as f32 * TAU).sin_cos();
+                    model(Vec3::new(
+                        sin_theta * cos_phi,
+                        sin_theta * sin_phi,
+                        cos_theta,
+                    ))
+                })
+            })
+            .collect();
+        if !texels.iter().any(|&t| emits(t)) {
+            return None;
+        }
+        if Environment::is_singular(&self.light_to_world) {
+            tracing::warn!(
+                "{} light: singular transform, using the identity",
+                self.name()
+            );
+        }
+        Some(Environment::new(
+            Vec3::splat(self.gain),
+            Some(RgbImage::from_linear(w, h, texels)),
+            &self.light_to_world,
+            LatLongConvention::LuxRender,
+        ))
+    }
+}
