@@ -127,10 +127,7 @@ fn export_shape(
         Some(mapping) => Some(
             (0..mesh.positions.len())
                 .map(|i| {
-                    mapping.map(&TexturePoint {
-                        p: mesh.positions[i],
-                        uv: object_uv(i),
-                    })
+                    mapping.map(&TexturePoint::new(mesh.positions[i], object_uv(i)))
                 })
                 .collect(),
         ),

@@ -10,7 +10,12 @@
 //!
 //! A new material is one new file plus one line in [`MaterialDesc::read`]'s name table (and
 //! one line in each `match` below).
+//!
+//! Every material but `mix` and `null` may carry a bump or normal map ([`bump`]): read here
+//! for all of them, kept as a [`MaterialDesc::Bumped`] wrapper, applied to the shading normal
+//! in [`Materials::bsdf`].
 
+pub mod bump;
 pub mod eval;
 pub mod glass;
 pub mod glossy;
@@ -24,9 +29,10 @@ pub mod null;
 #[cfg(test)]
 mod tests;
 
-use glam::Vec3;
+use glam::Affine3A;
 
 pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
+pub use bump::Bump;
 pub use glass::Glass;
 pub use glossy::Glossy;
 pub use matte::Matte;
@@ -59,6 +65,8 @@ pub enum MaterialDesc {
     MatteTranslucent(MatteTranslucent),
     Null(Null),
     Mix(Mix),
+    /// A material with a bump or normal map (never a mix or null: LuxRender's take none).
+    Bumped(Box<MaterialDesc>, Bump),
 }
 
 impl MaterialDesc {
@@ -66,6 +74,23 @@ impl MaterialDesc {
     /// from LuxRender's material names to kinds. An unsupported type warns and becomes a matte
     /// (with its Kd when given).
     pub fn read(
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let material = Self::read_kind(ty, params, pos, ctx)?;
+        if matches!(material, Self::Mix(_) | Self::Null(_)) {
+            return Ok(material);
+        }
+        Ok(match Bump::read(params, ctx)? {
+            Some(bump) => Self::Bumped(Box::new(material), bump),
+            None => material,
+        })
+    }
+
+    /// The material of LuxRender type `ty`, without its bump map.
+    fn read_kind(
         ty: &str,
         params: &ParamList,
         pos: &SourcePos,
@@ -110,6 +135,7 @@ impl MaterialDesc {
             Self::MatteTranslucent(_) => "mattetranslucent",
             Self::Null(_) => "null",
             Self::Mix(_) => "mix",
+            Self::Bumped(m, _) => m.name(),
         }
     }
 
@@ -124,6 +150,7 @@ impl MaterialDesc {
             Self::MatteTranslucent(m) => m.textures(),
             Self::Null(m) => m.textures(),
             Self::Mix(m) => m.textures(),
+            Self::Bumped(m, bump) => m.textures().into_iter().chain([bump.map]).collect(),
         }
     }
 
@@ -131,6 +158,7 @@ impl MaterialDesc {
     pub fn materials(&self) -> Vec<MaterialId> {
         match self {
             Self::Mix(m) => m.materials(),
+            Self::Bumped(m, _) => m.materials(),
             _ => Vec::new(),
         }
     }
@@ -147,6 +175,7 @@ impl MaterialDesc {
             Self::MatteTranslucent(m) => m.bxdf(eval),
             Self::Null(m) => m.bxdf(),
             Self::Mix(_) => Matte::default_bxdf(),
+            Self::Bumped(m, _) => m.bxdf(eval),
         }
     }
 }
@@ -173,46 +202,60 @@ impl Materials {
         Self { materials }
     }
 
-    /// Follows `mix` materials down to a leaf. At each level `u_mix` chooses a side against
-    /// the amount and is rescaled to [0, 1) within the chosen side (see [`Mix::choose`]).
-    fn resolve(&self, id: MaterialId, eval: &TextureEval, u_mix: f32) -> Option<&MaterialDesc> {
+    /// Follows `mix` materials down to a leaf, and the leaf's bump map. At each level `u_mix`
+    /// chooses a side against the amount and is rescaled to [0, 1) within the chosen side (see
+    /// [`Mix::choose`]).
+    fn resolve(
+        &self,
+        id: MaterialId,
+        eval: &TextureEval,
+        u_mix: f32,
+    ) -> Option<(&MaterialDesc, Option<&Bump>)> {
         let mut material = self.materials.get(id.0 as usize)?;
         let mut u = u_mix;
         // A well-formed scene cannot nest deeper than it has materials; more means a cycle.
         for _ in 0..=self.materials.len() {
-            let MaterialDesc::Mix(mix) = material else {
-                return Some(material);
-            };
-            let next;
-            (next, u) = mix.choose(eval, u);
-            material = self.materials.get(next.0 as usize)?;
+            match material {
+                MaterialDesc::Mix(mix) => {
+                    let next;
+                    (next, u) = mix.choose(eval, u);
+                    material = self.materials.get(next.0 as usize)?;
+                }
+                MaterialDesc::Bumped(leaf, bump) => return Some((leaf, Some(bump))),
+                leaf => return Some((leaf, None)),
+            }
         }
-        Some(material)
+        Some((material, None))
     }
 
-    /// The BSDF of material `id` at `hit`, whose position in its shape's object space is
-    /// `p_object` (what 3D texture mappings see). `u_mix` resolves `mix` materials
-    /// stochastically.
+    /// The BSDF of material `id` at `hit` on a shape whose world-to-object transform is
+    /// `world_to_object` (the object-space position is what planar and local 3D texture
+    /// mappings see). `u_mix` resolves `mix` materials stochastically.
     pub fn bsdf(
         &self,
         id: MaterialId,
         hit: &SurfaceHit,
-        p_object: Vec3,
+        world_to_object: &Affine3A,
         textures: &Textures,
         u_mix: f32,
     ) -> Bsdf {
         let eval = TextureEval {
             textures,
             at: TexturePoint {
-                p: p_object,
+                p: world_to_object.transform_point3(hit.p),
+                p_world: hit.p,
                 uv: hit.uv,
+                prim: hit.prim,
             },
         };
-        let bxdf = match self.resolve(id, &eval, u_mix) {
-            Some(material) => material.bxdf(&eval),
+        let (bxdf, ns) = match self.resolve(id, &eval, u_mix) {
+            Some((material, bump)) => (
+                material.bxdf(&eval),
+                bump.map_or(hit.ns, |b| b.normal(hit, &eval, world_to_object)),
+            ),
             // A dangling id or a mix cycle (resolve gives up on it).
-            None => Matte::default_bxdf(),
+            None => (Matte::default_bxdf(), hit.ns),
         };
-        Bsdf::new(Frame::from_normal_tangent(hit.ns, hit.dpdu), hit.ng, bxdf)
+        Bsdf::new(Frame::from_normal_tangent(ns, hit.dpdu), hit.ng, bxdf)
     }
 }
