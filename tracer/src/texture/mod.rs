@@ -2,7 +2,8 @@
 //! defaults, reading and evaluation: [`imagemap`], [`normalmap`], [`checkerboard`] (2D and 3D),
 //! [`constant`], [`scale`], [`arithmetic`] (add, subtract), [`mix`], [`band`], [`bilerp`],
 //! [`uv`], [`harlequin`], [`dots`], [`brick`], [`fbm`], [`wrinkled`], [`windy`], [`marble`],
-//! [`blackbody`] (read as a constant), and [`fresnel`] (the fresnel textures metal2 folds in).
+//! the [`blender`] family (blender_clouds, _wood, _marble, _musgrave, _stucci, _noise,
+//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`] (read as a constant), and [`fresnel`] (the fresnel textures metal2 folds in).
 //! [`mapping`] holds the 2D mappings (uv, spherical, cylindrical, planar) and the 3D mapping
 //! (global, local, uv coordinates with scale, rotate, translate); [`noise`] the Perlin noise,
 //! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator
@@ -24,6 +25,7 @@ pub mod arithmetic;
 pub mod band;
 pub mod bilerp;
 pub mod blackbody;
+pub mod blender;
 pub mod brick;
 pub mod checkerboard;
 pub mod common;
@@ -108,6 +110,7 @@ pub enum TextureKind {
     Windy(Windy),
     Marble(Marble),
     NormalMap(NormalMap),
+    Blender(blender::Blender),
 }
 
 /// What a `Texture` statement defines under its name.
@@ -192,7 +195,10 @@ impl TextureKind {
             "marble" => Self::Marble(Marble::read(params, pos, ctx)?),
             "normalmap" => Self::NormalMap(NormalMap::read(decl, params, pos, ctx)?),
             "blackbody" => Self::Constant(blackbody::read(params)?),
-            _ => return Ok(None),
+            _ => match blender::Blender::read(class, decl, params, pos, ctx)? {
+                Some(b) => Self::Blender(b),
+                None => return Ok(None),
+            },
         }))
     }
 
@@ -216,6 +222,7 @@ impl TextureKind {
             Self::Windy(_) => "windy",
             Self::Marble(_) => "marble",
             Self::NormalMap(_) => "normalmap",
+            Self::Blender(t) => t.name(),
         }
     }
 
@@ -240,6 +247,7 @@ impl TextureKind {
             Self::Band(t) => t.textures.iter().copied().chain([t.amount]).collect(),
             Self::Dots(t) => vec![t.outside, t.inside],
             Self::Brick(t) => vec![t.brick, t.mortar, t.modulation],
+            Self::Blender(t) => t.references(),
         }
     }
 
@@ -375,6 +383,7 @@ impl Textures {
             TextureKind::Marble(t) => t.eval(at),
             // A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
             TextureKind::NormalMap(_) => Vec3::ZERO,
+            TextureKind::Blender(t) => t.eval(at, self),
         };
         if texture.is_color {
             value
