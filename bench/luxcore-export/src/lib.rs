@@ -21,6 +21,7 @@ mod error;
 mod lights;
 mod materials;
 mod options;
+mod procedural;
 mod ply;
 mod props;
 mod shapes;
