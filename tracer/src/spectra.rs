@@ -48,6 +48,35 @@ pub fn blackbody_rgb(kelvin: f32) -> Vec3 {
     }
 }
 
+/// The RGB of a reflectance (or any relative) spectrum `f` (nm -> value): its CIE XYZ under an
+/// equal-energy light, in linear sRGB, divided channel by channel by that of the constant
+/// spectrum 1, so that a flat spectrum of value v is exactly (v, v, v).
+pub fn spectrum_rgb(f: impl Fn(f64) -> f64) -> Vec3 {
+    let rgb = |f: &dyn Fn(f64) -> f64| {
+        let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+        let mut lambda = 380.0f64;
+        while lambda <= 780.0 {
+            let (cx, cy, cz) = cie_1931(lambda);
+            let v = f(lambda);
+            x += v * cx;
+            y += v * cy;
+            z += v * cz;
+            lambda += 5.0;
+        }
+        [
+            3.2406 * x - 1.5372 * y - 0.4986 * z,
+            -0.9689 * x + 1.8758 * y + 0.0415 * z,
+            0.0557 * x - 0.2040 * y + 1.0570 * z,
+        ]
+    };
+    let (c, white) = (rgb(&f), rgb(&|_| 1.0));
+    Vec3::new(
+        (c[0] / white[0]) as f32,
+        (c[1] / white[1]) as f32,
+        (c[2] / white[2]) as f32,
+    )
+}
+
 /// Planck's law, spectral radiance up to a constant factor (normalised away by the caller).
 fn planck(lambda_nm: f64, t: f64) -> f64 {
     const C2: f64 = 1.438_776_9e-2; // hc/k in m K

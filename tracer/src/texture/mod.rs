@@ -3,7 +3,7 @@
 //! [`constant`], [`scale`], [`arithmetic`] (add, subtract), [`mix`], [`band`], [`bilerp`],
 //! [`uv`], [`harlequin`], [`dots`], [`brick`], [`fbm`], [`wrinkled`], [`windy`], [`marble`],
 //! the [`blender`] family (blender_clouds, _wood, _marble, _musgrave, _stucci, _noise,
-//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`] (read as a constant), and [`fresnel`] (the fresnel textures metal2 folds in).
+//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`] and [`equalenergy`] (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in).
 //! [`mapping`] holds the 2D mappings (uv, spherical, cylindrical, planar) and the 3D mapping
 //! (global, local, uv coordinates with scale, rotate, translate); [`noise`] the Perlin noise,
 //! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator
@@ -31,8 +31,10 @@ pub mod checkerboard;
 pub mod common;
 pub mod constant;
 pub mod dots;
+pub mod equalenergy;
 pub mod fbm;
 pub mod fresnel;
+pub mod gaussian;
 pub mod harlequin;
 pub mod imagemap;
 pub mod mapping;
@@ -195,6 +197,8 @@ impl TextureKind {
             "marble" => Self::Marble(Marble::read(params, pos, ctx)?),
             "normalmap" => Self::NormalMap(NormalMap::read(decl, params, pos, ctx)?),
             "blackbody" => Self::Constant(blackbody::read(params)?),
+            "gaussian" => Self::Constant(gaussian::read(params)?),
+            "equalenergy" => Self::Constant(equalenergy::read(params)?),
             _ => match blender::Blender::read(class, decl, params, pos, ctx)? {
                 Some(b) => Self::Blender(b),
                 None => return Ok(None),

@@ -371,3 +371,23 @@ fn bad_procedural_parameters_are_errors_not_panics() {
     // Hostile octave counts are bounded, not an endless loop.
     assert!(parse("Texture \"f\" \"float\" \"fbm\" \"integer octaves\" 2000000000").is_ok());
 }
+
+#[test]
+fn spectral_textures_are_their_rgb_colours() {
+    let t = textures(
+        "Texture \"e\" \"color\" \"equalenergy\" \"float energy\" 0.7\n\
+         Texture \"flat\" \"color\" \"gaussian\" \"float width\" 1e6 \"float energy\" 0.5\n\
+         Texture \"red\" \"color\" \"gaussian\" \"float wavelength\" 620 \"float width\" 20\n\
+         Texture \"green\" \"color\" \"gaussian\" \"float wavelength\" 530 \"float width\" 20\n\
+         Texture \"blue\" \"color\" \"gaussian\" \"float wavelength\" 450 \"float width\" 20",
+    );
+    let c = |name: &str| eval_at(&t, name, Vec3::ZERO, Vec2::ZERO);
+    assert_eq!(c("e"), Vec3::splat(0.7));
+    // A Gaussian far wider than the visible range is flat: its value in every channel.
+    assert!((c("flat") - Vec3::splat(0.5)).abs().max_element() < 1e-3, "{}", c("flat"));
+    // Narrow bands land in their own channel.
+    let (r, g, b) = (c("red"), c("green"), c("blue"));
+    assert!(r.x > 2.0 * r.y && r.x > 2.0 * r.z, "red {r}");
+    assert!(g.y > g.x && g.y > 2.0 * g.z, "green {g}");
+    assert!(b.z > 2.0 * b.x && b.z > 2.0 * b.y, "blue {b}");
+}
