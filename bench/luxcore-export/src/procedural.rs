@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use yat_tracer::desc::{Mapping2D, Tex, TextureKind};
-use yat_tracer::texture::blender::{musgrave, Blender, BlenderKind};
 use yat_tracer::texture::blender::noise_basis::{Metric, NoiseBasis};
+use yat_tracer::texture::blender::{musgrave, Blender, BlenderKind};
 use yat_tracer::texture::{Bond, Coordinates, Fbm, Mapping3D, NormalMap, Op, Wrinkled};
 
 use crate::props::{matrix, quoted, tex_value, v3, Props};
@@ -81,7 +81,10 @@ fn write_blender(p: &mut Props, prefix: &str, t: &Blender, color: bool, notes: &
             set("turbulence", w.turbulence.to_string());
         }
         BlenderKind::Marble(m) => {
-            set("marbletype", quoted(["soft", "sharp", "sharper"][m.sharpness]));
+            set(
+                "marbletype",
+                quoted(["soft", "sharp", "sharper"][m.sharpness]),
+            );
             set("noisebasis2", wave_name(m.wave));
             set("noisebasis", quoted(basis_name(m.basis)));
             set("noisetype", hard(m.hard));
@@ -101,7 +104,10 @@ fn write_blender(p: &mut Props, prefix: &str, t: &Blender, color: bool, notes: &
             set("noisesize", m.size.to_string());
         }
         BlenderKind::Stucci(s) => {
-            set("stuccitype", quoted(["plastic", "wall_in", "wall_out"][s.kind]));
+            set(
+                "stuccitype",
+                quoted(["plastic", "wall_in", "wall_out"][s.kind]),
+            );
             set("noisebasis", quoted(basis_name(s.basis)));
             set("noisetype", hard(s.hard));
             set("noisesize", s.size.to_string());
@@ -126,7 +132,9 @@ fn write_blender(p: &mut Props, prefix: &str, t: &Blender, color: bool, notes: &
             set("intensity", v.outscale.to_string());
             set("noisesize", v.size.to_string());
             if v.coltype != 0 {
-                notes.push(format!("{prefix}: blender_voronoi colour type exported as intensity"));
+                notes.push(format!(
+                    "{prefix}: blender_voronoi colour type exported as intensity"
+                ));
             }
         }
         BlenderKind::DistortedNoise(d) => {
@@ -140,14 +148,28 @@ fn write_blender(p: &mut Props, prefix: &str, t: &Blender, color: bool, notes: &
             set("turbulence", m.turbulence.to_string());
         }
         BlenderKind::Blend(b) => {
-            let names = ["linear", "quadratic", "easing", "diagonal", "spherical", "halo", "radial"];
+            let names = [
+                "linear",
+                "quadratic",
+                "easing",
+                "diagonal",
+                "spherical",
+                "halo",
+                "radial",
+            ];
             set("progressiontype", quoted(names[b.kind]));
-            set("direction", quoted(if b.flip { "vertical" } else { "horizontal" }));
+            set(
+                "direction",
+                quoted(if b.flip { "vertical" } else { "horizontal" }),
+            );
         }
     }
     write_mapping3d(p, &f, &t.base.mapping);
     p.set(format!("{prefix}.type"), quoted("mix"));
-    p.set(format!("{prefix}.amount"), quoted(&f["scene.textures.".len()..]));
+    p.set(
+        format!("{prefix}.amount"),
+        quoted(&f["scene.textures.".len()..]),
+    );
     p.set(format!("{prefix}.texture1"), tex_value(&t.base.tex1, color));
     p.set(format!("{prefix}.texture2"), tex_value(&t.base.tex2, color));
 }
@@ -241,10 +263,14 @@ pub fn write_procedural(
             }
         }
         TextureKind::Arithmetic(t) => {
-            set(p, "type", quoted(match t.op {
-                Op::Add => "add",
-                Op::Subtract => "subtract",
-            }));
+            set(
+                p,
+                "type",
+                quoted(match t.op {
+                    Op::Add => "add",
+                    Op::Subtract => "subtract",
+                }),
+            );
             set(p, "texture1", tv(&t.tex1));
             set(p, "texture2", tv(&t.tex2));
         }
@@ -285,8 +311,14 @@ fn write_mapping2d(p: &mut Props, prefix: &str, mapping: &Mapping2D, notes: &mut
         }
     };
     p.set(format!("{prefix}.mapping.type"), quoted("uvmapping2d"));
-    p.set(format!("{prefix}.mapping.uvscale"), format!("{} {}", s.0, s.1));
-    p.set(format!("{prefix}.mapping.uvdelta"), format!("{} {}", d.0, d.1));
+    p.set(
+        format!("{prefix}.mapping.uvscale"),
+        format!("{} {}", s.0, s.1),
+    );
+    p.set(
+        format!("{prefix}.mapping.uvdelta"),
+        format!("{} {}", d.0, d.1),
+    );
 }
 
 #[cfg(test)]
@@ -329,7 +361,10 @@ mod tests {
         assert_eq!(value(&scn, "scene.textures.tex0.type"), "\"fbm\"");
         assert_eq!(value(&scn, "scene.textures.tex0.octaves"), "5");
         assert_eq!(value(&scn, "scene.textures.tex0.roughness"), "0.7");
-        assert_eq!(value(&scn, "scene.textures.tex0.mapping.type"), "\"globalmapping3d\"");
+        assert_eq!(
+            value(&scn, "scene.textures.tex0.mapping.type"),
+            "\"globalmapping3d\""
+        );
         // World to texture: the translation is undone (column-major, last column -t).
         let m: Vec<f32> = value(&scn, "scene.textures.tex0.mapping.transformation")
             .split_whitespace()
@@ -344,7 +379,10 @@ mod tests {
             "Texture \"w\" \"float\" \"blender_wood\" \"string type\" \"rings\" \"float tex1\" 0.2 \"float tex2\" 0.8\n\
              Material \"matte\" \"texture Kd\" \"w\"",
         );
-        assert_eq!(value(&scn, "scene.textures.tex0_f.type"), "\"blender_wood\"");
+        assert_eq!(
+            value(&scn, "scene.textures.tex0_f.type"),
+            "\"blender_wood\""
+        );
         assert_eq!(value(&scn, "scene.textures.tex0_f.woodtype"), "\"rings\"");
         assert_eq!(value(&scn, "scene.textures.tex0.type"), "\"mix\"");
         assert_eq!(value(&scn, "scene.textures.tex0.amount"), "\"tex0_f\"");
@@ -353,12 +391,13 @@ mod tests {
 
     #[test]
     fn a_bump_map_becomes_bumptex() {
-        let scn = sdl(
-            "Texture \"h\" \"float\" \"wrinkled\"\n\
-             Material \"glossy\" \"texture bumpmap\" \"h\" \"float bumpmapsampledistance\" 0.002",
-        );
+        let scn = sdl("Texture \"h\" \"float\" \"wrinkled\"\n\
+             Material \"glossy\" \"texture bumpmap\" \"h\" \"float bumpmapsampledistance\" 0.002");
         assert_eq!(value(&scn, "scene.materials.mat0.type"), "\"glossy2\"");
         assert_eq!(value(&scn, "scene.materials.mat0.bumptex"), "\"tex0\"");
-        assert_eq!(value(&scn, "scene.materials.mat0.bumpsamplingdistance"), "0.002");
+        assert_eq!(
+            value(&scn, "scene.materials.mat0.bumpsamplingdistance"),
+            "0.002"
+        );
     }
 }

@@ -49,7 +49,10 @@ pub struct Bump {
 
 impl Bump {
     /// The material's bump map, if it names a texture (a constant height bumps nothing).
-    pub fn read(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Option<Self>, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Option<Self>, ParseError> {
         let distance = params.float("bumpmapsampledistance", DEFAULT_SAMPLE_DISTANCE)?;
         let sample_distance = if distance > 0.0 && distance.is_finite() {
             distance
@@ -144,7 +147,11 @@ mod tests {
             panic!("a bumped material: {material:?}")
         };
         let bump = bump.clone();
-        (Textures::new(&desc.textures, &source).unwrap(), bump, material)
+        (
+            Textures::new(&desc.textures, &source).unwrap(),
+            bump,
+            material,
+        )
     }
 
     fn plane_hit(uv: Vec2, dpdu: Vec3, dpdv: Vec3) -> SurfaceHit {
@@ -186,17 +193,29 @@ mod tests {
         assert_eq!(bump.sample_distance, DEFAULT_SAMPLE_DISTANCE);
         let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-3;
         // uv in world units: n = normalise(-0.1, -0.1, 1).
-        let n = normal_at(&textures, &bump, &plane_hit(Vec2::splat(0.25), Vec3::X, Vec3::Y));
+        let n = normal_at(
+            &textures,
+            &bump,
+            &plane_hit(Vec2::splat(0.25), Vec3::X, Vec3::Y),
+        );
         let expected = Vec3::new(-0.1, -0.1, 1.0).normalize();
         assert!(close(n, expected), "{n} vs {expected}");
         // u runs half as fast over the surface (|dp/du| = 2): the slope along x halves, as
         // LuxRender's differences along dp/du give (dp/du + dh/du n) x (dp/dv + dh/dv n).
-        let n = normal_at(&textures, &bump, &plane_hit(Vec2::splat(0.25), 2.0 * Vec3::X, Vec3::Y));
+        let n = normal_at(
+            &textures,
+            &bump,
+            &plane_hit(Vec2::splat(0.25), 2.0 * Vec3::X, Vec3::Y),
+        );
         let expected = Vec3::new(-0.05, -0.1, 1.0).normalize();
         assert!(close(n, expected), "{n} vs {expected}");
         // Mirrored uv (dp/dv along -y): still in the hemisphere of the shading normal, and
         // tilted against the height's gradient in world space (+y is -v).
-        let n = normal_at(&textures, &bump, &plane_hit(Vec2::splat(0.25), Vec3::X, -Vec3::Y));
+        let n = normal_at(
+            &textures,
+            &bump,
+            &plane_hit(Vec2::splat(0.25), Vec3::X, -Vec3::Y),
+        );
         let expected = Vec3::new(-0.1, 0.1, 1.0).normalize();
         assert!(close(n, expected), "{n} vs {expected}");
     }
@@ -215,10 +234,18 @@ mod tests {
         );
         let close = |a: Vec3, b: Vec3| (a - b).length() < 0.01;
         // Tangent frame (x, y, z): the normal leans towards +x.
-        let n = normal_at(&textures, &bump, &plane_hit(Vec2::splat(0.5), Vec3::X, Vec3::Y));
+        let n = normal_at(
+            &textures,
+            &bump,
+            &plane_hit(Vec2::splat(0.5), Vec3::X, Vec3::Y),
+        );
         assert!(close(n, Vec3::new(0.6, 0.0, 0.8)), "{n}");
         // With u along +y the map leans towards +y.
-        let n = normal_at(&textures, &bump, &plane_hit(Vec2::splat(0.5), Vec3::Y, -Vec3::X));
+        let n = normal_at(
+            &textures,
+            &bump,
+            &plane_hit(Vec2::splat(0.5), Vec3::Y, -Vec3::X),
+        );
         assert!(close(n, Vec3::new(0.0, 0.6, 0.8)), "{n}");
         // Read as a plain float texture a normal map is 0 (no height).
         let eval = TextureEval {
@@ -252,7 +279,10 @@ mod tests {
         assert!(ns.z < 0.1, "steep: {ns}");
         let dirs: Vec<Vec3> = (0..400)
             .map(|i| {
-                let (a, b) = ((i as f32 * 0.618_034).fract(), (i as f32 * 0.754_877_7).fract());
+                let (a, b) = (
+                    (i as f32 * 0.618_034).fract(),
+                    (i as f32 * 0.754_877_7).fract(),
+                );
                 let z = 2.0 * a - 1.0;
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let phi = std::f32::consts::TAU * b;
@@ -276,7 +306,10 @@ mod tests {
             }
         }
         assert_eq!(through, 0);
-        assert!(differs > 10_000, "the bump changes the shading of {differs} pairs");
+        assert!(
+            differs > 10_000,
+            "the bump changes the shading of {differs} pairs"
+        );
     }
 
     #[test]

@@ -24,7 +24,9 @@ pub const DEFAULT_ENERGY: f32 = 1.0;
 
 pub fn read(params: &ParamList) -> Result<Constant, ParseError> {
     let mean = f64::from(params.float("wavelength", DEFAULT_WAVELENGTH)?);
-    let width = f64::from(params.float("width", DEFAULT_WIDTH)?).abs().max(1e-3);
+    let width = f64::from(params.float("width", DEFAULT_WIDTH)?)
+        .abs()
+        .max(1e-3);
     let energy = f64::from(params.float("energy", DEFAULT_ENERGY)?);
     Ok(Constant {
         value: spectrum_rgb(|l| energy * (-0.5 * ((l - mean) / width).powi(2)).exp()),

@@ -228,7 +228,10 @@ impl Mapping3D {
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        let coordinates = match params.string_or("coordinates", DEFAULT_COORDINATES)?.as_str() {
+        let coordinates = match params
+            .string_or("coordinates", DEFAULT_COORDINATES)?
+            .as_str()
+        {
             "global" => Coordinates::Global,
             "local" => Coordinates::Local,
             "uv" => Coordinates::Uv,

@@ -40,7 +40,11 @@ fn perm(i: usize) -> usize {
 /// directions, 4 repeated) with the offset from it.
 fn grad(x: usize, y: usize, z: usize, d: Vec3) -> f32 {
     let h = perm(perm(perm(x) + y) + z) & 15;
-    let u = if h < 8 || h == 12 || h == 13 { d.x } else { d.y };
+    let u = if h < 8 || h == 12 || h == 13 {
+        d.x
+    } else {
+        d.y
+    };
     let v = if h < 4 || h == 12 || h == 13 {
         d.y
     } else {

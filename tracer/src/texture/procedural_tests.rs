@@ -23,8 +23,14 @@ fn textures(statements: &str) -> (Textures, Vec<String>) {
 
 /// The value of the texture called `name` at world (= object) position `p` and uv `uv`.
 fn eval_at(t: &(Textures, Vec<String>), name: &str, p: Vec3, uv: Vec2) -> Vec3 {
-    let id = t.1.iter().rposition(|n| n == name).expect("texture defined");
-    t.0.eval(Tex::Texture(TextureId(id as u32)), &TexturePoint::new(p, uv))
+    let id =
+        t.1.iter()
+            .rposition(|n| n == name)
+            .expect("texture defined");
+    t.0.eval(
+        Tex::Texture(TextureId(id as u32)),
+        &TexturePoint::new(p, uv),
+    )
 }
 
 fn value(t: &(Textures, Vec<String>), name: &str, p: Vec3) -> f32 {
@@ -57,10 +63,38 @@ fn noise_sums_and_marble_match_luxrender_at_fixed_points() {
     // Columns: noise, fbm(8 octaves, omega 0.5), turbulence (same), fbm(3, 0.7), windy,
     // marble's red channel (defaults), as LuxRender 1.x computes them.
     let reference: [[f32; 6]; 4] = [
-        [0.574_470_9, 0.334_738_34, 0.857_778_7, 0.236_165_85, 0.058_011_975, 0.859_488_7],
-        [-0.080_628_22, -0.097_249_37, 0.400_612_35, -0.091_964_945, -0.023_715_762, 0.890_684_7],
-        [0.314_955_95, 0.301_802_28, 0.422_378_06, 0.282_721_85, 0.081_769_8, 0.835_214_1],
-        [-0.125, -0.118_037_567, 0.187_650_77, -0.137_513_22, -0.030_882_87, 0.847_064_3],
+        [
+            0.574_470_9,
+            0.334_738_34,
+            0.857_778_7,
+            0.236_165_85,
+            0.058_011_975,
+            0.859_488_7,
+        ],
+        [
+            -0.080_628_22,
+            -0.097_249_37,
+            0.400_612_35,
+            -0.091_964_945,
+            -0.023_715_762,
+            0.890_684_7,
+        ],
+        [
+            0.314_955_95,
+            0.301_802_28,
+            0.422_378_06,
+            0.282_721_85,
+            0.081_769_8,
+            0.835_214_1,
+        ],
+        [
+            -0.125,
+            -0.118_037_567,
+            0.187_650_77,
+            -0.137_513_22,
+            -0.030_882_87,
+            0.847_064_3,
+        ],
     ];
     let t = textures(
         "Texture \"f\" \"float\" \"fbm\"\n\
@@ -143,7 +177,10 @@ fn perlin_noise_is_zero_on_the_lattice_continuous_and_centred() {
         .iter()
         .fold((f32::MAX, f32::MIN), |(l, h), &v| (l.min(v), h.max(v)));
     assert!(mean.abs() < 0.01, "mean {mean}");
-    assert!(lo > -1.05 && hi < 1.05 && lo < -0.6 && hi > 0.6, "range [{lo}, {hi}]");
+    assert!(
+        lo > -1.05 && hi < 1.05 && lo < -0.6 && hi > 0.6,
+        "range [{lo}, {hi}]"
+    );
     // Not finite: 0, never a panic.
     assert_eq!(noise::noise(Vec3::new(f32::NAN, 0.0, 1.0)), 0.0);
     assert_eq!(noise::noise(Vec3::splat(f32::INFINITY)), 0.0);
@@ -167,12 +204,21 @@ fn noise_textures_have_their_ranges_and_means() {
         (mean, lo, hi)
     };
     let (mean, lo, hi) = stats("f");
-    assert!(mean.abs() < 0.01 && lo < -0.5 && hi > 0.5 && lo > -2.0 && hi < 2.0, "fbm {mean} [{lo}, {hi}]");
+    assert!(
+        mean.abs() < 0.01 && lo < -0.5 && hi > 0.5 && lo > -2.0 && hi < 2.0,
+        "fbm {mean} [{lo}, {hi}]"
+    );
     // Turbulence sums |noise| (mean about 0.2 per unit amplitude, 1 + 0.5 + ... ~ 2).
     let (mean, lo, hi) = stats("w");
-    assert!(lo >= 0.0 && (0.3..0.6).contains(&mean) && hi < 2.0, "wrinkled {mean} [{lo}, {hi}]");
+    assert!(
+        lo >= 0.0 && (0.3..0.6).contains(&mean) && hi < 2.0,
+        "wrinkled {mean} [{lo}, {hi}]"
+    );
     let (mean, lo, hi) = stats("wind");
-    assert!(mean.abs() < 0.01 && lo > -1.0 && hi < 1.0 && hi > 0.1, "windy {mean} [{lo}, {hi}]");
+    assert!(
+        mean.abs() < 0.01 && lo > -1.0 && hi < 1.0 && hi > 0.1,
+        "windy {mean} [{lo}, {hi}]"
+    );
     // Marble stays inside its palette's hull times 1.5, and uses both ends of it.
     let mut lo = Vec3::splat(f32::MAX);
     let mut hi = Vec3::splat(f32::MIN);
@@ -181,8 +227,14 @@ fn noise_textures_have_their_ranges_and_means() {
         lo = lo.min(c);
         hi = hi.max(c);
     }
-    assert!(lo.cmpge(Vec3::splat(0.3)).all() && hi.cmple(Vec3::splat(0.9 + 1e-5)).all(), "marble [{lo}, {hi}]");
-    assert!(lo.x < 0.45 && hi.x > 0.85, "marble uses its dark vein and its light grey: [{lo}, {hi}]");
+    assert!(
+        lo.cmpge(Vec3::splat(0.3)).all() && hi.cmple(Vec3::splat(0.9 + 1e-5)).all(),
+        "marble [{lo}, {hi}]"
+    );
+    assert!(
+        lo.x < 0.45 && hi.x > 0.85,
+        "marble uses its dark vein and its light grey: [{lo}, {hi}]"
+    );
 }
 
 #[test]
@@ -214,7 +266,10 @@ fn vector_scale_rotate_translate_move_the_pattern_exactly() {
         // pattern at p is the plain one at Rz(90) p = (-y, x, z).
         let turned = value(&t, "turned", p);
         let expected = value(&t, "plain", Vec3::new(-p.y, p.x, p.z));
-        assert!(near(turned, expected), "rotate at {p}: {turned} vs {expected}");
+        assert!(
+            near(turned, expected),
+            "rotate at {p}: {turned} vs {expected}"
+        );
         // The transform at the Texture statement moves the pattern too.
         let placed = value(&t, "placed", p + Vec3::new(3.0, 0.0, 0.0));
         assert!(near(placed, plain), "CTM at {p}: {placed} vs {plain}");
@@ -228,7 +283,8 @@ fn local_and_uv_coordinates_read_the_object_position_and_the_uv() {
          Texture \"local\" \"float\" \"fbm\" \"string coordinates\" \"local\"\n\
          Texture \"uv\" \"float\" \"fbm\" \"string coordinates\" \"uv\"",
     );
-    let id = |name: &str| Tex::Texture(TextureId(t.1.iter().position(|n| n == name).unwrap() as u32));
+    let id =
+        |name: &str| Tex::Texture(TextureId(t.1.iter().position(|n| n == name).unwrap() as u32));
     let at = TexturePoint {
         p: Vec3::new(0.3, 0.7, -1.2),
         p_world: Vec3::new(12.25, -3.5, 0.125),
@@ -301,8 +357,18 @@ fn harlequin_gives_each_primitive_its_colour() {
         )
     };
     // Radical inverses of 1 (0.5, 1/3, 1/5) and 4 (1/8, 4/9, 4/5).
-    assert!((colour(0) - Vec3::new(0.5, 1.0 / 3.0, 0.2)).abs().max_element() < 1e-6);
-    assert!((colour(1) - Vec3::new(0.125, 4.0 / 9.0, 0.8)).abs().max_element() < 1e-6);
+    assert!(
+        (colour(0) - Vec3::new(0.5, 1.0 / 3.0, 0.2))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert!(
+        (colour(1) - Vec3::new(0.125, 4.0 / 9.0, 0.8))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
     assert_eq!(colour(31), colour(0));
     let distinct: std::collections::HashSet<[u32; 3]> = (0..31)
         .map(|i| colour(i).to_array().map(f32::to_bits))
@@ -328,7 +394,9 @@ fn every_brick_bond_shows_bricks_and_mortar_in_proportion() {
             "Texture \"b\" \"float\" \"brick\" \"string brickbond\" \"{bond}\" \
              \"float bricktex\" 1 \"float mortartex\" 0"
         ));
-        let values: Vec<f32> = points(40000, -3.0, 3.0).map(|p| value(&t, "b", p)).collect();
+        let values: Vec<f32> = points(40000, -3.0, 3.0)
+            .map(|p| value(&t, "b", p))
+            .collect();
         assert!(values.iter().all(|&v| v == 0.0 || v == 1.0), "{bond}");
         let share = values.iter().sum::<f32>() / values.len() as f32;
         assert!((lo..hi).contains(&share), "{bond}: brick share {share}");
@@ -384,7 +452,11 @@ fn spectral_textures_are_their_rgb_colours() {
     let c = |name: &str| eval_at(&t, name, Vec3::ZERO, Vec2::ZERO);
     assert_eq!(c("e"), Vec3::splat(0.7));
     // A Gaussian far wider than the visible range is flat: its value in every channel.
-    assert!((c("flat") - Vec3::splat(0.5)).abs().max_element() < 1e-3, "{}", c("flat"));
+    assert!(
+        (c("flat") - Vec3::splat(0.5)).abs().max_element() < 1e-3,
+        "{}",
+        c("flat")
+    );
     // Narrow bands land in their own channel.
     let (r, g, b) = (c("red"), c("green"), c("blue"));
     assert!(r.x > 2.0 * r.y && r.x > 2.0 * r.z, "red {r}");

@@ -67,12 +67,19 @@ fn a_bump_changes_the_shading_but_not_the_silhouette() {
     // A pixel all of whose samples miss the sphere shows exactly the sky (as the corner does)
     // in both renders.
     let background = flat.pixel(0, 0);
-    assert!((background - Vec3::splat(0.1)).abs().max_element() < 1e-4, "{background}");
+    assert!(
+        (background - Vec3::splat(0.1)).abs().max_element() < 1e-4,
+        "{background}"
+    );
     let sky = |film: &Film, x: u32, y: u32| film.pixel(x, y) == background;
     let (mut sphere, mut diff, mut sum) = (0, 0.0, 0.0);
     for y in 0..SIZE {
         for x in 0..SIZE {
-            assert_eq!(sky(&flat, x, y), sky(&bumped, x, y), "silhouette differs at ({x}, {y})");
+            assert_eq!(
+                sky(&flat, x, y),
+                sky(&bumped, x, y),
+                "silhouette differs at ({x}, {y})"
+            );
             if !sky(&flat, x, y) {
                 sphere += 1;
                 diff += (flat.pixel(x, y) - bumped.pixel(x, y)).abs().x;

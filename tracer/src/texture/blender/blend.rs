@@ -32,7 +32,11 @@ pub struct Blend {
 }
 
 impl Blend {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             kind: read_choice(params, "type", &TYPES, pos, ctx)?,
             flip: params.bool("flipxy", false)?,

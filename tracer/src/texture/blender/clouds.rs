@@ -32,7 +32,11 @@ pub struct Clouds {
 }
 
 impl Clouds {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             color: read_choice(params, "type", &["default", "color"], pos, ctx)? == 1,
             basis: NoiseBasis::read(params, "noisebasis", pos, ctx)?,

@@ -88,15 +88,24 @@ impl Base {
 }
 
 /// Whether `string noisetype` asks for hard noise.
-pub fn read_hard(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<bool, ParseError> {
-    Ok(match params.string_or("noisetype", "soft_noise")?.as_str() {
-        "soft_noise" => false,
-        "hard_noise" => true,
-        other => {
-            ctx.warn(pos, format!("unknown noise type \"{other}\"; using soft_noise"));
-            false
-        }
-    })
+pub fn read_hard(
+    params: &ParamList,
+    pos: &SourcePos,
+    ctx: &mut dyn ParseContext,
+) -> Result<bool, ParseError> {
+    Ok(
+        match params.string_or("noisetype", "soft_noise")?.as_str() {
+            "soft_noise" => false,
+            "hard_noise" => true,
+            other => {
+                ctx.warn(
+                    pos,
+                    format!("unknown noise type \"{other}\"; using soft_noise"),
+                );
+                false
+            }
+        },
+    )
 }
 
 /// A string parameter that picks one of `names` (the first is the default); an unknown name
@@ -112,7 +121,10 @@ pub fn read_choice(
     Ok(match names.iter().position(|n| *n == value) {
         Some(i) => i,
         None => {
-            ctx.warn(pos, format!("unknown {name} \"{value}\"; using {}", names[0]));
+            ctx.warn(
+                pos,
+                format!("unknown {name} \"{value}\"; using {}", names[0]),
+            );
             0
         }
     })

@@ -31,7 +31,11 @@ pub struct DistortedNoise {
 }
 
 impl DistortedNoise {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         params.ignore("nabla");
         Ok(Self {
             distorted: NoiseBasis::read(params, "type", pos, ctx)?,
@@ -43,6 +47,11 @@ impl DistortedNoise {
 
     pub fn pattern(&self, p: Vec3) -> Pattern {
         let p = if self.size != 0.0 { p / self.size } else { p };
-        Pattern::Intensity(distorted_noise(p, self.amount, self.distortion, self.distorted))
+        Pattern::Intensity(distorted_noise(
+            p,
+            self.amount,
+            self.distortion,
+            self.distorted,
+        ))
     }
 }

@@ -17,7 +17,9 @@
 
 use glam::Vec3;
 
-use super::common::{read_choice, read_depth, read_hard, Pattern, Wave, DEFAULT_NOISESIZE, DEFAULT_TURBULENCE};
+use super::common::{
+    read_choice, read_depth, read_hard, Pattern, Wave, DEFAULT_NOISESIZE, DEFAULT_TURBULENCE,
+};
 use super::noise_basis::NoiseBasis;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
@@ -37,7 +39,11 @@ pub struct Marble {
 }
 
 impl Marble {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             sharpness: read_choice(params, "type", &["soft", "sharp", "sharper"], pos, ctx)?,
             wave: Wave::from_index(read_choice(params, "noisebasis2", &Wave::NAMES, pos, ctx)?),

@@ -65,7 +65,9 @@ impl Blender {
             "blender_clouds" => BlenderKind::Clouds(clouds::Clouds::read(params, pos, ctx)?),
             "blender_wood" => BlenderKind::Wood(wood::Wood::read(params, pos, ctx)?),
             "blender_marble" => BlenderKind::Marble(marble::Marble::read(params, pos, ctx)?),
-            "blender_musgrave" => BlenderKind::Musgrave(musgrave::Musgrave::read(params, pos, ctx)?),
+            "blender_musgrave" => {
+                BlenderKind::Musgrave(musgrave::Musgrave::read(params, pos, ctx)?)
+            }
             "blender_stucci" => BlenderKind::Stucci(stucci::Stucci::read(params, pos, ctx)?),
             "blender_noise" => BlenderKind::Noise(noise::Noise::read(params)?),
             "blender_voronoi" => BlenderKind::Voronoi(voronoi::Voronoi::read(params, pos, ctx)?),
@@ -113,8 +115,10 @@ impl Blender {
         match &self.kind {
             BlenderKind::Magic(_) | BlenderKind::Blend(_) | BlenderKind::Noise(_) => false,
             BlenderKind::Wood(w) => {
-                matches!(w.kind, wood::WoodType::BandNoise | wood::WoodType::RingNoise)
-                    && w.basis != CellNoise
+                matches!(
+                    w.kind,
+                    wood::WoodType::BandNoise | wood::WoodType::RingNoise
+                ) && w.basis != CellNoise
             }
             BlenderKind::Clouds(c) => c.basis != CellNoise,
             BlenderKind::Marble(m) => m.basis != CellNoise,
@@ -148,7 +152,10 @@ impl Blender {
 
     pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
         let f = self.base.weight(self.pattern(self.base.mapping.map(at)));
-        let (a, b) = (textures.eval(self.base.tex1, at), textures.eval(self.base.tex2, at));
+        let (a, b) = (
+            textures.eval(self.base.tex1, at),
+            textures.eval(self.base.tex2, at),
+        );
         a + f * (b - a)
     }
 }

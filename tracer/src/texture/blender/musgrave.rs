@@ -46,7 +46,11 @@ pub struct Musgrave {
 }
 
 impl Musgrave {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             kind: read_choice(params, "type", &TYPES, pos, ctx)?,
             fractal: Fractal {

@@ -42,7 +42,9 @@ fn random(p: Vec3) -> u32 {
 impl Noise {
     pub fn read(params: &ParamList) -> Result<Self, ParseError> {
         Ok(Self {
-            depth: params.int("noisedepth", DEFAULT_NOISEDEPTH)?.clamp(0, MAX_DEPTH) as u32,
+            depth: params
+                .int("noisedepth", DEFAULT_NOISEDEPTH)?
+                .clamp(0, MAX_DEPTH) as u32,
         })
     }
 

@@ -159,7 +159,10 @@ impl NoiseBasis {
             "voronoi_crackle" => Self::VoronoiCrackle,
             "cell_noise" => Self::CellNoise,
             other => {
-                ctx.warn(pos, format!("unknown noise basis \"{other}\"; using blender_original"));
+                ctx.warn(
+                    pos,
+                    format!("unknown noise basis \"{other}\"; using blender_original"),
+                );
                 Self::BlenderOriginal
             }
         })

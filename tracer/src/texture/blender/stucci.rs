@@ -33,9 +33,19 @@ pub struct Stucci {
 }
 
 impl Stucci {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
-            kind: read_choice(params, "type", &["plastic", "wall_in", "wall_out"], pos, ctx)?,
+            kind: read_choice(
+                params,
+                "type",
+                &["plastic", "wall_in", "wall_out"],
+                pos,
+                ctx,
+            )?,
             basis: NoiseBasis::read(params, "noisebasis", pos, ctx)?,
             hard: read_hard(params, pos, ctx)?,
             size: params.float("noisesize", DEFAULT_NOISESIZE)?,
@@ -49,7 +59,9 @@ impl Stucci {
         if self.kind != 0 {
             offset *= b2 * b2;
         }
-        let mut v = self.basis.g_noise(self.size, p + Vec3::new(0.0, 0.0, offset), self.hard);
+        let mut v = self
+            .basis
+            .g_noise(self.size, p + Vec3::new(0.0, 0.0, offset), self.hard);
         if self.kind == 2 {
             v = 1.0 - v;
         }

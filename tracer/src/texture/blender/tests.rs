@@ -18,13 +18,19 @@ fn texture(statements: &str) -> impl Fn(Vec3) -> f32 {
     source.insert("main.lxs", text.as_bytes().into());
     let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
     assert!(
-        desc.warnings.iter().all(|w| w.message.contains("random tables")),
+        desc.warnings
+            .iter()
+            .all(|w| w.message.contains("random tables")),
         "{:?}",
         desc.warnings
     );
     let last = TextureId(desc.textures.len() as u32 - 1);
     let textures = Textures::new(&desc.textures, &source).unwrap();
-    move |p| textures.eval(Tex::Texture(last), &TexturePoint::new(p, Vec2::ZERO)).x
+    move |p| {
+        textures
+            .eval(Tex::Texture(last), &TexturePoint::new(p, Vec2::ZERO))
+            .x
+    }
 }
 
 const POINTS: [Vec3; 4] = [
@@ -43,9 +49,33 @@ fn blend_matches_luxrender() {
     // Types lin .. halo, then radial with x and y swapped, at the four points.
     let reference: [[f32; 7]; 4] = [
         [0.65, 0.422_499_96, 0.718_249_9, 0.75, 0.0, 0.0, 0.564_440_5],
-        [0.625, 0.390_625, 0.683_593_75, 0.4375, 0.427_178_03, 0.182_481_07, 0.926_208_2],
-        [0.105, 0.011_025, 0.030_759_744, 0.3775, 0.126_787_54, 0.016_075_08, 0.307_761_43],
-        [0.525, 0.275_624_96, 0.537_468_67, 0.525, 0.495_024_77, 0.245_049_52, 0.625],
+        [
+            0.625,
+            0.390_625,
+            0.683_593_75,
+            0.4375,
+            0.427_178_03,
+            0.182_481_07,
+            0.926_208_2,
+        ],
+        [
+            0.105,
+            0.011_025,
+            0.030_759_744,
+            0.3775,
+            0.126_787_54,
+            0.016_075_08,
+            0.307_761_43,
+        ],
+        [
+            0.525,
+            0.275_624_96,
+            0.537_468_67,
+            0.525,
+            0.495_024_77,
+            0.245_049_52,
+            0.625,
+        ],
     ];
     for (kind, name) in super::blend::TYPES.iter().enumerate() {
         let flip = if *name == "radial" { "true" } else { "false" };
@@ -53,7 +83,12 @@ fn blend_matches_luxrender() {
             "Texture \"b\" \"float\" \"blender_blend\" \"string type\" \"{name}\" \"bool flipxy\" \"{flip}\""
         ));
         for (p, r) in POINTS.iter().zip(reference) {
-            assert!(near(t(*p), r[kind]), "{name} at {p}: {} vs {}", t(*p), r[kind]);
+            assert!(
+                near(t(*p), r[kind]),
+                "{name} at {p}: {} vs {}",
+                t(*p),
+                r[kind]
+            );
         }
     }
 }
@@ -61,10 +96,62 @@ fn blend_matches_luxrender() {
 #[test]
 fn magic_matches_luxrender_at_every_depth_with_brightness_and_contrast() {
     let reference: [[f32; 12]; 4] = [
-        [0.844_350_16, 0.955_785_63, 0.698_347_03, 0.731_456_04, 0.860_665_8, 0.576_024_9, 0.868_952_6, 0.797_078_4, 0.787_436_9, 0.990_803_2, 0.796_934_6, 0.796_934_6],
-        [0.817_535_34, 0.937_764_94, 0.716_765_4, 0.752_066_67, 0.884_597_84, 0.526_820_36, 0.856_575_5, 0.799_531_16, 0.777_511, 0.987_118_5, 0.812_068_34, 0.812_068_34],
-        [0.826_992_57, 0.935_324_5, 0.715_828_2, 0.784_287_75, 0.987_136_2, 0.667_431_06, 0.938_435_7, 0.888_031_54, 0.871_224_8, 0.969_400_9, 0.760_925_4, 0.760_925_4],
-        [0.791_157_37, 0.684_894_26, 0.564_939_74, 0.728_352_25, 0.947_321_3, 0.876_846_67, 1.0, 1.0, 1.0, 1.0, 0.774_157_9, 0.774_157_9],
+        [
+            0.844_350_16,
+            0.955_785_63,
+            0.698_347_03,
+            0.731_456_04,
+            0.860_665_8,
+            0.576_024_9,
+            0.868_952_6,
+            0.797_078_4,
+            0.787_436_9,
+            0.990_803_2,
+            0.796_934_6,
+            0.796_934_6,
+        ],
+        [
+            0.817_535_34,
+            0.937_764_94,
+            0.716_765_4,
+            0.752_066_67,
+            0.884_597_84,
+            0.526_820_36,
+            0.856_575_5,
+            0.799_531_16,
+            0.777_511,
+            0.987_118_5,
+            0.812_068_34,
+            0.812_068_34,
+        ],
+        [
+            0.826_992_57,
+            0.935_324_5,
+            0.715_828_2,
+            0.784_287_75,
+            0.987_136_2,
+            0.667_431_06,
+            0.938_435_7,
+            0.888_031_54,
+            0.871_224_8,
+            0.969_400_9,
+            0.760_925_4,
+            0.760_925_4,
+        ],
+        [
+            0.791_157_37,
+            0.684_894_26,
+            0.564_939_74,
+            0.728_352_25,
+            0.947_321_3,
+            0.876_846_67,
+            1.0,
+            1.0,
+            1.0,
+            1.0,
+            0.774_157_9,
+            0.774_157_9,
+        ],
     ];
     for depth in 0..12 {
         let turbulence = if depth == 3 { 2.5 } else { 5.0 };
@@ -74,7 +161,11 @@ fn magic_matches_luxrender_at_every_depth_with_brightness_and_contrast() {
         ));
         for (p, r) in POINTS.iter().zip(reference) {
             let got = t(*p);
-            assert!((got - r[depth]).abs() < 1e-5, "depth {depth} at {p}: {got} vs {}", r[depth]);
+            assert!(
+                (got - r[depth]).abs() < 1e-5,
+                "depth {depth} at {p}: {got} vs {}",
+                r[depth]
+            );
         }
     }
 }
@@ -98,10 +189,17 @@ fn wood_bands_and_rings_follow_their_wave_exactly() {
     for p in POINTS {
         let a = (p.x + p.y + p.z) * 10.0;
         assert!(near(sin(p), 0.5 + 0.5 * a.sin()), "sin at {p}");
-        assert!(near(saw(p), a.rem_euclid(TAU) / TAU), "saw at {p}: {}", saw(p));
+        assert!(
+            near(saw(p), a.rem_euclid(TAU) / TAU),
+            "saw at {p}: {}",
+            saw(p)
+        );
         // A triangle wave: 1 at multiples of 2 pi, 0 half way.
         let r = p.length() * 20.0 / TAU;
-        assert!(near(tri(p), 1.0 - 2.0 * (r - r.round()).abs()), "tri at {p}");
+        assert!(
+            near(tri(p), 1.0 - 2.0 * (r - r.round()).abs()),
+            "tri at {p}"
+        );
     }
 }
 
@@ -128,23 +226,63 @@ fn noise_textures_stay_in_range_and_vary() {
     for (ty, params, mean_range) in [
         ("blender_clouds", "", 0.45..0.55),
         ("blender_clouds", "\"string type\" \"color\"", 0.45..0.55),
-        ("blender_clouds", "\"string noisetype\" \"hard_noise\"", 0.15..0.3),
-        ("blender_clouds", "\"string noisebasis\" \"voronoi_crackle\"", 0.7..0.9),
-        ("blender_clouds", "\"string noisebasis\" \"cell_noise\"", 0.45..0.55),
+        (
+            "blender_clouds",
+            "\"string noisetype\" \"hard_noise\"",
+            0.15..0.3,
+        ),
+        (
+            "blender_clouds",
+            "\"string noisebasis\" \"voronoi_crackle\"",
+            0.7..0.9,
+        ),
+        (
+            "blender_clouds",
+            "\"string noisebasis\" \"cell_noise\"",
+            0.45..0.55,
+        ),
         ("blender_wood", "\"string type\" \"ringnoise\"", 0.45..0.55),
         ("blender_marble", "", 0.45..0.55),
-        ("blender_marble", "\"string type\" \"sharper\" \"string noisebasis2\" \"tri\"", 0.7..0.9),
+        (
+            "blender_marble",
+            "\"string type\" \"sharper\" \"string noisebasis2\" \"tri\"",
+            0.7..0.9,
+        ),
         ("blender_musgrave", "\"float outscale\" 0.5", 0.45..0.55),
-        ("blender_musgrave", "\"string type\" \"ridged_multifractal\" \"float octs\" 3.5", 0.7..0.9),
-        ("blender_musgrave", "\"string type\" \"hybrid_multifractal\"", 0.9..1.0),
-        ("blender_musgrave", "\"string type\" \"hetero_terrain\"", 0.9..1.0),
-        ("blender_musgrave", "\"string type\" \"fbm\" \"string noisebasis\" \"improved_perlin\"", 0.08..0.18),
+        (
+            "blender_musgrave",
+            "\"string type\" \"ridged_multifractal\" \"float octs\" 3.5",
+            0.7..0.9,
+        ),
+        (
+            "blender_musgrave",
+            "\"string type\" \"hybrid_multifractal\"",
+            0.9..1.0,
+        ),
+        (
+            "blender_musgrave",
+            "\"string type\" \"hetero_terrain\"",
+            0.9..1.0,
+        ),
+        (
+            "blender_musgrave",
+            "\"string type\" \"fbm\" \"string noisebasis\" \"improved_perlin\"",
+            0.08..0.18,
+        ),
         ("blender_stucci", "", 0.45..0.55),
         ("blender_stucci", "\"string type\" \"wall_out\"", 0.45..0.55),
         ("blender_voronoi", "", 0.45..0.6),
-        ("blender_voronoi", "\"string distmetric\" \"manhattan\" \"float w1\" 1 \"float w2\" 1", 0.8..0.95),
+        (
+            "blender_voronoi",
+            "\"string distmetric\" \"manhattan\" \"float w1\" 1 \"float w2\" 1",
+            0.8..0.95,
+        ),
         ("blender_voronoi", "\"integer coltype\" 2", 0.3..0.5),
-        ("blender_distortednoise", "\"float distamount\" 3", 0.05..0.2),
+        (
+            "blender_distortednoise",
+            "\"float distamount\" 3",
+            0.05..0.2,
+        ),
         ("blender_noise", "", 0.11..0.14),
     ] {
         let statement = format!("Texture \"t\" \"float\" \"{ty}\" {params}");
@@ -154,7 +292,11 @@ fn noise_textures_stay_in_range_and_vary() {
         assert!(hi - lo > 0.2, "{statement} varies: [{lo}, {hi}]");
         assert!(mean_range.contains(&mean), "{statement}: mean {mean}");
         let p = Vec3::new(0.3, -0.2, 0.9);
-        assert_eq!(t(p).to_bits(), t(p).to_bits(), "{statement} is deterministic");
+        assert_eq!(
+            t(p).to_bits(),
+            t(p).to_bits(),
+            "{statement} is deterministic"
+        );
     }
 }
 

@@ -45,7 +45,11 @@ pub struct Voronoi {
 }
 
 impl Voronoi {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         let exponent = params.float("minkovsky_exp", 2.5)?;
         let metric = match read_choice(params, "distmetric", &METRICS, pos, ctx)? {
             0 => Metric::Actual,
@@ -76,7 +80,11 @@ impl Voronoi {
         let (da, pa) = voronoi(p, self.metric);
         let aw = self.weights.map(f32::abs);
         let total: f32 = aw.iter().sum();
-        let sc = if total != 0.0 { self.outscale / total } else { 0.0 };
+        let sc = if total != 0.0 {
+            self.outscale / total
+        } else {
+            0.0
+        };
         let w = self.weights;
         let intensity = sc * (w[0] * da[0] + w[1] * da[1] + w[2] * da[2] + w[3] * da[3]).abs();
         if self.coltype == 0 {

@@ -43,9 +43,24 @@ pub struct Wood {
 }
 
 impl Wood {
-    pub fn read(params: &ParamList, pos: &SourcePos, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
-        let kinds = [WoodType::Bands, WoodType::Rings, WoodType::BandNoise, WoodType::RingNoise];
-        let kind = kinds[read_choice(params, "type", &["bands", "rings", "bandnoise", "ringnoise"], pos, ctx)?];
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let kinds = [
+            WoodType::Bands,
+            WoodType::Rings,
+            WoodType::BandNoise,
+            WoodType::RingNoise,
+        ];
+        let kind = kinds[read_choice(
+            params,
+            "type",
+            &["bands", "rings", "bandnoise", "ringnoise"],
+            pos,
+            ctx,
+        )?];
         Ok(Self {
             kind,
             wave: Wave::from_index(read_choice(params, "noisebasis2", &Wave::NAMES, pos, ctx)?),
