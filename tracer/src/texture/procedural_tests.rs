@@ -89,7 +89,7 @@ fn noise_sums_and_marble_match_luxrender_at_fixed_points() {
         ],
         [
             -0.125,
-            -0.118_037_567,
+            -0.118_037_57,
             0.187_650_77,
             -0.137_513_22,
             -0.030_882_87,

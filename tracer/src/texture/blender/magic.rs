@@ -15,6 +15,10 @@
 use glam::Vec3;
 
 use super::common::{Pattern, DEFAULT_NOISEDEPTH, DEFAULT_TURBULENCE};
+
+/// One nesting level: which coordinate it replaces (0 x, 1 y, 2 z) and by what wave of the
+/// three.
+type Level = fn(f32, f32, f32) -> (usize, f32);
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
@@ -42,7 +46,7 @@ impl Magic {
             y *= turb;
             z *= turb;
             // Each level replaces one coordinate by a wave of the three, in Blender's order.
-            let levels: [fn(f32, f32, f32) -> (usize, f32); 10] = [
+            let levels: [Level; 10] = [
                 |x, y, z| (1, -(x - y + z).cos()),
                 |x, y, z| (0, (x - y - z).cos()),
                 |x, y, z| (2, (-x - y - z).sin()),

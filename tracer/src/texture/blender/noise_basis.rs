@@ -343,8 +343,8 @@ impl Fractal {
         for _ in 1..n {
             p *= self.lacunarity;
             let weight = (signal * gain).clamp(0.0, 1.0);
-            signal = offset - self.basis.signed(p).abs();
-            signal *= signal * weight;
+            let s = offset - self.basis.signed(p).abs();
+            signal = s * s * weight;
             result += signal * pwr;
             pwr *= step;
         }
