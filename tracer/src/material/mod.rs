@@ -188,8 +188,12 @@ impl Materials {
     /// The materials indexed by [`MaterialId`].
     pub fn new(materials: Vec<MaterialDesc>) -> Self {
         let multibounce = materials.iter().any(|m| {
+            let leaf = match m {
+                MaterialDesc::Bumped(leaf, _) => leaf,
+                m => m,
+            };
             matches!(
-                m,
+                leaf,
                 MaterialDesc::Glossy(Glossy {
                     multibounce: true,
                     ..
