@@ -277,9 +277,11 @@ impl AnalyticShape {
             } => {
                 let theta = (p.z / radius).clamp(-1.0, 1.0).acos();
                 let v = (theta - theta_z_min) / (theta_z_max - theta_z_min);
-                // dp/dtheta = (z cos phi, z sin phi, -r sin theta), with r sin theta = rho.
+                // dp/dtheta = (z cos phi, z sin phi, -r sin theta), with r sin theta = rho,
+                // cos phi = x / rho, sin phi = y / rho (no trigonometry on the hot path; at a
+                // pole it is not finite and the fallback below takes over).
                 let rho = (p.x * p.x + p.y * p.y).sqrt();
-                let dpdtheta = Vec3A::new(p.z * phi.cos(), p.z * phi.sin(), -rho);
+                let dpdtheta = Vec3A::new(p.z * p.x / rho, p.z * p.y / rho, -rho);
                 (
                     Vec2::new(phi / phi_max, v),
                     u_tangent(p, phi_max),
