@@ -69,11 +69,33 @@ pub fn emission_rgb(spectrum: impl Fn(f64) -> f64) -> Vec3 {
 
 /// CIE XYZ to linear sRGB (D65 white).
 pub fn xyz_to_linear_srgb(xyz: DVec3) -> Vec3 {
+    xyz_to_srgb(xyz).as_vec3()
+}
+
+fn xyz_to_srgb(xyz: DVec3) -> DVec3 {
     let (x, y, z) = (xyz.x, xyz.y, xyz.z);
-    let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
-    let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
-    let b = 0.0557 * x - 0.2040 * y + 1.0570 * z;
-    Vec3::new(r as f32, g as f32, b as f32)
+    DVec3::new(
+        3.2406 * x - 1.5372 * y - 0.4986 * z,
+        -0.9689 * x + 1.8758 * y + 0.0415 * z,
+        0.0557 * x - 0.2040 * y + 1.0570 * z,
+    )
+}
+
+/// The RGB of a reflectance (or any relative) spectrum `f` (nm -> value): its CIE XYZ under an
+/// equal-energy light, in linear sRGB, divided channel by channel by that of the constant
+/// spectrum 1, so that a flat spectrum of value v is exactly (v, v, v).
+pub fn spectrum_rgb(f: impl Fn(f64) -> f64) -> Vec3 {
+    let rgb = |f: &dyn Fn(f64) -> f64| {
+        let mut xyz = DVec3::ZERO;
+        let mut lambda = 380.0f64;
+        while lambda <= 780.0 {
+            let (cx, cy, cz) = cie_1931(lambda);
+            xyz += f(lambda) * DVec3::new(cx, cy, cz);
+            lambda += 5.0;
+        }
+        xyz_to_srgb(xyz)
+    };
+    (rgb(&f) / rgb(&|_| 1.0)).as_vec3()
 }
 
 /// Planck's law, spectral radiance up to a constant factor (normalised away by the caller).

@@ -24,6 +24,7 @@ mod materials;
 mod materials_extra;
 mod options;
 mod ply;
+mod procedural;
 mod props;
 mod shapes;
 mod textures;

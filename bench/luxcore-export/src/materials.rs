@@ -7,7 +7,7 @@ use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix};
 
 use crate::materials_extra;
-use crate::props::{mat_name, quoted, tex_value, v3, Props};
+use crate::props::{mat_name, quoted, tex_name, tex_value, v3, Props};
 
 /// Writes material `m` under `name`; `emission` is added for emitting shapes (a null material
 /// that emits becomes black matte: it shows the light and reflects nothing).
@@ -107,6 +107,17 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
         MaterialDesc::Null(_) if emission.is_some() => {
             set("type", quoted("matte"));
             set("kd", "0 0 0".into());
+        }
+        MaterialDesc::Bumped(material, bump) => {
+            write_material(p, name, material, emission);
+            // A normalmap texture is exported as LuxCore's normalmap, which bumps through
+            // bumptex as well.
+            p.set(format!("{prefix}.bumptex"), quoted(&tex_name(bump.map)));
+            p.set(
+                format!("{prefix}.bumpsamplingdistance"),
+                bump.sample_distance,
+            );
+            return;
         }
         MaterialDesc::Mix(Mix { a, b, amount }) => {
             set("type", quoted("mix"));

@@ -126,12 +126,7 @@ fn export_shape(
     let uvs: Option<Vec<Vec2>> = match material_bake(desc, shape.material)? {
         Some(mapping) => Some(
             (0..mesh.positions.len())
-                .map(|i| {
-                    mapping.map(&TexturePoint {
-                        p: mesh.positions[i],
-                        uv: object_uv(i),
-                    })
-                })
+                .map(|i| mapping.map(&TexturePoint::new(mesh.positions[i], object_uv(i))))
                 .collect(),
         ),
         None => mesh

@@ -8,7 +8,8 @@ use yat_tracer::desc::{Mapping2D, SceneDesc, TextureId, TextureKind, Wrap};
 use yat_tracer::texture::{Checkerboard2D, Checkerboard3D, Constant, ImageMap, Mix, Scale};
 
 use crate::error::ExportError;
-use crate::props::{matrix, quoted, tex_name, tex_value, v3, Props};
+use crate::procedural::{write_mapping3d, write_procedural};
+use crate::props::{quoted, tex_name, tex_value, v3, Props};
 
 /// LuxCore's uvmapping2d is YAT's uv mapping (scale, then offset), and both read image row
 /// t x height counted from the top, so the parameters carry over unchanged.
@@ -81,20 +82,12 @@ pub fn write_textures(
             TextureKind::Checkerboard3D(Checkerboard3D {
                 tex1,
                 tex2,
-                world_to_texture,
+                mapping,
             }) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard3d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
-                p.set(format!("{prefix}.mapping.type"), quoted("globalmapping3d"));
-                p.set(
-                    format!("{prefix}.mapping.transformation"),
-                    matrix(world_to_texture),
-                );
-                notes.push(format!(
-                    "texture \"{}\": checkerboard3d in world space (YAT: the shape's object space)",
-                    t.name
-                ));
+                write_mapping3d(p, &prefix, mapping);
             }
             TextureKind::Constant(Constant { value }) => {
                 p.set(format!("{prefix}.type"), quoted("constfloat3"));
@@ -111,8 +104,7 @@ pub fn write_textures(
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 p.set(format!("{prefix}.amount"), tex_value(amount, false));
             }
-            // A texture type the exporter does not map yet (none today).
-            #[allow(unreachable_patterns)]
+            other if write_procedural(p, &prefix, other, color, scene_dir, notes) => {}
             other => {
                 return Err(ExportError::Unsupported(format!(
                     "texture \"{}\": no LuxCore equivalent for type \"{}\"",

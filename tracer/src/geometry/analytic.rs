@@ -267,7 +267,7 @@ impl AnalyticShape {
 
     pub(crate) fn hit(&self, hit: QuadricHit, prim: u32) -> SurfaceHit {
         let QuadricHit { t, p, phi } = hit;
-        let (uv, dpdu, n) = match self.quadric {
+        let (uv, dpdu, dpdv, n) = match self.quadric {
             Quadric::Sphere {
                 radius,
                 theta_z_min,
@@ -277,9 +277,15 @@ impl AnalyticShape {
             } => {
                 let theta = (p.z / radius).clamp(-1.0, 1.0).acos();
                 let v = (theta - theta_z_min) / (theta_z_max - theta_z_min);
+                // dp/dtheta = (z cos phi, z sin phi, -r sin theta), with r sin theta = rho,
+                // cos phi = x / rho, sin phi = y / rho (no trigonometry on the hot path; at a
+                // pole it is not finite and the fallback below takes over).
+                let rho = (p.x * p.x + p.y * p.y).sqrt();
+                let dpdtheta = Vec3A::new(p.z * p.x / rho, p.z * p.y / rho, -rho);
                 (
                     Vec2::new(phi / phi_max, v),
                     u_tangent(p, phi_max),
+                    (theta_z_max - theta_z_min) * dpdtheta,
                     p / radius,
                 )
             }
@@ -291,7 +297,13 @@ impl AnalyticShape {
             } => {
                 let r_hit = (p.x * p.x + p.y * p.y).sqrt();
                 let v = (radius - r_hit) / (radius - inner_radius);
-                (Vec2::new(phi / phi_max, v), u_tangent(p, phi_max), Vec3A::Z)
+                let dpdv = Vec3A::new(p.x, p.y, 0.0) * ((inner_radius - radius) / r_hit);
+                (
+                    Vec2::new(phi / phi_max, v),
+                    u_tangent(p, phi_max),
+                    dpdv,
+                    Vec3A::Z,
+                )
             }
             Quadric::Cylinder {
                 radius,
@@ -301,22 +313,24 @@ impl AnalyticShape {
             } => {
                 let v = (p.z - z_min) / (z_max - z_min);
                 let n = Vec3A::new(p.x / radius, p.y / radius, 0.0);
-                (Vec2::new(phi / phi_max, v), u_tangent(p, phi_max), n)
+                let dpdv = Vec3A::new(0.0, 0.0, z_max - z_min);
+                (Vec2::new(phi / phi_max, v), u_tangent(p, phi_max), dpdv, n)
             }
         };
         let ng = self.world_normal(n);
         let dpdu = Vec3::from(self.object_to_world.transform_vector3a(dpdu));
+        let dpdv = Vec3::from(self.object_to_world.transform_vector3a(dpdv));
+        let fallback = Frame::from_normal(ng);
+        let usable = |d: Vec3| d.length_squared() > 0.0 && d.is_finite();
         SurfaceHit {
             t,
             p: self.object_to_world.transform_point3a(p).into(),
             ng,
             ns: ng,
             uv,
-            dpdu: if dpdu.length_squared() > 0.0 && dpdu.is_finite() {
-                dpdu
-            } else {
-                Frame::from_normal(ng).s
-            },
+            dpdu: if usable(dpdu) { dpdu } else { fallback.s },
+            // At a pole (or a disk's centre) the v tangent vanishes.
+            dpdv: if usable(dpdv) { dpdv } else { fallback.t },
             shape: self.shape,
             prim,
         }

@@ -15,6 +15,9 @@ pub struct SurfaceHit {
     pub uv: Vec2,
     /// Surface tangent along u (world space, not normalised; any tangent when uv is absent).
     pub dpdu: Vec3,
+    /// Surface tangent along v (world space, not normalised; `ng x dpdu` when uv is absent):
+    /// with `dpdu`, what a bump map's height derivatives are taken along.
+    pub dpdv: Vec3,
     /// Index into `SceneDesc::shapes` (material, area light).
     pub shape: u32,
     /// Primitive within the scene's geometry (for light sampling pdfs).

@@ -66,6 +66,7 @@ impl InfinitePlane {
             ns: n,
             uv: Vec2::new(local.dot(self.axes.s), local.dot(self.axes.t)),
             dpdu: self.object_to_world.transform_vector3(self.axes.s),
+            dpdv: self.object_to_world.transform_vector3(self.axes.t),
             shape: self.shape,
             prim,
         }

@@ -206,30 +206,35 @@ impl WorldMesh {
             }
             _ => ng,
         };
+        let (dpdu, dpdv) = uv_tangents([p0, p0 + e1, p0 + e2], [uv0, uv1, uv2], ng);
         SurfaceHit {
             t,
             p: p0 + b1 * e1 + b2 * e2,
             ng,
             ns,
             uv: b0 * uv0 + b1 * uv1 + b2 * uv2,
-            dpdu: dpdu([p0, p0 + e1, p0 + e2], [uv0, uv1, uv2], ng),
+            dpdu,
+            dpdv,
             shape: self.shape,
             prim,
         }
     }
 }
 
-/// pbrt's partial derivative of position along u, from the uv differences over the triangle;
-/// any tangent when the uvs are degenerate.
-fn dpdu([p0, p1, p2]: [Vec3; 3], [uv0, uv1, uv2]: [Vec2; 3], ng: Vec3) -> Vec3 {
+/// pbrt's partial derivatives of position along u and v, from the uv differences over the
+/// triangle; any orthonormal tangents when the uvs are degenerate.
+fn uv_tangents([p0, p1, p2]: [Vec3; 3], [uv0, uv1, uv2]: [Vec2; 3], ng: Vec3) -> (Vec3, Vec3) {
     let (duv02, duv12) = (uv0 - uv2, uv1 - uv2);
     let (dp02, dp12) = (p0 - p2, p1 - p2);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;
     let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
-    if det.abs() > 1e-12 && dpdu.is_finite() && dpdu != Vec3::ZERO {
-        dpdu
+    let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+    let usable = |d: Vec3| d.is_finite() && d != Vec3::ZERO;
+    if det.abs() > 1e-12 && usable(dpdu) && usable(dpdv) {
+        (dpdu, dpdv)
     } else {
-        Frame::from_normal(ng).s
+        let frame = Frame::from_normal(ng);
+        (frame.s, frame.t)
     }
 }
 

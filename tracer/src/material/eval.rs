@@ -28,7 +28,12 @@ impl TextureEval<'_> {
 
     /// A float parameter.
     pub fn float(&self, t: Tex) -> f32 {
-        self.textures.eval(t, &self.at).x
+        self.float_at(t, &self.at)
+    }
+
+    /// A float parameter at another point (a bump map's finite differences).
+    pub fn float_at(&self, t: Tex, at: &TexturePoint) -> f32 {
+        self.textures.eval(t, at).x
     }
 
     /// The microfacet distribution for (u, v) roughness; None is a perfectly smooth surface.

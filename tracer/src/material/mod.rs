@@ -12,7 +12,12 @@
 //!
 //! A new material is one new file plus one line in [`MaterialDesc::read`]'s name table (and
 //! one line in each `match` below).
+//!
+//! Every material but `mix` and `null` may carry a bump or normal map ([`bump`]): read here
+//! for all of them, kept as a [`MaterialDesc::Bumped`] wrapper, applied to the shading normal
+//! in [`Materials::bsdf`].
 
+pub mod bump;
 pub mod carpaint;
 pub mod eval;
 pub mod glass;
@@ -34,9 +39,10 @@ pub mod velvet;
 #[cfg(test)]
 mod tests;
 
-use glam::Vec3;
+use glam::Affine3A;
 
 pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
+pub use bump::Bump;
 pub use carpaint::CarPaint;
 pub use glass::Glass;
 pub use glossy::Glossy;
@@ -84,6 +90,8 @@ pub enum MaterialDesc {
     GlossyTranslucent(GlossyTranslucent),
     Layered(Layered),
     Scatter(Scatter),
+    /// A material with a bump or normal map (never a mix or null: LuxRender's take none).
+    Bumped(Box<MaterialDesc>, Bump),
 }
 
 /// What a ray that no layer of a `layered` material catches meets.
@@ -94,6 +102,23 @@ impl MaterialDesc {
     /// from LuxRender's material names to kinds. An unsupported type warns and becomes a matte
     /// (with its Kd when given).
     pub fn read(
+        ty: &str,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let material = Self::read_kind(ty, params, pos, ctx)?;
+        if matches!(material, Self::Mix(_) | Self::Null(_)) {
+            return Ok(material);
+        }
+        Ok(match Bump::read(params, ctx)? {
+            Some(bump) => Self::Bumped(Box::new(material), bump),
+            None => material,
+        })
+    }
+
+    /// The material of LuxRender type `ty`, without its bump map.
+    fn read_kind(
         ty: &str,
         params: &ParamList,
         pos: &SourcePos,
@@ -154,6 +179,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(_) => "glossytranslucent",
             Self::Layered(_) => "layered",
             Self::Scatter(_) => "scatter",
+            Self::Bumped(m, _) => m.name(),
         }
     }
 
@@ -175,6 +201,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(m) => m.textures(),
             Self::Layered(m) => m.textures(),
             Self::Scatter(m) => m.textures(),
+            Self::Bumped(m, bump) => m.textures().into_iter().chain([bump.map]).collect(),
         }
     }
 
@@ -185,6 +212,7 @@ impl MaterialDesc {
             Self::Mix(m) => m.materials(),
             Self::Layered(m) => m.materials(),
             Self::GlossyCoating(m) => vec![m.base],
+            Self::Bumped(m, _) => m.materials(),
             _ => Vec::new(),
         }
     }
@@ -207,6 +235,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(m) => m.bxdf(eval),
             Self::Scatter(m) => m.bxdf(eval),
             Self::Mix(_) | Self::Layered(_) | Self::GlossyCoating(_) => Matte::default_bxdf(),
+            Self::Bumped(m, _) => m.bxdf(eval, u),
         }
     }
 
@@ -216,6 +245,7 @@ impl MaterialDesc {
             Self::Glossy(m) => Some(m.coating(eval)),
             Self::CarPaint(m) => Some(m.coating(eval)),
             Self::GlossyTranslucent(m) => Some(m.coating(eval)),
+            Self::Bumped(m, _) => m.coating(eval),
             _ => None,
         }
     }
@@ -228,6 +258,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(m) => {
                 m.front.multibounce || m.back.as_ref().is_some_and(|b| b.multibounce)
             }
+            Self::Bumped(m, _) => m.multibounce(),
             _ => false,
         }
     }
@@ -246,17 +277,18 @@ impl Materials {
         Self { materials }
     }
 
-    /// Follows `mix` and `layered` materials down to a leaf. At each level `u` chooses a side
-    /// (or layer) against the amounts and is rescaled to [0, 1) within the chosen one (see
-    /// [`Mix::choose`]); the leaf gets what is left of it.
+    /// Follows `mix` and `layered` materials down to a leaf, and the leaf's bump map. At each
+    /// level `u` chooses a side (or layer) against the amounts and is rescaled to [0, 1) within
+    /// the chosen one (see [`Mix::choose`]); the leaf gets what is left of it.
     fn resolve(
         &self,
         id: MaterialId,
         eval: &TextureEval,
         u_mix: f32,
-    ) -> Option<(&MaterialDesc, f32)> {
+    ) -> Option<(&MaterialDesc, f32, Option<&Bump>)> {
         let mut material = self.materials.get(id.0 as usize)?;
         let mut u = u_mix;
+        let mut bump = None;
         // A well-formed scene cannot nest deeper than it has materials; more means a cycle.
         for _ in 0..=self.materials.len() {
             let next = match material {
@@ -270,67 +302,76 @@ impl Materials {
                     (next, u) = layered.choose(eval, u);
                     match next {
                         Some(next) => next,
-                        None => return Some((&PASS_THROUGH, u)),
+                        None => return Some((&PASS_THROUGH, u, bump)),
                     }
                 }
-                _ => return Some((material, u)),
+                MaterialDesc::Bumped(leaf, leaf_bump) => {
+                    bump = Some(leaf_bump);
+                    material = leaf;
+                    continue;
+                }
+                _ => return Some((material, u, bump)),
             };
             material = self.materials.get(next.0 as usize)?;
         }
         None
     }
 
-    /// The lobe and coat of material `id`: a glossycoating's coat over its base's lobe (whose
-    /// own coat, if any, is dropped).
+    /// The lobe, coat and bump map of material `id`: a glossycoating's coat over its base's
+    /// lobe (whose own coat, if any, is dropped; its bump map applies when the coating has
+    /// none).
     fn scattering(
         &self,
         id: MaterialId,
         eval: &TextureEval,
         u_mix: f32,
-    ) -> (Bxdf, Option<Coating>) {
-        let Some((leaf, u)) = self.resolve(id, eval, u_mix) else {
-            return (Matte::default_bxdf(), None);
+    ) -> (Bxdf, Option<Coating>, Option<&Bump>) {
+        let Some((leaf, u, bump)) = self.resolve(id, eval, u_mix) else {
+            return (Matte::default_bxdf(), None, None);
         };
         let MaterialDesc::GlossyCoating(coating) = leaf else {
-            return (leaf.bxdf(eval, u), leaf.coating(eval));
+            return (leaf.bxdf(eval, u), leaf.coating(eval), bump);
         };
-        let (mut base, mut u) = (leaf, u);
+        let (mut base, mut u, mut bump) = (leaf, u, bump);
         for _ in 0..=self.materials.len() {
             let MaterialDesc::GlossyCoating(g) = base else {
                 let bxdf = base.bxdf(eval, u);
                 let diffuse = matches!(bxdf, Bxdf::Diffuse(_) | Bxdf::Translucent(_));
-                return (bxdf, Some(coating.coating(eval, diffuse)));
+                return (bxdf, Some(coating.coating(eval, diffuse)), bump);
             };
-            let Some(next) = self.resolve(g.base, eval, u) else {
+            let Some((next, next_u, next_bump)) = self.resolve(g.base, eval, u) else {
                 break;
             };
-            (base, u) = next;
+            (base, u, bump) = (next, next_u, bump.or(next_bump));
         }
-        (Matte::default_bxdf(), None)
+        (Matte::default_bxdf(), None, None)
     }
 
-    /// The BSDF of material `id` at `hit`, whose position in its shape's object space is
-    /// `p_object` (what 3D texture mappings see). `u_mix` resolves `mix` materials
-    /// stochastically.
+    /// The BSDF of material `id` at `hit` on a shape whose world-to-object transform is
+    /// `world_to_object` (the object-space position is what planar and local 3D texture
+    /// mappings see). `u_mix` resolves `mix` materials stochastically.
     pub fn bsdf(
         &self,
         id: MaterialId,
         hit: &SurfaceHit,
-        p_object: Vec3,
+        world_to_object: &Affine3A,
         textures: &Textures,
         u_mix: f32,
     ) -> Bsdf {
         let eval = TextureEval {
             textures,
             at: TexturePoint {
-                p: p_object,
+                p: world_to_object.transform_point3(hit.p),
+                p_world: hit.p,
                 uv: hit.uv,
+                prim: hit.prim,
             },
         };
         // A dangling id or a mix cycle shows the default matte.
-        let (bxdf, coating) = self.scattering(id, &eval, u_mix);
+        let (bxdf, coating, bump) = self.scattering(id, &eval, u_mix);
+        let ns = bump.map_or(hit.ns, |b| b.normal(hit, &eval, world_to_object));
         Bsdf::new(
-            Frame::from_normal_tangent(hit.ns, hit.dpdu),
+            Frame::from_normal_tangent(ns, hit.dpdu),
             hit.ng,
             bxdf,
             coating,

@@ -5,7 +5,7 @@
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
 use super::*;
 use crate::desc::MaterialDesc;
@@ -23,6 +23,7 @@ fn hit_with(ng: Vec3, ns: Vec3) -> SurfaceHit {
         ns,
         uv: Vec2::ZERO,
         dpdu: Vec3::X,
+        dpdv: Vec3::Y,
         shape: 0,
         prim: 0,
     }
@@ -32,7 +33,7 @@ fn bsdf_of(material: MaterialDesc) -> Bsdf {
     Materials::new(vec![material]).bsdf(
         MaterialId(0),
         &hit_with(Vec3::Z, Vec3::Z),
-        Vec3::ZERO,
+        &Affine3A::IDENTITY,
         &Textures::default(),
         0.5,
     )
@@ -98,7 +99,7 @@ fn bsdf_of_set(materials: Vec<MaterialDesc>) -> Bsdf {
     Materials::new(materials).bsdf(
         MaterialId(0),
         &hit_with(Vec3::Z, Vec3::Z),
-        Vec3::ZERO,
+        &Affine3A::IDENTITY,
         &Textures::default(),
         0.5,
     )
@@ -749,7 +750,7 @@ fn shading_normals_do_not_leak_light() {
     let bsdf = Materials::new(vec![matte(1.0, 0.0)]).bsdf(
         MaterialId(0),
         &hit,
-        hit.p,
+        &Affine3A::IDENTITY,
         &Textures::default(),
         0.0,
     );
@@ -793,7 +794,7 @@ fn mix_chooses_each_side_in_proportion_to_amount() {
         for i in 0..n {
             let u = (i as f32 + 0.5) / n as f32;
             let kd = materials
-                .bsdf(MaterialId(id), &hit, hit.p, &textures, u)
+                .bsdf(MaterialId(id), &hit, &Affine3A::IDENTITY, &textures, u)
                 .eval(Vec3::Z, Vec3::Z)
                 .x
                 * PI;
@@ -827,7 +828,13 @@ fn null_passes_through_and_bad_ids_fall_back_to_matte() {
     })]);
     let hit = hit_with(Vec3::Z, Vec3::Z);
     for id in [0, 7] {
-        let bsdf = materials.bsdf(MaterialId(id), &hit, hit.p, &Textures::default(), 0.3);
+        let bsdf = materials.bsdf(
+            MaterialId(id),
+            &hit,
+            &Affine3A::IDENTITY,
+            &Textures::default(),
+            0.3,
+        );
         assert!((bsdf.eval(Vec3::Z, Vec3::Z).x * PI - 0.9).abs() < 1e-5);
     }
 }

@@ -125,6 +125,45 @@ impl ParamList {
         Some(p)
     }
 
+    /// The last parameter named `name` whose type passes `ty`, marked used.
+    fn find_typed(&self, name: &str, ty: impl Fn(ParamType) -> bool) -> Option<&Param> {
+        let p = self
+            .params
+            .iter()
+            .rev()
+            .find(|p| p.name == name && ty(p.ty))?;
+        p.used.set(true);
+        Some(p)
+    }
+
+    /// [`Self::float`] among the float and integer parameters only. LuxRender looks a
+    /// parameter up by type and name, so marble's "float scale" and its 3D mapping's "vector
+    /// scale" are two parameters.
+    pub fn float_typed(&self, name: &str, default: f32) -> Result<f32, ParseError> {
+        let Some(p) = self.find_typed(name, |t| matches!(t, ParamType::Float | ParamType::Integer))
+        else {
+            return Ok(default);
+        };
+        let v = self.exactly(p, 1, "one float")?;
+        self.to_f32(p, 0, v[0])
+    }
+
+    /// [`Self::vec3`] among the point, vector and normal parameters only (see
+    /// [`Self::float_typed`]).
+    pub fn vec3_typed(&self, name: &str, default: Vec3) -> Result<Vec3, ParseError> {
+        let Some(p) = self.find_typed(name, |t| {
+            matches!(t, ParamType::Point | ParamType::Vector | ParamType::Normal)
+        }) else {
+            return Ok(default);
+        };
+        let v = self.exactly(p, 3, "one 3-component value")?;
+        Ok(Vec3::new(
+            self.to_f32(p, 0, v[0])?,
+            self.to_f32(p, 1, v[1])?,
+            self.to_f32(p, 2, v[2])?,
+        ))
+    }
+
     /// Marks a parameter as knowingly ignored.
     pub fn ignore(&self, name: &str) {
         for p in self.params.iter().filter(|p| p.name == name) {

@@ -128,11 +128,10 @@ impl RenderScene {
     /// The BSDF at a hit; `u_mix` resolves mix materials.
     pub fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
         let shape = hit.shape as usize;
-        let p_object = self.world_to_object[shape].transform_point3(hit.p);
         self.materials.bsdf(
             self.desc.shapes[shape].material,
             hit,
-            p_object,
+            &self.world_to_object[shape],
             &self.textures,
             u_mix,
         )

@@ -11,15 +11,12 @@
 //! | `tex1`              | 1       | texture or constant of the declared kind: the cells whose coordinates sum to an even number |
 //! | `tex2`              | 0       | the other cells |
 //! | `string aamode`     | -       | accepted and ignored (no antialiasing) |
-//! | mapping             | uv      | dimension 2 only, see [`super::mapping`] |
-//!
-//! Dimension 3 uses texture space: the inverse of the transform current at the `Texture`
-//! statement, applied to the shaded point's object-space position.
+//! | mapping             | uv      | dimension 2: the 2D mapping, dimension 3: the 3D mapping (global coordinates by default), see [`super::mapping`] |
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 
 use super::common::{Declared, TextureEval, TexturePoint};
-use super::mapping::Mapping2D;
+use super::mapping::{Mapping2D, Mapping3D};
 use crate::diag::SourcePos;
 use crate::param::Tex;
 use crate::parse::context::ParseContext;
@@ -41,7 +38,7 @@ pub struct Checkerboard2D {
 pub struct Checkerboard3D {
     pub tex1: Tex,
     pub tex2: Tex,
-    pub world_to_texture: Mat4,
+    pub mapping: Mapping3D,
 }
 
 /// What `"checkerboard"` reads as, by its dimension.
@@ -70,7 +67,7 @@ impl Checkerboard {
             3 => Checkerboard::D3(Checkerboard3D {
                 tex1,
                 tex2,
-                world_to_texture: ctx.ctm().inverse(),
+                mapping: Mapping3D::read(params, pos, ctx)?,
             }),
             d => {
                 let p = params.find("dimension").expect("read above");
@@ -90,7 +87,7 @@ impl Checkerboard2D {
 
 impl Checkerboard3D {
     pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
-        let p = self.world_to_texture.transform_point3(at.p).floor();
+        let p = self.mapping.map(at).floor();
         let first = (p.x + p.y + p.z).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
     }

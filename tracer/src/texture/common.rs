@@ -17,7 +17,24 @@ pub struct TexturePoint {
     /// scenes are composed this way: their planar-mapped walls are scaled unit quads that show
     /// the image once per unit of object space, whatever their size in the world.
     pub p: Vec3,
+    /// Position in world space: what LuxRender's "global" 3D mapping (the default of the
+    /// procedural textures) transforms.
+    pub p_world: Vec3,
     pub uv: Vec2,
+    /// The primitive hit (harlequin colours each one differently).
+    pub prim: u32,
+}
+
+impl TexturePoint {
+    /// A point whose object and world positions coincide (tests, bakes).
+    pub fn new(p: Vec3, uv: Vec2) -> Self {
+        Self {
+            p,
+            p_world: p,
+            uv,
+            prim: 0,
+        }
+    }
 }
 
 /// Evaluates a texture-or-constant parameter: what a texture that combines other textures

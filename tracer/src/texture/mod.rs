@@ -1,9 +1,13 @@
 //! Textures: one file per LuxRender texture type, each with its `.lxs` statement, parameters,
-//! defaults, reading and evaluation: [`imagemap`], [`checkerboard`] (2D and 3D), [`constant`],
-//! [`scale`], [`mix`], [`blackbody`] (read as a constant), and [`fresnel`] (the fresnel
-//! textures metal2 folds in). [`mapping`] holds the 2D mappings (uv, spherical, cylindrical,
-//! planar); [`common`] the surface point, the evaluator interface and the statement header
-//! every texture file shares.
+//! defaults, reading and evaluation: [`imagemap`], [`normalmap`], [`checkerboard`] (2D and 3D),
+//! [`constant`], [`scale`], [`arithmetic`] (add, subtract), [`mix`], [`band`], [`bilerp`],
+//! [`uv`], [`harlequin`], [`dots`], [`brick`], [`fbm`], [`wrinkled`], [`windy`], [`marble`],
+//! the [`blender`] family (blender_clouds, _wood, _marble, _musgrave, _stucci, _noise,
+//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`] and [`equalenergy`] (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in).
+//! [`mapping`] holds the 2D mappings (uv, spherical, cylindrical, planar) and the 3D mapping
+//! (global, local, uv coordinates with scale, rotate, translate); [`noise`] the Perlin noise,
+//! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator
+//! interface and the statement header every texture file shares.
 //!
 //! This file maps names to kinds (one line each in [`TextureKind::read`]), says what a kind is
 //! called and what it references, and evaluates the scene's textures ([`Textures`]: built once
@@ -17,16 +21,34 @@
 //! [`TextureKind`]: the variant, the name table, `name()`, `references()` and the dispatch in
 //! [`Textures::eval`]. A texture that evaluates other textures takes `&impl TextureEval`.
 
+pub mod arithmetic;
+pub mod band;
+pub mod bilerp;
 pub mod blackbody;
+pub mod blender;
+pub mod brick;
 pub mod checkerboard;
 pub mod common;
 pub mod constant;
+pub mod dots;
+pub mod equalenergy;
+pub mod fbm;
 pub mod fresnel;
+pub mod gaussian;
+pub mod harlequin;
 pub mod imagemap;
 pub mod mapping;
+pub mod marble;
 pub mod mix;
+pub mod noise;
+pub mod normalmap;
 pub mod scale;
+pub mod uv;
+pub mod windy;
+pub mod wrinkled;
 
+#[cfg(test)]
+mod procedural_tests;
 #[cfg(test)]
 mod tests;
 
@@ -42,13 +64,25 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
+pub use arithmetic::{Arithmetic, Op};
+pub use band::Band;
+pub use bilerp::Bilerp;
+pub use brick::{Bond, Brick};
 pub use checkerboard::{Checkerboard, Checkerboard2D, Checkerboard3D};
 pub use common::{Declared, TextureEval, TexturePoint};
 pub use constant::Constant;
+pub use dots::Dots;
+pub use fbm::{Fbm, Octaves};
+pub use harlequin::Harlequin;
 pub use imagemap::{ImageMap, Wrap};
-pub use mapping::Mapping2D;
+pub use mapping::{Coordinates, Mapping2D, Mapping3D};
+pub use marble::Marble;
 pub use mix::Mix;
+pub use normalmap::NormalMap;
 pub use scale::Scale;
+pub use uv::Uv;
+pub use windy::Windy;
+pub use wrinkled::Wrinkled;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureDesc {
@@ -65,7 +99,20 @@ pub enum TextureKind {
     Checkerboard3D(Checkerboard3D),
     Constant(Constant),
     Scale(Scale),
+    Arithmetic(Arithmetic),
     Mix(Mix),
+    Band(Band),
+    Bilerp(Bilerp),
+    Uv(Uv),
+    Harlequin(Harlequin),
+    Dots(Dots),
+    Brick(Brick),
+    Fbm(Fbm),
+    Wrinkled(Wrinkled),
+    Windy(Windy),
+    Marble(Marble),
+    NormalMap(NormalMap),
+    Blender(blender::Blender),
 }
 
 /// What a `Texture` statement defines under its name.
@@ -135,9 +182,27 @@ impl TextureKind {
             "checkerboard" => Checkerboard::read(decl, params, pos, ctx)?.into(),
             "constant" => Self::Constant(Constant::read(decl, params)?),
             "scale" => Self::Scale(Scale::read(decl, params, ctx)?),
+            "add" => Self::Arithmetic(Arithmetic::read(Op::Add, decl, params, ctx)?),
+            "subtract" => Self::Arithmetic(Arithmetic::read(Op::Subtract, decl, params, ctx)?),
             "mix" => Self::Mix(Mix::read(decl, params, ctx)?),
+            "band" => Self::Band(Band::read(decl, params, pos, ctx)?),
+            "bilerp" => Self::Bilerp(Bilerp::read(decl, params, pos, ctx)?),
+            "uv" => Self::Uv(Uv::read(params, pos, ctx)?),
+            "harlequin" => Self::Harlequin(Harlequin),
+            "dots" => Self::Dots(Dots::read(decl, params, pos, ctx)?),
+            "brick" => Self::Brick(Brick::read(decl, params, pos, ctx)?),
+            "fbm" => Self::Fbm(Fbm::read(params, pos, ctx)?),
+            "wrinkled" => Self::Wrinkled(Wrinkled::read(params, pos, ctx)?),
+            "windy" => Self::Windy(Windy::read(params, pos, ctx)?),
+            "marble" => Self::Marble(Marble::read(params, pos, ctx)?),
+            "normalmap" => Self::NormalMap(NormalMap::read(decl, params, pos, ctx)?),
             "blackbody" => Self::Constant(blackbody::read(params)?),
-            _ => return Ok(None),
+            "gaussian" => Self::Constant(gaussian::read(params)?),
+            "equalenergy" => Self::Constant(equalenergy::read(params)?),
+            _ => match blender::Blender::read(class, decl, params, pos, ctx)? {
+                Some(b) => Self::Blender(b),
+                None => return Ok(None),
+            },
         }))
     }
 
@@ -148,25 +213,52 @@ impl TextureKind {
             Self::Checkerboard2D(_) | Self::Checkerboard3D(_) => "checkerboard",
             Self::Constant(_) => "constant",
             Self::Scale(_) => "scale",
+            Self::Arithmetic(t) => t.name(),
             Self::Mix(_) => "mix",
+            Self::Band(_) => "band",
+            Self::Bilerp(_) => "bilerp",
+            Self::Uv(_) => "uv",
+            Self::Harlequin(_) => "harlequin",
+            Self::Dots(_) => "dots",
+            Self::Brick(_) => "brick",
+            Self::Fbm(_) => "fbm",
+            Self::Wrinkled(_) => "wrinkled",
+            Self::Windy(_) => "windy",
+            Self::Marble(_) => "marble",
+            Self::NormalMap(_) => "normalmap",
+            Self::Blender(t) => t.name(),
         }
     }
 
     /// The textures (or constants) this texture reads, in parameter order.
     pub fn references(&self) -> Vec<Tex> {
         match self {
-            Self::ImageMap(_) | Self::Constant(_) => Vec::new(),
+            Self::ImageMap(_)
+            | Self::Constant(_)
+            | Self::Bilerp(_)
+            | Self::Uv(_)
+            | Self::Harlequin(_)
+            | Self::Fbm(_)
+            | Self::Wrinkled(_)
+            | Self::Windy(_)
+            | Self::Marble(_)
+            | Self::NormalMap(_) => Vec::new(),
             Self::Checkerboard2D(t) => vec![t.tex1, t.tex2],
             Self::Checkerboard3D(t) => vec![t.tex1, t.tex2],
             Self::Scale(t) => vec![t.tex1, t.tex2],
+            Self::Arithmetic(t) => vec![t.tex1, t.tex2],
             Self::Mix(t) => vec![t.tex1, t.tex2, t.amount],
+            Self::Band(t) => t.textures.iter().copied().chain([t.amount]).collect(),
+            Self::Dots(t) => vec![t.outside, t.inside],
+            Self::Brick(t) => vec![t.brick, t.mortar, t.modulation],
+            Self::Blender(t) => t.references(),
         }
     }
 
     /// The image file this texture reads, and the gamma it is decoded with.
     pub fn file(&self) -> Option<(&str, f32)> {
         match self {
-            Self::ImageMap(t) => Some((&t.filename, t.gamma)),
+            Self::ImageMap(t) | Self::NormalMap(NormalMap(t)) => Some((&t.filename, t.gamma)),
             _ => None,
         }
     }
@@ -175,7 +267,11 @@ impl TextureKind {
     pub fn mapping(&self) -> Option<&Mapping2D> {
         match self {
             Self::ImageMap(ImageMap { mapping, .. })
-            | Self::Checkerboard2D(Checkerboard2D { mapping, .. }) => Some(mapping),
+            | Self::NormalMap(NormalMap(ImageMap { mapping, .. }))
+            | Self::Checkerboard2D(Checkerboard2D { mapping, .. })
+            | Self::Dots(Dots { mapping, .. })
+            | Self::Bilerp(Bilerp { mapping, .. })
+            | Self::Uv(Uv { mapping }) => Some(mapping),
             _ => None,
         }
     }
@@ -277,12 +373,39 @@ impl Textures {
             TextureKind::Checkerboard3D(t) => t.eval(at, self),
             TextureKind::Constant(t) => t.eval(),
             TextureKind::Scale(t) => t.eval(at, self),
+            TextureKind::Arithmetic(t) => t.eval(at, self),
             TextureKind::Mix(t) => t.eval(at, self),
+            TextureKind::Band(t) => t.eval(at, self),
+            TextureKind::Bilerp(t) => t.eval(at),
+            TextureKind::Uv(t) => t.eval(at),
+            TextureKind::Harlequin(t) => t.eval(at),
+            TextureKind::Dots(t) => t.eval(at, self),
+            TextureKind::Brick(t) => t.eval(at, self),
+            TextureKind::Fbm(t) => t.eval(at),
+            TextureKind::Wrinkled(t) => t.eval(at),
+            TextureKind::Windy(t) => t.eval(at),
+            TextureKind::Marble(t) => t.eval(at),
+            // A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
+            TextureKind::NormalMap(_) => Vec3::ZERO,
+            TextureKind::Blender(t) => t.eval(at, self),
         };
         if texture.is_color {
             value
         } else {
             Vec3::splat(value.element_sum() / 3.0)
+        }
+    }
+
+    /// The tangent-space normal (x along u, y along v, z along the normal; not normalised) of
+    /// `tex` at `at` when it is a normal map, else `None`.
+    pub fn normal_map(&self, tex: Tex, at: &TexturePoint) -> Option<Vec3> {
+        let Tex::Texture(TextureId(id)) = tex else {
+            return None;
+        };
+        let texture = self.textures.get(id as usize)?;
+        match &texture.kind {
+            TextureKind::NormalMap(t) => Some(t.normal(at, self.image(texture))),
+            _ => None,
         }
     }
 
@@ -292,7 +415,8 @@ impl Textures {
     }
 
     /// The value of `tex` when it is the same at every point, from the descriptions alone:
-    /// constants (and blackbody, read as one) and scale or mix of such. What a light colour
+    /// constants (and the spectral textures, read as one) and scale, mix, add or subtract of
+    /// such. What a light colour
     /// given as a texture reads (LuxRender accepts a texture wherever a colour goes). None
     /// for a texture that varies over a surface or reads a file.
     pub fn uniform_value(descs: &[TextureDesc], tex: Tex) -> Option<Vec3> {
@@ -303,7 +427,10 @@ impl Textures {
             descs.get(id as usize).is_some_and(|d| {
                 matches!(
                     d.kind,
-                    TextureKind::Constant(_) | TextureKind::Scale(_) | TextureKind::Mix(_)
+                    TextureKind::Constant(_)
+                        | TextureKind::Scale(_)
+                        | TextureKind::Mix(_)
+                        | TextureKind::Arithmetic(_)
                 ) && d.kind.references().into_iter().all(|r| match r {
                     // Only earlier textures: rules out cycles.
                     Tex::Texture(TextureId(used)) => used < id && uniform(descs, r),
@@ -326,10 +453,7 @@ impl Textures {
                 .collect(),
             images: Vec::new(),
         };
-        let origin = TexturePoint {
-            p: Vec3::ZERO,
-            uv: glam::Vec2::ZERO,
-        };
+        let origin = TexturePoint::new(Vec3::ZERO, glam::Vec2::ZERO);
         Some(textures.eval(tex, &origin))
     }
 }

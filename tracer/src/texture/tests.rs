@@ -61,10 +61,7 @@ fn imagemap(wrap: Wrap, gamma: f32, gain: f32, mapping: Mapping2D) -> TextureDes
 }
 
 fn at_uv(u: f32, v: f32) -> TexturePoint {
-    TexturePoint {
-        p: Vec3::ZERO,
-        uv: Vec2::new(u, v),
-    }
+    TexturePoint::new(Vec3::ZERO, Vec2::new(u, v))
 }
 
 /// Texture coordinates of the centre of texel (x, y), which may lie outside the image.
@@ -212,7 +209,7 @@ fn checkerboards_alternate() {
             kind: TextureKind::Checkerboard3D(Checkerboard3D {
                 tex1: Tex::color(Vec3::ONE),
                 tex2: Tex::color(Vec3::ZERO),
-                world_to_texture: Mat4::from_scale(Vec3::splat(2.0)),
+                mapping: Mapping3D::global(Mat4::from_scale(Vec3::splat(2.0))),
             }),
         },
     ];
@@ -237,7 +234,7 @@ fn checkerboards_alternate() {
         let got = textures
             .eval(
                 Tex::Texture(TextureId(1)),
-                &TexturePoint { p, uv: Vec2::ZERO },
+                &TexturePoint::new(p, Vec2::ZERO),
             )
             .x;
         assert_eq!(got, expected, "3D at {p}");

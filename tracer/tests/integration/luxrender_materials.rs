@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use yat_tracer::assets::{AssetKind, MemorySource};
 use yat_tracer::desc::*;
 use yat_tracer::geometry::SurfaceHit;
@@ -144,6 +144,7 @@ fn hit() -> SurfaceHit {
         ns: Vec3::Z,
         uv: Vec2::ZERO,
         dpdu: Vec3::X,
+        dpdv: Vec3::Y,
         shape: 0,
         prim: 0,
     }
@@ -158,7 +159,7 @@ fn resolve_stats(d: &SceneDesc, id: MaterialId) -> (f64, f64) {
     let (mut through, mut f) = (0u32, 0.0f64);
     for i in 0..n {
         let u = (i as f32 + 0.5) / n as f32;
-        let bsdf = materials.bsdf(id, &hit(), Vec3::ZERO, &textures, u);
+        let bsdf = materials.bsdf(id, &hit(), &Affine3A::IDENTITY, &textures, u);
         if bsdf.is_pass_through() {
             through += 1;
         } else {
@@ -194,8 +195,8 @@ fn glossycoating_puts_its_coat_over_its_base() {
     );
     let materials = Materials::new(d.materials.clone());
     let textures = Textures::default();
-    let coated = materials.bsdf(d.shapes[0].material, &hit(), Vec3::ZERO, &textures, 0.5);
-    let glossy = materials.bsdf(d.shapes[1].material, &hit(), Vec3::ZERO, &textures, 0.5);
+    let coated = materials.bsdf(d.shapes[0].material, &hit(), &Affine3A::IDENTITY, &textures, 0.5);
+    let glossy = materials.bsdf(d.shapes[1].material, &hit(), &Affine3A::IDENTITY, &textures, 0.5);
     // A smooth coat over matte is glossy: the base seen through it at normal incidence is
     // Kd (1 - 0.04)^2 / (1 - F_avg) / pi.
     let f_avg = 0.04 + 0.96 / 21.0;
@@ -218,7 +219,7 @@ fn shinymetal_mixes_mirror_and_glossy_in_proportion() {
         .filter(|i| {
             let u = (*i as f32 + 0.5) / n as f32;
             materials
-                .bsdf(d.shapes[0].material, &hit(), Vec3::ZERO, &textures, u)
+                .bsdf(d.shapes[0].material, &hit(), &Affine3A::IDENTITY, &textures, u)
                 .is_specular()
         })
         .count();

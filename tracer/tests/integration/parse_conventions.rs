@@ -11,7 +11,7 @@ use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
-use yat_tracer::texture::{Checkerboard3D, Constant, ImageMap, Mix};
+use yat_tracer::texture::{Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
 
 fn source(files: &[(&str, &[u8])]) -> MemorySource {
     let mut s = MemorySource::new();
@@ -470,7 +470,7 @@ fn textures_map_to_descriptions() {
         TextureKind::Checkerboard3D(Checkerboard3D {
             tex1: Tex::float(1.0),
             tex2: Tex::Texture(TextureId(1)),
-            world_to_texture: inv
+            mapping: Mapping3D::global(inv)
         })
     );
     assert_eq!(

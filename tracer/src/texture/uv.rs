@@ -1,0 +1,41 @@
+//! The 2D texture coordinates as a colour: red = frac(s), green = frac(t), blue = 0 (for
+//! checking a mesh's uv layout).
+//!
+//! ```text
+//! Texture "name" "color" "uv" "float uscale" 4
+//! ```
+//!
+//! | parameter | default | notes |
+//! |-----------|---------|-------|
+//! | mapping   | uv      | see [`super::mapping`] |
+
+use glam::Vec3;
+
+use super::common::TexturePoint;
+use super::mapping::Mapping2D;
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uv {
+    pub mapping: Mapping2D,
+}
+
+impl Uv {
+    pub fn read(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Ok(Self {
+            mapping: Mapping2D::read(params, pos, ctx)?,
+        })
+    }
+
+    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+        let st = self.mapping.map(at);
+        Vec3::new(st.x - st.x.floor(), st.y - st.y.floor(), 0.0)
+    }
+}
