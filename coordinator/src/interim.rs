@@ -99,7 +99,9 @@ impl InterimOutputs {
         if let (true, Some(image)) = (due.status_image, &image) {
             self.status.publish_image(image.clone());
         }
-        let preview = preview_file.zip(image).map(|(p, image)| (p.path.clone(), image));
+        let preview = preview_file
+            .zip(image)
+            .map(|(p, image)| (p.path.clone(), image));
         let checkpoint = self
             .checkpoint
             .as_ref()

@@ -117,7 +117,8 @@ fn http(address: &str, method: &str, path: &str, headers: &[(&str, &str)]) -> Re
     stream
         .set_read_timeout(Some(Duration::from_secs(20)))
         .unwrap();
-    let mut request = format!("{method} {path} HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n");
+    let mut request =
+        format!("{method} {path} HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n");
     for (name, value) in headers {
         request.push_str(&format!("{name}: {value}\r\n"));
     }
@@ -180,13 +181,17 @@ fn parse_prometheus(text: &str) -> Vec<(String, f64)> {
             if !labels.is_empty() {
                 assert!(labels.starts_with('{') && labels.ends_with('}'), "{line:?}");
                 for pair in labels[1..labels.len() - 1].split("\",") {
-                    let (label, value) = pair.split_once("=\"").unwrap_or_else(|| panic!("{line:?}"));
+                    let (label, value) =
+                        pair.split_once("=\"").unwrap_or_else(|| panic!("{line:?}"));
                     assert!(label.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'));
                     assert!(!value.trim_end_matches('"').contains('\n'));
                 }
             }
         }
-        samples.push((series.to_string(), value.parse().unwrap_or_else(|_| panic!("{line:?}"))));
+        samples.push((
+            series.to_string(),
+            value.parse().unwrap_or_else(|_| panic!("{line:?}")),
+        ));
     }
     samples
 }
@@ -318,7 +323,10 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
     // /metrics: well-formed, and the same figures.
     let response = coordinator.get("/metrics", &[]);
     assert_eq!(response.code, 200);
-    assert!(response.header("content-type").unwrap().starts_with("text/plain; version=0.0.4"));
+    assert!(response
+        .header("content-type")
+        .unwrap()
+        .starts_with("text/plain; version=0.0.4"));
     let samples = parse_prometheus(&response.text());
     assert_eq!(
         metric(&samples, "yat_samples_total"),
@@ -340,11 +348,17 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
         1.0
     );
     assert_eq!(
-        metric(&samples, &format!("yat_worker_failures_total{{worker=\"{a_address}\"}}")),
+        metric(
+            &samples,
+            &format!("yat_worker_failures_total{{worker=\"{a_address}\"}}")
+        ),
         killed["failures"].as_f64().unwrap()
     );
     assert_eq!(
-        metric(&samples, &format!("yat_worker_units_total{{worker=\"{}\"}}", b.address)),
+        metric(
+            &samples,
+            &format!("yat_worker_units_total{{worker=\"{}\"}}", b.address)
+        ),
         worker(&done, &b.address)["units"].as_f64().unwrap()
     );
 
@@ -360,10 +374,18 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
     // The page itself: generated, self-contained.
     let page = coordinator.get("/", &[]);
     assert_eq!(page.code, 200);
-    assert!(page.header("content-type").unwrap().starts_with("text/html"));
+    assert!(page
+        .header("content-type")
+        .unwrap()
+        .starts_with("text/html"));
     let html = page.text();
-    assert!(html.contains("/api/status") && !html.contains("http://") && !html.contains("https://"));
-    assert!(page.header("content-security-policy").unwrap().contains("default-src 'none'"));
+    assert!(
+        html.contains("/api/status") && !html.contains("http://") && !html.contains("https://")
+    );
+    assert!(page
+        .header("content-security-policy")
+        .unwrap()
+        .contains("default-src 'none'"));
 
     // Nothing else: no file by a path from the request, no other method.
     for path in [
@@ -379,7 +401,10 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
         assert!(!response.text().contains("root:"), "{path}");
     }
     for method in ["POST", "PUT", "DELETE"] {
-        assert_eq!(http(&coordinator.address, method, "/api/status", &[]).code, 405);
+        assert_eq!(
+            http(&coordinator.address, method, "/api/status", &[]).code,
+            405
+        );
     }
     coordinator.stop();
 }
@@ -403,10 +428,19 @@ fn a_token_protects_the_status_page() {
         assert_eq!(response.code, code, "{headers:?}: {}", response.head);
         if code == 401 {
             let text = response.text();
-            assert!(text.contains("<form") && !text.contains("samples"), "{text}");
+            assert!(
+                text.contains("<form") && !text.contains("samples"),
+                "{text}"
+            );
         }
     }
-    for path in ["/", "/metrics", "/image.png", "/Cargo.toml", "/?token=wrong"] {
+    for path in [
+        "/",
+        "/metrics",
+        "/image.png",
+        "/Cargo.toml",
+        "/?token=wrong",
+    ] {
         assert_eq!(coordinator.get(path, &[]).code, 401, "{path}");
     }
     // The token in the URL once: a cookie, and the address without the token.
@@ -415,7 +449,10 @@ fn a_token_protects_the_status_page() {
     assert_eq!(login.header("location"), Some("/"));
     let set_cookie = login.header("set-cookie").unwrap();
     assert!(set_cookie.contains("HttpOnly") && set_cookie.contains("SameSite=Strict"));
-    assert!(!set_cookie.contains("s3cret"), "the cookie holds a digest, not the token");
+    assert!(
+        !set_cookie.contains("s3cret"),
+        "the cookie holds a digest, not the token"
+    );
     let cookie = set_cookie.split(';').next().unwrap();
     let page = coordinator.get("/", &[("Cookie", cookie)]);
     assert_eq!(page.code, 200);
@@ -512,13 +549,23 @@ fn headless_chromium_shows_the_image_and_the_workers() {
         &["--spp", "64", "--resolution", "128x96"],
         &["--workers", &workers, "--quiet"],
     ));
-    coordinator.poll_until("an image", |_| {}, |s| {
-        s["image"]["generation"].as_u64().unwrap() >= 1
-            && s["progress"]["units_done"].as_u64().unwrap() >= 4
-    });
+    coordinator.poll_until(
+        "an image",
+        |_| {},
+        |s| {
+            s["image"]["generation"].as_u64().unwrap() >= 1
+                && s["progress"]["units_done"].as_u64().unwrap() >= 4
+        },
+    );
     let url = format!("http://{}/", coordinator.address);
 
-    let dom = run_chromium(&chromium, &dir.path().join("profile"), "--dump-dom", &url, 3000);
+    let dom = run_chromium(
+        &chromium,
+        &dir.path().join("profile"),
+        "--dump-dom",
+        &url,
+        3000,
+    );
     let rendering = coordinator.status()["state"] == "rendering";
     let table = dom
         .split("<tbody id=\"workers\">")
@@ -529,7 +576,10 @@ fn headless_chromium_shows_the_image_and_the_workers() {
         table.contains(&a.address) && table.contains(&b.address),
         "the worker table lists both workers: {table}"
     );
-    assert!(dom.contains("src=\"/image.png?v="), "the image is loaded: {dom}");
+    assert!(
+        dom.contains("src=\"/image.png?v="),
+        "the image is loaded: {dom}"
+    );
     assert!(dom.contains("box.lxs"), "{dom}");
 
     let shot = dir.path().join("status-page.png");
@@ -554,7 +604,10 @@ fn headless_chromium_shows_the_image_and_the_workers() {
         .collect();
     let mean = luma.iter().sum::<f64>() / luma.len() as f64;
     let variance = luma.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / luma.len() as f64;
-    assert!(variance > 100.0, "the screenshot is nearly flat: variance {variance}");
+    assert!(
+        variance > 100.0,
+        "the screenshot is nearly flat: variance {variance}"
+    );
     let colours: std::collections::HashSet<[u8; 3]> = (0..h / 2)
         .flat_map(|y| (0..w / 2).map(move |x| (x, y)))
         .map(|(x, y)| screenshot.get_pixel(x, y).0)

@@ -78,7 +78,12 @@ pub struct RenderArgs {
     pub status_addr: Option<SocketAddr>,
     /// Keep serving the status page this long after the render ends (its final image and
     /// summary), then exit.
-    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, requires = "status_addr")]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.0,
+        requires = "status_addr"
+    )]
     pub status_linger: f64,
     #[command(flatten)]
     pub budget: BudgetArgs,
@@ -148,7 +153,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             spp: settings.spp,
             max_depth: settings.max_depth,
             seed: settings.seed,
-            executor: if workers.is_some() { "distributed" } else { "in-process" }.into(),
+            executor: if workers.is_some() {
+                "distributed"
+            } else {
+                "in-process"
+            }
+            .into(),
             threads: None,
         },
         args.status_addr.is_some(),

@@ -13,8 +13,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::snapshot::{
-    Event, EventKind, ImageInfo, ProgressFigures, RenderState, SceneInfo, SettingsInfo,
-    Snapshot, Summary, WorkerRow, WorkerState, SNAPSHOT_VERSION,
+    Event, EventKind, ImageInfo, ProgressFigures, RenderState, SceneInfo, SettingsInfo, Snapshot,
+    Summary, WorkerRow, WorkerState, SNAPSHOT_VERSION,
 };
 
 /// Events kept for the page; older ones are dropped.
@@ -152,7 +152,13 @@ impl StatusBoard {
         self.push_event(&mut s, kind, None, text);
     }
 
-    fn push_event(&self, s: &mut BoardState, kind: EventKind, worker: Option<String>, text: String) {
+    fn push_event(
+        &self,
+        s: &mut BoardState,
+        kind: EventKind,
+        worker: Option<String>,
+        text: String,
+    ) {
         if s.events.len() == MAX_EVENTS {
             s.events.pop_front();
         }
@@ -259,11 +265,14 @@ impl StatusBoard {
             progress,
             workers: s.workers.clone(),
             events: s.events.iter().cloned().collect(),
-            image: s.image.as_ref().map_or_else(ImageInfo::default, |i| ImageInfo {
-                generation: i.generation,
-                width: i.image.width(),
-                height: i.image.height(),
-            }),
+            image: s
+                .image
+                .as_ref()
+                .map_or_else(ImageInfo::default, |i| ImageInfo {
+                    generation: i.generation,
+                    width: i.image.width(),
+                    height: i.image.height(),
+                }),
             summary: s.summary.clone(),
         }
     }
@@ -279,25 +288,26 @@ fn rate(s: &BoardState) -> f64 {
 }
 
 /// What changed for one worker between two publications.
-fn worker_events(
-    before: Option<&WorkerRow>,
-    now: &WorkerRow,
-) -> Vec<(EventKind, String, String)> {
+fn worker_events(before: Option<&WorkerRow>, now: &WorkerRow) -> Vec<(EventKind, String, String)> {
     let address = &now.address;
     let mut events = Vec::new();
-    let was_up = before.is_some_and(|b| matches!(b.state, WorkerState::Connected | WorkerState::Stalled));
+    let was_up =
+        before.is_some_and(|b| matches!(b.state, WorkerState::Connected | WorkerState::Stalled));
     let is_up = matches!(now.state, WorkerState::Connected | WorkerState::Stalled);
     if is_up && !was_up {
         events.push((
             EventKind::WorkerJoined,
             address.clone(),
             format!(
-                "worker {address} ({}, {} threads) joined",
-                now.hostname, now.threads
+                "worker {address} ({}, {} thread{}) joined",
+                now.hostname,
+                now.threads,
+                if now.threads == 1 { "" } else { "s" }
             ),
         ));
     }
-    let requeued = now.units_requeued - before.map_or(0, |b| b.units_requeued.min(now.units_requeued));
+    let requeued =
+        now.units_requeued - before.map_or(0, |b| b.units_requeued.min(now.units_requeued));
     if requeued > 0 {
         events.push((
             EventKind::UnitsRequeued,
@@ -355,7 +365,10 @@ mod tests {
         let snap = board.snapshot();
         assert_eq!(snap.state, RenderState::Finished);
         let summary = snap.summary.unwrap();
-        assert_eq!(summary.samples, 200, "the resumed samples are not this run's");
+        assert_eq!(
+            summary.samples, 200,
+            "the resumed samples are not this run's"
+        );
         assert_eq!(snap.progress.eta_seconds, None);
         assert_eq!(snap.events.last().unwrap().kind, EventKind::RenderFinished);
     }
@@ -385,16 +398,25 @@ mod tests {
     #[test]
     fn a_connected_worker_without_results_is_stalled() {
         let board = StatusBoard::unserved();
-        board.set_workers(vec![row("a:1", WorkerState::Connected, 5, 0)], Duration::ZERO);
+        board.set_workers(
+            vec![row("a:1", WorkerState::Connected, 5, 0)],
+            Duration::ZERO,
+        );
         // The floor keeps a fresh worker connected.
         assert_eq!(board.snapshot().workers[0].state, WorkerState::Connected);
         let mut s = board.state();
         let since = s.last_progress.get_mut("a:1").unwrap();
         since.1 -= MIN_STALLED_AFTER;
         drop(s);
-        board.set_workers(vec![row("a:1", WorkerState::Connected, 5, 0)], Duration::ZERO);
+        board.set_workers(
+            vec![row("a:1", WorkerState::Connected, 5, 0)],
+            Duration::ZERO,
+        );
         assert_eq!(board.snapshot().workers[0].state, WorkerState::Stalled);
-        board.set_workers(vec![row("a:1", WorkerState::Connected, 6, 0)], Duration::ZERO);
+        board.set_workers(
+            vec![row("a:1", WorkerState::Connected, 6, 0)],
+            Duration::ZERO,
+        );
         assert_eq!(board.snapshot().workers[0].state, WorkerState::Connected);
     }
 
@@ -402,12 +424,17 @@ mod tests {
     fn events_are_bounded() {
         let board = StatusBoard::unserved();
         for i in 0..MAX_EVENTS + 7 {
-            board.event(EventKind::CheckpointWritten, format!("{i} {}", "x".repeat(1000)));
+            board.event(
+                EventKind::CheckpointWritten,
+                format!("{i} {}", "x".repeat(1000)),
+            );
         }
         let events = board.snapshot().events;
         assert_eq!(events.len(), MAX_EVENTS);
         assert!(events[0].text.starts_with("7 "), "the oldest went first");
-        assert!(events.iter().all(|e| e.text.chars().count() <= MAX_EVENT_CHARS));
+        assert!(events
+            .iter()
+            .all(|e| e.text.chars().count() <= MAX_EVENT_CHARS));
     }
 
     #[test]
