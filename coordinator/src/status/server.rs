@@ -11,7 +11,6 @@
 //! Bounds: at most [`MAX_CONNECTIONS`] connections at once (more wait to be accepted), the
 //! request head within [`HEADER_TIMEOUT`], a connection at most [`CONNECTION_LIFETIME`] long.
 
-use std::convert::Infallible;
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
@@ -214,14 +213,8 @@ async fn require_token(
             .map(|(_, value)| value.into_owned())
     });
     if !from_url.as_deref().is_some_and(matches) {
-        let status = StatusCode::UNAUTHORIZED;
-        let mut response = (status, html(LOGIN)).into_response();
-        if from_url.is_some() {
-            response
-                .headers_mut()
-                .insert("x-yat-login", HeaderValue::from_static("wrong token"));
-        }
-        return response;
+        let challenge = [(header::WWW_AUTHENTICATE, "Bearer realm=\"yat status\"")];
+        return (StatusCode::UNAUTHORIZED, challenge, html(LOGIN)).into_response();
     }
     let set_cookie = HeaderValue::try_from(format!(
         "{COOKIE}={expected}; HttpOnly; SameSite=Strict; Path=/"
@@ -301,6 +294,6 @@ async fn image_png(State(state): State<Arc<AppState>>) -> Response {
     (headers, Body::from(cached.1.clone())).into_response()
 }
 
-async fn not_found() -> Result<Response, Infallible> {
-    Ok((StatusCode::NOT_FOUND, "not found").into_response())
+async fn not_found() -> impl IntoResponse {
+    (StatusCode::NOT_FOUND, "not found")
 }
