@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # What the status page costs a render: the same in-process render of the Cornell box without
 # --status-addr, and with it while a client polls /api/status and /image.png once a second
-# (what the page itself does), alternated RUNS times each so drift on a shared machine hits
-# both alike.
+# (what the page itself does), RUNS times each in the order ABBA..., so drift on a shared
+# machine hits both alike.
 #
-# Prints each run's samples/s (from --stats-json) and the median of each side and their ratio
-# (target: within noise, >= 0.99).
+# Prints each run's samples/s (from --stats-json) and CPU seconds (user + system, from
+# getrusage of the child), the median of each side and their ratios (target: within noise,
+# >= 0.99). On a shared, loaded machine the wall-clock rate is noisy; the CPU seconds are what
+# the page adds to the render's work whatever the load.
 #
 # Usage: bench/status.sh [SCENE.lxs]   (env: SPP=64, RUNS=3, THREADS=2, YAT=path/to/yat)
 set -euo pipefail
@@ -24,7 +26,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
 python3 - "$yat" "$scene" "$spp" "$runs" "$threads" "$out" <<'PY'
-import json, statistics, subprocess, sys, threading, time, urllib.request
+import json, resource, statistics, subprocess, sys, threading, urllib.request
 yat, scene, spp, runs, threads, out = sys.argv[1:]
 
 def render(name, status):
@@ -34,6 +36,7 @@ def render(name, status):
            "--stats-json", stats]
     if status:
         cmd += ["--status-addr", "127.0.0.1:0"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
     polls = 0
     if status:
@@ -54,20 +57,25 @@ def render(name, status):
     proc.stdout.read()
     if proc.wait() != 0:
         sys.exit(f"yat failed: {cmd}")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if status:
         done.set()
         poller.join()
-    return json.load(open(stats))["samples_per_second"], polls
+    return json.load(open(stats))["samples_per_second"], cpu, polls
 
-plain, served = [], []
+sides = {"plain": ([], []), "status": ([], [])}
 for i in range(int(runs)):
-    for name, side, status in (("plain", plain, False), ("status", served, True)):
-        rate, polls = render(f"{name}{i}", status)
-        side.append(rate)
-        print(f"run {i} {name:6}: {rate / 1e6:.3f} M samples/s" +
+    # Alternated (ABBA...) so a machine slowing down or speeding up hits both sides alike.
+    order = (("plain", False), ("status", True))
+    for name, status in order if i % 2 == 0 else order[::-1]:
+        rate, cpu, polls = render(f"{name}{i}", status)
+        sides[name][0].append(rate)
+        sides[name][1].append(cpu)
+        print(f"run {i} {name:6}: {rate / 1e6:.3f} M samples/s, {cpu:.2f} CPU s" +
               (f" ({polls} polls of the JSON and the image)" if status else ""))
-a, b = statistics.median(plain), statistics.median(served)
-print(f"median without --status-addr: {a / 1e6:.3f} M samples/s")
-print(f"median with it, polled 1/s:   {b / 1e6:.3f} M samples/s")
-print(f"ratio: {b / a:.4f}")
+(ra, ca), (rb, cb) = [tuple(map(statistics.median, sides[n])) for n in ("plain", "status")]
+print(f"median without --status-addr: {ra / 1e6:.3f} M samples/s, {ca:.2f} CPU s")
+print(f"median with it, polled 1/s:   {rb / 1e6:.3f} M samples/s, {cb:.2f} CPU s")
+print(f"samples/s ratio {rb / ra:.4f}, CPU seconds ratio {cb / ca:.4f}")
 PY
