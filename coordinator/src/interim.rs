@@ -94,10 +94,11 @@ impl InterimOutputs {
     /// bytes. Render threads wait for it.
     pub fn stage(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> StagedOutputs {
         let preview_file = self.preview.as_ref().filter(|_| due.preview);
+        let started = Instant::now();
         let image = (preview_file.is_some() || due.status_image)
             .then(|| checkpoint.film().to_display(desc));
         if let (true, Some(image)) = (due.status_image, &image) {
-            self.status.publish_image(image.clone());
+            self.status.publish_image(image.clone(), started.elapsed());
         }
         let preview = preview_file
             .zip(image)

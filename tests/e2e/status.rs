@@ -427,7 +427,10 @@ fn a_token_protects_the_status_page() {
         let response = coordinator.get("/api/status", &headers);
         assert_eq!(response.code, code, "{headers:?}: {}", response.head);
         if code == 401 {
-            assert!(response.header("www-authenticate").unwrap().starts_with("Bearer"));
+            assert!(response
+                .header("www-authenticate")
+                .unwrap()
+                .starts_with("Bearer"));
             let text = response.text();
             assert!(
                 text.contains("<form") && !text.contains("samples"),

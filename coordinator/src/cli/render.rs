@@ -220,7 +220,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let outcome = match outcome {
         Ok(outcome) => {
             if server.is_some() {
-                status.publish_image(outcome.film.to_display(&job.scene.desc.film));
+                let image = outcome.film.to_display(&job.scene.desc.film);
+                status.publish_image(image, Duration::ZERO);
             }
             status.finish(Some(job.output_png.display().to_string()), None);
             outcome

@@ -21,6 +21,10 @@ use super::snapshot::{
 pub const MAX_EVENTS: usize = 50;
 /// A new image is made at most this often (tone mapping the film costs the render a moment).
 pub const IMAGE_EVERY: Duration = Duration::from_secs(1);
+/// And at most once per this many times what the last one cost to make (tone mapping and PNG
+/// encoding), so the page takes at most ~1% of a core however large the film: a 512x512
+/// image costs ~10 ms (once a second), a 4K one ~0.2 s (once every 20 s).
+pub const IMAGE_COST_FACTOR: u32 = 100;
 /// New images are made only while someone fetched one within this time: an unwatched page
 /// costs nothing.
 pub const IMAGE_INTEREST: Duration = Duration::from_secs(30);
@@ -59,6 +63,9 @@ struct BoardState {
     events: VecDeque<Event>,
     image: Option<PublishedImage>,
     image_at: Option<Instant>,
+    /// What the last image cost: tone mapping (the executor's) and encoding (the server's).
+    image_cost: Duration,
+    encode_cost: Duration,
     units_at_image: u64,
     image_asked: Option<Instant>,
     summary: Option<Summary>,
@@ -171,7 +178,8 @@ impl StatusBoard {
     }
 
     /// Whether the executor should publish a new image now: the first one, then at most every
-    /// [`IMAGE_EVERY`] while someone watches and the film has changed.
+    /// [`IMAGE_EVERY`] (or [`IMAGE_COST_FACTOR`] times its cost) while someone watches and the
+    /// film has changed.
     pub fn image_due(&self) -> bool {
         if !self.serving {
             return false;
@@ -180,15 +188,16 @@ impl StatusBoard {
         match s.image_at {
             None => true,
             Some(at) => {
-                at.elapsed() >= IMAGE_EVERY
+                let cost = (s.image_cost + s.encode_cost).saturating_mul(IMAGE_COST_FACTOR);
+                at.elapsed() >= IMAGE_EVERY.max(cost)
                     && s.units_at_image != s.progress.units_done
                     && s.image_asked.is_some_and(|t| t.elapsed() < IMAGE_INTEREST)
             }
         }
     }
 
-    /// The image so far, tone mapped as the preview is.
-    pub fn publish_image(&self, image: image::RgbImage) {
+    /// The image so far, tone mapped as the preview is, which took `cost`.
+    pub fn publish_image(&self, image: image::RgbImage, cost: Duration) {
         let mut s = self.state();
         let generation = s.image.as_ref().map_or(0, |i| i.generation) + 1;
         s.image = Some(PublishedImage {
@@ -196,7 +205,13 @@ impl StatusBoard {
             image: Arc::new(image),
         });
         s.image_at = Some(Instant::now());
+        s.image_cost = cost;
         s.units_at_image = s.progress.units_done;
+    }
+
+    /// What encoding the last image took the server.
+    pub fn note_encode_cost(&self, cost: Duration) {
+        self.state().encode_cost = cost;
     }
 
     /// The newest image, for the server; asking counts as watching.
@@ -442,7 +457,7 @@ mod tests {
         assert!(!StatusBoard::unserved().image_due());
         let board = StatusBoard::new(SceneInfo::default(), SettingsInfo::default(), true);
         assert!(board.image_due(), "the first one");
-        board.publish_image(image::RgbImage::new(4, 3));
+        board.publish_image(image::RgbImage::new(4, 3), Duration::ZERO);
         assert!(!board.image_due(), "not again at once");
         board.state().image_at = Some(Instant::now() - IMAGE_EVERY);
         assert!(!board.image_due(), "the film has not changed");
@@ -451,7 +466,14 @@ mod tests {
         let first = board.image().unwrap();
         assert_eq!((first.generation, first.image.width()), (1, 4));
         assert!(board.image_due());
-        board.publish_image(image::RgbImage::new(4, 3));
+        // An image that cost 20 ms to make and 5 ms to encode waits 2.5 s for the next.
+        board.publish_image(image::RgbImage::new(4, 3), Duration::from_millis(20));
+        board.note_encode_cost(Duration::from_millis(5));
         assert_eq!(board.snapshot().image.generation, 2);
+        board.unit_merged(1);
+        board.state().image_at = Some(Instant::now() - IMAGE_EVERY);
+        assert!(!board.image_due(), "1 s is not enough for a costly image");
+        board.state().image_at = Some(Instant::now() - Duration::from_millis(2500));
+        assert!(board.image_due());
     }
 }

@@ -272,7 +272,9 @@ async fn image_png(State(state): State<Arc<AppState>>) -> Response {
     let mut cached = state.png.lock().await;
     if cached.0 != published.generation {
         let image = published.image.clone();
+        let started = std::time::Instant::now();
         let encoded = tokio::task::spawn_blocking(move || encode_png(&image)).await;
+        state.board.note_encode_cost(started.elapsed());
         match encoded {
             Ok(Ok(png)) => *cached = (published.generation, png.into()),
             _ => return StatusCode::INTERNAL_SERVER_ERROR.into_response(),
