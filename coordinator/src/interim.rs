@@ -1,8 +1,10 @@
 //! What a render writes while it runs, each on its own period: the preview image
-//! (`<output>.preview.png`) and the checkpoint (`<output>.resume`). Both go once the final
-//! image is written.
+//! (`<output>.preview.png`), the checkpoint (`<output>.resume`) and, for the status page, the
+//! same image as the preview into the status board. The files go once the final image is
+//! written.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -10,6 +12,8 @@ use yat_tracer::desc::FilmDesc;
 use yat_tracer::private_file::StagedFile;
 
 use crate::checkpoint::{Checkpoint, CheckpointFile};
+use crate::status::snapshot::EventKind;
+use crate::status::StatusBoard;
 
 /// The tone-mapped image so far, rewritten every so often next to the output.
 pub struct PreviewFile {
@@ -26,10 +30,12 @@ impl PreviewFile {
     }
 }
 
-/// The render's interim outputs; either may be off.
+/// The render's interim outputs; either file may be off.
 pub struct InterimOutputs {
     pub preview: Option<PreviewFile>,
     pub checkpoint: Option<CheckpointFile>,
+    /// What the status page shows (a board nobody reads without `--status-addr`).
+    pub status: Arc<StatusBoard>,
 }
 
 /// When each interim output was last written (or the render started).
@@ -53,11 +59,13 @@ impl Default for InterimClock {
 pub struct Due {
     pub preview: bool,
     pub checkpoint: bool,
+    /// A new image for the status page (the board says when).
+    pub status_image: bool,
 }
 
 impl Due {
     pub fn any(self) -> bool {
-        self.preview || self.checkpoint
+        self.preview || self.checkpoint || self.status_image
     }
 }
 
@@ -77,23 +85,31 @@ impl InterimOutputs {
                 &mut clock.checkpoint,
                 self.checkpoint.as_ref().map(CheckpointFile::every),
             ),
+            status_image: self.status.image_due(),
         }
     }
 
     /// The part of writing the due outputs that reads the render so far, and is quick: tone
-    /// mapping the preview, writing the checkpoint's bytes. Render threads wait for it.
+    /// mapping the preview (once, for the file and the status page), writing the checkpoint's
+    /// bytes. Render threads wait for it.
     pub fn stage(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> StagedOutputs {
-        let preview = self
-            .preview
-            .as_ref()
-            .filter(|_| due.preview)
-            .map(|p| (p.path.clone(), checkpoint.film().to_display(desc)));
+        let preview_file = self.preview.as_ref().filter(|_| due.preview);
+        let started = Instant::now();
+        let image = (preview_file.is_some() || due.status_image)
+            .then(|| checkpoint.film().to_display(desc));
+        if let (true, Some(image)) = (due.status_image, &image) {
+            self.status.publish_image(image.clone(), started.elapsed());
+        }
+        let preview = preview_file
+            .zip(image)
+            .map(|(p, image)| (p.path.clone(), image));
         let checkpoint = self
             .checkpoint
             .as_ref()
             .filter(|_| due.checkpoint)
             .map(|c| c.stage(checkpoint));
         StagedOutputs {
+            status: checkpoint.is_some().then(|| self.status.clone()),
             preview,
             checkpoint,
         }
@@ -114,6 +130,8 @@ impl InterimOutputs {
 pub struct StagedOutputs {
     preview: Option<(PathBuf, image::RgbImage)>,
     checkpoint: Option<anyhow::Result<StagedFile>>,
+    /// Told when the checkpoint is written.
+    status: Option<Arc<StatusBoard>>,
 }
 
 impl StagedOutputs {
@@ -132,6 +150,9 @@ impl StagedOutputs {
         let checkpoint = self
             .checkpoint
             .map(|staged| staged.and_then(CheckpointFile::commit));
+        if let (Some(Ok(())), Some(status)) = (&checkpoint, &self.status) {
+            status.event(EventKind::CheckpointWritten, "checkpoint written".into());
+        }
         [preview, checkpoint]
             .into_iter()
             .flatten()
@@ -153,6 +174,7 @@ mod tests {
                 Duration::from_millis(200),
             )),
             checkpoint: None,
+            status: StatusBoard::unserved(),
         };
         let mut clock = InterimClock::default();
         assert_eq!(outputs.due(&mut clock), Due::default());

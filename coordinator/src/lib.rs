@@ -4,7 +4,7 @@
 //! A render goes: [`scene`] loads the scene, [`cli::render`] makes a [`job`] of it (settings,
 //! outputs, the [`checkpoint`] and the [`interim`] outputs, the scene's files by content in
 //! [`manifest`]), an executor in [`exec`] renders it (in-process, or over gRPC workers), and
-//! [`render_report`] says what it cost. [`shutdown`] turns Ctrl-C and SIGTERM into a stop.
+//! [`render_report`] says what it cost; [`status`] serves a live page of it. [`shutdown`] turns Ctrl-C and SIGTERM into a stop.
 
 pub mod checkpoint;
 pub mod cli;
@@ -17,3 +17,4 @@ pub mod render_report;
 pub mod sanitize;
 pub mod scene;
 pub mod shutdown;
+pub mod status;

@@ -13,6 +13,7 @@ mod hostile_worker;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;
 mod resume;
+mod status;
 mod util;
 #[path = "../fixtures/workspace.rs"]
 mod workspace;

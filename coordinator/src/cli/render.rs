@@ -1,8 +1,11 @@
 //! `yat render`: load the scene, make the render job from the flags, hand it to the in-process
-//! executor or the distributed one, then write the image the scene's Film names and report.
+//! executor or the distributed one, then write the image the scene's Film names and report;
+//! with `--status-addr`, serve the status page meanwhile (and for `--status-linger` after).
 
+use std::net::SocketAddr;
 use std::path::PathBuf;
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use yat_tracer::render::settings::MAX_SIDE;
@@ -20,6 +23,9 @@ use crate::manifest::SceneManifest;
 use crate::render_report::RenderReport;
 use crate::scene::{ParsedScene, Warnings};
 use crate::shutdown::Interrupt;
+use crate::status::server::StatusServer;
+use crate::status::snapshot::{SceneInfo, SettingsInfo};
+use crate::status::StatusBoard;
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -64,6 +70,21 @@ pub struct RenderArgs {
     /// Rewrite `<output>.preview.png` this often during the render; 0 disables.
     #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
     pub preview_every: f64,
+    /// Serve a live status page (the image, progress, workers, events; JSON at /api/status,
+    /// Prometheus text at /metrics) on this address, e.g. 127.0.0.1:8080 or 0.0.0.0:8080 (port
+    /// 0: any free port; the address is printed). A token (--token, --token-file, YAT_TOKEN)
+    /// protects it. See docs/status.md.
+    #[arg(long, value_name = "IP:PORT")]
+    pub status_addr: Option<SocketAddr>,
+    /// Keep serving the status page this long after the render ends (its final image and
+    /// summary), then exit.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.0,
+        requires = "status_addr"
+    )]
+    pub status_linger: f64,
     #[command(flatten)]
     pub budget: BudgetArgs,
     #[command(flatten)]
@@ -119,7 +140,38 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     check_output_path(&output_png)?;
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
     let preview_every = seconds("preview-every", args.preview_every)?;
+    let status_linger = seconds("status-linger", args.status_linger)?;
     let workers = args.distributed.config()?;
+    let status = Arc::new(StatusBoard::new(
+        SceneInfo {
+            path: args.scene.display().to_string(),
+            name: scene.main_name.clone(),
+        },
+        SettingsInfo {
+            width: settings.width,
+            height: settings.height,
+            spp: settings.spp,
+            max_depth: settings.max_depth,
+            seed: settings.seed,
+            executor: if workers.is_some() {
+                "distributed"
+            } else {
+                "in-process"
+            }
+            .into(),
+            threads: None,
+        },
+        args.status_addr.is_some(),
+    ));
+    let server = match args.status_addr {
+        Some(address) => {
+            let token = args.distributed.token.resolve()?;
+            let server = StatusServer::start(address, status.clone(), token.as_deref())?;
+            println!("status page on http://{}/", server.address());
+            Some(server)
+        }
+        None => None,
+    };
     // The files by content: what workers receive, and what names the render for its checkpoint.
     let manifest = if workers.is_some() || !checkpoint_every.is_zero() {
         Some(SceneManifest::read(&scene)?)
@@ -145,6 +197,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             preview: (!preview_every.is_zero())
                 .then(|| PreviewFile::beside(&output_png, preview_every)),
             checkpoint,
+            status: status.clone(),
         },
         output_png,
         exr: args.exr,
@@ -153,17 +206,35 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     };
 
     let outcome = match (workers, manifest) {
-        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest)?,
+        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest),
         (_, manifest) => {
             // The in-process render reads the files itself: their copies go before it starts.
             drop(manifest);
-            in_process::render(&job, args.threads)?
+            in_process::render(&job, args.threads)
+        }
+    };
+    let outcome = outcome.and_then(|outcome| {
+        job.write_final(&outcome.film)?;
+        Ok(outcome)
+    });
+    let outcome = match outcome {
+        Ok(outcome) => {
+            if server.is_some() {
+                let image = outcome.film.to_display(&job.scene.desc.film);
+                status.publish_image(image, Duration::ZERO);
+            }
+            status.finish(Some(job.output_png.display().to_string()), None);
+            outcome
+        }
+        Err(e) => {
+            status.finish(None, Some(format!("{e:#}")));
+            linger(server, status_linger, &job.interrupt);
+            return Err(e);
         }
     };
     let build_time = outcome.build.as_ref().map(|b| b.time).unwrap_or_default();
     let render_time = started.elapsed() - job.scene.parse_time - build_time;
 
-    job.write_final(&outcome.film)?;
     let report = RenderReport::new(&job, &outcome, render_time);
     if let Some(path) = &args.stats_json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
@@ -173,5 +244,29 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         println!("wrote {}", job.output_png.display());
         report.print();
     }
+    linger(server, status_linger, &job.interrupt);
     Ok(())
 }
+
+/// Keeps the status page up for `--status-linger` after the render (or until Ctrl-C), then
+/// stops it.
+fn linger(server: Option<StatusServer>, linger: Duration, interrupt: &Interrupt) {
+    let Some(server) = server else {
+        return;
+    };
+    if linger.is_zero() {
+        return;
+    }
+    eprintln!(
+        "status page on http://{}/ for {:.0} s more (Ctrl-C ends it)",
+        server.address(),
+        linger.as_secs_f64()
+    );
+    let until = Instant::now() + linger;
+    while Instant::now() < until && !interrupt.is_set() {
+        std::thread::sleep(LINGER_POLL.min(until.saturating_duration_since(Instant::now())));
+    }
+}
+
+/// How often a lingering status page looks for Ctrl-C.
+const LINGER_POLL: Duration = Duration::from_millis(100);

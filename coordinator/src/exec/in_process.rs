@@ -37,10 +37,14 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         .filter(|u| !start.is_done(u))
         .copied()
         .collect();
-    let progress = Progress::new(
-        units.iter().map(WorkUnit::sample_count).sum(),
+    let total_samples = units.iter().map(WorkUnit::sample_count).sum();
+    let progress = Progress::new(total_samples, start.done_samples(&units), job.quiet);
+    let status = &job.interim.status;
+    status.plan(
+        units.len(),
+        start.done_count(),
+        total_samples,
         start.done_samples(&units),
-        job.quiet,
     );
     let state = Mutex::new(InProcessState {
         checkpoint: start,
@@ -50,11 +54,10 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     // One thread writes at a time; one finding another writing leaves it to that one.
     let writing = Mutex::new(());
     let poisoned = || anyhow::anyhow!("a render thread panicked");
+    let threads = crate::cpus::threads_or_usable_cpus(threads, "in-process render");
+    status.set_threads(threads);
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(crate::cpus::threads_or_usable_cpus(
-            threads,
-            "in-process render",
-        ))
+        .num_threads(threads)
         .build()
         .context("cannot start the render threads")?;
     let result = pool.install(|| {
@@ -80,6 +83,7 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
                 })
             };
             progress.add_samples(unit_stats.samples);
+            status.unit_merged(unit_stats.samples);
             // Encoding and syncing happen with the render's lock released.
             if let Some((_guard, staged)) = staged {
                 for e in staged.finish() {

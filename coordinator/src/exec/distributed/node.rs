@@ -5,6 +5,7 @@ use std::sync::Mutex;
 
 use super::client::ClientConfig;
 use super::local::LocalWorker;
+use crate::status::snapshot::{WorkerRow, WorkerState};
 
 /// What a worker did in this render (the final summary and `--workers-json`).
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -31,9 +32,41 @@ pub struct NodeReport {
     pub result_pixels: u64,
     #[serde(skip)]
     pub connected: bool,
+    /// Its sessions ended because the render did (or it was asked to leave).
+    #[serde(skip)]
+    pub finished: bool,
     /// Why this worker is not used (any more), if so: refused, exited, removed from DNS.
     pub gone: Option<String>,
     pub last_error: Option<String>,
+}
+
+impl NodeReport {
+    /// Its row on the status page: connecting until its first handshake (which names its
+    /// host), connected while a session renders, done when the render ended with it there,
+    /// gone when retired, removed or lost.
+    pub fn status_row(&self) -> WorkerRow {
+        let state = match (self.connected, &self.gone) {
+            (_, Some(_)) => WorkerState::Gone,
+            (true, None) => WorkerState::Connected,
+            (false, None) if self.finished => WorkerState::Done,
+            (false, None) if self.hostname.is_empty() => WorkerState::Connecting,
+            (false, None) => WorkerState::Gone,
+        };
+        WorkerRow {
+            address: self.address.clone(),
+            hostname: self.hostname.clone(),
+            threads: self.threads,
+            state,
+            units: self.units,
+            samples: self.samples,
+            samples_per_second: 0.0,
+            failures: self.failures,
+            units_requeued: self.units_requeued,
+            bytes_sent: self.bytes_sent,
+            bytes_received: self.bytes_received,
+            reason: self.gone.clone().or_else(|| self.last_error.clone()),
+        }
+    }
 }
 
 pub struct Node {

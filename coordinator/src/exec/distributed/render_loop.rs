@@ -41,6 +41,12 @@ impl RenderLoop<'_> {
             checkpoint.done_samples(self.units),
             self.job.quiet,
         );
+        self.job.interim.status.plan(
+            self.units.len(),
+            checkpoint.done_count(),
+            self.shared.schedule.sample_count(),
+            checkpoint.done_samples(self.units),
+        );
         let mut stats = UnitStats::default();
         let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
@@ -60,6 +66,7 @@ impl RenderLoop<'_> {
                         stats += unit_stats;
                         last_merged = Instant::now();
                         progress.add_samples(unit_stats.samples);
+                        self.job.interim.status.unit_merged(unit_stats.samples);
                         progress.set_status(self.status(&checkpoint));
                     }
                     Event::Notice(line) => progress.say(&line),
@@ -69,6 +76,7 @@ impl RenderLoop<'_> {
                         break Err(anyhow::anyhow!("interrupted"));
                     }
                     progress.set_status(self.status(&checkpoint));
+                    self.publish_workers();
                     let due = self.job.interim.due(&mut clock);
                     if due.any() {
                         // Lets the runtime's other thread serve the workers meanwhile.
@@ -103,6 +111,7 @@ impl RenderLoop<'_> {
             }
         };
         self.roster.stop_all();
+        self.publish_workers();
         progress.finish();
         if let Err(why) = result {
             return Err(self.job.stopped(&checkpoint, self.units, why));
@@ -123,6 +132,19 @@ impl RenderLoop<'_> {
             self.alive(),
             self.roster.current_count()
         )
+    }
+
+    /// The workers' figures for the status page; a worker is stalled after half the time a
+    /// unit may take without a result.
+    fn publish_workers(&self) {
+        let rows = self
+            .roster
+            .nodes()
+            .iter()
+            .map(|n| n.report.lock().unwrap().status_row())
+            .collect();
+        let stalled_after = self.shared.deadline.current() / 2;
+        self.job.interim.status.set_workers(rows, stalled_after);
     }
 
     fn alive(&self) -> usize {

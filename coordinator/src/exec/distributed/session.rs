@@ -127,7 +127,10 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Re
             bad_in_a_row = 0;
         }
         match outcome {
-            Ok(()) => return,
+            Ok(()) => {
+                node.update(|r| r.finished = true);
+                return;
+            }
             Err(SessionError::Permanent(reason)) => {
                 retire(&node, &shared, reason);
                 return;

@@ -1,0 +1,224 @@
+//! `/metrics`: the snapshot in the Prometheus text exposition format (version 0.0.4), the
+//! figures a farm operator graphs: samples and units over time, the progress ratio, and per
+//! worker its state, samples, units, failures and bytes. Written by hand: a dozen families
+//! do not need a registry.
+
+use std::fmt::Write;
+
+use super::snapshot::{RenderState, Snapshot, WorkerRow, WorkerState};
+
+pub const CONTENT_TYPE: &str = "text/plain; version=0.0.4; charset=utf-8";
+
+/// The exposition of `snap`.
+pub fn render(snap: &Snapshot) -> String {
+    let mut out = String::new();
+    let p = &snap.progress;
+    let mut family = |name: &str, kind: &str, help: &str, samples: &[(String, f64)]| {
+        let _ = writeln!(out, "# HELP {name} {help}");
+        let _ = writeln!(out, "# TYPE {name} {kind}");
+        for (labels, value) in samples {
+            let _ = writeln!(out, "{name}{labels} {value}");
+        }
+    };
+    let one = |v: f64| vec![(String::new(), v)];
+    family(
+        "yat_up",
+        "gauge",
+        "1 while the render runs, 0 once it has ended.",
+        &one(f64::from(u8::from(snap.state == RenderState::Rendering))),
+    );
+    family(
+        "yat_render_failed",
+        "gauge",
+        "1 if the render ended in an error.",
+        &one(f64::from(u8::from(snap.state == RenderState::Failed))),
+    );
+    family(
+        "yat_samples_total",
+        "counter",
+        "Camera samples merged into the image (a resumed checkpoint's included).",
+        &one(p.samples_done as f64),
+    );
+    family(
+        "yat_samples_planned",
+        "gauge",
+        "Camera samples of the whole render.",
+        &one(p.samples_total as f64),
+    );
+    family(
+        "yat_units_done_total",
+        "counter",
+        "Work units merged.",
+        &one(p.units_done as f64),
+    );
+    family(
+        "yat_units_planned",
+        "gauge",
+        "Work units of the whole render.",
+        &one(p.units_total as f64),
+    );
+    family(
+        "yat_units_requeued_total",
+        "counter",
+        "Work units a worker lost or gave back, sent again.",
+        &one(p.units_requeued as f64),
+    );
+    family(
+        "yat_progress_ratio",
+        "gauge",
+        "Samples merged over samples planned, 0 to 1.",
+        &one(p.ratio),
+    );
+    family(
+        "yat_samples_per_second",
+        "gauge",
+        "Samples this run merged per second so far.",
+        &one(p.samples_per_second),
+    );
+    family(
+        "yat_elapsed_seconds",
+        "gauge",
+        "Seconds since the render started.",
+        &one(p.elapsed_seconds),
+    );
+    let per_worker = |value: fn(&WorkerRow) -> f64| -> Vec<(String, f64)> {
+        snap.workers
+            .iter()
+            .map(|w| (labels(&[("worker", &w.address)]), value(w)))
+            .collect()
+    };
+    family(
+        "yat_worker_up",
+        "gauge",
+        "1 while the worker is connected (stalled included).",
+        &per_worker(|w| {
+            f64::from(u8::from(matches!(
+                w.state,
+                WorkerState::Connected | WorkerState::Stalled
+            )))
+        }),
+    );
+    let states: Vec<_> = snap
+        .workers
+        .iter()
+        .flat_map(|w| {
+            WorkerState::ALL.iter().map(|&state| {
+                (
+                    labels(&[
+                        ("worker", &w.address),
+                        ("host", &w.hostname),
+                        ("state", state.name()),
+                    ]),
+                    f64::from(u8::from(w.state == state)),
+                )
+            })
+        })
+        .collect();
+    family(
+        "yat_worker_state",
+        "gauge",
+        "1 for the worker's state: connecting, connected, stalled, gone or done.",
+        &states,
+    );
+    family(
+        "yat_worker_threads",
+        "gauge",
+        "Render threads the worker reported.",
+        &per_worker(|w| f64::from(w.threads)),
+    );
+    family(
+        "yat_worker_samples_total",
+        "counter",
+        "Camera samples of the worker's units that were merged.",
+        &per_worker(|w| w.samples as f64),
+    );
+    family(
+        "yat_worker_units_total",
+        "counter",
+        "Work units of the worker that were merged.",
+        &per_worker(|w| w.units as f64),
+    );
+    family(
+        "yat_worker_failures_total",
+        "counter",
+        "Sessions the worker lost and bad replies it sent.",
+        &per_worker(|w| w.failures as f64),
+    );
+    family(
+        "yat_worker_units_requeued_total",
+        "counter",
+        "Work units the worker held that went back to the queue.",
+        &per_worker(|w| w.units_requeued as f64),
+    );
+    family(
+        "yat_worker_sent_bytes_total",
+        "counter",
+        "Bytes of every request sent to the worker, scene files included.",
+        &per_worker(|w| w.bytes_sent as f64),
+    );
+    family(
+        "yat_worker_received_bytes_total",
+        "counter",
+        "Bytes of every reply received from the worker.",
+        &per_worker(|w| w.bytes_received as f64),
+    );
+    out
+}
+
+/// `{a="x",b="y"}` with the values escaped as the format asks (backslash, quote, newline).
+fn labels(pairs: &[(&str, &str)]) -> String {
+    let body: Vec<String> = pairs
+        .iter()
+        .map(|(name, value)| {
+            let value = value
+                .replace('\\', "\\\\")
+                .replace('"', "\\\"")
+                .replace('\n', "\\n");
+            format!("{name}=\"{value}\"")
+        })
+        .collect();
+    format!("{{{}}}", body.join(","))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::board::StatusBoard;
+    use super::super::snapshot::{SceneInfo, SettingsInfo};
+    use super::*;
+
+    #[test]
+    fn figures_and_escaped_labels() {
+        let board = StatusBoard::new(SceneInfo::default(), SettingsInfo::default(), false);
+        board.plan(4, 0, 400, 0);
+        board.unit_merged(100);
+        let worker = WorkerRow {
+            address: "10.0.0.1:7000".into(),
+            hostname: "evil\"\\\nhost".into(),
+            threads: 8,
+            state: WorkerState::Gone,
+            units: 1,
+            samples: 100,
+            samples_per_second: 0.0,
+            failures: 2,
+            units_requeued: 3,
+            bytes_sent: 10,
+            bytes_received: 20,
+            reason: None,
+        };
+        board.set_workers(vec![worker], std::time::Duration::ZERO);
+        let text = render(&board.snapshot());
+        assert!(text.contains("\nyat_samples_total 100\n"), "{text}");
+        assert!(text.contains("\nyat_progress_ratio 0.25\n"), "{text}");
+        assert!(text.contains("\nyat_units_requeued_total 3\n"), "{text}");
+        assert!(text.contains("yat_worker_failures_total{worker=\"10.0.0.1:7000\"} 2\n"));
+        assert!(text.contains(
+            "yat_worker_state{worker=\"10.0.0.1:7000\",host=\"evil\\\"\\\\\\nhost\",state=\"gone\"} 1\n"
+        ));
+        assert!(text.contains("state=\"connected\"} 0\n"));
+        // Every line is a comment or `name{labels} value` with a number.
+        for line in text.lines().filter(|l| !l.starts_with('#')) {
+            let value = line.rsplit(' ').next().unwrap();
+            assert!(value.parse::<f64>().is_ok(), "{line}");
+        }
+    }
+}
