@@ -3,7 +3,8 @@
 (pyluxcore, PATHCPU) and writes linear RGB as EXR plus its figures as JSON. bench.py runs it
 in the benchmark's virtualenv, one process per render (as it runs yat).
 
-    luxcore.py EXPORT_DIR --spp N --depth D --threads T --out rgb.exr --stats stats.json
+    luxcore.py EXPORT_DIR --spp N --depth D --threads T [--width W --height H] \
+        --out rgb.exr --stats stats.json
 
 Timing starts when RenderSession.Start() returns (scene and BVH ready) and stops when the
 halt condition is met, like yat's render_seconds.
@@ -23,6 +24,8 @@ def main():
     ap.add_argument("--threads", type=int, required=True)
     ap.add_argument("--sampler", default="SOBOL", help="SOBOL (LuxCore's default) or RANDOM")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--width", type=int, help="image width (default: the export's film)")
+    ap.add_argument("--height", type=int, help="image height (default: the export's film)")
     ap.add_argument("--out", required=True, help="linear RGB EXR")
     ap.add_argument("--stats", required=True, help="JSON figures")
     args = ap.parse_args()
@@ -48,6 +51,9 @@ def main():
         "film.outputs.0.type": "RGB",
         "film.outputs.0.filename": out,
     }
+    if args.width and args.height:
+        props["film.width"] = args.width
+        props["film.height"] = args.height
     for key, value in props.items():
         cfg.Set(pyluxcore.Property(key, value))
 
