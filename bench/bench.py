@@ -428,13 +428,16 @@ def main():
                     help="spp of the side by side's timed renders (default 16)")
     ap.add_argument("--ref-spp", type=int, default=1024,
                     help="spp of the side by side's converged references (default 1024)")
+    ap.add_argument("--no-build", action="store_true",
+                    help="use the release binary as it is (do not run cargo build first)")
     args = ap.parse_args()
     spp = 4 if args.quick else args.spp
     with_compare = not (args.quick or args.no_compare) and SEED.exists()
     if with_compare:
         ensure_venv()
 
-    build()
+    if not args.no_build:
+        build()
     results = ROOT / "bench/RESULTS.md"
     if args.compare_only:
         section = side_by_side_section(args)

@@ -83,8 +83,14 @@ fn null_emitter_is_clear_glass_that_neither_reflects_nor_bends_with_the_parsed_r
     assert_eq!(value(scn, "scene.materials.emitter0.type"), "\"glass\"");
     assert_eq!(floats(value(scn, "scene.materials.emitter0.kr")), [0.0; 3]);
     assert_eq!(floats(value(scn, "scene.materials.emitter0.kt")), [1.0; 3]);
-    assert_eq!(floats(value(scn, "scene.materials.emitter0.interiorior")), [1.0]);
-    assert_eq!(floats(value(scn, "scene.materials.emitter0.exteriorior")), [1.0]);
+    assert_eq!(
+        floats(value(scn, "scene.materials.emitter0.interiorior")),
+        [1.0]
+    );
+    assert_eq!(
+        floats(value(scn, "scene.materials.emitter0.exteriorior")),
+        [1.0]
+    );
     assert!(!scn.contains("scene.materials.emitter0.kd"), "{scn}");
     assert_eq!(
         floats(value(scn, "scene.materials.emitter0.emission")),
