@@ -376,8 +376,8 @@ def side_by_side_section(args):
 
 - machine: {machine()}; {args.threads} render threads for every renderer
 - date: {datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
-- command: `python3 bench/bench.py --compare-only` (setup: `bench/setup-env.sh`, which
-  `bench.py` runs itself)
+- command: `python3 bench/bench.py {" ".join(sys.argv[1:])}` (setup: `bench/setup-env.sh`,
+  which `bench.py` runs itself)
 - load average (1 min) {before[0]:.1f} at the start, {after[0]:.1f} at the end; the "load"
   column is at each scene's timed renders. The machine is shared with other builds: absolute
   figures move with the load, ratios within one scene's renders (run back to back) are what
@@ -386,7 +386,13 @@ def side_by_side_section(args):
 Each scene as YAT parsed it, written out by `yat export-luxcore` (LuxCore's own .lxs importer
 drops the spheres and the planar mapping, refuses metal2's fresnel colour and loses the named
 materials and the camera) and converted from that export to Mitsuba 3's XML by
-`bench/mitsuba3.py`. All render at {size[0]}x{size[1]}, path depth {args.depth}, on the same
+`bench/mitsuba3.py`. The export writes YAT's null-material lamps (they emit and let every ray
+through) as clear, index-matched glass carrying the emission: a surface rays stop at, collect
+the emission and go on through unchanged. It used to write black matte, which absorbed the rays
+reaching the lamp (LuxCore's Cornell box came out 1.3% darker than YAT's); LuxCore's own `null`
+material is skipped inside its intersection routine, so no ray would see the emission. LuxCore's
+image also comes out one pixel row lower than YAT's and Mitsuba's; `bench/luxcore.py` moves
+its screen window down one row to match. All render at {size[0]}x{size[1]}, path depth {args.depth}, on the same
 threads. Each renderer renders a converged reference of its own ({args.ref_spp} spp, another
 seed; Mitsuba's with `{MITSUBA_REFERENCE[0]}` and `{MITSUBA_REFERENCE[1]}`, one reference for
 both variants) and short renders ({args.compare_spp} spp). MSE is per channel over all pixels of

@@ -136,7 +136,6 @@ class Converter:
         self.textures = group(self.scene, "scene.textures")
         self.materials = group(self.scene, "scene.materials")
         self.written_textures = {}
-        self.lines = []
 
     # -- values ---------------------------------------------------------------------------
 
