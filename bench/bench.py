@@ -364,6 +364,7 @@ def machine():
 def side_by_side_section(args):
     """The side-by-side section of RESULTS.md (run now)."""
     sys.path.insert(0, str(ROOT / "bench"))
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
     import mitsuba3
 
     before = os.getloadavg()
