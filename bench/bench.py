@@ -3,16 +3,22 @@
 binary and prints, per scene, resolution, spp, parse/build time, render time, samples/s, rays/s,
 peak memory and core-seconds per sample; sets our time for the seed scenes (scaled to 1000 spp)
 beside the original tracer's published table; and renders the compared seed scenes with
-LuxCoreRender too (same machine, threads, spp and depth), reporting samples/s and Monte Carlo
-efficiency 1 / (MSE against the renderer's own converged reference x render seconds).
+LuxCoreRender and Mitsuba 3 too (same machine, threads, resolution, spp and depth), reporting
+samples/s and Monte Carlo efficiency 1 / (MSE against the renderer's own converged reference x
+render seconds).
 
-    python3 bench/bench.py               # everything, writes bench/RESULTS.md
-    python3 bench/bench.py --quick       # fewer samples, no LuxCore, prints only
-    python3 bench/bench.py --no-luxcore  # our scenes and the seed table only
+    python3 bench/bench.py                 # everything, writes bench/RESULTS.md
+    python3 bench/bench.py --quick         # fewer samples, no side by side, prints only
+    python3 bench/bench.py --no-compare    # our scenes and the seed table only
+    python3 bench/bench.py --compare-only  # only the side by side: rewrites its section of
+                                           # bench/RESULTS.md, keeps the rest
 
-The script makes its own virtualenv (bench/.venv: pyluxcore, numpy, OpenEXR) and re-runs itself
-in it. Converged references are cached in bench/out/refs (YAT's keyed by the binary, LuxCore's by
-the exported scene). Speed lives here, never in timed tests.
+The side by side runs bench/setup-env.sh first (the virtualenv bench/.venv with pyluxcore,
+mitsuba, numpy and OpenEXR, and Debian's libllvm19 for Mitsuba's llvm variant) and re-runs
+itself in that virtualenv. Scenes go to LuxCore through `yat export-luxcore` and on to Mitsuba
+through bench/mitsuba3.py's converter. Converged references are cached in target/bench-refs
+(keyed by scene, resolution, spp and depth, and by YAT's binary, the exported scene or the
+converted scene). Speed lives here, never in timed tests.
 """
 
 import argparse
@@ -29,20 +35,30 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SEED = Path(os.environ.get("YAT_SEED_SCENES", ROOT.parent / "shared/seed-project/scenes"))
-YAT = ROOT / "target/release/yat"
+# Cargo's target folder (CARGO_TARGET_DIR when set, as build() builds there).
+TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+YAT = TARGET / "release/yat"
 VENV = ROOT / "bench/.venv"
 VENV_PYTHON = VENV / "bin/python"
-REQUIREMENTS = ["pyluxcore==2.11.2", "numpy>=1.26", "OpenEXR>=3.2"]
-REFS = ROOT / "bench/out/refs"
+SETUP = ROOT / "bench/setup-env.sh"
+REFS = TARGET / "bench-refs"
 
-# Seed scenes rendered by both YAT and LuxCore: (scene, short-render spp, reference spp). The
-# fisheye scenes are left out (LuxCore has no such camera). CaptainFalcon has 4x the pixels.
-LUXCORE_SCENES = [
-    ("DepthOfField/depth-of-field-high.lxs", 16, 256),
-    ("CornellBox/cornell-box.lxs", 16, 256),
-    ("MetalMario/metal-mario-bg1.lxs", 16, 256),
-    ("CaptainFalcon/captainfalcon.lxs", 4, 64),
+# Seed scenes rendered by YAT, LuxCore and Mitsuba 3, all at one resolution (a quarter of the
+# pixels of 960x540; the same aspect as every one of them). The fisheye scenes are left out
+# (neither LuxCore nor Mitsuba has the course's fisheye camera).
+COMPARED_SCENES = [
+    "CornellBox/cornell-box.lxs",
+    "DepthOfField/depth-of-field-high.lxs",
+    "MetalMario/metal-mario-bg1.lxs",
+    "CaptainFalcon/captainfalcon.lxs",
 ]
+COMPARED_RESOLUTION = (480, 270)
+MITSUBA_VARIANTS = ["scalar_rgb", "llvm_ad_rgb"]
+# Mitsuba's default sampler and its two stratified ones.
+MITSUBA_SAMPLERS = ["independent", "multijitter", "ldsampler"]
+# Mitsuba's converged reference: any sampler converges to the same image; the vectorised
+# variant gets there soonest.
+MITSUBA_REFERENCE = ("llvm_ad_rgb", "independent")
 SHORT_SEED, REFERENCE_SEED = 1, 7
 
 # (scene relative to its root, the original tracer's published time at 1000 spp on 8 cores in
@@ -93,18 +109,15 @@ def build():
         )
 
 
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
 def ensure_venv():
-    """Re-runs this script inside bench/.venv, creating it and installing REQUIREMENTS first."""
+    """Re-runs this script inside bench/.venv, made or brought up to date by SETUP first."""
     if Path(sys.prefix).resolve() == VENV.resolve():
         return
-    if not VENV_PYTHON.exists():
-        print(f"creating {VENV} ...", file=sys.stderr, flush=True)
-        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
-    subprocess.run(
-        [str(VENV_PYTHON), "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
-         *REQUIREMENTS],
-        check=True,
-    )
+    subprocess.run([str(SETUP)], check=True)
     os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), __file__, *sys.argv[1:]])
 
 
@@ -125,25 +138,26 @@ def run_measured(cmd, what, stats):
     return figures
 
 
-def render(scene, spp, depth, threads, out_dir, seed=0):
-    """One YAT render in-process on `threads` threads; writes out_dir/out.png and out.exr.
-    No previews or checkpoints: the figures time rendering, and LuxCore writes nothing meanwhile
-    either."""
+def render(scene, spp, depth, threads, out_dir, seed=0, size=None):
+    """One YAT render in-process on `threads` threads (at `size`, else the Film's); writes
+    out_dir/out.png and out.exr. No previews or checkpoints: the figures time rendering, and the
+    other renderers write nothing meanwhile either."""
     stats = out_dir / "stats.json"
     cmd = [
         str(YAT), "render", str(scene), "--quiet", "--spp", str(spp), "--maxdepth", str(depth),
         "--threads", str(threads), "--seed", str(seed), "--stats-json", str(stats),
         "-o", str(out_dir / "out.png"), "--exr", "--preview-every", "0", "--checkpoint-every", "0",
-    ]
+    ] + (["--resolution", f"{size[0]}x{size[1]}"] if size else [])
     return run_measured(cmd, f"yat on {scene}", stats)
 
 
-def render_luxcore(export_dir, spp, depth, threads, out_dir, seed):
-    """One LuxCore render of an exported scene; writes out_dir/lux.exr."""
+def render_luxcore(export_dir, spp, depth, threads, out_dir, seed, size):
+    """One LuxCore render of an exported scene at `size`; writes out_dir/lux.exr."""
     stats = out_dir / "lux.json"
     cmd = [
         str(VENV_PYTHON), str(ROOT / "bench/luxcore.py"), str(export_dir), "--spp", str(spp),
         "--depth", str(depth), "--threads", str(threads), "--seed", str(seed),
+        "--width", str(size[0]), "--height", str(size[1]),
         "--out", str(out_dir / "lux.exr"), "--stats", str(stats),
     ]
     return run_measured(cmd, f"LuxCore on {export_dir}", stats)
@@ -183,6 +197,13 @@ def reference(kind, setting, digest, make):
     return read_exr(path)
 
 
+def mse(image, ref):
+    """Mean squared error per channel over all pixels."""
+    import numpy as np
+
+    return float(np.mean((image - ref) ** 2))
+
+
 def block_correlation(a, b, block=16):
     """Correlation of block-mean luminance: the same picture, whatever the noise."""
     import numpy as np
@@ -195,14 +216,29 @@ def block_correlation(a, b, block=16):
     return float(np.corrcoef(blocks(a), blocks(b))[0, 1])
 
 
-def luxcore_comparison(args):
-    """YAT and LuxCore side by side on LUXCORE_SCENES; returns the Markdown table and the
-    export notes."""
+def render_mitsuba(xml, variant, sampler, spp, depth, threads, size, out_dir, seed, warm_up):
+    """One Mitsuba 3 render of a converted scene; writes out_dir/mitsuba.exr."""
+    stats = out_dir / "mitsuba.json"
+    cmd = [
+        str(VENV_PYTHON), str(ROOT / "bench/mitsuba3.py"), "render", str(xml), "--variant",
+        variant, "--sampler", sampler, "--spp", str(spp), "--depth", str(depth), "--threads",
+        str(threads), "--width", str(size[0]), "--height", str(size[1]), "--seed", str(seed),
+        "--out", str(out_dir / "mitsuba.exr"), "--stats", str(stats),
+    ] + (["--warm-up"] if warm_up else [])
+    return run_measured(cmd, f"Mitsuba {variant} {sampler} on {xml}", stats)
+
+
+def side_by_side(args):
+    """YAT, LuxCore and Mitsuba 3 (both variants, three samplers) on COMPARED_SCENES at
+    COMPARED_RESOLUTION; returns the Markdown tables and the export notes."""
     import numpy as np
 
+    size = COMPARED_RESOLUTION
+    res = f"{size[0]}x{size[1]}"
+    spp, ref_spp = args.compare_spp, args.ref_spp
     yat_key = file_digest(YAT)
-    rows, notes = [], []
-    for rel, spp, ref_spp in LUXCORE_SCENES:
+    runs, summary, notes = [], [], []
+    for rel in COMPARED_SCENES:
         if args.only and args.only not in rel:
             continue
         scene = SEED / rel
@@ -219,47 +255,90 @@ def luxcore_comparison(args):
                 continue
             notes += [f"{name}: {line[6:]}" for line in proc.stderr.splitlines()
                       if line.startswith("note: ")]
-            lux_key = file_digest(export / "scene.scn", ROOT / "bench/luxcore.py")
+            proc = subprocess.run(
+                [str(VENV_PYTHON), str(ROOT / "bench/mitsuba3.py"), "convert", str(export),
+                 str(export)],
+                capture_output=True, text=True,
+            )
+            if proc.returncode != 0:
+                notes.append(f"{name}: not compared: {proc.stderr.strip().splitlines()[-1]}")
+                continue
+            xml = export / "scene.xml"
+            meshes = sorted((export / "meshes").glob("*.ply"))
+            lux_key = file_digest(export / "scene.scn", *meshes, ROOT / "bench/luxcore.py")
+            mi_key = file_digest(xml, *meshes, *sorted((export / "textures").glob("*")),
+                                 ROOT / "bench/mitsuba3.py")
 
             def yat_ref(d):
-                print(f"  YAT reference {name} at {ref_spp} spp ...", file=sys.stderr, flush=True)
-                render(scene, ref_spp, args.depth, args.threads, d, REFERENCE_SEED)
+                log(f"  YAT reference {name} at {ref_spp} spp ...")
+                render(scene, ref_spp, args.depth, args.threads, d, REFERENCE_SEED, size)
                 (d / "out.exr").rename(d / "ref.exr")
 
             def lux_ref(d):
-                print(f"  LuxCore reference {name} at {ref_spp} spp ...", file=sys.stderr,
-                      flush=True)
-                render_luxcore(export, ref_spp, args.depth, args.threads, d, REFERENCE_SEED)
+                log(f"  LuxCore reference {name} at {ref_spp} spp ...")
+                render_luxcore(export, ref_spp, args.depth, args.threads, d, REFERENCE_SEED,
+                               size)
                 (d / "lux.exr").rename(d / "ref.exr")
 
-            setting = f"{name}-{ref_spp}spp-d{args.depth}"
+            def mi_ref(d):
+                log(f"  Mitsuba reference {name} at {ref_spp} spp ...")
+                render_mitsuba(xml, MITSUBA_REFERENCE[0], MITSUBA_REFERENCE[1], ref_spp,
+                               args.depth, args.threads, size, d, REFERENCE_SEED, False)
+                (d / "mitsuba.exr").rename(d / "ref.exr")
+
+            setting = f"{name}-{res}-{ref_spp}spp-d{args.depth}"
             y_ref = reference("yat", setting, yat_key, yat_ref)
             l_ref = reference("luxcore", setting, lux_key, lux_ref)
+            m_ref = reference("mitsuba", setting, mi_key, mi_ref)
 
-            print(f"comparing {name} at {spp} spp ...", file=sys.stderr, flush=True)
-            y = render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED)
-            l = render_luxcore(export, spp, args.depth, args.threads, tmp, SHORT_SEED)
-            y_mse = float(np.mean((read_exr(tmp / "out.exr") - y_ref) ** 2))
-            l_mse = float(np.mean((read_exr(tmp / "lux.exr") - l_ref) ** 2))
-            y_eff = 1 / (y_mse * y["render_seconds"])
-            l_eff = 1 / (l_mse * l["render_seconds"])
-            rows.append([
-                name, f"{y['width']}x{y['height']}", f"{spp} / {ref_spp}",
-                f"{y['render_seconds']:.2f}", f"{l['render_seconds']:.2f}",
-                f"{y['samples_per_second'] / 1e6:.3f}", f"{l['samples_per_second'] / 1e6:.3f}",
-                f"{y['samples_per_second'] / l['samples_per_second']:.2f}x",
-                f"{y['rays_per_second'] / 1e6:.2f}", f"{l['rays_per_second'] / 1e6:.2f}",
-                f"{y_mse:.3g}", f"{l_mse:.3g}", f"{y_eff:.3g}", f"{l_eff:.3g}",
-                f"{y_eff / l_eff:.2f}x",
+            load = os.getloadavg()[0]
+            log(f"comparing {name} at {spp} spp (load {load:.1f}) ...")
+            results = []  # (renderer, sampler, figures, mse)
+            y = render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED, size)
+            results.append(("YAT", "Owen-scrambled Sobol", y,
+                            mse(read_exr(tmp / "out.exr"), y_ref)))
+            lx = render_luxcore(export, spp, args.depth, args.threads, tmp, SHORT_SEED, size)
+            results.append((f"LuxCore {lx['pyluxcore']} PATHCPU", lx["sampler"], lx,
+                            mse(read_exr(tmp / "lux.exr"), l_ref)))
+            for variant in MITSUBA_VARIANTS:
+                for sampler in MITSUBA_SAMPLERS:
+                    m = render_mitsuba(xml, variant, sampler, spp, args.depth, args.threads,
+                                       size, tmp, SHORT_SEED, True)
+                    results.append((f"Mitsuba {m['mitsuba']} {variant}", sampler, m,
+                                    mse(read_exr(tmp / "mitsuba.exr"), m_ref)))
+            effs = [1 / (e * f["render_seconds"]) for _, _, f, e in results]
+            for (who, sampler, f, e), eff in zip(results, effs):
+                rays = f.get("rays_per_second")
+                runs.append([
+                    name, who, sampler, f"{f['render_seconds']:.2f}",
+                    f"{f['samples_per_second'] / 1e6:.3f}",
+                    f"{rays / 1e6:.2f}" if rays else "-", f"{e:.3g}", f"{eff:.3g}",
+                    f"{effs[0] / eff:.2f}x",
+                ])
+
+            def best(variant):
+                i = max((i for i, r in enumerate(results) if r[0].endswith(variant)),
+                        key=lambda i: effs[i])
+                return f"{effs[0] / effs[i]:.2f}x ({results[i][1]})"
+
+            summary.append([
+                name, res, f"{spp} / {ref_spp}", f"{load:.1f}",
                 f"{y_ref.mean() / l_ref.mean():.3f}", f"{block_correlation(y_ref, l_ref):.4f}",
+                f"{y_ref.mean() / m_ref.mean():.3f}", f"{block_correlation(y_ref, m_ref):.4f}",
+                f"{effs[0] / effs[1]:.2f}x", best("scalar_rgb"), best("llvm_ad_rgb"),
             ])
-    header = [
-        "scene", "resolution", "spp / ref spp", "YAT s", "LuxCore s", "YAT M samples/s",
-        "LuxCore M samples/s", "samples/s ratio", "YAT M rays/s", "LuxCore M rays/s", "YAT MSE",
-        "LuxCore MSE", "YAT efficiency", "LuxCore efficiency", "efficiency ratio",
-        "mean ratio (refs)", "block corr (refs)",
-    ]
-    return table(header, rows), notes
+    runs_table = table(
+        ["scene", "renderer", "sampler", "render s", "M samples/s", "M rays/s", "MSE",
+         "efficiency", "YAT efficiency / this"],
+        runs,
+    )
+    summary_table = table(
+        ["scene", "resolution", "spp / ref spp", "load", "mean YAT / LuxCore (refs)",
+         "block corr", "mean YAT / Mitsuba (refs)", "block corr",
+         "efficiency YAT / LuxCore", "YAT / Mitsuba scalar best", "YAT / Mitsuba llvm best"],
+        summary,
+    )
+    return runs_table, summary_table, notes
 
 
 def fmt_row(cols, widths):
@@ -273,6 +352,74 @@ def table(header, rows):
     return "\n".join(lines)
 
 
+def machine():
+    cpu = platform.processor() or platform.machine()
+    try:
+        cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if "model name" in l)
+    except (OSError, StopIteration):
+        pass
+    return f"{cpu}, {os.cpu_count()} cores"
+
+
+def side_by_side_section(args):
+    """The side-by-side section of RESULTS.md (run now)."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+    import mitsuba3
+
+    before = os.getloadavg()
+    runs_table, summary_table, notes = side_by_side(args)
+    after = os.getloadavg()
+    notes = "\n".join(f"- {n}" for n in notes) or "- none"
+    approximations = "\n".join(f"- {a}" for a in mitsuba3.APPROXIMATIONS)
+    size = COMPARED_RESOLUTION
+    return f"""## Side by side with LuxCoreRender and Mitsuba 3
+
+- machine: {machine()}; {args.threads} render threads for every renderer
+- date: {datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
+- command: `python3 bench/bench.py {" ".join(sys.argv[1:])}` (setup: `bench/setup-env.sh`,
+  which `bench.py` runs itself)
+- load average (1 min) {before[0]:.1f} at the start, {after[0]:.1f} at the end; the "load"
+  column is at each scene's timed renders. The machine is shared with other builds: absolute
+  figures move with the load, ratios within one scene's renders (run back to back) are what
+  the table is for.
+
+Each scene as YAT parsed it, written out by `yat export-luxcore` (LuxCore's own .lxs importer
+drops the spheres and the planar mapping, refuses metal2's fresnel colour and loses the named
+materials and the camera) and converted from that export to Mitsuba 3's XML by
+`bench/mitsuba3.py`. The export writes YAT's null-material lamps (they emit and let every ray
+through) as clear, index-matched glass carrying the emission: a surface rays stop at, collect
+the emission and go on through unchanged. It used to write black matte, which absorbed the rays
+reaching the lamp (LuxCore's Cornell box came out 1.3% darker than YAT's); LuxCore's own `null`
+material is skipped inside its intersection routine, so no ray would see the emission. LuxCore's
+image also comes out one pixel row lower than YAT's and Mitsuba's; `bench/luxcore.py` moves
+its screen window down one row to match. All render at {size[0]}x{size[1]}, path depth {args.depth}, on the same
+threads. Each renderer renders a converged reference of its own ({args.ref_spp} spp, another
+seed; Mitsuba's with `{MITSUBA_REFERENCE[0]}` and `{MITSUBA_REFERENCE[1]}`, one reference for
+both variants) and short renders ({args.compare_spp} spp). MSE is per channel over all pixels of
+the linear images, efficiency = 1 / (MSE x render s), and "YAT efficiency / this" is YAT's over
+the row's. The summary compares the references (mean radiance, and correlation of 16x16-pixel
+block luminance: the renderers rendered the same picture) and names each Mitsuba variant's
+most efficient sampler.
+
+Render seconds: YAT's and LuxCore's from the scene and BVH being ready to the last sample;
+Mitsuba's around `mi.render` on a loaded scene, after an untimed render of the same size (the
+llvm variant JIT-compiles its kernels on the first render, several seconds; they are cached
+after that). LuxCore runs PATHCPU with its default sampler (SOBOL, adaptive strength 0.95);
+its samples/s and rays/s are its own statistics.
+
+{summary_table}
+
+{runs_table}
+
+What the Mitsuba conversion matches and approximates:
+{approximations}
+
+Export notes:
+{notes}
+"""
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--spp", type=int, default=16, help="samples per pixel (default 16)")
@@ -280,31 +427,48 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count(), help="render threads")
     ap.add_argument("--quick", action="store_true", help="4 spp, and do not write RESULTS.md")
     ap.add_argument("--only", help="render only scenes whose path contains this text")
-    ap.add_argument("--no-luxcore", action="store_true", help="skip the LuxCore side by side")
-    ap.add_argument("--luxcore-only", action="store_true",
-                    help="only the LuxCore side by side (prints, does not write RESULTS.md)")
+    ap.add_argument("--no-compare", action="store_true",
+                    help="skip the side by side with LuxCore and Mitsuba")
+    ap.add_argument("--compare-only", action="store_true",
+                    help="only the side by side; rewrites its section of RESULTS.md")
+    ap.add_argument("--compare-spp", type=int, default=16,
+                    help="spp of the side by side's timed renders (default 16)")
+    ap.add_argument("--ref-spp", type=int, default=1024,
+                    help="spp of the side by side's converged references (default 1024)")
+    ap.add_argument("--no-build", action="store_true",
+                    help="use the release binary as it is (do not run cargo build first)")
     args = ap.parse_args()
     spp = 4 if args.quick else args.spp
-    with_luxcore = not (args.quick or args.no_luxcore) and SEED.exists()
-    if with_luxcore:
+    with_compare = not (args.quick or args.no_compare) and SEED.exists()
+    if with_compare:
         ensure_venv()
 
-    build()
+    if not args.no_build:
+        build()
+    results = ROOT / "bench/RESULTS.md"
+    if args.compare_only:
+        section = side_by_side_section(args)
+        print(section)
+        if not args.only:
+            old = results.read_text() if results.exists() else "# YAT benchmark results\n"
+            head = old.split("## Side by side")[0].rstrip("\n")
+            results.write_text(f"{head}\n\n{section}")
+            log("rewrote the side-by-side section of bench/RESULTS.md")
+        return
+
     scenes = [("seed", SEED / s, (t, here)) for s, t, here in SEED_TABLE] + [
         ("own", ROOT / "scenes" / s, None) for s in OWN_SCENES
     ]
     if args.only:
         scenes = [s for s in scenes if args.only in str(s[1])]
     if not SEED.exists():
-        print(f"seed scenes not found at {SEED}: benchmarking our own scenes only", file=sys.stderr)
+        log(f"seed scenes not found at {SEED}: benchmarking our own scenes only")
         scenes = [s for s in scenes if s[0] == "own"]
-    if args.luxcore_only:
-        scenes = []
 
     rows, seed_rows = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for kind, scene, original in scenes:
-            print(f"rendering {scene.name} at {spp} spp ...", file=sys.stderr, flush=True)
+            log(f"rendering {scene.name} at {spp} spp ...")
             f = render(scene, spp, args.depth, args.threads, Path(tmp))
             core_s_per_sample = f["render_seconds"] * args.threads / max(f["samples"], 1)
             rows.append([
@@ -343,36 +507,10 @@ def main():
          "core-s ratio", "hardware", "beyond hardware"],
         seed_rows,
     )
-    luxcore_section = ""
-    if with_luxcore:
-        lux_table, lux_notes = luxcore_comparison(args)
-        notes = "\n".join(f"- {n}" for n in lux_notes)
-        luxcore_section = f"""
-## Side by side with LuxCoreRender
-
-Each scene as YAT parsed it, written out by `yat export-luxcore` (LuxCore's own .lxs importer
-drops the spheres and the planar mapping, refuses metal2's fresnel colour and loses the named
-materials and the camera), rendered by pyluxcore {REQUIREMENTS[0].split("==")[1]} with PATHCPU and
-its default sampler (SOBOL, adaptive strength 0.95), same threads and path depth. Each renderer
-renders a converged reference of its own (ref spp, another seed) and a short render (spp);
-MSE is per channel over all pixels of the linear images, efficiency = 1 / (MSE x render s), and
-the efficiency ratio is YAT's over LuxCore's. "mean ratio" and "block corr" compare the two
-references (mean radiance, and correlation of 16x16-pixel block luminance): the two renderers
-rendered the same picture.
-
-{lux_table}
-
-Export notes:
-{notes}
-"""
-    cpu = platform.processor() or platform.machine()
-    try:
-        cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if "model name" in l)
-    except (OSError, StopIteration):
-        pass
+    compare_section = side_by_side_section(args) if with_compare else ""
     report = f"""# YAT benchmark results
 
-- machine: {cpu}, {os.cpu_count()} cores; {args.threads} render threads
+- machine: {machine()}; {args.threads} render threads
 - date: {datetime.date.today().isoformat()}
 - command: `python3 bench/bench.py{' --spp ' + str(args.spp) if args.spp != 16 else ''}`
 - settings: {spp} spp, path depth {args.depth}, release build
@@ -393,11 +531,12 @@ here (2 threads, depth 10; measured on five of the scenes). "beyond hardware" is
 core-seconds ratio divided by it: the part of the lead that is YAT's, not the machine's.
 
 {seed_table}
-{luxcore_section}"""
+
+{compare_section}"""
     print(report)
-    if not (args.quick or args.only or args.luxcore_only or args.no_luxcore):
-        (ROOT / "bench/RESULTS.md").write_text(report)
-        print("wrote bench/RESULTS.md", file=sys.stderr)
+    if not (args.quick or args.only or args.no_compare):
+        results.write_text(report)
+        log("wrote bench/RESULTS.md")
 
 
 if __name__ == "__main__":

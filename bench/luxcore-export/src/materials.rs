@@ -9,8 +9,8 @@ use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror
 use crate::materials_extra;
 use crate::props::{mat_name, quoted, tex_name, tex_value, v3, Props};
 
-/// Writes material `m` under `name`; `emission` is added for emitting shapes (a null material
-/// that emits becomes black matte: it shows the light and reflects nothing).
+/// Writes material `m` under `name`; `emission` is added for emitting shapes. A null material
+/// that emits becomes clear glass (see [`write_null_emitter`]).
 pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<Vec3>) {
     let prefix = format!("scene.materials.{name}");
     let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
@@ -104,10 +104,7 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
             set("kr", tex_value(kr, true));
             set("kt", tex_value(kt, true));
         }
-        MaterialDesc::Null(_) if emission.is_some() => {
-            set("type", quoted("matte"));
-            set("kd", "0 0 0".into());
-        }
+        MaterialDesc::Null(_) if emission.is_some() => write_null_emitter(p, &prefix),
         MaterialDesc::Bumped(material, bump) => {
             write_material(p, name, material, emission);
             // A normalmap texture is exported as LuxCore's normalmap, which bumps through
@@ -139,4 +136,21 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
         p.set(format!("{prefix}.emission.power"), 0);
         p.set(format!("{prefix}.emission.efficency"), 0);
     }
+}
+
+/// A lamp with YAT's `null` material emits and is otherwise invisible: a ray that reaches it
+/// collects the emission and goes on through unchanged. LuxCore's own `null` material is no
+/// good for that: it is a pass-through surface, skipped inside scene intersection, so rays
+/// never stop on it and its emission is only ever seen by light sampling (MIS loses the BSDF
+/// half). Black matte (what this export once wrote) stops and absorbs every ray that reaches
+/// the lamp, darkening what lies behind it (about 1% in the Cornell box). Clear glass with no
+/// reflection and matched indices is a real hit (emission with MIS) whose only event carries
+/// the ray straight on with weight 1; it blocks shadow rays, as YAT's null surfaces do. What
+/// differs: LuxCore counts that crossing as a specular bounce of the path depth, YAT does not.
+fn write_null_emitter(p: &mut Props, prefix: &str) {
+    p.set(format!("{prefix}.type"), quoted("glass"));
+    p.set(format!("{prefix}.kr"), "0 0 0");
+    p.set(format!("{prefix}.kt"), "1 1 1");
+    p.set(format!("{prefix}.interiorior"), 1);
+    p.set(format!("{prefix}.exteriorior"), 1);
 }

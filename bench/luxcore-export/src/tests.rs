@@ -69,7 +69,7 @@ fn fisheye_is_refused() {
 }
 
 #[test]
-fn emitter_gets_its_own_black_material_with_the_parsed_radiance() {
+fn null_emitter_is_clear_glass_that_neither_reflects_nor_bends_with_the_parsed_radiance() {
     let lux = export_world(
         "AttributeBegin\nMaterial \"null\"\n\
          AreaLightSource \"area\" \"color L\" [1 0.5 0.25] \"float gain\" [4] \"float power\" [0]\n\
@@ -78,8 +78,20 @@ fn emitter_gets_its_own_black_material_with_the_parsed_radiance() {
     );
     let scn = &lux.scene;
     assert_eq!(value(scn, "scene.objects.object0.material"), "\"emitter0\"");
-    assert_eq!(value(scn, "scene.materials.emitter0.type"), "\"matte\"");
-    assert_eq!(floats(value(scn, "scene.materials.emitter0.kd")), [0.0; 3]);
+    // Not a black blocker (matte kd 0) and not LuxCore's pass-through null (which hides the
+    // emission from every ray that reaches it): a hit that transmits everything straight on.
+    assert_eq!(value(scn, "scene.materials.emitter0.type"), "\"glass\"");
+    assert_eq!(floats(value(scn, "scene.materials.emitter0.kr")), [0.0; 3]);
+    assert_eq!(floats(value(scn, "scene.materials.emitter0.kt")), [1.0; 3]);
+    assert_eq!(
+        floats(value(scn, "scene.materials.emitter0.interiorior")),
+        [1.0]
+    );
+    assert_eq!(
+        floats(value(scn, "scene.materials.emitter0.exteriorior")),
+        [1.0]
+    );
+    assert!(!scn.contains("scene.materials.emitter0.kd"), "{scn}");
     assert_eq!(
         floats(value(scn, "scene.materials.emitter0.emission")),
         [4.0, 2.0, 1.0]
