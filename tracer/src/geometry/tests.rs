@@ -695,7 +695,7 @@ fn bvh_throughput() {
         let occluded = |r: &Ray| geometry.occluded(r, f32::INFINITY);
         let reference_intersect = |r: &Ray| {
             let ray = obvhs::ray::Ray::new_inf(r.origin.into(), canonical_dir(r.dir));
-            let mut hit = RayHit::none();
+            let mut hit = obvhs::ray::RayHit::none();
             reference.ray_traverse(ray, &mut hit, |ray, id| {
                 tris[reference.primitive_indices[id] as usize].intersect(ray)
             })
