@@ -32,7 +32,7 @@ use crate::shape::Geometry;
 use crate::shape::ShapeDesc;
 
 pub use analytic::AnalyticShape;
-pub use hit::{SurfaceHit, SurfaceSample};
+pub use hit::{PrimHit, SurfaceHit, SurfaceSample};
 pub use simd::Isa;
 pub use triangle::TriangleSurface;
 pub use world_range::MAX_WORLD_COORD;
@@ -202,21 +202,31 @@ impl SceneGeometry {
         self.bvh.set_isa(isa)
     }
 
-    /// Closest hit with t in (0, tmax). Equal distances go to the lowest primitive index.
+    /// Closest hit with t in (0, tmax), with everything shading needs.
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<SurfaceHit> {
+        self.surface(ray, &self.closest(ray, tmax)?)
+    }
+
+    /// The closest primitive with t in (0, tmax): the traversal alone. Equal distances go to
+    /// the lowest primitive index.
+    pub fn closest(&self, ray: &Ray, tmax: f32) -> Option<PrimHit> {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) || tmax.is_nan() {
             return None;
         }
         let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
-        let mut plane_hit = None;
+        let mut closest = None;
         let mut t_closest = tmax;
         for (i, plane) in self.planes.iter().enumerate() {
             if let Some(t) = plane.intersect(origin, dir, t_closest) {
                 t_closest = t;
-                plane_hit = Some(i);
+                closest = Some(PrimHit {
+                    prim: (self.prims.len() + i) as u32,
+                    t,
+                    b1: 0.0,
+                    b2: 0.0,
+                });
             }
         }
-
         let hit = self.bvh.closest(origin, dir, t_closest, |slot, bound| {
             match self.prims[slot as usize] {
                 Prim::Analytic(a) => self.analytic[a as usize]
@@ -225,24 +235,33 @@ impl SceneGeometry {
                 Prim::Triangle { .. } => None,
             }
         });
-        match (hit, plane_hit) {
-            (Some(hit), _) => match self.prims[hit.slot as usize] {
-                Prim::Triangle { edges, mesh, tri } => Some(self.meshes[mesh as usize].hit(
-                    tri, &edges, hit.t, hit.b1, hit.b2, hit.slot,
-                )),
-                Prim::Analytic(a) => {
-                    // The details of the accepted root: the nearest root below t's successor
-                    // is t again (the traversal's bound was at least that).
-                    let shape = &self.analytic[a as usize];
-                    let quadric = shape.intersect(origin, dir, hit.t.next_up())?;
-                    Some(shape.hit(quadric, hit.slot))
-                }
-            },
-            (None, Some(i)) => {
-                let prim = (self.prims.len() + i) as u32;
-                Some(self.planes[i].hit(origin, dir, t_closest, prim))
+        hit.map(|h| PrimHit {
+            prim: h.slot,
+            t: h.t,
+            b1: h.b1,
+            b2: h.b2,
+        })
+        .or(closest)
+    }
+
+    /// The surface data of `hit`, which [`Self::closest`] returned for `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &PrimHit) -> Option<SurfaceHit> {
+        let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
+        match self.prims.get(hit.prim as usize) {
+            Some(&Prim::Triangle { edges, mesh, tri }) => Some(
+                self.meshes[mesh as usize].hit(tri, &edges, hit.t, hit.b1, hit.b2, hit.prim),
+            ),
+            Some(&Prim::Analytic(a)) => {
+                // The details of the accepted root: the nearest root below t's successor is t
+                // again (the traversal's bound was at least that).
+                let shape = &self.analytic[a as usize];
+                let quadric = shape.intersect(origin, dir, hit.t.next_up())?;
+                Some(shape.hit(quadric, hit.prim))
             }
-            (None, None) => None,
+            None => {
+                let plane = self.planes.get(hit.prim as usize - self.prims.len())?;
+                Some(plane.hit(origin, dir, hit.t, hit.prim))
+            }
         }
     }
 

@@ -245,22 +245,8 @@ impl WideBvh {
         let mut node = 0u32;
         'nodes: loop {
             let n = &self.nodes[node as usize];
-            let mut mask = K::slabs(n, &kray, best.t, &mut tnear);
-            // Push the hit children so that the nearest is on top (equal distances keep slot
-            // order): an insertion sort, as most nodes have one to three hits.
-            let base = sp;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let entry = (n.child[i], tnear[i]);
-                let mut j = sp;
-                while j > base && stack[j - 1].1 < entry.1 {
-                    stack[j] = stack[j - 1];
-                    j -= 1;
-                }
-                stack[j] = entry;
-                sp += 1;
-            }
+            let mask = K::slabs(n, &kray, best.t, &mut tnear);
+            sp = push_nearest_last(stack, sp, n, mask, &tnear);
             while sp > 0 {
                 sp -= 1;
                 let (child, near) = stack[sp];
@@ -320,41 +306,38 @@ impl WideBvh {
         other: impl FnMut(u32, f32) -> bool,
     ) -> bool {
         if self.stack_size <= INLINE_STACK {
-            let mut stack = [0u32; INLINE_STACK];
+            let mut stack = [(0u32, 0f32); INLINE_STACK];
             self.any_on::<K>(ray, tmax, other, &mut stack)
         } else {
-            let mut stack = vec![0u32; self.stack_size];
+            let mut stack = vec![(0u32, 0f32); self.stack_size];
             self.any_on::<K>(ray, tmax, other, &mut stack)
         }
     }
 
+    /// Visits children nearest first, like [`Self::closest`]: a hit near the origin is found
+    /// sooner, and shadow rays usually end on something near.
     #[inline(always)]
     fn any_on<K: Kernel>(
         &self,
         ray: &TraversalRay,
         tmax: f32,
         mut other: impl FnMut(u32, f32) -> bool,
-        stack: &mut [u32],
+        stack: &mut [(u32, f32)],
     ) -> bool {
         let kray = K::prepare(ray);
         // The kernels accept t <= bound; the query wants t < tmax.
         let bound = tmax.next_down();
         let mut tnear = [0f32; WIDTH];
         let mut hits = PacketHits::default();
-        stack[0] = 0;
+        stack[0] = (0, 0.0);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let child = stack[sp];
+            let child = stack[sp].0;
             if child & LEAF == 0 {
                 let n = &self.nodes[child as usize];
-                let mut mask = K::slabs(n, &kray, bound, &mut tnear);
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp] = n.child[i];
-                    sp += 1;
-                }
+                let mask = K::slabs(n, &kray, bound, &mut tnear);
+                sp = push_nearest_last(stack, sp, n, mask, &tnear);
                 continue;
             }
             let index = (child & MAX_PACKETS) as usize;
@@ -374,4 +357,31 @@ impl WideBvh {
         }
         false
     }
+}
+
+/// Pushes the children of `node` set in `mask` onto `stack[sp..]` with their entry distances,
+/// the nearest last (on top; equal distances keep slot order): an insertion sort, as most
+/// nodes have one to three hits. Returns the new stack size.
+#[inline(always)]
+fn push_nearest_last(
+    stack: &mut [(u32, f32)],
+    mut sp: usize,
+    node: &Node,
+    mut mask: u32,
+    tnear: &[f32; WIDTH],
+) -> usize {
+    let base = sp;
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let entry = (node.child[i], tnear[i]);
+        let mut j = sp;
+        while j > base && stack[j - 1].1 < entry.1 {
+            stack[j] = stack[j - 1];
+            j -= 1;
+        }
+        stack[j] = entry;
+        sp += 1;
+    }
+    sp
 }

@@ -1,7 +1,7 @@
 //! The kernels as plain scalar code: the reference every SIMD kernel matches bit for bit, and
 //! the path on CPUs without one (aarch64).
 
-use super::super::wide_node::{
+use crate::geometry::wide_node::{
     slab_lane, triangle_lane, Kernel, Node, Packet, PacketHits, TraversalRay, PACKET, WIDTH,
 };
 

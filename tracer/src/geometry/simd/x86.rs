@@ -10,7 +10,7 @@
 
 use std::arch::x86_64::*;
 
-use super::super::wide_node::{
+use crate::geometry::wide_node::{
     far_row_of, Kernel, Node, Packet, PacketHits, TraversalRay, SLAB_ROBUST, WIDTH,
 };
 
@@ -152,11 +152,15 @@ impl Kernel for Avx2 {
     #[inline(always)]
     fn prepare(ray: &TraversalRay) -> Avx2Ray {
         // SAFETY: only called from traversal functions compiled with AVX2 after detection.
+        // (No closures around AVX intrinsics here: a closure is its own function without the
+        // caller's target features, so the intrinsics in it would not inline.)
         unsafe {
+            let [ox, oy, oz] = ray.origin;
+            let [ix, iy, iz] = ray.inv_dir;
             Avx2Ray {
                 tri: Ray4::new(ray),
-                origin: ray.origin.map(|v| _mm256_set1_ps(v)),
-                inv_dir: ray.inv_dir.map(|v| _mm256_set1_ps(v)),
+                origin: [_mm256_set1_ps(ox), _mm256_set1_ps(oy), _mm256_set1_ps(oz)],
+                inv_dir: [_mm256_set1_ps(ix), _mm256_set1_ps(iy), _mm256_set1_ps(iz)],
                 near_row: ray.near_row,
                 far_row: ray.near_row.map(far_row_of),
             }
@@ -168,18 +172,30 @@ impl Kernel for Avx2 {
         // SAFETY: AVX2 as above; each load reads one bound row of 8 floats and the store
         // writes `tnear`'s 8 floats.
         unsafe {
-            let plane = |row: usize, axis: usize| {
-                let b = _mm256_loadu_ps(node.bounds[row].as_ptr());
-                _mm256_mul_ps(_mm256_sub_ps(b, ray.origin[axis]), ray.inv_dir[axis])
-            };
-            let n = [0, 1, 2].map(|a| plane(ray.near_row[a], a));
-            let f = [0, 1, 2].map(|a| plane(ray.far_row[a], a));
-            let near = _mm256_max_ps(
-                _mm256_max_ps(n[0], n[1]),
-                _mm256_max_ps(n[2], _mm256_setzero_ps()),
+            macro_rules! plane {
+                ($row:expr, $axis:expr) => {
+                    _mm256_mul_ps(
+                        _mm256_sub_ps(
+                            _mm256_loadu_ps(node.bounds[$row].as_ptr()),
+                            ray.origin[$axis],
+                        ),
+                        ray.inv_dir[$axis],
+                    )
+                };
+            }
+            let (n0, n1, n2) = (
+                plane!(ray.near_row[0], 0),
+                plane!(ray.near_row[1], 1),
+                plane!(ray.near_row[2], 2),
             );
+            let (f0, f1, f2) = (
+                plane!(ray.far_row[0], 0),
+                plane!(ray.far_row[1], 1),
+                plane!(ray.far_row[2], 2),
+            );
+            let near = _mm256_max_ps(_mm256_max_ps(n0, n1), _mm256_max_ps(n2, _mm256_setzero_ps()));
             let far = _mm256_mul_ps(
-                _mm256_min_ps(_mm256_min_ps(f[0], f[1]), f[2]),
+                _mm256_min_ps(_mm256_min_ps(f0, f1), f2),
                 _mm256_set1_ps(SLAB_ROBUST),
             );
             let far = _mm256_min_ps(far, _mm256_set1_ps(tmax));
