@@ -8,6 +8,8 @@
 //! visit in the same order (children sorted by entry distance, equal distances by slot), so
 //! every code path returns the same hit, bit for bit.
 
+use std::mem::MaybeUninit;
+
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -24,6 +26,11 @@ use super::wide_node::{
 /// Stack entries a traversal keeps on the thread's stack; a deeper BVH (degenerate input)
 /// gets a heap stack instead.
 const INLINE_STACK: usize = 256;
+
+/// A traversal stack entry: a child reference and its entry distance. Left uninitialised
+/// until pushed (zeroing 2 KB per ray cost more than a node visit); entries below the stack
+/// size have always been written.
+type Entry = MaybeUninit<(u32, f32)>;
 
 /// A closest hit: the leaf-order primitive index, t, and for triangles the barycentric
 /// weights of the second and third vertices.
@@ -85,6 +92,7 @@ impl WideBvh {
             for i in (0..WIDTH).filter(|&i| !cw.is_child_empty(i)) {
                 let (b, child) = if cw.is_leaf(i) {
                     let (start, n) = cw.child_primitives(i);
+                    node.leaves |= 1 << i;
                     (leaf_box(start, n), wide.push_packet(start, n, triangles))
                 } else {
                     let c = cw.child_node_index(i) as usize;
@@ -128,6 +136,24 @@ impl WideBvh {
         self.packets.push(packet);
         self.other_lanes.push(other);
         LEAF | index | if other != 0 { LEAF_HAS_OTHER } else { 0 }
+    }
+
+    /// The node a child reference (without the leaf bit) names.
+    #[inline(always)]
+    fn node(&self, child: u32) -> &Node {
+        debug_assert!((child as usize) < self.nodes.len());
+        // SAFETY: child references are made by `new`, each the index of a node it pushed, and
+        // the traversals start at node 0 only when there are nodes.
+        unsafe { self.nodes.get_unchecked(child as usize) }
+    }
+
+    /// The packet a leaf reference's index names.
+    #[inline(always)]
+    fn packet(&self, index: usize) -> &Packet {
+        debug_assert!(index < self.packets.len());
+        // SAFETY: leaf references are made by `push_packet`, each the index of the packet it
+        // pushed.
+        unsafe { self.packets.get_unchecked(index) }
     }
 
     /// Runs the traversal on `isa` from now on; false (and no change) when this CPU lacks it.
@@ -215,10 +241,10 @@ impl WideBvh {
         other: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<WideHit> {
         if self.stack_size <= INLINE_STACK {
-            let mut stack = [(0u32, 0f32); INLINE_STACK];
+            let mut stack = [Entry::uninit(); INLINE_STACK];
             self.closest_on::<K>(ray, tmax, other, &mut stack)
         } else {
-            let mut stack = vec![(0u32, 0f32); self.stack_size];
+            let mut stack = vec![Entry::uninit(); self.stack_size];
             self.closest_on::<K>(ray, tmax, other, &mut stack)
         }
     }
@@ -229,7 +255,7 @@ impl WideBvh {
         ray: &TraversalRay,
         tmax: f32,
         mut other: impl FnMut(u32, f32) -> Option<f32>,
-        stack: &mut [(u32, f32)],
+        stack: &mut [Entry],
     ) -> Option<WideHit> {
         let kray = K::prepare(ray);
         // Slot 0 with t = tmax: the tie rule (equal t, lower slot) never accepts t = tmax.
@@ -244,12 +270,21 @@ impl WideBvh {
         let mut sp = 0;
         let mut node = 0u32;
         'nodes: loop {
-            let n = &self.nodes[node as usize];
+            let n = self.node(node);
             let mask = K::slabs(n, &kray, best.t, &mut tnear);
+            // One internal child hit (common for coherent rays): descend without the stack.
+            if mask != 0 && mask & (mask - 1) == 0 {
+                let child = n.child[mask.trailing_zeros() as usize];
+                if child & LEAF == 0 {
+                    node = child;
+                    continue;
+                }
+            }
             sp = push_nearest_last(stack, sp, n, mask, &tnear);
             while sp > 0 {
                 sp -= 1;
-                let (child, near) = stack[sp];
+                // SAFETY: entries below the stack size were pushed.
+                let (child, near) = unsafe { stack.get_unchecked(sp).assume_init() };
                 if near > best.t {
                     continue;
                 }
@@ -258,7 +293,7 @@ impl WideBvh {
                     continue 'nodes;
                 }
                 let index = (child & MAX_PACKETS) as usize;
-                let packet = &self.packets[index];
+                let packet = self.packet(index);
                 let mut lanes = K::triangles(packet, &kray, best.t, &mut hits);
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
@@ -306,53 +341,66 @@ impl WideBvh {
         other: impl FnMut(u32, f32) -> bool,
     ) -> bool {
         if self.stack_size <= INLINE_STACK {
-            let mut stack = [(0u32, 0f32); INLINE_STACK];
+            let mut stack = [MaybeUninit::uninit(); INLINE_STACK];
             self.any_on::<K>(ray, tmax, other, &mut stack)
         } else {
-            let mut stack = vec![(0u32, 0f32); self.stack_size];
+            let mut stack = vec![MaybeUninit::uninit(); self.stack_size];
             self.any_on::<K>(ray, tmax, other, &mut stack)
         }
     }
 
-    /// Visits children nearest first, like [`Self::closest`]: a hit near the origin is found
-    /// sooner, and shadow rays usually end on something near.
+    /// Tests a node's leaf children as soon as the node is hit, before descending (large
+    /// triangles high in the tree end most shadow rays early); internal children are visited
+    /// in slot order, unsorted: any hit will do.
     #[inline(always)]
     fn any_on<K: Kernel>(
         &self,
         ray: &TraversalRay,
         tmax: f32,
         mut other: impl FnMut(u32, f32) -> bool,
-        stack: &mut [(u32, f32)],
+        stack: &mut [MaybeUninit<u32>],
     ) -> bool {
         let kray = K::prepare(ray);
         // The kernels accept t <= bound; the query wants t < tmax.
         let bound = tmax.next_down();
         let mut tnear = [0f32; WIDTH];
         let mut hits = PacketHits::default();
-        stack[0] = (0, 0.0);
+        stack[0] = MaybeUninit::new(0);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let child = stack[sp].0;
-            if child & LEAF == 0 {
-                let n = &self.nodes[child as usize];
-                let mask = K::slabs(n, &kray, bound, &mut tnear);
-                sp = push_nearest_last(stack, sp, n, mask, &tnear);
-                continue;
-            }
-            let index = (child & MAX_PACKETS) as usize;
-            let packet = &self.packets[index];
-            if K::triangles(packet, &kray, bound, &mut hits) != 0 {
-                return true;
-            }
-            if child & LEAF_HAS_OTHER != 0 {
-                let lanes = self.other_lanes[index];
-                if (0..PACKET)
-                    .filter(|lane| lanes & (1 << lane) != 0)
-                    .any(|lane| other(packet.slot[lane], tmax))
-                {
+            // SAFETY: entries below the stack size were pushed.
+            let n = self.node(unsafe { stack.get_unchecked(sp).assume_init() });
+            let mask = K::slabs(n, &kray, bound, &mut tnear);
+            let mut leaves = mask & n.leaves;
+            while leaves != 0 {
+                let i = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                let child = n.child[i];
+                let index = (child & MAX_PACKETS) as usize;
+                let packet = self.packet(index);
+                if K::triangles(packet, &kray, bound, &mut hits) != 0 {
                     return true;
                 }
+                if child & LEAF_HAS_OTHER != 0 {
+                    let lanes = self.other_lanes[index];
+                    if (0..PACKET)
+                        .filter(|lane| lanes & (1 << lane) != 0)
+                        .any(|lane| other(packet.slot[lane], tmax))
+                    {
+                        return true;
+                    }
+                }
+            }
+            let mut inner = mask & !n.leaves;
+            while inner != 0 {
+                let i = inner.trailing_zeros() as usize;
+                inner &= inner - 1;
+                debug_assert!(sp < stack.len());
+                // SAFETY: `stack` holds `stack_size` entries, at least what a traversal of
+                // this BVH's depth pushes (see `push_nearest_last`).
+                unsafe { *stack.get_unchecked_mut(sp) = MaybeUninit::new(n.child[i]) };
+                sp += 1;
             }
         }
         false
@@ -364,7 +412,7 @@ impl WideBvh {
 /// nodes have one to three hits. Returns the new stack size.
 #[inline(always)]
 fn push_nearest_last(
-    stack: &mut [(u32, f32)],
+    stack: &mut [Entry],
     mut sp: usize,
     node: &Node,
     mut mask: u32,
@@ -376,11 +424,18 @@ fn push_nearest_last(
         mask &= mask - 1;
         let entry = (node.child[i], tnear[i]);
         let mut j = sp;
-        while j > base && stack[j - 1].1 < entry.1 {
-            stack[j] = stack[j - 1];
-            j -= 1;
+        debug_assert!(sp < stack.len());
+        // SAFETY: entries base..sp were pushed, and j <= sp < stack.len(): a node at depth d
+        // is visited with at most 7 entries per level above it on the stack (its ancestors'
+        // other children) and pushes at most 8, and `WideBvh::stack_size` (the stack's
+        // length) is 7 x the BVH's depth + 8.
+        unsafe {
+            while j > base && stack.get_unchecked(j - 1).assume_init().1 < entry.1 {
+                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                j -= 1;
+            }
+            *stack.get_unchecked_mut(j) = Entry::new(entry);
         }
-        stack[j] = entry;
         sp += 1;
     }
     sp

@@ -37,12 +37,14 @@ pub const MIN_X: usize = 0;
 pub const MAX_X: usize = 3;
 
 /// Eight children's boxes (rows min x, min y, min z, max x, max y, max z; empty slots have
-/// min = +inf, max = -inf) and references. Four cache lines.
+/// min = +inf, max = -inf) and references. Four cache lines (the last one partly padding).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Node {
     pub bounds: [[f32; WIDTH]; 6],
     pub child: [u32; WIDTH],
+    /// Bit i set when child i is a leaf.
+    pub leaves: u32,
 }
 
 impl Node {
@@ -56,6 +58,7 @@ impl Node {
             [f32::NEG_INFINITY; WIDTH],
         ],
         child: [EMPTY; WIDTH],
+        leaves: 0,
     };
 }
 
