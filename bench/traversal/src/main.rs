@@ -17,7 +17,6 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-
 use anyhow::{bail, ensure, Context, Result};
 use clap::Parser;
 use glam::{Vec2, Vec3, Vec3A};
@@ -81,7 +80,11 @@ fn main() -> Result<()> {
     let args = Args::parse();
     let desc = load(&args.scene)?;
     let (positions, indices) = world_triangles(&desc);
-    ensure!(!indices.is_empty(), "{} has no triangles", args.scene.display());
+    ensure!(
+        !indices.is_empty(),
+        "{} has no triangles",
+        args.scene.display()
+    );
     // YAT's geometry from the meshes only, so that all three trace the same triangles.
     let shapes: Vec<_> = desc
         .shapes
@@ -159,7 +162,8 @@ fn main() -> Result<()> {
             }
             if let Some(embree) = &args.embree {
                 let out = tmp.join("out.bin");
-                let (secs, a) = trace_embree(embree, &args.quality, &geometry_file, &ray_file, &out)?;
+                let (secs, a) =
+                    trace_embree(embree, &args.quality, &geometry_file, &ray_file, &out)?;
                 record("Embree".into(), secs);
                 if round == 0 {
                     answers.push(("Embree".into(), a));
@@ -170,12 +174,21 @@ fn main() -> Result<()> {
 
         println!("\n{set_name} rays: {}", rays.len());
         let hits = answers[0].1.closest.iter().filter(|h| h.is_some()).count();
-        println!("  hits {hits} ({:.1}%)", 100.0 * hits as f64 / rays.len() as f64);
+        println!(
+            "  hits {hits} ({:.1}%)",
+            100.0 * hits as f64 / rays.len() as f64
+        );
         let reference = &answers[0];
         let mut failed = false;
         for (name, a) in &answers[1..] {
             let closest = disagreements(&reference.1.closest, &a.closest);
-            let any = reference.1.any.iter().zip(&a.any).filter(|(x, y)| x != y).count();
+            let any = reference
+                .1
+                .any
+                .iter()
+                .zip(&a.any)
+                .filter(|(x, y)| x != y)
+                .count();
             let allowed = (rays.len() as f64 * ALLOWED_DISAGREEMENT).ceil() as usize;
             let ok = closest <= allowed && any <= allowed;
             failed |= !ok;
@@ -193,9 +206,8 @@ fn main() -> Result<()> {
         );
         for (name, secs) in &best {
             let rate = secs.map(|s| rays.len() as f64 / s / 1e6);
-            let ratio = |q: usize| {
-                embree.map_or("-".to_string(), |e| format!("{:.2}", e[q] / secs[q]))
-            };
+            let ratio =
+                |q: usize| embree.map_or("-".to_string(), |e| format!("{:.2}", e[q] / secs[q]));
             println!(
                 "  {name:<12} {:>14.2} {:>14.2} {:>10} {:>10}",
                 rate[0],
@@ -255,10 +267,12 @@ fn camera_rays(desc: &SceneDesc, width: u32) -> Vec<BenchRay> {
         .flat_map(|y| (0..width).map(move |x| (x, y)))
         .filter_map(|(x, y)| {
             let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            camera.generate_ray(film, Vec2::splat(0.5)).map(|ray| BenchRay {
-                ray,
-                tmax: f32::INFINITY,
-            })
+            camera
+                .generate_ray(film, Vec2::splat(0.5))
+                .map(|ray| BenchRay {
+                    ray,
+                    tmax: f32::INFINITY,
+                })
         })
         .collect()
 }
@@ -270,7 +284,11 @@ fn bounce_rays(geometry: &SceneGeometry, camera: &[BenchRay]) -> Vec<BenchRay> {
         .filter_map(|r| geometry.intersect(&r.ray, r.tmax))
         .zip(camera)
         .map(|(hit, r)| {
-            let n = if hit.ng.dot(r.ray.dir) > 0.0 { -hit.ng } else { hit.ng };
+            let n = if hit.ng.dot(r.ray.dir) > 0.0 {
+                -hit.ng
+            } else {
+                hit.ng
+            };
             // Uniform over the hemisphere around n.
             let z = rng.f32();
             let phi = std::f32::consts::TAU * rng.f32();
@@ -373,7 +391,10 @@ fn trace_embree(
         .with_context(|| format!("cannot run {}", program.display()))?;
     ensure!(status.success(), "{} failed: {status}", program.display());
     let bytes = std::fs::read(out)?;
-    ensure!(bytes.len() >= 16 && (bytes.len() - 16) % 9 == 0, "bad embree output");
+    ensure!(
+        bytes.len() >= 16 && (bytes.len() - 16) % 9 == 0,
+        "bad embree output"
+    );
     let f64_at = |i: usize| f64::from_le_bytes(bytes[i..i + 8].try_into().expect("8 bytes"));
     let (mut closest, mut any) = (Vec::new(), Vec::new());
     for rec in bytes[16..].chunks_exact(9) {
@@ -424,4 +445,3 @@ fn write_rays(path: &Path, rays: &[BenchRay]) -> Result<()> {
     }
     Ok(std::fs::write(path, out)?)
 }
-

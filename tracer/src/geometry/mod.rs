@@ -248,9 +248,9 @@ impl SceneGeometry {
     pub fn surface(&self, ray: &Ray, hit: &PrimHit) -> Option<SurfaceHit> {
         let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
         match self.prims.get(hit.prim as usize) {
-            Some(&Prim::Triangle { edges, mesh, tri }) => Some(
-                self.meshes[mesh as usize].hit(tri, &edges, hit.t, hit.b1, hit.b2, hit.prim),
-            ),
+            Some(&Prim::Triangle { edges, mesh, tri }) => {
+                Some(self.meshes[mesh as usize].hit(tri, &edges, hit.t, hit.b1, hit.b2, hit.prim))
+            }
             Some(&Prim::Analytic(a)) => {
                 // The details of the accepted root: the nearest root below t's successor is t
                 // again (the traversal's bound was at least that).

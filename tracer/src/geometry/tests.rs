@@ -751,7 +751,8 @@ fn seed_falcon() -> Option<Vec<ShapeDesc>> {
     let root = std::env::var_os("YAT_SEED_SCENES")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| {
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/seed-project/scenes")
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shared/seed-project/scenes")
         });
     let dir = root.join("CaptainFalcon");
     if !dir.is_dir() {
@@ -832,7 +833,11 @@ fn every_isa_returns_bit_identical_hits() {
                     _ => a + (b - a) * rng.f32() + (c - a) * rng.f32() * 0.5,
                 };
                 let dir = (Vec3::from(target) - origin).normalize_or_zero();
-                let dir = if i % 5 == 4 { random_unit(&mut rng) } else { dir };
+                let dir = if i % 5 == 4 {
+                    random_unit(&mut rng)
+                } else {
+                    dir
+                };
                 let tmax = if i % 4 == 3 {
                     rng.f32() * (hi - lo).length()
                 } else {
@@ -850,6 +855,9 @@ fn every_isa_returns_bit_identical_hits() {
                 assert_eq!(r, g, "{name}, ray {i}: Scalar vs {isa:?}");
             }
         }
-        println!("{name}: {} rays, {hits} hits, identical on {isas:?}", rays.len());
+        println!(
+            "{name}: {} rays, {hits} hits, identical on {isas:?}",
+            rays.len()
+        );
     }
 }

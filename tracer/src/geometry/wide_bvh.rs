@@ -14,9 +14,9 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 
-use super::simd::{Isa, Scalar};
 #[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Sse};
+use super::simd::{Isa, Scalar};
 use super::triangle::TriangleEdges;
 use super::wide_node::{
     Kernel, Node, Packet, PacketHits, TraversalRay, LEAF, LEAF_HAS_OTHER, MAX_PACKETS, PACKET,

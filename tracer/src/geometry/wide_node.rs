@@ -30,7 +30,8 @@ pub const NO_SLOT: u32 = u32::MAX;
 
 /// pbrt's robust slab test factor, 1 + 2 gamma(3): the far distance is scaled up so rounding
 /// in the slab arithmetic never rejects a box the ray touches.
-pub const SLAB_ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub const SLAB_ROBUST: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// Order of the six bound rows in [`Node::bounds`].
 pub const MIN_X: usize = 0;
@@ -106,7 +107,13 @@ impl TraversalRay {
             1.0 / safe
         };
         let inv_dir = dir.map(inv);
-        let near_row = [0, 1, 2].map(|a| if inv_dir[a] >= 0.0 { MIN_X + a } else { MAX_X + a });
+        let near_row = [0, 1, 2].map(|a| {
+            if inv_dir[a] >= 0.0 {
+                MIN_X + a
+            } else {
+                MAX_X + a
+            }
+        });
         Self {
             origin,
             dir,
@@ -145,9 +152,8 @@ pub trait Kernel {
 pub fn slab_lane(node: &Node, ray: &TraversalRay, lane: usize, tmax: f32) -> (bool, f32) {
     let min = |a: f32, b: f32| if a < b { a } else { b };
     let max = |a: f32, b: f32| if a > b { a } else { b };
-    let plane = |row: usize, axis: usize| {
-        (node.bounds[row][lane] - ray.origin[axis]) * ray.inv_dir[axis]
-    };
+    let plane =
+        |row: usize, axis: usize| (node.bounds[row][lane] - ray.origin[axis]) * ray.inv_dir[axis];
     let near = [0, 1, 2].map(|a| plane(ray.near_row[a], a));
     let far = [0, 1, 2].map(|a| plane(far_row_of(ray.near_row[a]), a));
     let tnear = max(max(near[0], near[1]), max(near[2], 0.0));

@@ -43,9 +43,21 @@ fn triangles4(packet: &Packet, ray: &Ray4, tmax: f32, hits: &mut PacketHits) -> 
         let load = |row: &[f32; 4]| _mm_loadu_ps(row.as_ptr());
         let [ox, oy, oz] = ray.origin;
         let [dx, dy, dz] = ray.dir;
-        let (p0x, p0y, p0z) = (load(&packet.p0[0]), load(&packet.p0[1]), load(&packet.p0[2]));
-        let (e1x, e1y, e1z) = (load(&packet.e1[0]), load(&packet.e1[1]), load(&packet.e1[2]));
-        let (e2x, e2y, e2z) = (load(&packet.e2[0]), load(&packet.e2[1]), load(&packet.e2[2]));
+        let (p0x, p0y, p0z) = (
+            load(&packet.p0[0]),
+            load(&packet.p0[1]),
+            load(&packet.p0[2]),
+        );
+        let (e1x, e1y, e1z) = (
+            load(&packet.e1[0]),
+            load(&packet.e1[1]),
+            load(&packet.e1[2]),
+        );
+        let (e2x, e2y, e2z) = (
+            load(&packet.e2[0]),
+            load(&packet.e2[1]),
+            load(&packet.e2[2]),
+        );
         let mul = |a, b| _mm_mul_ps(a, b);
         let sub = |a, b| _mm_sub_ps(a, b);
         let add = |a, b| _mm_add_ps(a, b);
@@ -118,7 +130,10 @@ impl Kernel for Sse {
                 let n = [0, 1, 2].map(|a| plane(ray.near_row[a], a));
                 let f = [0, 1, 2].map(|a| plane(ray.far_row[a], a));
                 let near = _mm_max_ps(_mm_max_ps(n[0], n[1]), _mm_max_ps(n[2], _mm_setzero_ps()));
-                let far = _mm_mul_ps(_mm_min_ps(_mm_min_ps(f[0], f[1]), f[2]), _mm_set1_ps(SLAB_ROBUST));
+                let far = _mm_mul_ps(
+                    _mm_min_ps(_mm_min_ps(f[0], f[1]), f[2]),
+                    _mm_set1_ps(SLAB_ROBUST),
+                );
                 let far = _mm_min_ps(far, _mm_set1_ps(tmax));
                 _mm_storeu_ps(tnear.as_mut_ptr().add(at), near);
                 mask |= (_mm_movemask_ps(_mm_cmple_ps(near, far)) as u32) << at;
@@ -193,7 +208,10 @@ impl Kernel for Avx2 {
                 plane!(ray.far_row[1], 1),
                 plane!(ray.far_row[2], 2),
             );
-            let near = _mm256_max_ps(_mm256_max_ps(n0, n1), _mm256_max_ps(n2, _mm256_setzero_ps()));
+            let near = _mm256_max_ps(
+                _mm256_max_ps(n0, n1),
+                _mm256_max_ps(n2, _mm256_setzero_ps()),
+            );
             let far = _mm256_mul_ps(
                 _mm256_min_ps(_mm256_min_ps(f0, f1), f2),
                 _mm256_set1_ps(SLAB_ROBUST),
