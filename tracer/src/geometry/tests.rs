@@ -763,12 +763,15 @@ fn seed_falcon() -> Option<Vec<ShapeDesc>> {
     Some(desc.shapes)
 }
 
+/// A ray's closest hit (slot, t, b1 and b2 bits) and any-hit answer.
+type IsaAnswer = (Option<(u32, u32, u32, u32)>, bool);
+
 /// The closest hit and the any-hit answer of every ray on one instruction set.
 fn trace_on(
     geometry: &mut SceneGeometry,
     isa: Isa,
     rays: &[(Ray, f32)],
-) -> Vec<(Option<(u32, u32, u32, u32)>, bool)> {
+) -> Vec<IsaAnswer> {
     assert!(geometry.set_isa(isa));
     rays.iter()
         .map(|(ray, tmax)| {

@@ -174,7 +174,7 @@ impl WideBvh {
         tmax: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<WideHit> {
-        if self.nodes.is_empty() || !(tmax > 0.0) {
+        if self.nodes.is_empty() || tmax.is_nan() || tmax <= 0.0 {
             return None;
         }
         let ray = TraversalRay::new(origin.into(), dir.into());
@@ -197,7 +197,7 @@ impl WideBvh {
         tmax: f32,
         other: impl FnMut(u32, f32) -> bool,
     ) -> bool {
-        if self.nodes.is_empty() || !(tmax > 0.0) {
+        if self.nodes.is_empty() || tmax.is_nan() || tmax <= 0.0 {
             return false;
         }
         let ray = TraversalRay::new(origin.into(), dir.into());
