@@ -24,6 +24,18 @@ pub struct SurfaceHit {
     pub prim: u32,
 }
 
+/// A ray's closest primitive as the traversal finds it, before any shading data is read
+/// ([`super::SceneGeometry::surface`] turns it into a [`SurfaceHit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimHit {
+    /// As [`SurfaceHit::prim`].
+    pub prim: u32,
+    pub t: f32,
+    /// Barycentric weights of a triangle's second and third vertices (0 for other shapes).
+    pub(crate) b1: f32,
+    pub(crate) b2: f32,
+}
+
 /// A point sampled on a primitive's surface.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceSample {

@@ -1,16 +1,20 @@
 //! World-space geometry and ray queries: every shape of the scene (triangles and analytic
-//! shapes) in one obvhs BVH.
+//! shapes) in one BVH.
 //!
-//! The BVH is one obvhs CWBVH8 built over primitive bounding boxes: each triangle of every mesh
-//! and each sphere, disk and cylinder is one primitive (`build_cwbvh` over AABBs is what
+//! obvhs builds a CWBVH8 over primitive bounding boxes: each triangle of every mesh and each
+//! sphere, disk and cylinder is one primitive (`build_cwbvh` over AABBs is what
 //! `build_cwbvh_from_tris` does when spatial splits are off, as in `medium_build`). Primitive
-//! data is stored in BVH leaf order for locality. The infinite planes have no bounding box and
-//! are tested separately.
+//! data is stored in BVH leaf order for locality. `wide_bvh` converts the CWBVH into its own
+//! SIMD layout and traces it. The infinite planes have no bounding box and are tested
+//! separately.
 
 mod analytic;
 mod hit;
 mod plane;
+mod simd;
 mod triangle;
+mod wide_bvh;
+mod wide_node;
 mod world_range;
 
 #[cfg(test)]
@@ -21,8 +25,6 @@ use std::time::{Duration, Instant};
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::builder::build_cwbvh;
-use obvhs::cwbvh::CwBvh;
-use obvhs::ray::RayHit;
 use obvhs::BvhBuildParams;
 
 use crate::math::Ray;
@@ -30,13 +32,14 @@ use crate::shape::Geometry;
 use crate::shape::ShapeDesc;
 
 pub use analytic::AnalyticShape;
-pub use hit::{SurfaceHit, SurfaceSample};
+pub use hit::{PrimHit, SurfaceHit, SurfaceSample};
+pub use simd::Isa;
 pub use triangle::TriangleSurface;
 pub use world_range::MAX_WORLD_COORD;
 
-use analytic::QuadricHit;
 use plane::InfinitePlane;
 use triangle::{TriangleEdges, WorldMesh};
+use wide_bvh::WideBvh;
 use world_range::within_world;
 
 /// A BVH primitive: what the traversal reads, and where its shading data lives.
@@ -63,7 +66,7 @@ pub enum ShapeSurface {
 }
 
 pub struct SceneGeometry {
-    bvh: CwBvh,
+    bvh: WideBvh,
     /// BVH primitives in leaf order. `SurfaceHit::prim` is the leaf-order index, or
     /// `prims.len()` + the index of a plane.
     prims: Vec<Prim>,
@@ -74,26 +77,6 @@ pub struct SceneGeometry {
     /// Bounds of everything but the planes (invalid when there is nothing).
     bounds: Aabb,
     build_time: Duration,
-}
-
-/// The closest primitive found so far during a traversal.
-#[derive(Clone, Copy)]
-enum Closest {
-    None,
-    Triangle {
-        slot: u32,
-        edges: TriangleEdges,
-        mesh: u32,
-        tri: u32,
-        b1: f32,
-        b2: f32,
-    },
-    Analytic {
-        slot: u32,
-        shape: u32,
-        hit: QuadricHit,
-    },
-    Plane(u32),
 }
 
 impl SceneGeometry {
@@ -163,21 +146,27 @@ impl SceneGeometry {
         }
 
         let bounds = aabbs.iter().fold(Aabb::INVALID, |b, a| b.union(a));
-        let bvh = if aabbs.is_empty() {
-            CwBvh::default()
+        let (bvh, prims) = if aabbs.is_empty() {
+            (WideBvh::default(), Vec::new())
         } else {
             let mut core_time = Duration::ZERO;
             // obvhs's slow preset (pre-splitting, wider PLOC search, more reinsertion) traces
             // CaptainFalcon 13% faster and the 2M-triangle heavy scene 10% faster than the
             // medium one, for +1.5 us of build per triangle on 2 cores (heavy: 2.3 -> 5.4 s):
             // paid back within seconds of rendering at 1080p.
-            build_cwbvh(&aabbs, BvhBuildParams::slow_build(), &mut core_time)
+            let cwbvh = build_cwbvh(&aabbs, BvhBuildParams::slow_build(), &mut core_time);
+            let order = &cwbvh.primitive_indices;
+            let prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();
+            let boxes: Vec<Aabb> = order.iter().map(|&i| aabbs[i as usize]).collect();
+            let triangles: Vec<Option<TriangleEdges>> = prims
+                .iter()
+                .map(|p| match *p {
+                    Prim::Triangle { edges, .. } => Some(edges),
+                    Prim::Analytic(_) => None,
+                })
+                .collect();
+            (WideBvh::new(&cwbvh, &boxes, &triangles), prims)
         };
-        let prims = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| prims[i as usize])
-            .collect();
         let triangle_count = meshes.iter().map(WorldMesh::triangle_count).sum();
         Self {
             bvh,
@@ -207,75 +196,71 @@ impl SceneGeometry {
             .then(|| (self.bounds.min.into(), self.bounds.max.into()))
     }
 
-    /// Closest hit with t in (0, tmax).
+    /// Runs ray queries on `isa` from now on (all give the same results; tests and benches
+    /// compare them); false when this CPU lacks it.
+    pub fn set_isa(&mut self, isa: Isa) -> bool {
+        self.bvh.set_isa(isa)
+    }
+
+    /// Closest hit with t in (0, tmax), with everything shading needs.
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<SurfaceHit> {
+        self.surface(ray, &self.closest(ray, tmax)?)
+    }
+
+    /// The closest primitive with t in (0, tmax): the traversal alone. Equal distances go to
+    /// the lowest primitive index.
+    pub fn closest(&self, ray: &Ray, tmax: f32) -> Option<PrimHit> {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) || tmax.is_nan() {
             return None;
         }
         let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
-        let mut closest = Closest::None;
+        let mut closest = None;
         let mut t_closest = tmax;
         for (i, plane) in self.planes.iter().enumerate() {
             if let Some(t) = plane.intersect(origin, dir, t_closest) {
                 t_closest = t;
-                closest = Closest::Plane(i as u32);
+                closest = Some(PrimHit {
+                    prim: (self.prims.len() + i) as u32,
+                    t,
+                    b1: 0.0,
+                    b2: 0.0,
+                });
             }
         }
-
-        let bvh_ray = obvhs::ray::Ray::new(origin, dir, 0.0, t_closest);
-        let mut bvh_hit = RayHit::none();
-        // The traversal accepts exactly the t values below its current tmax, and every test
-        // below only returns such values, so recording the details here is recording the
-        // accepted hit.
-        self.bvh.ray_traverse(bvh_ray, &mut bvh_hit, |r, slot| {
-            match self.prims[slot] {
-                Prim::Triangle { edges, mesh, tri } => {
-                    if let Some((t, b1, b2)) = edges.intersect(r.origin, r.direction, r.tmax) {
-                        closest = Closest::Triangle {
-                            slot: slot as u32,
-                            edges,
-                            mesh,
-                            tri,
-                            b1,
-                            b2,
-                        };
-                        return t;
-                    }
-                }
-                Prim::Analytic(a) => {
-                    let shape = &self.analytic[a as usize];
-                    if let Some(hit) = shape.intersect(r.origin, r.direction, r.tmax) {
-                        closest = Closest::Analytic {
-                            slot: slot as u32,
-                            shape: a,
-                            hit,
-                        };
-                        return hit.t;
-                    }
-                }
+        let hit = self.bvh.closest(origin, dir, t_closest, |slot, bound| {
+            match self.prims[slot as usize] {
+                Prim::Analytic(a) => self.analytic[a as usize]
+                    .intersect(origin, dir, bound)
+                    .map(|h| h.t),
+                Prim::Triangle { .. } => None,
             }
-            f32::INFINITY
         });
-        if bvh_hit.t < t_closest {
-            t_closest = bvh_hit.t;
-        }
+        hit.map(|h| PrimHit {
+            prim: h.slot,
+            t: h.t,
+            b1: h.b1,
+            b2: h.b2,
+        })
+        .or(closest)
+    }
 
-        match closest {
-            Closest::None => None,
-            Closest::Triangle {
-                slot,
-                edges,
-                mesh,
-                tri,
-                b1,
-                b2,
-            } => Some(self.meshes[mesh as usize].hit(tri, &edges, t_closest, b1, b2, slot)),
-            Closest::Analytic { slot, shape, hit } => {
-                Some(self.analytic[shape as usize].hit(hit, slot))
+    /// The surface data of `hit`, which [`Self::closest`] returned for `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &PrimHit) -> Option<SurfaceHit> {
+        let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
+        match self.prims.get(hit.prim as usize) {
+            Some(&Prim::Triangle { edges, mesh, tri }) => {
+                Some(self.meshes[mesh as usize].hit(tri, &edges, hit.t, hit.b1, hit.b2, hit.prim))
             }
-            Closest::Plane(i) => {
-                let prim = (self.prims.len() + i as usize) as u32;
-                Some(self.planes[i as usize].hit(origin, dir, t_closest, prim))
+            Some(&Prim::Analytic(a)) => {
+                // The details of the accepted root: the nearest root below t's successor is t
+                // again (the traversal's bound was at least that).
+                let shape = &self.analytic[a as usize];
+                let quadric = shape.intersect(origin, dir, hit.t.next_up())?;
+                Some(shape.hit(quadric, hit.prim))
+            }
+            None => {
+                let plane = self.planes.get(hit.prim as usize - self.prims.len())?;
+                Some(plane.hit(origin, dir, hit.t, hit.prim))
             }
         }
     }
@@ -293,17 +278,13 @@ impl SceneGeometry {
         {
             return true;
         }
-        let bvh_ray = obvhs::ray::Ray::new(origin, dir, 0.0, tmax);
-        !self.bvh.ray_traverse_miss(bvh_ray, |r, slot| {
-            let t = match self.prims[slot] {
-                Prim::Triangle { edges, .. } => edges
-                    .intersect(r.origin, r.direction, r.tmax)
-                    .map(|(t, _, _)| t),
+        self.bvh.any(origin, dir, tmax, |slot, tmax| {
+            match self.prims[slot as usize] {
                 Prim::Analytic(a) => self.analytic[a as usize]
-                    .intersect(r.origin, r.direction, r.tmax)
-                    .map(|hit| hit.t),
-            };
-            t.unwrap_or(f32::INFINITY)
+                    .intersect(origin, dir, tmax)
+                    .is_some(),
+                Prim::Triangle { .. } => false,
+            }
         })
     }
 
@@ -321,9 +302,8 @@ impl SceneGeometry {
     }
 }
 
-/// The ray direction with -0.0 components turned into +0.0. obvhs picks a node's near and far
-/// planes by `dir < 0.0` but divides by the direction's sign, so a -0.0 component (as in
-/// `-Vec3::X`) makes it swap the slab bounds and miss every box.
+/// The ray direction with -0.0 components turned into +0.0, so that a zero component has one
+/// sign whatever produced it (the slab test picks near and far planes by the sign).
 #[inline(always)]
 fn canonical_dir(dir: Vec3) -> Vec3A {
     Vec3A::from(dir) + Vec3A::ZERO

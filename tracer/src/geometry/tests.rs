@@ -695,7 +695,7 @@ fn bvh_throughput() {
         let occluded = |r: &Ray| geometry.occluded(r, f32::INFINITY);
         let reference_intersect = |r: &Ray| {
             let ray = obvhs::ray::Ray::new_inf(r.origin.into(), canonical_dir(r.dir));
-            let mut hit = RayHit::none();
+            let mut hit = obvhs::ray::RayHit::none();
             reference.ray_traverse(ray, &mut hit, |ray, id| {
                 tris[reference.primitive_indices[id] as usize].intersect(ray)
             })
@@ -743,4 +743,124 @@ fn thread_cpu_seconds() -> Option<f64> {
     let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     let nanos: f64 = stat.split_whitespace().next()?.parse().ok()?;
     Some(nanos * 1e-9)
+}
+
+/// Captain Falcon's shapes from the seed project (`YAT_SEED_SCENES` or
+/// `<workspace>/../shared/seed-project/scenes`), or None when the seed project is absent.
+fn seed_falcon() -> Option<Vec<ShapeDesc>> {
+    let root = std::env::var_os("YAT_SEED_SCENES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shared/seed-project/scenes")
+        });
+    let dir = root.join("CaptainFalcon");
+    if !dir.is_dir() {
+        return None;
+    }
+    let source = crate::assets::FsSource::new(dir);
+    let desc = crate::parse::parse_scene("captainfalcon.lxs", &source).expect("Falcon parses");
+    Some(desc.shapes)
+}
+
+/// A ray's closest hit (slot, t, b1 and b2 bits) and any-hit answer.
+type IsaAnswer = (Option<(u32, u32, u32, u32)>, bool);
+
+/// The closest hit and the any-hit answer of every ray on one instruction set.
+fn trace_on(
+    geometry: &mut SceneGeometry,
+    isa: Isa,
+    rays: &[(Ray, f32)],
+) -> Vec<IsaAnswer> {
+    assert!(geometry.set_isa(isa));
+    rays.iter()
+        .map(|(ray, tmax)| {
+            let (o, d) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
+            let hit = geometry.bvh.closest(o, d, *tmax, |slot, bound| {
+                match geometry.prims[slot as usize] {
+                    Prim::Analytic(a) => geometry.analytic[a as usize]
+                        .intersect(o, d, bound)
+                        .map(|h| h.t),
+                    Prim::Triangle { .. } => None,
+                }
+            });
+            if let Some(h) = hit {
+                // Triangle hits carry exactly the numbers of the glam form of the test.
+                if let Prim::Triangle { edges, .. } = geometry.prims[h.slot as usize] {
+                    let (t, b1, b2) = edges.intersect(o, d, h.t.next_up()).expect("same test");
+                    assert_eq!(
+                        (t.to_bits(), b1.to_bits(), b2.to_bits()),
+                        (h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()),
+                        "{isa:?}"
+                    );
+                }
+            }
+            let hit = hit.map(|h| (h.slot, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+            (hit, geometry.occluded(ray, *tmax))
+        })
+        .collect()
+}
+
+/// Workers on different CPUs render the same bytes only if every instruction set returns the
+/// same hit: same primitive, same t, b1 and b2 bits. Rays aim at vertices and edge midpoints
+/// (where neighbouring triangles tie) as well as anywhere.
+#[test]
+fn every_isa_returns_bit_identical_hits() {
+    let mut rng = fastrand::Rng::with_seed(11);
+    let mut scenes = vec![("random", random_scene(&mut rng).shapes)];
+    match seed_falcon() {
+        Some(shapes) => scenes.push(("CaptainFalcon", shapes)),
+        None => println!("seed project absent: CaptainFalcon skipped, random scene only"),
+    }
+    let isas = Isa::available();
+    println!("instruction sets: {isas:?}");
+    for (name, shapes) in scenes {
+        let mut geometry = SceneGeometry::build(&shapes);
+        let (lo, hi) = geometry.bounds().expect("finite geometry");
+        let triangles: Vec<[Vec3A; 3]> = geometry
+            .prims
+            .iter()
+            .filter_map(|p| match p {
+                Prim::Triangle { edges, .. } => Some(edges.vertices()),
+                Prim::Analytic(_) => None,
+            })
+            .collect();
+        let rays: Vec<(Ray, f32)> = (0..60_000)
+            .map(|i| {
+                let origin = lo + (hi - lo) * Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 1.4
+                    - (hi - lo) * 0.2;
+                let [a, b, c] = triangles[rng.usize(..triangles.len())];
+                let target = match i % 3 {
+                    0 => a,
+                    1 => (b + c) * 0.5,
+                    _ => a + (b - a) * rng.f32() + (c - a) * rng.f32() * 0.5,
+                };
+                let dir = (Vec3::from(target) - origin).normalize_or_zero();
+                let dir = if i % 5 == 4 {
+                    random_unit(&mut rng)
+                } else {
+                    dir
+                };
+                let tmax = if i % 4 == 3 {
+                    rng.f32() * (hi - lo).length()
+                } else {
+                    f32::INFINITY
+                };
+                (Ray::new(origin, dir), tmax)
+            })
+            .collect();
+        let reference = trace_on(&mut geometry, Isa::Scalar, &rays);
+        let hits = reference.iter().filter(|r| r.0.is_some()).count();
+        assert!(hits > rays.len() / 2, "{name}: only {hits} hits");
+        for &isa in &isas[1..] {
+            let got = trace_on(&mut geometry, isa, &rays);
+            for (i, (r, g)) in reference.iter().zip(&got).enumerate() {
+                assert_eq!(r, g, "{name}, ray {i}: Scalar vs {isa:?}");
+            }
+        }
+        println!(
+            "{name}: {} rays, {hits} hits, identical on {isas:?}",
+            rays.len()
+        );
+    }
 }

@@ -33,16 +33,22 @@ impl TriangleEdges {
         }
     }
 
+    /// (vertex 0, edge 1, edge 2): what the wide BVH's leaf packets store.
+    pub fn parts(&self) -> [Vec3A; 3] {
+        [self.p0, self.e1, self.e2]
+    }
+
     #[cfg(test)]
     pub fn vertices(&self) -> [Vec3A; 3] {
         [self.p0, self.p0 + self.e1, self.p0 + self.e2]
     }
 
     /// Möller-Trumbore. Returns (t, b1, b2) for a hit with t in (0, tmax); b1 and b2 are the
-    /// barycentric weights of the second and third vertices. Branch-free until the end:
-    /// incoherent rays make early exits mispredict. A zero determinant gives infinite or NaN
-    /// values, which fail the comparisons.
-    #[inline(always)]
+    /// barycentric weights of the second and third vertices. A zero determinant gives infinite
+    /// or NaN values, which fail the comparisons. The wide BVH's kernels
+    /// (`wide_node::triangle_lane`) compute exactly this arithmetic lane by lane; this glam form
+    /// is the oracle the tests hold them to (and the form images were rendered with before).
+    #[cfg(test)]
     pub fn intersect(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<(f32, f32, f32)> {
         let pvec = dir.cross(self.e2);
         let inv_det = 1.0 / self.e1.dot(pvec);
