@@ -241,20 +241,38 @@ impl Round {
         units
     }
 
-    /// Camera samples of this round's units, and an upper bound of the samples of the rounds
-    /// after it (every block active now staying active to the end).
-    pub fn samples(&self, settings: &RenderSettings, adaptive: &AdaptiveSettings) -> (u64, u64) {
+    /// Camera samples: of the rounds before this one, of this round, and at most of the rounds
+    /// after it (if every block active now stayed active to the end).
+    pub fn samples(&self, settings: &RenderSettings, adaptive: &AdaptiveSettings) -> RoundSamples {
         let (start, end) = self.range(settings, adaptive);
         let grid = BlockGrid::of(settings);
-        let pixels: u64 = (0..self.planned.len())
-            .filter(|&b| self.is_active(b, settings, adaptive))
-            .map(|b| block_pixels(grid, b as u32, settings))
-            .sum();
-        (
-            pixels * u64::from(end - start),
-            pixels * u64::from(settings.spp - end.max(start)),
-        )
+        let mut counts = RoundSamples::default();
+        for (b, &planned) in self.planned.iter().enumerate() {
+            let pixels = block_pixels(grid, b as u32, settings);
+            counts.before += pixels * u64::from(planned.min(start));
+            if self.is_active(b, settings, adaptive) {
+                counts.now += pixels * u64::from(end - start);
+                counts.later += pixels * u64::from(settings.spp - end);
+            }
+        }
+        counts
     }
+}
+
+/// Camera samples of an adaptive render, seen from a round: see [`Round::samples`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RoundSamples {
+    pub before: u64,
+    pub now: u64,
+    pub later: u64,
+}
+
+/// The most units a round can have: a tile's round is cut into chunks of at least
+/// `UNIT_SAMPLES / TILE_SIZE^2` samples (a full tile's), and no round has more than spp.
+pub fn max_round_units(settings: &RenderSettings) -> usize {
+    let tiles = settings.width.div_ceil(TILE_SIZE) as usize * settings.height.div_ceil(TILE_SIZE) as usize;
+    let full_tile_chunk = UNIT_SAMPLES / u64::from(TILE_SIZE * TILE_SIZE);
+    tiles * u64::from(settings.spp).div_ceil(full_tile_chunk) as usize
 }
 
 /// Pixels of block `b` (the last column and row are cut by the image's edge).
@@ -489,9 +507,11 @@ mod tests {
         for (i, (&c, &e)) in count.iter().zip(&expected).enumerate() {
             assert_eq!(c, e - 16, "pixel {i}");
         }
-        let (now, later) = round.samples(&s, &ADAPTIVE);
-        assert_eq!(now, units.iter().map(WorkUnit::sample_count).sum::<u64>());
-        assert_eq!(later, now / 16 * 32, "32 more samples each to reach 64");
+        let counts = round.samples(&s, &ADAPTIVE);
+        assert_eq!(counts.now, units.iter().map(WorkUnit::sample_count).sum::<u64>());
+        assert_eq!(counts.later, counts.now / 16 * 32, "32 more samples each to reach 64");
+        assert_eq!(counts.before, 16 * u64::from(s.width * s.height));
+        assert!(units.len() <= max_round_units(&s));
         let wrong = Round {
             index: 1,
             planned: vec![20; grid.len()],
