@@ -127,7 +127,11 @@ impl Checkpoint {
     /// Once every unit is in, moves an adaptive render to its next round, decided from the
     /// merged film alone ([`adaptive::next_round`]); false when there is none (or the render is
     /// uniform, or units are missing): the render is done.
-    pub fn advance(&mut self, settings: &RenderSettings, adaptive: Option<&AdaptiveSettings>) -> bool {
+    pub fn advance(
+        &mut self,
+        settings: &RenderSettings,
+        adaptive: Option<&AdaptiveSettings>,
+    ) -> bool {
         let (Some(round), Some(a)) = (&self.round, adaptive) else {
             return false;
         };
@@ -304,7 +308,8 @@ impl Checkpoint {
         let stored_identity = &body[MAGIC.len() + 4..MAGIC.len() + 4 + IDENTITY_LEN];
         let dims_at = MAGIC.len() + 4 + IDENTITY_LEN;
         let (width, height, units) = (u32_at(dims_at), u32_at(dims_at + 4), u32_at(dims_at + 8));
-        if stored_identity != identity.0.as_bytes() || (width, height) != (settings.width, settings.height)
+        if stored_identity != identity.0.as_bytes()
+            || (width, height) != (settings.width, settings.height)
         {
             return Err(CheckpointError::OtherRender);
         }
@@ -517,14 +522,17 @@ mod tests {
     }
 
     fn identity(name: &str) -> RenderIdentity {
-        RenderIdentity::of(&pb::LoadSceneRequest {
-            main: Some(pb::SceneFile {
-                path: name.into(),
-                sha256: "0".repeat(64),
-            }),
-            assets: vec![],
-            settings: Some((&settings()).into()),
-        }, None)
+        RenderIdentity::of(
+            &pb::LoadSceneRequest {
+                main: Some(pb::SceneFile {
+                    path: name.into(),
+                    sha256: "0".repeat(64),
+                }),
+                assets: vec![],
+                settings: Some((&settings()).into()),
+            },
+            None,
+        )
     }
 
     /// A checkpoint holding every third unit of the plan, with distinct sums per unit.
@@ -566,7 +574,12 @@ mod tests {
         let mut checkpoint = Checkpoint::new(&s, Some(&a));
         // Round 0, then round 1 after a noisy film, then part of round 1.
         let fill = |checkpoint: &mut Checkpoint, every: usize| {
-            for (n, unit) in checkpoint.units(&s, Some(&a)).iter().enumerate().step_by(every) {
+            for (n, unit) in checkpoint
+                .units(&s, Some(&a))
+                .iter()
+                .enumerate()
+                .step_by(every)
+            {
                 let mut buffer = SampleBuffer::new(*unit);
                 for i in 0..buffer.weight.len() {
                     let v = ((i * 7919 + n * 104_729) % 97) as f32 / 9.0;
@@ -584,7 +597,10 @@ mod tests {
         let round = checkpoint.round().unwrap().clone();
         assert_eq!(round.index, 1);
         let id = RenderIdentity::of(&pb::LoadSceneRequest::default(), Some(&a));
-        assert_ne!(id, RenderIdentity::of(&pb::LoadSceneRequest::default(), None));
+        assert_ne!(
+            id,
+            RenderIdentity::of(&pb::LoadSceneRequest::default(), None)
+        );
         let bytes = encode(&checkpoint, &id);
         assert_eq!(bytes.len() as u64, Checkpoint::file_len(&s, Some(&a)));
         let back = Checkpoint::decode(&bytes, &id, &s, Some(&a)).unwrap();
@@ -605,7 +621,7 @@ mod tests {
 
     #[test]
     fn another_render_or_a_damaged_file_is_refused() {
-        let (checkpoint, units) = partial();
+        let (checkpoint, _) = partial();
         let id = identity("a.lxs");
         let bytes = encode(&checkpoint, &id);
         let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
@@ -649,11 +665,9 @@ mod tests {
         let output = dir.path().join("out.png");
         let file = CheckpointFile::beside(&output, identity("a.lxs"), Duration::from_secs(1));
         assert_eq!(file.path(), dir.path().join("out.resume"));
-        let units = plan_units(&settings());
         assert!(file.load(&settings(), None).unwrap().is_none());
         let (checkpoint, _) = partial();
-        file.save(&Checkpoint::new(&settings(), None))
-            .unwrap();
+        file.save(&Checkpoint::new(&settings(), None)).unwrap();
         file.save(&checkpoint).unwrap();
         let loaded = file.resume(&settings(), None, true);
         assert_eq!(loaded.film().sums(), checkpoint.film().sums());

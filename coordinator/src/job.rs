@@ -105,7 +105,20 @@ impl RenderJob {
     /// The error of a render that stopped short, after saving what it merged and saying how to
     /// resume it.
     pub fn stopped(&self, checkpoint: &Checkpoint, why: anyhow::Error) -> anyhow::Error {
-        let something = checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
+        let something =
+            checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
+        // The best image so far, every merged unit in it: the preview, when previews are on.
+        let preview = crate::interim::Due {
+            preview: something,
+            checkpoint: false,
+        };
+        for e in self
+            .interim
+            .stage(preview, checkpoint, &self.scene.desc.film)
+            .finish()
+        {
+            eprintln!("{e:#}");
+        }
         let kept = match &self.interim.checkpoint {
             Some(file) if something => Some(match file.save(checkpoint) {
                 Ok(()) => {

@@ -247,9 +247,15 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
                 "exceeds the unit's samples per pixel as a weight sum",
             ));
         }
-        let (x, y) = (unit.x0 + (i % tile_width) as u32, unit.y0 + (i / tile_width) as u32);
+        let (x, y) = (
+            unit.x0 + (i % tile_width) as u32,
+            unit.y0 + (i / tile_width) as u32,
+        );
         if !unit.renders(x, y) && values.iter().any(|&v| v != 0.0) {
-            return Err(refuse(values[3], "belongs to a block the unit's mask leaves out"));
+            return Err(refuse(
+                values[3],
+                "belongs to a block the unit's mask leaves out",
+            ));
         }
         let (rgb, weight) = if half {
             (&mut buffer.half_rgb, &mut buffer.half_weight)
@@ -451,10 +457,16 @@ mod tests {
         assert!(decode_pixels(unit, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
         let mut heavy_half = buffer.clone();
         heavy_half.half_weight[0] = 3.0;
-        assert!(decode_pixels(unit, &encode_pixels(&heavy_half)).is_err(), "3 of 2 odd samples");
+        assert!(
+            decode_pixels(unit, &encode_pixels(&heavy_half)).is_err(),
+            "3 of 2 odd samples"
+        );
         let mut outside = buffer.clone();
         outside.rgb[10 * 36 + 6] = [0.1, 0.0, 0.0];
-        assert!(decode_pixels(unit, &encode_pixels(&outside)).is_err(), "a masked-out pixel");
+        assert!(
+            decode_pixels(unit, &encode_pixels(&outside)).is_err(),
+            "a masked-out pixel"
+        );
     }
 
     /// A 2x1 tile of 4 samples per pixel whose second pixel's values are `values`, encoded.

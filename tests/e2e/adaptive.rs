@@ -67,10 +67,7 @@ fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
     let map = image::open(&map).unwrap().to_luma8();
     assert_eq!(map.dimensions(), (128, 96));
     let values: Vec<u8> = map.pixels().map(|p| p.0[0]).collect();
-    let (least, most) = (
-        *values.iter().min().unwrap(),
-        *values.iter().max().unwrap(),
-    );
+    let (least, most) = (*values.iter().min().unwrap(), *values.iter().max().unwrap());
     assert_eq!(most, 255);
     assert!(least < most, "every pixel got the same samples");
     let white = values.iter().filter(|&&v| v == 255).count();
@@ -93,12 +90,15 @@ fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
     let b = Worker::start(&["--throttle-ms", "40"]);
     let workers = format!("{},{}", a.address, b.address);
     let out = dir.path().join("killed.png");
-    let mut render = adaptive_render(&scene, &out, &["--workers", &workers])
+    let render = adaptive_render(&scene, &out, &["--workers", &workers])
         .spawn()
         .unwrap();
     let started = Instant::now();
     while a.stats(None).units_done + b.stats(None).units_done < 6 {
-        assert!(started.elapsed() < Duration::from_secs(60), "render stalled");
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "render stalled"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     a.kill();
@@ -113,7 +113,10 @@ fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
     let mut render = adaptive_render(&scene, &out, &every).spawn().unwrap();
     let started = Instant::now();
     while !checkpoint.exists() {
-        assert!(render.try_wait().unwrap().is_none(), "ended before a checkpoint");
+        assert!(
+            render.try_wait().unwrap().is_none(),
+            "ended before a checkpoint"
+        );
         assert!(started.elapsed() < Duration::from_secs(60), "no checkpoint");
         std::thread::sleep(Duration::from_millis(5));
     }
@@ -158,8 +161,12 @@ fn a_uniform_render_is_untouched_by_the_adaptive_flags_absence() {
     // min-spp = spp: one round, every pixel 16 samples, the same samples as the uniform
     // render; only the unit cut differs (one unit per tile instead of 8 passes), which changes
     // the f32 sums' rounding at most.
-    let a = image::open(uniform.with_extension("exr")).unwrap().to_rgb32f();
-    let b = image::open(adaptive.with_extension("exr")).unwrap().to_rgb32f();
+    let a = image::open(uniform.with_extension("exr"))
+        .unwrap()
+        .to_rgb32f();
+    let b = image::open(adaptive.with_extension("exr"))
+        .unwrap()
+        .to_rgb32f();
     let worst = a
         .pixels()
         .zip(b.pixels())

@@ -310,7 +310,13 @@ impl Film {
         }
         add_tile(&mut self.sums, self.width, u, &buffer.rgb, &buffer.weight);
         if half_len > 0 {
-            add_tile(&mut self.half, self.width, u, &buffer.half_rgb, &buffer.half_weight);
+            add_tile(
+                &mut self.half,
+                self.width,
+                u,
+                &buffer.half_rgb,
+                &buffer.half_weight,
+            );
         }
         Ok(())
     }

@@ -119,12 +119,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     settings
         .check()
         .with_context(|| format!("cannot render {}", args.scene.display()))?;
-    let adaptive = args
-        .noise_threshold
-        .map(|threshold| AdaptiveSettings {
-            threshold,
-            min_spp: args.min_spp,
-        });
+    let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
+        threshold,
+        min_spp: args.min_spp,
+    });
     if let Some(a) = &adaptive {
         a.check()
             .with_context(|| format!("cannot render {}", args.scene.display()))?;

@@ -61,7 +61,10 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
                 progress.set_status(format!("| round {}", round.index));
             }
             let units = checkpoint.units(settings, adaptive);
-            units.into_iter().filter(|u| !checkpoint.is_done(u)).collect()
+            units
+                .into_iter()
+                .filter(|u| !checkpoint.is_done(u))
+                .collect()
         };
         todo.par_iter().try_for_each(|unit| {
             if job.interrupt.is_set() {

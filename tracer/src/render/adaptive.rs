@@ -165,7 +165,12 @@ impl Round {
     }
 
     /// Whether block `b` takes part in this round.
-    pub fn is_active(&self, b: usize, settings: &RenderSettings, adaptive: &AdaptiveSettings) -> bool {
+    pub fn is_active(
+        &self,
+        b: usize,
+        settings: &RenderSettings,
+        adaptive: &AdaptiveSettings,
+    ) -> bool {
         let (start, end) = self.range(settings, adaptive);
         start < end && self.planned.get(b) == Some(&end)
     }
@@ -270,7 +275,8 @@ pub struct RoundSamples {
 /// The most units a round can have: a tile's round is cut into chunks of at least
 /// `UNIT_SAMPLES / TILE_SIZE^2` samples (a full tile's), and no round has more than spp.
 pub fn max_round_units(settings: &RenderSettings) -> usize {
-    let tiles = settings.width.div_ceil(TILE_SIZE) as usize * settings.height.div_ceil(TILE_SIZE) as usize;
+    let tiles =
+        settings.width.div_ceil(TILE_SIZE) as usize * settings.height.div_ceil(TILE_SIZE) as usize;
     let full_tile_chunk = UNIT_SAMPLES / u64::from(TILE_SIZE * TILE_SIZE);
     tiles * u64::from(settings.spp).div_ceil(full_tile_chunk) as usize
 }
@@ -342,7 +348,9 @@ pub fn next_round(
                 continue;
             }
             let noisy = (by.saturating_sub(1)..(by + 2).min(grid.rows))
-                .flat_map(|y| (bx.saturating_sub(1)..(bx + 2).min(grid.columns)).map(move |x| (x, y)))
+                .flat_map(|y| {
+                    (bx.saturating_sub(1)..(bx + 2).min(grid.columns)).map(move |x| (x, y))
+                })
                 .any(|(x, y)| errors[(y * grid.columns + x) as usize] > threshold);
             if noisy {
                 planned[b] = end;
@@ -433,7 +441,9 @@ mod tests {
                     }
                     let i = ((y - unit.y0) * w + (x - unit.x0)) as usize;
                     for s in unit.sample_start..unit.sample_end {
-                        let u = 2.0 * hash01((u64::from(y) << 40) ^ (u64::from(x) << 20) ^ u64::from(s)) - 1.0;
+                        let u = 2.0
+                            * hash01((u64::from(y) << 40) ^ (u64::from(x) << 20) ^ u64::from(s))
+                            - 1.0;
                         let v = (mean(x) + noise(x) * u) as f32;
                         let add = |rgb: &mut [f32; 3], wt: &mut f32| {
                             rgb.iter_mut().for_each(|c| *c += v);
@@ -471,7 +481,12 @@ mod tests {
         assert_eq!(a.round_range(1, 10), None);
         assert_eq!(a.round_range(40, u32::MAX), None, "no overflow");
         assert!(AdaptiveSettings { min_spp: 3, ..a }.check().is_err());
-        assert!(AdaptiveSettings { threshold: 0.0, ..a }.check().is_err());
+        assert!(AdaptiveSettings {
+            threshold: 0.0,
+            ..a
+        }
+        .check()
+        .is_err());
         assert!(a.check().is_ok());
     }
 
@@ -508,8 +523,15 @@ mod tests {
             assert_eq!(c, e - 16, "pixel {i}");
         }
         let counts = round.samples(&s, &ADAPTIVE);
-        assert_eq!(counts.now, units.iter().map(WorkUnit::sample_count).sum::<u64>());
-        assert_eq!(counts.later, counts.now / 16 * 32, "32 more samples each to reach 64");
+        assert_eq!(
+            counts.now,
+            units.iter().map(WorkUnit::sample_count).sum::<u64>()
+        );
+        assert_eq!(
+            counts.later,
+            counts.now / 16 * 32,
+            "32 more samples each to reach 64"
+        );
         assert_eq!(counts.before, 16 * u64::from(s.width * s.height));
         assert!(units.len() <= max_round_units(&s));
         let wrong = Round {
@@ -543,9 +565,18 @@ mod tests {
         // The pixel standard deviation is 0.73 / sqrt 3 = 0.42 relative to 0.5: the error
         // estimate (~ 0.73 / sqrt n) falls under 0.05 between 128 and 256 samples (0.059,
         // 0.042); a block's neighbours may keep it one round more.
-        let noisy: Vec<u32> = (64..128).step_by(8).map(|x| spp[(s.width * 30 + x) as usize]).collect();
-        assert!(noisy.iter().all(|n| [256, 512].contains(n)), "{noisy:?} {history:?}");
-        assert!(noisy.iter().filter(|&&n| n == 256).count() >= 4, "{noisy:?}");
+        let noisy: Vec<u32> = (64..128)
+            .step_by(8)
+            .map(|x| spp[(s.width * 30 + x) as usize])
+            .collect();
+        assert!(
+            noisy.iter().all(|n| [256, 512].contains(n)),
+            "{noisy:?} {history:?}"
+        );
+        assert!(
+            noisy.iter().filter(|&&n| n == 256).count() >= 4,
+            "{noisy:?}"
+        );
         assert!(spp[(s.width * 10 + 60) as usize] >= 128, "dilated");
         assert!(history.windows(2).all(|w| w[1] <= w[0]), "{history:?}");
     }
@@ -558,15 +589,36 @@ mod tests {
         for (n, amplitude) in [(16u32, 0.3f64), (64, 0.3), (256, 0.6)] {
             let s = settings(64, 64, n);
             let mut film = Film::with_half(64, 64);
-            let round = Round::first(&s, &AdaptiveSettings { min_spp: n, ..ADAPTIVE });
-            render(&mut film, &round.units(&s, &AdaptiveSettings { min_spp: n, ..ADAPTIVE }), |_| 1.0, |_| amplitude);
+            let round = Round::first(
+                &s,
+                &AdaptiveSettings {
+                    min_spp: n,
+                    ..ADAPTIVE
+                },
+            );
+            render(
+                &mut film,
+                &round.units(
+                    &s,
+                    &AdaptiveSettings {
+                        min_spp: n,
+                        ..ADAPTIVE
+                    },
+                ),
+                |_| 1.0,
+                |_| amplitude,
+            );
             let errors = block_errors(&film, &s);
             let mean_error = errors.iter().sum::<f64>() / errors.len() as f64;
             let sigma = amplitude / 3f64.sqrt();
-            let expected = (2.0 / std::f64::consts::PI).sqrt() * sigma / f64::from(n).sqrt()
+            let expected = (2.0 / std::f64::consts::PI).sqrt() * sigma
+                / f64::from(n).sqrt()
                 / (1.0 + DARK_FRACTION).sqrt();
             let ratio = mean_error / expected;
-            assert!((0.85..1.15).contains(&ratio), "n {n}: {mean_error} vs {expected}");
+            assert!(
+                (0.85..1.15).contains(&ratio),
+                "n {n}: {mean_error} vs {expected}"
+            );
         }
     }
 

@@ -189,7 +189,9 @@ impl RenderScene {
                         let path = trace_path(self, ray, &mut sampler);
                         stats.rays += u64::from(path.rays);
                         if path.radiance.is_finite() {
-                            rgb[..parts].iter_mut().for_each(|s| *s += path.radiance * w);
+                            rgb[..parts]
+                                .iter_mut()
+                                .for_each(|s| *s += path.radiance * w);
                             weight[..parts].iter_mut().for_each(|s| *s += w);
                         } else {
                             stats.dropped += 1;

@@ -46,7 +46,11 @@ impl WorkUnit {
             None => self.pixel_count(),
             Some(_) => (self.y0..self.y1)
                 .step_by(BLOCK_SIZE as usize)
-                .flat_map(|y| (self.x0..self.x1).step_by(BLOCK_SIZE as usize).map(move |x| (x, y)))
+                .flat_map(|y| {
+                    (self.x0..self.x1)
+                        .step_by(BLOCK_SIZE as usize)
+                        .map(move |x| (x, y))
+                })
                 .filter(|&(x, y)| self.renders(x, y))
                 .map(|(x, y)| {
                     ((self.x1 - x).min(BLOCK_SIZE) * (self.y1 - y).min(BLOCK_SIZE)) as usize

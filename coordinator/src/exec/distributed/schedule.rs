@@ -409,11 +409,16 @@ mod tests {
         let first = plan();
         let s = Schedule::new(first.clone(), |_| false, false);
         let mut rx = s.watch();
-        let taken: Vec<_> = std::iter::from_fn(|| s.take("a")).take(first.len()).collect();
+        let taken: Vec<_> = std::iter::from_fn(|| s.take("a"))
+            .take(first.len())
+            .collect();
         for u in &taken {
             assert!(s.complete(u));
         }
-        assert!(!s.is_finished(), "an adaptive round ends; the render goes on");
+        assert!(
+            !s.is_finished(),
+            "an adaptive round ends; the render goes on"
+        );
         rx.mark_unchanged();
         let second: Vec<WorkUnit> = first
             .iter()
@@ -425,7 +430,10 @@ mod tests {
             })
             .collect();
         s.start_round(second.clone());
-        assert!(rx.has_changed().unwrap(), "idle workers wake for the new round");
+        assert!(
+            rx.has_changed().unwrap(),
+            "idle workers wake for the new round"
+        );
         assert_eq!(s.len(), first.len() + 3);
         assert!(!s.complete(&first[0]), "round 0's unit 0 is not round 1's");
         s.requeue(&first[1]);
