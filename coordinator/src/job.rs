@@ -6,7 +6,8 @@ use std::time::Duration;
 
 use anyhow::Context;
 use yat_tracer::film::Film;
-use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
+use yat_tracer::render::adaptive::{self, AdaptiveSettings, Round};
+use yat_tracer::render::{RenderSettings, UnitStats};
 
 use crate::checkpoint::Checkpoint;
 use crate::interim::InterimOutputs;
@@ -17,6 +18,11 @@ use crate::shutdown::{Interrupt, Interrupted};
 pub struct RenderJob {
     pub scene: ParsedScene,
     pub settings: RenderSettings,
+    /// Adaptive sampling: rounds until the noise is under the threshold (settings.spp is the
+    /// most any pixel gets); None renders every pixel with spp samples.
+    pub adaptive: Option<AdaptiveSettings>,
+    /// Where to write the sample map of an adaptive render, at the end.
+    pub sample_map: Option<PathBuf>,
     /// The PNG the render will write; previews and the checkpoint go next to it.
     pub output_png: PathBuf,
     /// Also write linear radiance as OpenEXR next to the PNG.
@@ -76,6 +82,8 @@ pub struct RenderOutcome {
     pub stats: UnitStats,
     /// Building the scene in this process, if it was (workers build their own).
     pub build: Option<SceneBuild>,
+    /// An adaptive render's last round: each block's samples per pixel.
+    pub round: Option<Round>,
 }
 
 /// What building the scene cost.
@@ -86,29 +94,43 @@ pub struct SceneBuild {
 
 impl RenderJob {
     /// The render to start from: the checkpoint a previous run of this render left, or nothing.
-    pub fn resume(&self, units: &[WorkUnit]) -> Checkpoint {
+    pub fn resume(&self) -> Checkpoint {
+        let adaptive = self.adaptive.as_ref();
         match &self.interim.checkpoint {
-            Some(file) => file.resume(&self.settings, units, self.quiet),
-            None => Checkpoint::new(&self.settings, units.len()),
+            Some(file) => file.resume(&self.settings, adaptive, self.quiet),
+            None => Checkpoint::new(&self.settings, adaptive),
         }
     }
 
     /// The error of a render that stopped short, after saving what it merged and saying how to
     /// resume it.
-    pub fn stopped(
-        &self,
-        checkpoint: &Checkpoint,
-        units: &[WorkUnit],
-        why: anyhow::Error,
-    ) -> anyhow::Error {
+    pub fn stopped(&self, checkpoint: &Checkpoint, why: anyhow::Error) -> anyhow::Error {
+        let something =
+            checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
+        // The best image so far, every merged unit in it: the preview, when previews are on.
+        let preview = crate::interim::Due {
+            preview: something,
+            checkpoint: false,
+            status_image: something,
+        };
+        for e in self
+            .interim
+            .stage(preview, checkpoint, &self.scene.desc.film)
+            .finish()
+        {
+            eprintln!("{e:#}");
+        }
         let kept = match &self.interim.checkpoint {
-            Some(file) if checkpoint.done_count() > 0 => Some(match file.save(checkpoint) {
-                Ok(()) => format!(
-                    "{:.1}% of the samples are kept in {}; the same command resumes the render",
-                    100.0 * checkpoint.done_samples(units) as f64
-                        / units.iter().map(WorkUnit::sample_count).sum::<u64>().max(1) as f64,
-                    file.path().display()
-                ),
+            Some(file) if something => Some(match file.save(checkpoint) {
+                Ok(()) => {
+                    let (done, total) = checkpoint.samples(&self.settings, self.adaptive.as_ref());
+                    format!(
+                        "{:.1}% of the samples{} are kept in {}; the same command resumes the render",
+                        100.0 * done as f64 / total.max(1) as f64,
+                        if self.adaptive.is_some() { " (at most)" } else { "" },
+                        file.path().display()
+                    )
+                }
                 Err(e) => format!("{e:#}"),
             }),
             _ => None,
@@ -124,14 +146,28 @@ impl RenderJob {
     }
 
     /// Writes the final image, the PNG (and the linear EXR when asked) exactly the same way for
-    /// every executor, then removes the interim outputs it replaces.
-    pub fn write_final(&self, film: &Film) -> anyhow::Result<()> {
+    /// every executor, and the sample map when asked; then removes the interim outputs they
+    /// replace.
+    pub fn write_final(&self, outcome: &RenderOutcome) -> anyhow::Result<()> {
+        let film = &outcome.film;
         film.write_png(&self.output_png, &self.scene.desc.film)
             .with_context(|| format!("cannot write {}", self.output_png.display()))?;
         if self.exr {
             let path = self.output_png.with_extension("exr");
             film.write_exr(&path)
                 .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let (Some(path), Some(round)) = (&self.sample_map, &outcome.round) {
+            let (map, least, most) = adaptive::sample_map(round, &self.settings);
+            map.save_with_format(path, image::ImageFormat::Png)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            if !self.quiet {
+                println!(
+                    "wrote the sample map {}: samples per pixel on a log scale, from {least} \
+                     (darkest grey) to {most} (white), one grey step per doubling",
+                    path.display()
+                );
+            }
         }
         self.interim.remove();
         Ok(())

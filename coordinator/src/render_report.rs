@@ -21,6 +21,8 @@ pub struct RenderReport {
     pub samples_per_second: f64,
     pub rays_per_second: f64,
     pub peak_memory_bytes: Option<u64>,
+    /// Rounds of an adaptive render (its spp is then the most a pixel got).
+    pub adaptive_rounds: Option<u32>,
 }
 
 impl RenderReport {
@@ -44,15 +46,24 @@ impl RenderReport {
             samples_per_second: stats.samples as f64 / render_secs,
             rays_per_second: stats.rays as f64 / render_secs,
             peak_memory_bytes: peak_memory_bytes(),
+            adaptive_rounds: outcome.round.as_ref().map(|r| r.index + 1),
         }
     }
 
     pub fn print(&self) {
+        let pixels = u64::from(self.width) * u64::from(self.height);
         println!(
-            "{}x{} at {} spp, depth {}{}",
+            "{}x{} at {}, depth {}{}",
             self.width,
             self.height,
-            self.spp,
+            match self.adaptive_rounds {
+                Some(rounds) => format!(
+                    "{:.1} spp on average (adaptive: {rounds} rounds, at most {})",
+                    self.samples as f64 / pixels.max(1) as f64,
+                    self.spp
+                ),
+                None => format!("{} spp", self.spp),
+            },
             self.max_depth,
             self.triangles
                 .map_or(String::new(), |t| format!(", {t} triangles"))

@@ -67,6 +67,7 @@ const UNIT: WorkUnit = WorkUnit {
     y1: 8,
     sample_start: 0,
     sample_end: 2,
+    mask: None,
 };
 
 /// Words the mutator inserts: statement keywords, type names, parameter declarations, the

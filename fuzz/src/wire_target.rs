@@ -641,6 +641,7 @@ fn seed_sessions() -> Vec<Session> {
             y1: tile.3,
             sample_start: 0,
             sample_end: spp.min(8),
+            block_mask: None,
         };
         let pixels = ((tile.2 - tile.0) * (tile.3 - tile.1)) as usize;
         let reply = pb::RenderUnitReply {
@@ -803,6 +804,7 @@ mod tests {
             y1: 5,
             sample_start: 6,
             sample_end: 7,
+            block_mask: None,
         }
         .encode_to_vec();
         assert_eq!(parse_fields(&bytes).unwrap().len(), 7);

@@ -4,6 +4,7 @@
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{SampleBuffer, MAX_SUM};
+use yat_tracer::render::unit::{BLOCK_SIZE, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::pb;
@@ -102,12 +103,14 @@ impl From<&WorkUnit> for pb::WorkUnit {
             y1: u.y1,
             sample_start: u.sample_start,
             sample_end: u.sample_end,
+            block_mask: u.mask,
         }
     }
 }
 
 /// A unit of a render with these settings: a non-empty tile inside the image, a non-empty
-/// sample range inside the pixel's samples, and at most [`MAX_UNIT_PIXELS`] pixels.
+/// sample range inside the pixel's samples, and at most [`MAX_UNIT_PIXELS`] pixels; with a
+/// block mask, at most [`MAX_MASKED_SIDE`] a side and a non-zero mask of the tile's blocks.
 pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<WorkUnit, WireError> {
     let invalid = |reason: String| WireError::Unit {
         index: u.index,
@@ -129,6 +132,23 @@ pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<Wor
     if pixels > MAX_UNIT_PIXELS {
         return Err(invalid(format!("{pixels} pixels exceed {MAX_UNIT_PIXELS}")));
     }
+    if let Some(mask) = u.block_mask {
+        let (w, h) = (u.x1 - u.x0, u.y1 - u.y0);
+        if w > MAX_MASKED_SIDE || h > MAX_MASKED_SIDE {
+            return Err(invalid(format!(
+                "a {w}x{h} tile with a block mask (at most {MAX_MASKED_SIDE} a side)"
+            )));
+        }
+        let (columns, rows) = (w.div_ceil(BLOCK_SIZE), h.div_ceil(BLOCK_SIZE));
+        let inside = (0..rows)
+            .flat_map(|by| (0..columns).map(move |bx| 1u64 << (by * 8 + bx)))
+            .fold(0, |all, bit| all | bit);
+        if mask == 0 || mask & !inside != 0 {
+            return Err(invalid(format!(
+                "block mask {mask:#018x} is empty or names blocks outside the tile"
+            )));
+        }
+    }
     Ok(WorkUnit {
         index: u.index,
         x0: u.x0,
@@ -137,6 +157,7 @@ pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<Wor
         y1: u.y1,
         sample_start: u.sample_start,
         sample_end: u.sample_end,
+        mask: u.block_mask,
     })
 }
 
@@ -160,10 +181,13 @@ impl From<pb::UnitStats> for UnitStats {
     }
 }
 
-/// The wire form of a sample buffer: per pixel, r, g, b, weight as little-endian f32.
+/// The wire form of a sample buffer: per pixel, r, g, b, weight as little-endian f32; then,
+/// for a masked unit, the same for its odd-index samples.
 pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
-    let mut out = BytesMut::with_capacity(buffer.weight.len() * BYTES_PER_PIXEL);
-    for (rgb, &weight) in buffer.rgb.iter().zip(&buffer.weight) {
+    let len = buffer.weight.len() + buffer.half_weight.len();
+    let mut out = BytesMut::with_capacity(len * BYTES_PER_PIXEL);
+    let all = buffer.rgb.iter().zip(&buffer.weight);
+    for (rgb, &weight) in all.chain(buffer.half_rgb.iter().zip(&buffer.half_weight)) {
         for v in rgb.iter().chain([&weight]) {
             out.put_f32_le(*v);
         }
@@ -171,14 +195,21 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
     out.freeze()
 }
 
+/// Bytes of a unit's sample buffer on the wire.
+pub fn pixels_len(unit: &WorkUnit) -> usize {
+    let sums = if unit.mask.is_some() { 2 } else { 1 };
+    unit.pixel_count() * BYTES_PER_PIXEL * sums
+}
+
 /// Reads a sample buffer of `unit` back from its wire form, checking what an honest render can
-/// produce: the length of the tile; finite values; sums the film can hold (under
-/// [`MAX_SUM`], so one value cannot saturate it); weight sums of at most the unit's samples per
-/// pixel in magnitude (each sample weighs +1 or -1, see `filter.rs`). Radiance has no bound
-/// short of the film's: a bright but finite sum is indistinguishable from a firefly. Negative
-/// sums are honest (filters with negative lobes give samples the weight -1).
+/// produce: the length of the tile (twice for a masked unit); finite values; sums the film can
+/// hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums of at most the unit's
+/// samples per pixel in magnitude (each sample weighs +1 or -1, see `filter.rs`; the odd half
+/// at most half of them, rounded up); zeros for the pixels a mask leaves out. Radiance has no
+/// bound short of the film's: a bright but finite sum is indistinguishable from a firefly.
+/// Negative sums are honest (filters with negative lobes give samples the weight -1).
 pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireError> {
-    let expected = unit.pixel_count() * BYTES_PER_PIXEL;
+    let expected = pixels_len(&unit);
     if bytes.len() != expected {
         return Err(WireError::PixelsLength {
             index: unit.index,
@@ -186,9 +217,11 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
             expected,
         });
     }
-    let max_weight = (unit.sample_end - unit.sample_start) as f32;
-    let mut rgb = Vec::with_capacity(unit.pixel_count());
-    let mut weight = Vec::with_capacity(unit.pixel_count());
+    let samples = unit.sample_end - unit.sample_start;
+    let odd = (unit.sample_end / 2).saturating_sub(unit.sample_start / 2);
+    let mut buffer = SampleBuffer::new(unit);
+    let tile_width = (unit.x1 - unit.x0) as usize;
+    let n = unit.pixel_count();
     for (pixel, px) in bytes.chunks_exact(BYTES_PER_PIXEL).enumerate() {
         let values: [f32; 4] =
             std::array::from_fn(|i| f32::from_le_bytes(px[4 * i..4 * i + 4].try_into().unwrap()));
@@ -206,16 +239,33 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
                 return Err(refuse(value, "exceeds what the film holds"));
             }
         }
+        let (half, i) = (pixel >= n, pixel % n);
+        let max_weight = if half { odd } else { samples } as f32;
         if values[3].abs() > max_weight {
             return Err(refuse(
                 values[3],
                 "exceeds the unit's samples per pixel as a weight sum",
             ));
         }
-        rgb.push([values[0], values[1], values[2]]);
-        weight.push(values[3]);
+        let (x, y) = (
+            unit.x0 + (i % tile_width) as u32,
+            unit.y0 + (i / tile_width) as u32,
+        );
+        if !unit.renders(x, y) && values.iter().any(|&v| v != 0.0) {
+            return Err(refuse(
+                values[3],
+                "belongs to a block the unit's mask leaves out",
+            ));
+        }
+        let (rgb, weight) = if half {
+            (&mut buffer.half_rgb, &mut buffer.half_weight)
+        } else {
+            (&mut buffer.rgb, &mut buffer.weight)
+        };
+        rgb[i] = [values[0], values[1], values[2]];
+        weight[i] = values[3];
     }
-    Ok(SampleBuffer { unit, rgb, weight })
+    Ok(buffer)
 }
 
 /// A worker's reply to `unit`, checked: the unit's own index, a sample buffer that
@@ -303,6 +353,7 @@ mod tests {
             y1: 50,
             sample_start: 8,
             sample_end: 16,
+            mask: None,
         };
         assert_eq!(unit_from_wire(&(&unit).into(), &s).unwrap(), unit);
         for bad in [
@@ -332,6 +383,7 @@ mod tests {
             y1: 2,
             sample_start: 0,
             sample_end: 4,
+            mask: None,
         };
         let buffer = SampleBuffer {
             unit,
@@ -339,6 +391,8 @@ mod tests {
                 .map(|i| [i as f32 * 0.1, -0.0, f32::MIN_POSITIVE / (i + 1) as f32])
                 .collect(),
             weight: (0..6).map(|i| 1.0 + i as f32 / 3.0).collect(),
+            half_rgb: Vec::new(),
+            half_weight: Vec::new(),
         };
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 6 * BYTES_PER_PIXEL);
@@ -355,6 +409,66 @@ mod tests {
         assert!(decode_pixels(unit, &bytes[1..]).is_err());
     }
 
+    #[test]
+    fn masked_units_name_blocks_of_their_tile_and_carry_half_sums() {
+        let s = RenderSettings {
+            width: 100,
+            spp: 64,
+            ..settings()
+        };
+        // A 36x50 tile: 5 x 7 blocks.
+        let unit = WorkUnit {
+            index: 2,
+            x0: 64,
+            y0: 0,
+            x1: 100,
+            y1: 50,
+            sample_start: 16,
+            sample_end: 21,
+            mask: Some(1 | 1 << 4 | 1 << 52),
+        };
+        assert_eq!(unit_from_wire(&(&unit).into(), &s).unwrap(), unit);
+        for mask in [0, 1 << 5, 1 << 56, u64::MAX] {
+            let bad = WorkUnit {
+                mask: Some(mask),
+                ..unit
+            };
+            assert!(unit_from_wire(&(&bad).into(), &s).is_err(), "{mask:#x}");
+        }
+        let wide = WorkUnit {
+            x0: 0,
+            x1: 65,
+            mask: Some(1),
+            ..unit
+        };
+        assert!(unit_from_wire(&(&wide).into(), &s).is_err());
+
+        // Samples 16..21: 5 in all, 2 odd (17, 19). Pixel (64, 0) is in block 0, (70, 10) in
+        // no active block.
+        let mut buffer = SampleBuffer::new(unit);
+        assert_eq!(buffer.half_rgb.len(), 36 * 50);
+        buffer.rgb[0] = [1.0, 2.0, 3.0];
+        buffer.weight[0] = 5.0;
+        buffer.half_rgb[0] = [0.5, 1.0, 1.5];
+        buffer.half_weight[0] = 2.0;
+        let bytes = encode_pixels(&buffer);
+        assert_eq!(bytes.len(), 2 * 36 * 50 * BYTES_PER_PIXEL);
+        assert_eq!(decode_pixels(unit, &bytes).unwrap(), buffer);
+        assert!(decode_pixels(unit, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
+        let mut heavy_half = buffer.clone();
+        heavy_half.half_weight[0] = 3.0;
+        assert!(
+            decode_pixels(unit, &encode_pixels(&heavy_half)).is_err(),
+            "3 of 2 odd samples"
+        );
+        let mut outside = buffer.clone();
+        outside.rgb[10 * 36 + 6] = [0.1, 0.0, 0.0];
+        assert!(
+            decode_pixels(unit, &encode_pixels(&outside)).is_err(),
+            "a masked-out pixel"
+        );
+    }
+
     /// A 2x1 tile of 4 samples per pixel whose second pixel's values are `values`, encoded.
     fn reply_with(values: [f32; 4]) -> (WorkUnit, pb::RenderUnitReply) {
         let unit = WorkUnit {
@@ -365,11 +479,14 @@ mod tests {
             y1: 1,
             sample_start: 4,
             sample_end: 8,
+            mask: None,
         };
         let buffer = SampleBuffer {
             unit,
             rgb: vec![[0.5, 0.25, 0.0], [values[0], values[1], values[2]]],
             weight: vec![4.0, values[3]],
+            half_rgb: Vec::new(),
+            half_weight: Vec::new(),
         };
         let reply = pb::RenderUnitReply {
             index: unit.index,

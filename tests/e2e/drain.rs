@@ -180,6 +180,7 @@ fn send_one_unit(runtime: &tokio::runtime::Runtime, address: &str) {
             y1: 16,
             sample_start: 0,
             sample_end: 1,
+            block_mask: None,
         };
         let request = pb::RenderUnitRequest {
             scene_id,

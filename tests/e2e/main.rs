@@ -1,6 +1,7 @@
 //! End-to-end tests: the real `yat` binary, real workers, real sockets. One test binary; each
 //! module is a part of the command line, and `architecture` checks the workspace's import graph.
 
+mod adaptive;
 mod architecture;
 mod check;
 mod discovery;

@@ -164,21 +164,29 @@ impl FilmDesc {
 }
 
 /// A unit's result: per pixel of its tile (row-major), the sum of sample radiance and the sum
-/// of sample weights. 16 bytes per pixel.
+/// of sample weights (16 bytes per pixel); for an adaptive unit (one with a block mask) the
+/// same sums over its odd-index samples too, the half the adaptive error estimate compares
+/// with the whole.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleBuffer {
     pub unit: WorkUnit,
     pub rgb: Vec<[f32; 3]>,
     pub weight: Vec<f32>,
+    /// Sums of the odd-index samples: as long as `rgb` for a masked unit, else empty.
+    pub half_rgb: Vec<[f32; 3]>,
+    pub half_weight: Vec<f32>,
 }
 
 impl SampleBuffer {
     pub fn new(unit: WorkUnit) -> Self {
         let n = unit.pixel_count();
+        let half = if unit.mask.is_some() { n } else { 0 };
         Self {
             unit,
             rgb: vec![[0.0; 3]; n],
             weight: vec![0.0; n],
+            half_rgb: vec![[0.0; 3]; half],
+            half_weight: vec![0.0; half],
         }
     }
 }
@@ -205,6 +213,9 @@ pub struct Film {
     height: u32,
     /// Per pixel: R, G, B and weight sums in fixed point.
     sums: Vec<[i64; 4]>,
+    /// The same sums over the odd-index samples, kept only by an adaptive render's film (which
+    /// takes only buffers that carry them); empty otherwise, so a uniform film costs nothing more.
+    half: Vec<[i64; 4]>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -221,7 +232,22 @@ impl Film {
             width,
             height,
             sums: vec![[0; 4]; width as usize * height as usize],
+            half: Vec::new(),
         }
+    }
+
+    /// The film of an adaptive render: it also keeps the sums of the odd-index samples, and
+    /// takes only buffers of masked units.
+    pub fn with_half(width: u32, height: u32) -> Self {
+        Self {
+            half: vec![[0; 4]; width as usize * height as usize],
+            ..Self::new(width, height)
+        }
+    }
+
+    /// Whether the film keeps the half sums (an adaptive render's).
+    pub fn has_half(&self) -> bool {
+        !self.sums.is_empty() && self.half.len() == self.sums.len()
     }
 
     pub fn width(&self) -> u32 {
@@ -238,25 +264,43 @@ impl Film {
         &self.sums
     }
 
-    /// A film holding these sums; None unless there are width x height of them.
-    pub fn from_sums(width: u32, height: u32, sums: Vec<[i64; 4]>) -> Option<Self> {
-        (sums.len() == width as usize * height as usize).then_some(Self {
+    /// The half sums (of the odd-index samples) per pixel, as [`Film::sums`]; empty unless
+    /// [`Film::has_half`].
+    pub fn half_sums(&self) -> &[[i64; 4]] {
+        &self.half
+    }
+
+    /// A film holding these sums (and half sums: empty, or as many); None unless there are
+    /// width x height of them.
+    pub fn from_sums(
+        width: u32,
+        height: u32,
+        sums: Vec<[i64; 4]>,
+        half: Vec<[i64; 4]>,
+    ) -> Option<Self> {
+        let pixels = width as usize * height as usize;
+        (sums.len() == pixels && (half.is_empty() || half.len() == pixels)).then_some(Self {
             width,
             height,
             sums,
+            half,
         })
     }
 
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
-    /// gives the same bits. A buffer that does not fit (wrong tile or length) is refused.
+    /// gives the same bits. A buffer that does not fit (wrong tile or length, half sums where
+    /// the film keeps none or none where it does) is refused.
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
         let u = &buffer.unit;
+        let half_len = if self.has_half() { u.pixel_count() } else { 0 };
         let fits = u.x0 < u.x1
             && u.y0 < u.y1
             && u.x1 <= self.width
             && u.y1 <= self.height
             && buffer.rgb.len() == u.pixel_count()
-            && buffer.weight.len() == u.pixel_count();
+            && buffer.weight.len() == u.pixel_count()
+            && buffer.half_rgb.len() == half_len
+            && buffer.half_weight.len() == half_len;
         if !fits {
             return Err(BufferMismatch {
                 index: u.index,
@@ -264,35 +308,28 @@ impl Film {
                 height: self.height,
             });
         }
-        let tile_width = (u.x1 - u.x0) as usize;
-        let rows = buffer
-            .rgb
-            .chunks_exact(tile_width)
-            .zip(buffer.weight.chunks_exact(tile_width));
-        for ((rgb, weight), y) in rows.zip(u.y0..u.y1) {
-            let start = y as usize * self.width as usize + u.x0 as usize;
-            let film_row = &mut self.sums[start..start + tile_width];
-            for ((sum, &[r, g, b]), &w) in film_row.iter_mut().zip(rgb).zip(weight) {
-                for (s, v) in sum.iter_mut().zip([r, g, b, w]) {
-                    *s = s.saturating_add(to_fixed(v));
-                }
-            }
+        add_tile(&mut self.sums, self.width, u, &buffer.rgb, &buffer.weight);
+        if half_len > 0 {
+            add_tile(
+                &mut self.half,
+                self.width,
+                u,
+                &buffer.half_rgb,
+                &buffer.half_weight,
+            );
         }
         Ok(())
     }
 
+    /// The radiance estimate of the pixel at `i` (row-major) from its odd-index samples alone
+    /// (black without them, or when the film keeps no half sums).
+    pub fn half_pixel(&self, i: usize) -> Vec3 {
+        self.half.get(i).map_or(Vec3::ZERO, mean)
+    }
+
     /// The pixel's radiance estimate (weighted mean of its samples; black without samples).
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
-        let [r, g, b, w] = self.sums[(y * self.width + x) as usize];
-        if w <= 0 {
-            return Vec3::ZERO;
-        }
-        let w = w as f64;
-        Vec3::new(
-            (r as f64 / w) as f32,
-            (g as f64 / w) as f32,
-            (b as f64 / w) as f32,
-        )
+        mean(&self.sums[(y * self.width + x) as usize])
     }
 
     /// Linear radiance of every pixel, rows top to bottom.
@@ -332,6 +369,36 @@ impl Film {
             .expect("buffer has width x height pixels");
         image::DynamicImage::ImageRgb32F(img).save_with_format(path, image::ImageFormat::OpenExr)
     }
+}
+
+/// Adds a tile's f32 sums into rows of fixed-point sums.
+fn add_tile(sums: &mut [[i64; 4]], width: u32, u: &WorkUnit, rgb: &[[f32; 3]], weight: &[f32]) {
+    let tile_width = (u.x1 - u.x0) as usize;
+    let rows = rgb
+        .chunks_exact(tile_width)
+        .zip(weight.chunks_exact(tile_width));
+    for ((rgb, weight), y) in rows.zip(u.y0..u.y1) {
+        let start = y as usize * width as usize + u.x0 as usize;
+        let film_row = &mut sums[start..start + tile_width];
+        for ((sum, &[r, g, b]), &w) in film_row.iter_mut().zip(rgb).zip(weight) {
+            for (s, v) in sum.iter_mut().zip([r, g, b, w]) {
+                *s = s.saturating_add(to_fixed(v));
+            }
+        }
+    }
+}
+
+/// The weighted mean radiance of fixed-point sums; black without weight.
+fn mean(&[r, g, b, w]: &[i64; 4]) -> Vec3 {
+    if w <= 0 {
+        return Vec3::ZERO;
+    }
+    let w = w as f64;
+    Vec3::new(
+        (r as f64 / w) as f32,
+        (g as f64 / w) as f32,
+        (b as f64 / w) as f32,
+    )
 }
 
 /// LuxRender's tone mapping kernels, turning radiance in place into values to be gamma encoded.
@@ -405,6 +472,7 @@ mod tests {
             y1,
             sample_start: 0,
             sample_end: 1,
+            mask: None,
         }
     }
 

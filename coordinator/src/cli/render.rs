@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
+use yat_tracer::render::adaptive::{AdaptiveSettings, DEFAULT_MIN_SPP};
 use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
@@ -39,9 +40,21 @@ pub struct RenderArgs {
     /// Also write linear radiance as OpenEXR next to the PNG.
     #[arg(long)]
     pub exr: bool,
-    /// Samples per pixel (default: the Film's haltspp, else 64).
+    /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the
+    /// most any pixel gets.
     #[arg(long)]
     pub spp: Option<u32>,
+    /// Adaptive sampling: render in rounds, each doubling the samples of the 8x8-pixel blocks
+    /// whose estimated relative error is still above this (e.g. 0.02), until none is or --spp
+    /// is reached. The image is the same bytes however and wherever it is rendered.
+    #[arg(long, value_name = "E")]
+    pub noise_threshold: Option<f32>,
+    /// With --noise-threshold: the samples every pixel gets in the first round (even).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MIN_SPP, requires = "noise_threshold")]
+    pub min_spp: u32,
+    /// With --noise-threshold: write a PNG of the samples each pixel got (grey, log scale).
+    #[arg(long, value_name = "PNG", requires = "noise_threshold")]
+    pub sample_map: Option<PathBuf>,
     /// Maximum path depth (default: the scene's integrator depth).
     #[arg(long)]
     pub maxdepth: Option<u32>,
@@ -127,6 +140,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     settings
         .check()
         .with_context(|| format!("cannot render {}", args.scene.display()))?;
+    let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
+        threshold,
+        min_spp: args.min_spp,
+    });
+    if let Some(a) = &adaptive {
+        a.check()
+            .with_context(|| format!("cannot render {}", args.scene.display()))?;
+    }
     let output_png = match &args.output {
         Some(output) => output.clone(),
         None => {
@@ -182,7 +203,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .as_ref()
         .filter(|_| !checkpoint_every.is_zero())
         .map(|m| {
-            let identity = RenderIdentity::of(&m.load_request(&settings));
+            let identity = RenderIdentity::of(&m.load_request(&settings), adaptive.as_ref());
             CheckpointFile::beside(&output_png, identity, checkpoint_every)
         });
     let interrupt = if checkpoint.is_some() {
@@ -193,6 +214,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let job = RenderJob {
         scene,
         settings,
+        adaptive,
+        sample_map: args.sample_map.clone(),
         interim: InterimOutputs {
             preview: (!preview_every.is_zero())
                 .then(|| PreviewFile::beside(&output_png, preview_every)),
@@ -214,7 +237,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
     };
     let outcome = outcome.and_then(|outcome| {
-        job.write_final(&outcome.film)?;
+        job.write_final(&outcome)?;
         Ok(outcome)
     });
     let outcome = match outcome {

@@ -1,13 +1,14 @@
 //! The in-process executor: builds the scene here and renders every unit of the plan not yet in
 //! the job's checkpoint on a rayon pool, merging as units finish and writing the preview and the
-//! checkpoint as often as the job asks.
+//! checkpoint as often as the job asks; an adaptive render does so round after round, each
+//! decided from the film merged by the last.
 
 use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Context;
 use rayon::prelude::*;
-use yat_tracer::render::{plan_units, UnitStats, WorkUnit};
+use yat_tracer::render::{UnitStats, WorkUnit};
 
 use super::progress::Progress;
 use crate::checkpoint::Checkpoint;
@@ -30,21 +31,17 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         triangles: scene.triangle_count(),
     };
 
-    let units = plan_units(scene.settings());
-    let start = job.resume(&units);
-    let todo: Vec<WorkUnit> = units
-        .iter()
-        .filter(|u| !start.is_done(u))
-        .copied()
-        .collect();
-    let total_samples = units.iter().map(WorkUnit::sample_count).sum();
-    let progress = Progress::new(total_samples, start.done_samples(&units), job.quiet);
+    let settings = &job.settings;
+    let adaptive = job.adaptive.as_ref();
+    let start = job.resume();
+    let (done, total) = start.samples(settings, adaptive);
+    let progress = Progress::new(total, done, job.quiet);
     let status = &job.interim.status;
     status.plan(
-        units.len(),
+        start.units(settings, adaptive).len(),
         start.done_count(),
-        total_samples,
-        start.done_samples(&units),
+        total,
+        done,
     );
     let state = Mutex::new(InProcessState {
         checkpoint: start,
@@ -60,7 +57,28 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         .num_threads(threads)
         .build()
         .context("cannot start the render threads")?;
-    let result = pool.install(|| {
+    // Round after round (a uniform render has one): the units not yet merged, then the next
+    // round decided from the merged film.
+    let result = pool.install(|| loop {
+        let todo: Vec<WorkUnit> = {
+            let state = state.lock().map_err(|_| poisoned())?;
+            let checkpoint = &state.checkpoint;
+            let units = checkpoint.units(settings, adaptive);
+            let todo: Vec<WorkUnit> = units
+                .into_iter()
+                .filter(|u| !checkpoint.is_done(u))
+                .collect();
+            if let (Some(round), Some(adaptive)) = (checkpoint.round(), adaptive) {
+                progress.set_status(format!("| round {}", round.index));
+                status.round(
+                    round.index,
+                    adaptive.round_count(settings.spp),
+                    todo.len(),
+                    checkpoint.samples(settings, Some(adaptive)).1,
+                );
+            }
+            todo
+        };
         todo.par_iter().try_for_each(|unit| {
             if job.interrupt.is_set() {
                 anyhow::bail!("interrupted");
@@ -91,14 +109,20 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
                 }
             }
             anyhow::Ok(())
-        })
+        })?;
+        let mut done = state.lock().map_err(|_| poisoned())?;
+        if !done.checkpoint.advance(settings, adaptive) {
+            break anyhow::Ok(());
+        }
+        progress.set_total(done.checkpoint.samples(settings, adaptive).1);
     });
     progress.finish();
     let state = state.into_inner().map_err(|_| poisoned())?;
     if let Err(why) = result {
-        return Err(job.stopped(&state.checkpoint, &units, why));
+        return Err(job.stopped(&state.checkpoint, why));
     }
     Ok(RenderOutcome {
+        round: state.checkpoint.round().cloned(),
         film: state.checkpoint.into_film(),
         stats: state.stats,
         build: Some(build),

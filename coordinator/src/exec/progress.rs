@@ -1,5 +1,6 @@
 //! A render's progress on the terminal, the same for every executor: a bar over samples that
-//! starts at what a checkpoint holds, a status after the ETA, and lines printed above it.
+//! starts at what a checkpoint holds (its length an estimate an adaptive render updates each
+//! round), a status after the ETA, and lines printed above it.
 
 use std::time::Duration;
 
@@ -32,6 +33,11 @@ impl Progress {
         );
         bar.enable_steady_tick(Duration::from_millis(200));
         Self { bar, quiet }
+    }
+
+    /// A new estimate of all the samples the render takes (an adaptive render's, per round).
+    pub fn set_total(&self, total_samples: u64) {
+        self.bar.set_length(total_samples);
     }
 
     /// Samples rendered since the last call.

@@ -109,6 +109,16 @@ impl StatusBoard {
         s.counting_since = Some(Instant::now());
     }
 
+    /// An adaptive round starts (`rounds` is how many there can be at most): `units_left` units
+    /// to render in it, and the render's samples now estimated at `samples_total`.
+    pub fn round(&self, index: u32, rounds: u32, units_left: usize, samples_total: u64) {
+        let mut s = self.state();
+        s.progress.round = Some(index);
+        s.progress.rounds = Some(rounds);
+        s.progress.units_total = s.progress.units_done + units_left as u64;
+        s.progress.samples_total = samples_total;
+    }
+
     /// Render threads of an in-process render.
     pub fn set_threads(&self, threads: usize) {
         self.state().settings.threads = Some(threads);

@@ -3,8 +3,10 @@
 //!
 //! Files: [`settings`] (resolved settings and command-line overrides), [`unit`] (a work unit
 //! and its counters: the leaf the film, the plan and the nodes share), [`plan`] (cutting an
-//! image into units), [`scene`] (the built scene and rendering one unit).
+//! image into units), [`adaptive`] (the rounds of an adaptive render and the decision between
+//! them), [`scene`] (the built scene and rendering one unit).
 
+pub mod adaptive;
 pub mod plan;
 pub mod scene;
 pub mod settings;

@@ -53,6 +53,7 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
                     y1: y0.saturating_add(tile).min(settings.height),
                     sample_start: start,
                     sample_end: end,
+                    mask: None,
                 });
             }
         }

@@ -138,7 +138,8 @@ impl RenderScene {
     }
 
     /// Renders one unit on the calling thread. Deterministic: the same unit gives the same
-    /// buffer bytes on any machine and thread.
+    /// buffer bytes on any machine and thread. An adaptive unit renders only the pixels of its
+    /// active blocks (the others stay zero) and sums its odd-index samples apart as well.
     pub fn render_unit(&self, unit: &WorkUnit) -> (SampleBuffer, UnitStats) {
         self.render_unit_cancellable(unit, &AtomicBool::new(false))
             .expect("never cancelled")
@@ -157,11 +158,16 @@ impl RenderScene {
         let mut buffer = SampleBuffer::new(*unit);
         let mut stats = UnitStats::default();
         let tile_width = unit.x1 - unit.x0;
+        let keep_half = unit.mask.is_some();
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
+                if !unit.renders(x, y) {
+                    continue;
+                }
                 let i = ((y - unit.y0) * tile_width + (x - unit.x0)) as usize;
-                let mut rgb = Vec3::ZERO;
-                let mut weight = 0.0f32;
+                // [all samples, odd-index samples]: the second only for adaptive units.
+                let mut rgb = [Vec3::ZERO; 2];
+                let mut weight = [0.0f32; 2];
                 for chunk in (unit.sample_start..unit.sample_end).step_by(CANCEL_CHECK_SAMPLES) {
                     if cancel.load(Ordering::Relaxed) {
                         return None;
@@ -174,22 +180,29 @@ impl RenderScene {
                         let lens = sampler.get_2d();
                         let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
                         stats.samples += 1;
+                        let parts = if keep_half && index % 2 == 1 { 2 } else { 1 };
                         let Some(ray) = self.camera.generate_ray(film, lens) else {
-                            weight += w;
+                            weight[..parts].iter_mut().for_each(|s| *s += w);
                             continue;
                         };
                         let path = trace_path(self, ray, &mut sampler);
                         stats.rays += u64::from(path.rays);
                         if path.radiance.is_finite() {
-                            rgb += path.radiance * w;
-                            weight += w;
+                            rgb[..parts]
+                                .iter_mut()
+                                .for_each(|s| *s += path.radiance * w);
+                            weight[..parts].iter_mut().for_each(|s| *s += w);
                         } else {
                             stats.dropped += 1;
                         }
                     }
                 }
-                buffer.rgb[i] = rgb.to_array();
-                buffer.weight[i] = weight;
+                buffer.rgb[i] = rgb[0].to_array();
+                buffer.weight[i] = weight[0];
+                if keep_half {
+                    buffer.half_rgb[i] = rgb[1].to_array();
+                    buffer.half_weight[i] = weight[1];
+                }
             }
         }
         Some((buffer, stats))

@@ -1,10 +1,17 @@
 //! What a unit of work is and what rendering it reports: the types the film, the unit plan and
 //! every node share. A leaf: it imports nothing from the crate.
 
+/// Side in pixels of the square blocks an adaptive unit's mask switches on and off: blocks
+/// start at multiples of it from the unit's corner.
+pub const BLOCK_SIZE: u32 = 8;
+
+/// The widest or tallest unit with a block mask: 8 x 8 blocks, one bit each in a u64.
+pub const MAX_MASKED_SIDE: u32 = 8 * BLOCK_SIZE;
+
 /// A tile of pixels x a range of sample indices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct WorkUnit {
-    /// Position in the plan; results are keyed by it.
+    /// Position in the plan (of its round, when adaptive); results are keyed by it.
     pub index: u32,
     pub x0: u32,
     pub y0: u32,
@@ -12,15 +19,49 @@ pub struct WorkUnit {
     pub y1: u32,
     pub sample_start: u32,
     pub sample_end: u32,
+    /// None: every pixel of the tile, and no half sums (a uniform render). Some(mask): an
+    /// adaptive unit, at most [`MAX_MASKED_SIDE`] a side, rendering only the blocks of
+    /// [`BLOCK_SIZE`] pixels whose bit is set (bit `by * 8 + bx` for the block `bx` blocks
+    /// right of and `by` below the corner) and reporting the sums of its odd-index samples too.
+    pub mask: Option<u64>,
 }
 
 impl WorkUnit {
+    /// Pixels of the tile: the length of the unit's sample buffer.
     pub fn pixel_count(&self) -> usize {
         ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
     }
 
+    /// Whether the unit renders the pixel (x, y) of its tile.
+    pub fn renders(&self, x: u32, y: u32) -> bool {
+        self.mask.is_none_or(|mask| {
+            let bit = (y - self.y0) / BLOCK_SIZE * 8 + (x - self.x0) / BLOCK_SIZE;
+            bit < 64 && mask >> bit & 1 == 1
+        })
+    }
+
+    /// Pixels the unit renders: the tile's, or those of its active blocks.
+    pub fn active_pixel_count(&self) -> usize {
+        match self.mask {
+            None => self.pixel_count(),
+            Some(_) => (self.y0..self.y1)
+                .step_by(BLOCK_SIZE as usize)
+                .flat_map(|y| {
+                    (self.x0..self.x1)
+                        .step_by(BLOCK_SIZE as usize)
+                        .map(move |x| (x, y))
+                })
+                .filter(|&(x, y)| self.renders(x, y))
+                .map(|(x, y)| {
+                    ((self.x1 - x).min(BLOCK_SIZE) * (self.y1 - y).min(BLOCK_SIZE)) as usize
+                })
+                .sum(),
+        }
+    }
+
+    /// Camera samples the unit takes.
     pub fn sample_count(&self) -> u64 {
-        self.pixel_count() as u64 * u64::from(self.sample_end - self.sample_start)
+        self.active_pixel_count() as u64 * u64::from(self.sample_end - self.sample_start)
     }
 }
 

@@ -38,6 +38,7 @@ fn parse_build_render(main: &str, includes: &[(&str, &str)]) {
         y1: 8,
         sample_start: 0,
         sample_end: 2,
+        mask: None,
     };
     // A panic fails the test by itself, with its message.
     if let Ok(desc) = parse_scene("main.lxs", &source) {

@@ -1,6 +1,7 @@
 //! The tracer's integration tests, one binary: the parser against its conventions and against
 //! malformed input, whole renders with numbers, and the seed scenes when they are present.
 
+mod adaptive;
 mod bump_render;
 mod daylight;
 mod fuzz_regressions;

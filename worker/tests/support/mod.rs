@@ -117,6 +117,7 @@ pub fn unit(scene_id: &str, index: u32, samples: std::ops::Range<u32>) -> pb::Re
             y1: 16,
             sample_start: samples.start,
             sample_end: samples.end,
+            block_mask: None,
         }),
     }
 }

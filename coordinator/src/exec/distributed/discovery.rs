@@ -548,7 +548,7 @@ mod tests {
         use super::super::schedule::{Schedule, UnitDeadline};
         use crate::manifest::SceneManifest;
         Roster::new(Arc::new(Shared {
-            schedule: Schedule::new(Vec::new(), |_| false),
+            schedule: Schedule::new(Vec::new(), |_| false, true),
             deadline: UnitDeadline::new(None),
             manifest: SceneManifest {
                 main: Default::default(),

@@ -1,6 +1,6 @@
 //! Rendering over gRPC workers: the coordinator ships the scene's files to every worker, hands
-//! out the units of the fixed plan pull-style, re-queues what a failing worker held, and merges
-//! each unit's result once. The plan and the exact film sums make the image bit-identical to an
+//! out the units of the fixed plan (or of each round of an adaptive render) pull-style, re-queues
+//! what a failing worker held, and merges each unit's result once. The plan and the exact film sums make the image bit-identical to an
 //! in-process render whatever the workers do.
 
 pub mod config;
@@ -21,7 +21,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 use tokio::sync::mpsc;
-use yat_tracer::render::plan_units;
 
 use crate::job::{RenderJob, RenderOutcome};
 use crate::manifest::SceneManifest;
@@ -78,11 +77,12 @@ pub fn render(
         .enable_all()
         .build()
         .context("cannot start the network runtime")?;
-    let units = plan_units(&job.settings);
-    let start = job.resume(&units);
+    let start = job.resume();
+    let units = start.units(&job.settings, job.adaptive.as_ref());
     let (events, event_rx) = mpsc::unbounded_channel();
     let shared = Arc::new(Shared {
-        schedule: Schedule::new(units.clone(), |u| start.is_done(u)),
+        // An adaptive render's round is never known to be the last before it is merged.
+        schedule: Schedule::new(units, |u| start.is_done(u), job.adaptive.is_none()),
         deadline: UnitDeadline::new(config.unit_deadline),
         load_request: manifest.load_request(&job.settings),
         manifest,
@@ -104,7 +104,6 @@ pub fn render(
             .await?;
         let render_loop = RenderLoop {
             job,
-            units: &units,
             roster: &roster,
             shared: &shared,
             timeout: config.timeout,

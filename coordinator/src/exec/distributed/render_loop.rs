@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::bail;
 use tokio::sync::mpsc;
-use yat_tracer::render::{UnitStats, WorkUnit};
+use yat_tracer::render::UnitStats;
 
 use super::discovery::Roster;
 use super::shared::{Event, Shared};
@@ -22,31 +22,31 @@ const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
 
 pub struct RenderLoop<'a> {
     pub job: &'a RenderJob,
-    pub units: &'a [WorkUnit],
     pub roster: &'a Roster,
     pub shared: &'a Arc<Shared>,
     pub timeout: Option<Duration>,
 }
 
 impl RenderLoop<'_> {
-    /// Merges results into `checkpoint` as they come until every unit is in, watching that
-    /// some worker is there to render and saving the checkpoint as often as the job asks.
+    /// Merges results into `checkpoint` as they come until every unit is in (of every round:
+    /// once a round is in, the next is decided from the merged film and handed to the
+    /// schedule), watching that some worker is there to render and saving the checkpoint as
+    /// often as the job asks.
     pub async fn run(
         self,
         mut checkpoint: Checkpoint,
         mut events: mpsc::UnboundedReceiver<Event>,
     ) -> anyhow::Result<RenderOutcome> {
-        let progress = Progress::new(
-            self.shared.schedule.sample_count(),
-            checkpoint.done_samples(self.units),
-            self.job.quiet,
-        );
+        let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
+        let (done, total) = checkpoint.samples(settings, adaptive);
+        let progress = Progress::new(total, done, self.job.quiet);
         self.job.interim.status.plan(
-            self.units.len(),
+            checkpoint.units(settings, adaptive).len(),
             checkpoint.done_count(),
-            self.shared.schedule.sample_count(),
-            checkpoint.done_samples(self.units),
+            total,
+            done,
         );
+        self.publish_round(&checkpoint);
         let mut stats = UnitStats::default();
         let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
@@ -55,7 +55,17 @@ impl RenderLoop<'_> {
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         let result = loop {
             if checkpoint.is_complete() {
-                break Ok(());
+                if !checkpoint.advance(settings, adaptive) {
+                    self.shared.schedule.finish();
+                    break Ok(());
+                }
+                self.shared
+                    .schedule
+                    .start_round(checkpoint.units(settings, adaptive));
+                progress.set_total(checkpoint.samples(settings, adaptive).1);
+                progress.set_status(self.status(&checkpoint));
+                self.publish_round(&checkpoint);
+                continue;
             }
             tokio::select! {
                 event = events.recv() => match event.expect("the shared state holds a sender") {
@@ -114,21 +124,43 @@ impl RenderLoop<'_> {
         self.publish_workers();
         progress.finish();
         if let Err(why) = result {
-            return Err(self.job.stopped(&checkpoint, self.units, why));
+            return Err(self.job.stopped(&checkpoint, why));
         }
         Ok(RenderOutcome {
+            round: checkpoint.round().cloned(),
             film: checkpoint.into_film(),
             stats,
             build: None,
         })
     }
 
-    /// Units merged and workers connected, after the progress bar's ETA.
+    /// An adaptive render's round on the status page: its number and the units it has left.
+    fn publish_round(&self, checkpoint: &Checkpoint) {
+        let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
+        if let (Some(round), Some(adaptive)) = (checkpoint.round(), adaptive) {
+            let units_left = checkpoint
+                .units(settings, Some(adaptive))
+                .iter()
+                .filter(|u| !checkpoint.is_done(u))
+                .count();
+            self.job.interim.status.round(
+                round.index,
+                adaptive.round_count(settings.spp),
+                units_left,
+                checkpoint.samples(settings, Some(adaptive)).1,
+            );
+        }
+    }
+
+    /// The round, units merged and workers connected, after the progress bar's ETA.
     fn status(&self, checkpoint: &Checkpoint) -> String {
         format!(
-            "| units {}/{}, workers {}/{}",
+            "| {}units {}/{}, workers {}/{}",
+            checkpoint
+                .round()
+                .map_or(String::new(), |r| format!("round {}, ", r.index)),
             checkpoint.done_count(),
-            self.units.len(),
+            checkpoint.unit_count(),
             self.alive(),
             self.roster.current_count()
         )

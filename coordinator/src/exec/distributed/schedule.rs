@@ -20,16 +20,24 @@ use std::time::Duration;
 use tokio::sync::watch;
 use yat_tracer::render::WorkUnit;
 
-/// Units of the fixed plan handed out to workers. A unit a worker loses goes back to the front
-/// of the queue; a unit's result is accepted once, whoever sends it first.
+/// Units of the fixed plan (or of an adaptive render's round) handed out to workers. A unit a
+/// worker loses goes back to the front of the queue; a unit's result is accepted once, whoever
+/// sends it first. An adaptive render's next round replaces the units once the round is in:
+/// a unit is known by all its fields, so a late result of another round is never taken for
+/// one of this round's.
 pub struct Schedule {
-    units: Vec<WorkUnit>,
     state: Mutex<QueueState>,
     /// Bumped whenever a unit becomes available or the render ends, to wake idle workers.
     changed: watch::Sender<u64>,
 }
 
 struct QueueState {
+    units: Vec<WorkUnit>,
+    /// Whether the render ends when these units are done (a uniform render's plan, an adaptive
+    /// render's last round once decided).
+    last: bool,
+    /// Units of every round so far.
+    planned: usize,
     pending: VecDeque<u32>,
     done: Vec<bool>,
     done_count: usize,
@@ -46,42 +54,67 @@ struct QueueState {
     copies: u64,
 }
 
-impl Schedule {
-    /// The plan's units, less those `already_done` (by a render this one resumes).
-    pub fn new(units: Vec<WorkUnit>, already_done: impl Fn(&WorkUnit) -> bool) -> Self {
+impl QueueState {
+    fn of(units: Vec<WorkUnit>, already_done: impl Fn(&WorkUnit) -> bool, last: bool) -> Self {
         let done: Vec<bool> = units.iter().map(already_done).collect();
-        let state = QueueState {
-            pending: (0..units.len() as u32)
-                .filter(|&i| !done[i as usize])
-                .collect(),
+        let n = units.len();
+        Self {
+            pending: (0..n as u32).filter(|&i| !done[i as usize]).collect(),
             done_count: done.iter().filter(|&&d| d).count(),
             done,
-            out: vec![false; units.len()],
+            out: vec![false; n],
             out_count: 0,
             handed: Vec::new(),
-            holder: vec![0; units.len()],
-            copied: vec![false; units.len()],
+            holder: vec![0; n],
+            copied: vec![false; n],
             copies: 0,
-        };
-        Self {
+            planned: n,
+            last,
             units,
-            state: Mutex::new(state),
+        }
+    }
+
+    /// Whether `unit` is one of these units (not one of another round's with its index).
+    fn holds(&self, unit: &WorkUnit) -> bool {
+        self.units.get(unit.index as usize) == Some(unit)
+    }
+}
+
+impl Schedule {
+    /// The plan's units, less those `already_done` (by a render this one resumes); `last`
+    /// when the render ends with them (else the render loop says what comes next).
+    pub fn new(units: Vec<WorkUnit>, already_done: impl Fn(&WorkUnit) -> bool, last: bool) -> Self {
+        Self {
+            state: Mutex::new(QueueState::of(units, already_done, last)),
             changed: watch::Sender::new(0),
         }
     }
 
-    pub fn len(&self) -> usize {
-        self.units.len()
+    /// Replaces the units, all done, with the next round's.
+    pub fn start_round(&self, units: Vec<WorkUnit>) {
+        let mut state = self.state.lock().unwrap();
+        let (planned, copies) = (state.planned, state.copies);
+        *state = QueueState::of(units, |_| false, false);
+        state.planned += planned;
+        state.copies += copies;
+        drop(state);
+        self.changed.send_modify(|v| *v += 1);
     }
 
-    /// Camera samples of the whole plan.
-    pub fn sample_count(&self) -> u64 {
-        self.units.iter().map(WorkUnit::sample_count).sum()
+    /// Says that the units, all done, were the last: the render is finished.
+    pub fn finish(&self) {
+        self.state.lock().unwrap().last = true;
+        self.changed.send_modify(|v| *v += 1);
+    }
+
+    /// Units planned, of every round so far.
+    pub fn len(&self) -> usize {
+        self.state.lock().unwrap().planned
     }
 
     pub fn is_finished(&self) -> bool {
         let state = self.state.lock().unwrap();
-        state.done_count == self.units.len()
+        state.last && state.done_count == state.units.len()
     }
 
     /// How many units a session that normally keeps `limit` in flight (two per worker thread)
@@ -110,8 +143,8 @@ impl Schedule {
                 state.handed.push(index);
                 // Requeued units are pushed again: now and then keep only the last place of
                 // each unit not yet done, so the list stays within twice the plan.
-                if state.handed.len() > 2 * self.units.len() {
-                    let mut kept = vec![false; self.units.len()];
+                if state.handed.len() > 2 * state.units.len() {
+                    let mut kept = vec![false; state.units.len()];
                     let mut handed: Vec<u32> = state
                         .handed
                         .iter()
@@ -125,7 +158,7 @@ impl Schedule {
                     handed.reverse();
                     state.handed = handed;
                 }
-                return Some(self.units[i]);
+                return Some(state.units[i]);
             }
         }
         // The end game. Done units at the back will never be copied: drop them as we go.
@@ -139,14 +172,14 @@ impl Schedule {
         })?;
         state.copied[index as usize] = true;
         state.copies += 1;
-        Some(self.units[index as usize])
+        Some(state.units[index as usize])
     }
 
     /// Puts a unit a worker failed to return back in front of the queue.
     pub fn requeue(&self, unit: &WorkUnit) {
         let mut state = self.state.lock().unwrap();
         let i = unit.index as usize;
-        if !state.done[i] && !state.pending.contains(&unit.index) {
+        if state.holds(unit) && !state.done[i] && !state.pending.contains(&unit.index) {
             if std::mem::take(&mut state.out[i]) {
                 state.out_count -= 1;
             }
@@ -156,9 +189,13 @@ impl Schedule {
         }
     }
 
-    /// Marks a unit done; true the first time only, so a late duplicate is not merged twice.
+    /// Marks a unit done; true the first time only, so a late duplicate (or a unit of an
+    /// earlier round) is not merged.
     pub fn complete(&self, unit: &WorkUnit) -> bool {
         let mut state = self.state.lock().unwrap();
+        if !state.holds(unit) {
+            return false;
+        }
         let i = unit.index as usize;
         let first = !std::mem::replace(&mut state.done[i], true);
         if first {
@@ -166,7 +203,7 @@ impl Schedule {
             if std::mem::take(&mut state.out[i]) {
                 state.out_count -= 1;
             }
-            if state.done_count == self.units.len() {
+            if state.done_count == state.units.len() {
                 drop(state);
                 self.changed.send_modify(|v| *v += 1);
             }
@@ -246,12 +283,12 @@ mod tests {
     }
 
     fn schedule() -> Schedule {
-        Schedule::new(plan(), |_| false)
+        Schedule::new(plan(), |_| false, true)
     }
 
     #[test]
     fn a_resumed_schedule_hands_out_only_what_is_missing() {
-        let s = Schedule::new(plan(), |u| u.index % 4 != 1);
+        let s = Schedule::new(plan(), |u| u.index % 4 != 1, true);
         let taken: Vec<u32> = std::iter::from_fn(|| s.take("a"))
             .map(|u| u.index)
             .collect();
@@ -266,7 +303,7 @@ mod tests {
             assert!(s.complete(&plan()[index as usize]));
         }
         assert!(s.is_finished());
-        let all_done = Schedule::new(plan(), |_| true);
+        let all_done = Schedule::new(plan(), |_| true, true);
         assert!(all_done.is_finished() && all_done.take("a").is_none());
     }
 
@@ -364,7 +401,50 @@ mod tests {
             s.requeue(&unit);
             assert_eq!(s.take("a").unwrap().index, unit.index);
         }
-        assert!(s.state.lock().unwrap().handed.len() <= 2 * s.len());
+        let planned = s.len();
+        assert!(s.state.lock().unwrap().handed.len() <= 2 * planned);
+    }
+
+    #[test]
+    fn rounds_replace_the_units_and_a_late_result_of_another_round_is_refused() {
+        let first = plan();
+        let s = Schedule::new(first.clone(), |_| false, false);
+        let mut rx = s.watch();
+        let taken: Vec<_> = std::iter::from_fn(|| s.take("a"))
+            .take(first.len())
+            .collect();
+        for u in &taken {
+            assert!(s.complete(u));
+        }
+        assert!(
+            !s.is_finished(),
+            "an adaptive round ends; the render goes on"
+        );
+        rx.mark_unchanged();
+        let second: Vec<WorkUnit> = first
+            .iter()
+            .take(3)
+            .map(|u| WorkUnit {
+                sample_start: 16,
+                sample_end: 32,
+                ..*u
+            })
+            .collect();
+        s.start_round(second.clone());
+        assert!(
+            rx.has_changed().unwrap(),
+            "idle workers wake for the new round"
+        );
+        assert_eq!(s.len(), first.len() + 3);
+        assert!(!s.complete(&first[0]), "round 0's unit 0 is not round 1's");
+        s.requeue(&first[1]);
+        assert_eq!(s.take("a"), Some(second[0]), "a stale requeue adds nothing");
+        for u in &second {
+            s.complete(u);
+        }
+        assert!(!s.is_finished());
+        s.finish();
+        assert!(s.is_finished());
     }
 
     #[test]

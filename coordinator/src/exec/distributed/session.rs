@@ -4,7 +4,7 @@
 //! back to the queue. A worker asked to leave (its address gone from DNS: a pod deleted, a node
 //! scaled away) takes no more units and finishes the ones it holds, which its drain allows.
 
-use std::collections::HashMap;
+use std::collections::HashSet;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -48,9 +48,9 @@ const MAX_SCENE_ID_BYTES: usize = 256;
 const REPLY_OVERHEAD_BYTES: u64 = 1024;
 
 /// The smallest message limit a worker may advertise: two of the smallest blob chunk, and the
-/// reply to the largest unit of any plan.
+/// reply to the largest unit of any plan (an adaptive unit's: its sums and its half sums).
 pub fn min_message_bytes() -> u64 {
-    let unit_reply = u64::from(TILE_SIZE * TILE_SIZE) * BYTES_PER_PIXEL as u64;
+    let unit_reply = 2 * u64::from(TILE_SIZE * TILE_SIZE) * BYTES_PER_PIXEL as u64;
     (2 * MIN_CHUNK_BYTES as u64).max(unit_reply + REPLY_OVERHEAD_BYTES)
 }
 
@@ -294,17 +294,18 @@ async fn upload_missing_blobs(
     Ok(())
 }
 
-/// Units this session holds; whatever is still held when it ends goes back to the queue.
+/// Units this session holds; whatever is still held when it ends goes back to the queue. Known
+/// by the whole unit: an adaptive render's rounds reuse indices.
 struct HeldUnits<'a> {
     schedule: &'a Schedule,
-    units: HashMap<u32, WorkUnit>,
+    units: HashSet<WorkUnit>,
     node: &'a Node,
 }
 
 impl Drop for HeldUnits<'_> {
     fn drop(&mut self) {
         let requeued = self.units.len() as u64;
-        for unit in self.units.values() {
+        for unit in &self.units {
             self.schedule.requeue(unit);
         }
         if requeued > 0 {
@@ -361,7 +362,7 @@ impl UnitLoop<'_> {
         let mut changed = schedule.watch();
         let mut held = HeldUnits {
             schedule,
-            units: HashMap::new(),
+            units: HashSet::new(),
             node,
         };
         // Dropped (aborting the calls) before `held` gives their units back.
@@ -382,7 +383,7 @@ impl UnitLoop<'_> {
                 let Some(unit) = schedule.take(node.address()) else {
                     break;
                 };
-                held.units.insert(unit.index, unit);
+                held.units.insert(unit);
                 let request = pb::RenderUnitRequest {
                     scene_id: scene_id.to_string(),
                     unit: Some((&unit).into()),
@@ -417,7 +418,7 @@ impl UnitLoop<'_> {
                     let outcome = match outcome {
                         // Refused without being worked on: back to the queue at once.
                         Err(SessionError::Draining(what)) => {
-                            held.units.remove(&unit.index);
+                            held.units.remove(&unit);
                             schedule.requeue(&unit);
                             node.update(|r| r.units_requeued += 1);
                             draining.get_or_insert(what);
@@ -427,7 +428,7 @@ impl UnitLoop<'_> {
                     };
                     // Kept in `held` until accepted: an error returns it to the queue.
                     accept(node, shared, unit, outcome)?;
-                    held.units.remove(&unit.index);
+                    held.units.remove(&unit);
                     *accepted += 1;
                 }
                 _ = changed.changed() => {}

@@ -1,0 +1,176 @@
+//! Adaptive sampling end to end: the rounds are decided from merged results only, so the image
+//! is the same bytes in-process, on two workers, with a worker killed half way and after a stop
+//! and resume; the sample map shows where the samples went.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::util::*;
+
+/// Up to 64 samples per pixel in five rounds (4, 4, 8, 16, 32 samples) of at most 4 units.
+const ADAPTIVE: [&str; 8] = [
+    "--spp",
+    "64",
+    "--resolution",
+    "128x96",
+    "--noise-threshold",
+    "0.15",
+    "--min-spp",
+    "4",
+];
+
+fn adaptive_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut command = render_command_with(scene, out, &ADAPTIVE, extra);
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    command
+}
+
+fn assert_same(out: &Path, expected: &(Vec<u8>, Vec<u8>), what: &str) {
+    let (png, exr) = image_bytes(out);
+    assert!(exr == expected.1, "{what}: the EXR differs from in-process");
+    assert!(png == expected.0, "{what}: the PNG differs from in-process");
+}
+
+fn signal(child: &Child, name: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{name}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{name} failed");
+}
+
+#[test]
+fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+
+    // In-process, with the sample map.
+    let reference = dir.path().join("in-process.png");
+    let map = dir.path().join("map.png");
+    let output = adaptive_render(
+        &scene,
+        &reference,
+        &["--threads", "2", "--sample-map", map.to_str().unwrap()],
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    let expected = image_bytes(&reference);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("sample map"), "{stdout}");
+
+    // The map: the flat walls stop early, the lamp's edges and the glossy sphere go on.
+    let map = image::open(&map).unwrap().to_luma8();
+    assert_eq!(map.dimensions(), (128, 96));
+    let values: Vec<u8> = map.pixels().map(|p| p.0[0]).collect();
+    let (least, most) = (*values.iter().min().unwrap(), *values.iter().max().unwrap());
+    assert_eq!(most, 255);
+    assert!(least < most, "every pixel got the same samples");
+    let white = values.iter().filter(|&&v| v == 255).count();
+    assert!(
+        white < values.len() * 9 / 10 && white > 0,
+        "{white} of {} pixels at the most samples",
+        values.len()
+    );
+
+    // Two local workers.
+    let out = dir.path().join("local.png");
+    let output = adaptive_render(&scene, &out, &["--local-workers", "2"])
+        .output()
+        .unwrap();
+    assert_success(&output);
+    assert_same(&out, &expected, "2 local workers");
+
+    // Two workers, one killed half way: its units go to the other.
+    let mut a = Worker::start(&["--throttle-ms", "40"]);
+    let b = Worker::start(&["--throttle-ms", "40"]);
+    let workers = format!("{},{}", a.address, b.address);
+    let out = dir.path().join("killed.png");
+    let render = adaptive_render(&scene, &out, &["--workers", &workers])
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while a.stats(None).units_done + b.stats(None).units_done < 6 {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "render stalled"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    a.kill();
+    let output = render.wait_with_output().unwrap();
+    assert_success(&output);
+    assert_same(&out, &expected, "a worker killed half way");
+
+    // Stopped by Ctrl-C once a checkpoint is saved, then resumed by the same command.
+    let out = dir.path().join("resumed.png");
+    let checkpoint = out.with_extension("resume");
+    let every = ["--checkpoint-every", "0.02", "--threads", "1"];
+    let mut render = adaptive_render(&scene, &out, &every).spawn().unwrap();
+    let started = Instant::now();
+    while !checkpoint.exists() {
+        assert!(
+            render.try_wait().unwrap().is_none(),
+            "ended before a checkpoint"
+        );
+        assert!(started.elapsed() < Duration::from_secs(60), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // Into a later round, where the checkpoint holds decisions, when the render is that slow.
+    std::thread::sleep(Duration::from_millis(300));
+    signal(&render, "INT");
+    let stopped = render.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&stopped.stderr);
+    if stopped.status.success() {
+        // Finished before the signal: nothing to resume, but still the same image.
+        assert_same(&out, &expected, "a render not stopped in time");
+    } else {
+        assert_eq!(stopped.status.code(), Some(130), "{stderr}");
+        assert!(checkpoint.exists(), "{stderr}");
+        let finished = adaptive_render(&scene, &out, &every).output().unwrap();
+        assert_success(&finished);
+        let stderr = String::from_utf8_lossy(&finished.stderr);
+        assert!(stderr.contains("resuming from"), "{stderr}");
+        assert_same(&out, &expected, "stopped and resumed");
+    }
+}
+
+#[test]
+fn a_uniform_render_is_untouched_by_the_adaptive_flags_absence() {
+    // A uniform render's checkpoint identity and image do not depend on adaptive code paths:
+    // the same command without --noise-threshold gives the bytes of a render with every
+    // adaptive flag absent, and an adaptive render of the same spp differs from it.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let uniform = dir.path().join("uniform.png");
+    assert_success(&render(&scene, &uniform, &["--threads", "2", "--quiet"]));
+    let adaptive = dir.path().join("adaptive.png");
+    let output = render_command_with(
+        &scene,
+        &adaptive,
+        &["--spp", "16", "--resolution", "128x96"],
+        &["--noise-threshold", "0.5", "--min-spp", "16", "--quiet"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    // min-spp = spp: one round, every pixel 16 samples, the same samples as the uniform
+    // render; only the unit cut differs (one unit per tile instead of 8 passes), which changes
+    // the f32 sums' rounding at most.
+    let a = image::open(uniform.with_extension("exr"))
+        .unwrap()
+        .to_rgb32f();
+    let b = image::open(adaptive.with_extension("exr"))
+        .unwrap()
+        .to_rgb32f();
+    let worst = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| (p.0[c] - q.0[c]).abs() / p.0[c].abs().max(1e-3)))
+        .fold(0f32, f32::max);
+    assert!(worst < 1e-4, "relative difference {worst}");
+}

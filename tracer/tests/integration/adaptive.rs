@@ -1,0 +1,129 @@
+//! Adaptive sampling on a whole render: against a converged reference, the rounds spend the
+//! same samples as a uniform render for less error, on a scene with a flat floor and a caustic.
+
+use std::sync::Arc;
+
+use yat_tracer::assets::MemorySource;
+use yat_tracer::desc::LatLongConvention;
+use yat_tracer::film::Film;
+use yat_tracer::parse::parse_scene;
+use yat_tracer::render::adaptive::{next_round, AdaptiveSettings, Round};
+use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
+
+/// A matte floor under a dim sky, lit by a small bright sphere light through a glass ball: the
+/// floor is smooth except for the ball's caustic and shadow, which path tracing finds rarely.
+const CAUSTIC: &str = r#"Film "fleximage" "integer xresolution" [48] "integer yresolution" [48]
+PixelFilter "box"
+SurfaceIntegrator "path" "integer maxdepth" [8]
+LookAt 0 -2.2 2.2  0 0 0  0 0 1
+Camera "perspective" "float fov" [50]
+WorldBegin
+LightSource "infinite" "color L" [0.3 0.3 0.3]
+AttributeBegin
+  Material "matte" "color Kd" [0.7 0.7 0.7]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-3 -3 0  3 -3 0  3 3 0  -3 3 0]
+AttributeEnd
+AttributeBegin
+  Translate 0.2 0.1 0.5
+  Material "glass" "float index" [1.5]
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+AttributeBegin
+  Translate 0.6 0.4 2.0
+  AreaLightSource "area" "color L" [300 280 250]
+  Shape "sphere" "float radius" 0.05
+AttributeEnd
+WorldEnd
+"#;
+
+fn settings(spp: u32, seed: u64) -> RenderSettings {
+    RenderSettings {
+        width: 48,
+        height: 48,
+        spp,
+        max_depth: 8,
+        seed,
+        latlong: LatLongConvention::Seed,
+    }
+}
+
+fn build(settings: &RenderSettings) -> RenderScene {
+    let mut source = MemorySource::new();
+    source.insert("caustic.lxs", Arc::from(CAUSTIC.as_bytes()));
+    let desc = parse_scene("caustic.lxs", &source).expect("parses");
+    RenderScene::build(&desc, &source, settings).expect("builds")
+}
+
+/// A uniform render: the film and its camera samples.
+fn uniform(spp: u32, seed: u64) -> (Film, u64) {
+    let s = settings(spp, seed);
+    let scene = build(&s);
+    let mut film = Film::new(s.width, s.height);
+    let mut samples = 0;
+    for unit in plan_units(&s) {
+        let (buffer, stats) = scene.render_unit(&unit);
+        film.add(&buffer).unwrap();
+        samples += stats.samples;
+    }
+    (film, samples)
+}
+
+/// An adaptive render to the end of its rounds: the film and its camera samples.
+fn adaptive(max_spp: u32, adaptive: &AdaptiveSettings) -> (Film, u64) {
+    let s = settings(max_spp, 0);
+    let scene = build(&s);
+    let mut film = Film::with_half(s.width, s.height);
+    let mut round = Round::first(&s, adaptive);
+    let mut samples = 0;
+    loop {
+        for unit in round.units(&s, adaptive) {
+            let (buffer, stats) = scene.render_unit(&unit);
+            film.add(&buffer).unwrap();
+            samples += stats.samples;
+        }
+        match next_round(&film, &round, &s, adaptive) {
+            Some(next) => round = next,
+            None => return (film, samples),
+        }
+    }
+}
+
+fn mse(a: &Film, b: &Film) -> f64 {
+    let (a, b) = (a.radiance(), b.radiance());
+    let sum: f64 = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| f64::from((*p - *q).length_squared()))
+        .sum();
+    sum / (3 * a.len()) as f64
+}
+
+#[test]
+fn adaptive_sampling_beats_uniform_at_the_same_samples() {
+    // The reference: another seed, 2048 samples per pixel.
+    let (reference, _) = uniform(2048, 7);
+    let (adaptive_film, adaptive_samples) = adaptive(
+        512,
+        &AdaptiveSettings {
+            threshold: 0.03,
+            min_spp: 16,
+        },
+    );
+    let pixels = 48 * 48;
+    let spp = (adaptive_samples / pixels) as u32;
+    assert!(
+        (32..400).contains(&spp),
+        "the rounds stop between round 0 and the maximum: {spp} spp on average"
+    );
+    let (uniform_film, uniform_samples) = uniform(spp, 0);
+    assert!(uniform_samples <= adaptive_samples);
+    let (e_adaptive, e_uniform) = (
+        mse(&adaptive_film, &reference),
+        mse(&uniform_film, &reference),
+    );
+    eprintln!("{spp} spp: MSE adaptive {e_adaptive:.4e}, uniform {e_uniform:.4e}");
+    assert!(
+        e_adaptive < 0.8 * e_uniform,
+        "adaptive {e_adaptive:.4e} vs uniform {e_uniform:.4e} at {spp} spp"
+    );
+}
