@@ -198,6 +198,19 @@ const FIXED_ONE: f64 = (1u64 << 24) as f64;
 /// would saturate the fixed-point sums, so no honest sample buffer holds one.
 pub const MAX_SUM: f32 = (i64::MAX as f64 / FIXED_ONE) as f32;
 
+/// The largest radiance sum one pixel of a unit reports, half of [`MAX_SUM`]. A pixel that sees
+/// the sun (about 1.3e9 cd/m^2, as LuxRender gives it) reaches [`MAX_SUM`] within a few hundred
+/// samples: its unit's sums are clamped here, so the buffer stays one that every coordinator
+/// accepts and the film saturates (the pixel is white in any tone map) instead of the unit
+/// being refused as hostile.
+pub const MAX_UNIT_SUM: f32 = MAX_SUM / 2.0;
+
+/// A unit pixel's radiance sum as reported: clamped to [`MAX_UNIT_SUM`] in magnitude.
+pub fn unit_sum(rgb: Vec3) -> [f32; 3] {
+    rgb.clamp(Vec3::splat(-MAX_UNIT_SUM), Vec3::splat(MAX_UNIT_SUM))
+        .to_array()
+}
+
 fn to_fixed(v: f32) -> i64 {
     // Truncation is as deterministic as rounding and compiles to one instruction (rounding calls
     // libm, which dominated the coordinator's merge time). `as` saturates and maps NaN to 0, so

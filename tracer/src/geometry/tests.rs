@@ -767,11 +767,7 @@ fn seed_falcon() -> Option<Vec<ShapeDesc>> {
 type IsaAnswer = (Option<(u32, u32, u32, u32)>, bool);
 
 /// The closest hit and the any-hit answer of every ray on one instruction set.
-fn trace_on(
-    geometry: &mut SceneGeometry,
-    isa: Isa,
-    rays: &[(Ray, f32)],
-) -> Vec<IsaAnswer> {
+fn trace_on(geometry: &mut SceneGeometry, isa: Isa, rays: &[(Ray, f32)]) -> Vec<IsaAnswer> {
     assert!(geometry.set_isa(isa));
     rays.iter()
         .map(|(ray, tmax)| {

@@ -9,7 +9,7 @@ use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::SceneDesc;
-use crate::film::SampleBuffer;
+use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::FilterSampler;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
@@ -197,10 +197,10 @@ impl RenderScene {
                         }
                     }
                 }
-                buffer.rgb[i] = rgb[0].to_array();
+                buffer.rgb[i] = unit_sum(rgb[0]);
                 buffer.weight[i] = weight[0];
                 if keep_half {
-                    buffer.half_rgb[i] = rgb[1].to_array();
+                    buffer.half_rgb[i] = unit_sum(rgb[1]);
                     buffer.half_weight[i] = weight[1];
                 }
             }

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::Vec3;
 use yat_tracer::assets::{FsSource, MemorySource};
 use yat_tracer::desc::*;
-use yat_tracer::film::Film;
+use yat_tracer::film::{Film, MAX_UNIT_SUM};
 use yat_tracer::lights::{PointLight, SkyLight, SunLight};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{blackbody_rgb, parse_scene};
@@ -181,4 +181,40 @@ fn the_daylight_scene_renders_lit() {
         (40.0..220.0).contains(&mean_byte),
         "mean display value {mean_byte}"
     );
+}
+
+/// A pixel that looks straight at the sun at LuxRender's gain of 1 sums past what the film
+/// holds within a few hundred samples; its unit reports the clamped sum (which every
+/// coordinator accepts) and the film shows it saturated, not black or wrapped.
+#[test]
+fn a_pixel_on_the_sun_reports_a_sum_the_film_holds() {
+    let desc = parse(
+        r#"Film "fleximage" "integer xresolution" [1] "integer yresolution" [1]
+LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" [0.01]
+WorldBegin
+LightSource "sun" "vector sundir" [0 0 1]
+WorldEnd
+"#,
+    );
+    let settings = RenderSettings::resolve(
+        &desc,
+        &RenderOverrides {
+            spp: Some(4096),
+            ..Default::default()
+        },
+    );
+    let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).expect("builds");
+    let mut film = Film::new(1, 1);
+    for unit in plan_units(&settings) {
+        let (buffer, _) = scene.render_unit(&unit);
+        for &[r, g, b] in &buffer.rgb {
+            for v in [r, g, b] {
+                assert!(v.is_finite() && v.abs() <= MAX_UNIT_SUM, "{v}");
+            }
+        }
+        film.add(&buffer).unwrap();
+    }
+    // 512 samples of a unit at about 1e9 each pass the clamp: the sums sit at it.
+    assert!(film.pixel(0, 0).min_element() > 1e7, "{}", film.pixel(0, 0));
 }

@@ -195,8 +195,20 @@ fn glossycoating_puts_its_coat_over_its_base() {
     );
     let materials = Materials::new(d.materials.clone());
     let textures = Textures::default();
-    let coated = materials.bsdf(d.shapes[0].material, &hit(), &Affine3A::IDENTITY, &textures, 0.5);
-    let glossy = materials.bsdf(d.shapes[1].material, &hit(), &Affine3A::IDENTITY, &textures, 0.5);
+    let coated = materials.bsdf(
+        d.shapes[0].material,
+        &hit(),
+        &Affine3A::IDENTITY,
+        &textures,
+        0.5,
+    );
+    let glossy = materials.bsdf(
+        d.shapes[1].material,
+        &hit(),
+        &Affine3A::IDENTITY,
+        &textures,
+        0.5,
+    );
     // A smooth coat over matte is glossy: the base seen through it at normal incidence is
     // Kd (1 - 0.04)^2 / (1 - F_avg) / pi.
     let f_avg = 0.04 + 0.96 / 21.0;
@@ -219,7 +231,13 @@ fn shinymetal_mixes_mirror_and_glossy_in_proportion() {
         .filter(|i| {
             let u = (*i as f32 + 0.5) / n as f32;
             materials
-                .bsdf(d.shapes[0].material, &hit(), &Affine3A::IDENTITY, &textures, u)
+                .bsdf(
+                    d.shapes[0].material,
+                    &hit(),
+                    &Affine3A::IDENTITY,
+                    &textures,
+                    u,
+                )
                 .is_specular()
         })
         .count();
