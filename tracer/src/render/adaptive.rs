@@ -403,18 +403,10 @@ pub fn sample_map(round: &Round, settings: &RenderSettings) -> (image::GrayImage
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::desc::LatLongConvention;
     use crate::film::SampleBuffer;
 
     fn settings(width: u32, height: u32, spp: u32) -> RenderSettings {
-        RenderSettings {
-            width,
-            height,
-            spp,
-            max_depth: 4,
-            seed: 0,
-            latlong: LatLongConvention::Seed,
-        }
+        RenderSettings::for_tests(width, height, spp)
     }
 
     const ADAPTIVE: AdaptiveSettings = AdaptiveSettings {

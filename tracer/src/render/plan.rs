@@ -65,17 +65,9 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::desc::LatLongConvention;
 
     fn settings(width: u32, height: u32, spp: u32) -> RenderSettings {
-        RenderSettings {
-            width,
-            height,
-            spp,
-            max_depth: 4,
-            seed: 0,
-            latlong: LatLongConvention::Seed,
-        }
+        RenderSettings::for_tests(width, height, spp)
     }
 
     /// How many units hold each (pixel, sample index).

@@ -15,6 +15,22 @@ pub struct RenderSettings {
     pub latlong: LatLongConvention,
 }
 
+#[cfg(test)]
+impl RenderSettings {
+    /// Settings of a `width` x `height` image at `spp` (depth 4, seed 0) for the render
+    /// modules' unit tests.
+    pub(crate) fn for_tests(width: u32, height: u32, spp: u32) -> Self {
+        Self {
+            width,
+            height,
+            spp,
+            max_depth: 4,
+            seed: 0,
+            latlong: LatLongConvention::Seed,
+        }
+    }
+}
+
 /// Command-line overrides of what the scene file says.
 #[derive(Clone, Debug, Default)]
 pub struct RenderOverrides {
