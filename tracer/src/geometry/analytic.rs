@@ -199,17 +199,11 @@ impl AnalyticShape {
                     if !(t > 0.0 && t < tmax) {
                         return None;
                     }
-                    // Reproject onto the surface to undo the error of o + t d.
-                    let mut p = o + t * d;
-                    p *= radius / p.length();
-                    if p.x == 0.0 && p.y == 0.0 {
-                        p.x = 1e-5 * radius;
-                    }
-                    let phi = phi_of(p);
-                    let clipped = (z_min > -radius && p.z < z_min)
-                        || (z_max < radius && p.z > z_max)
-                        || phi > phi_max;
-                    (!clipped).then_some(QuadricHit { t, p, phi })
+                    let hit = self.point_at(o, d, t);
+                    let clipped = (z_min > -radius && hit.p.z < z_min)
+                        || (z_max < radius && hit.p.z > z_max)
+                        || hit.phi > phi_max;
+                    (!clipped).then_some(hit)
                 })
             }
             Quadric::Disk {
@@ -225,14 +219,12 @@ impl AnalyticShape {
                 if !(t > 0.0 && t < tmax) {
                     return None;
                 }
-                let mut p = o + t * d;
-                p.z = height;
-                let dist2 = p.x * p.x + p.y * p.y;
+                let hit = self.point_at(o, d, t);
+                let dist2 = hit.p.x * hit.p.x + hit.p.y * hit.p.y;
                 if dist2 > radius * radius || dist2 < inner_radius * inner_radius {
                     return None;
                 }
-                let phi = phi_of(p);
-                (phi <= phi_max).then_some(QuadricHit { t, p, phi })
+                (hit.phi <= phi_max).then_some(hit)
             }
             Quadric::Cylinder {
                 radius,
@@ -253,16 +245,46 @@ impl AnalyticShape {
                     if !(t > 0.0 && t < tmax) {
                         return None;
                     }
-                    let mut p = o + t * d;
-                    let scale = radius / (p.x * p.x + p.y * p.y).sqrt();
-                    p.x *= scale;
-                    p.y *= scale;
-                    let phi = phi_of(p);
-                    let inside = p.z >= z_min && p.z <= z_max && phi <= phi_max;
-                    inside.then_some(QuadricHit { t, p, phi })
+                    let hit = self.point_at(o, d, t);
+                    let inside = hit.p.z >= z_min && hit.p.z <= z_max && hit.phi <= phi_max;
+                    inside.then_some(hit)
                 })
             }
         }
+    }
+
+    /// The point at distance `t` along the object-space ray (`o`, `d`), on the surface: what
+    /// [`Self::intersect`] returns for a root it accepts, computed the same way.
+    fn point_at(&self, o: Vec3A, d: Vec3A, t: f32) -> QuadricHit {
+        let mut p = o + t * d;
+        match self.quadric {
+            Quadric::Sphere { radius, .. } => {
+                // Reproject onto the surface to undo the error of o + t d.
+                p *= radius / p.length();
+                if p.x == 0.0 && p.y == 0.0 {
+                    p.x = 1e-5 * radius;
+                }
+            }
+            Quadric::Disk { height, .. } => p.z = height,
+            Quadric::Cylinder { radius, .. } => {
+                let scale = radius / (p.x * p.x + p.y * p.y).sqrt();
+                p.x *= scale;
+                p.y *= scale;
+            }
+        }
+        QuadricHit {
+            t,
+            p,
+            phi: phi_of(p),
+        }
+    }
+
+    /// The quadric hit at `t`, a distance [`Self::intersect`] returned for this world-space
+    /// ray: the shading data without solving for the root again.
+    pub(crate) fn hit_at(&self, origin: Vec3A, dir: Vec3A, t: f32) -> QuadricHit {
+        let o = self.world_to_object.transform_point3a(origin);
+        let d = self.world_to_object.transform_vector3a(dir);
+        self.point_at(o, d, t)
     }
 
     pub(crate) fn hit(&self, hit: QuadricHit, prim: u32) -> SurfaceHit {

@@ -252,11 +252,9 @@ impl SceneGeometry {
                 Some(self.meshes[mesh as usize].hit(tri, &edges, hit.t, hit.b1, hit.b2, hit.prim))
             }
             Some(&Prim::Analytic(a)) => {
-                // The details of the accepted root: the nearest root below t's successor is t
-                // again (the traversal's bound was at least that).
+                // The details of the accepted root, computed as the traversal's test did.
                 let shape = &self.analytic[a as usize];
-                let quadric = shape.intersect(origin, dir, hit.t.next_up())?;
-                Some(shape.hit(quadric, hit.prim))
+                Some(shape.hit(shape.hit_at(origin, dir, hit.t), hit.prim))
             }
             None => {
                 let plane = self.planes.get(hit.prim as usize - self.prims.len())?;
