@@ -47,14 +47,8 @@ def yat(binary, scene, args, out_dir, extra):
     return bench.run_measured(cmd, f"yat on {scene}", stats)
 
 
-def mse(a, b):
-    import numpy as np
-
-    return float(np.mean((a - b) ** 2))
-
-
 def measure(binary, scene, args, extra):
-    """(MSE against the reference, render seconds, samples per pixel) of one render."""
+    """(linear image, render seconds, mean samples per pixel) of one render."""
     with tempfile.TemporaryDirectory() as tmp:
         figures = yat(binary, scene, args, Path(tmp), extra)
         image = bench.read_exr(Path(tmp) / "out.exr")
@@ -99,7 +93,7 @@ def main():
         setting = f"adaptive-{Path(name).stem}-{args.resolution}-{args.reference_spp}"
         ref = bench.reference("yat", setting, bench.file_digest(binary, scene), make)
         image, uniform_s, _ = measure(binary, scene, args, ["--spp", str(args.target_spp)])
-        target = mse(image, ref)
+        target = bench.mse(image, ref)
         print(f"{name}: uniform {args.target_spp} spp MSE {target:.4g} in {uniform_s:.1f} s",
               file=sys.stderr, flush=True)
 
@@ -109,7 +103,7 @@ def main():
                 "--spp", str(max_spp), "--min-spp", str(args.min_spp),
                 "--noise-threshold", f"{threshold:.5g}",
             ])
-            error = mse(image, ref)
+            error = bench.mse(image, ref)
             print(f"  threshold {threshold:.4g}: MSE {error:.4g}, {seconds:.1f} s, {spp:.0f} spp",
                   file=sys.stderr, flush=True)
             return error, seconds, spp

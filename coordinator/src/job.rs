@@ -111,7 +111,7 @@ impl RenderJob {
         let preview = crate::interim::Due {
             preview: something,
             checkpoint: false,
-            status_image: something,
+            status_image: something && self.interim.status.serving(),
         };
         for e in self
             .interim

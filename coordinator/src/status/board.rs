@@ -187,6 +187,11 @@ impl StatusBoard {
         });
     }
 
+    /// Whether a server shows this board (else nothing needs its image).
+    pub fn serving(&self) -> bool {
+        self.serving
+    }
+
     /// Whether the executor should publish a new image now: the first one, then at most every
     /// [`IMAGE_EVERY`] (or [`IMAGE_COST_FACTOR`] times its cost) while someone watches and the
     /// film has changed.

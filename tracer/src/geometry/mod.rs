@@ -207,8 +207,8 @@ impl SceneGeometry {
         self.surface(ray, &self.closest(ray, tmax)?)
     }
 
-    /// The closest primitive with t in (0, tmax): the traversal alone. Equal distances go to
-    /// the lowest primitive index.
+    /// The closest primitive with t in (0, tmax): the traversal alone. Equal distances within
+    /// the BVH go to the lowest primitive index; a plane (tested first) keeps a tie with it.
     pub fn closest(&self, ray: &Ray, tmax: f32) -> Option<PrimHit> {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) || tmax.is_nan() {
             return None;
@@ -235,13 +235,7 @@ impl SceneGeometry {
                 Prim::Triangle { .. } => None,
             }
         });
-        hit.map(|h| PrimHit {
-            prim: h.slot,
-            t: h.t,
-            b1: h.b1,
-            b2: h.b2,
-        })
-        .or(closest)
+        hit.or(closest)
     }
 
     /// The surface data of `hit`, which [`Self::closest`] returned for `ray`.

@@ -772,17 +772,10 @@ fn trace_on(geometry: &mut SceneGeometry, isa: Isa, rays: &[(Ray, f32)]) -> Vec<
     rays.iter()
         .map(|(ray, tmax)| {
             let (o, d) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
-            let hit = geometry.bvh.closest(o, d, *tmax, |slot, bound| {
-                match geometry.prims[slot as usize] {
-                    Prim::Analytic(a) => geometry.analytic[a as usize]
-                        .intersect(o, d, bound)
-                        .map(|h| h.t),
-                    Prim::Triangle { .. } => None,
-                }
-            });
+            let hit = geometry.closest(ray, *tmax);
             if let Some(h) = hit {
                 // Triangle hits carry exactly the numbers of the glam form of the test.
-                if let Prim::Triangle { edges, .. } = geometry.prims[h.slot as usize] {
+                if let Prim::Triangle { edges, .. } = geometry.prims[h.prim as usize] {
                     let (t, b1, b2) = edges.intersect(o, d, h.t.next_up()).expect("same test");
                     assert_eq!(
                         (t.to_bits(), b1.to_bits(), b2.to_bits()),
@@ -791,7 +784,7 @@ fn trace_on(geometry: &mut SceneGeometry, isa: Isa, rays: &[(Ray, f32)]) -> Vec<
                     );
                 }
             }
-            let hit = hit.map(|h| (h.slot, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+            let hit = hit.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
             (hit, geometry.occluded(ray, *tmax))
         })
         .collect()

@@ -15,6 +15,7 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 
 #[cfg(target_arch = "x86_64")]
+use super::hit::PrimHit;
 use super::simd::{Avx2, Sse};
 use super::simd::{Isa, Scalar};
 use super::triangle::TriangleEdges;
@@ -31,16 +32,6 @@ const INLINE_STACK: usize = 256;
 /// until pushed (zeroing 2 KB per ray cost more than a node visit); entries below the stack
 /// size have always been written.
 type Entry = MaybeUninit<(u32, f32)>;
-
-/// A closest hit: the leaf-order primitive index, t, and for triangles the barycentric
-/// weights of the second and third vertices.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WideHit {
-    pub slot: u32,
-    pub t: f32,
-    pub b1: f32,
-    pub b2: f32,
-}
 
 #[derive(Default)]
 pub struct WideBvh {
@@ -173,7 +164,7 @@ impl WideBvh {
         dir: Vec3A,
         tmax: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> Option<WideHit> {
+    ) -> Option<PrimHit> {
         if self.nodes.is_empty() || tmax.is_nan() || tmax <= 0.0 {
             return None;
         }
@@ -218,7 +209,7 @@ impl WideBvh {
         ray: &TraversalRay,
         tmax: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> Option<WideHit> {
+    ) -> Option<PrimHit> {
         self.closest_with::<Avx2>(ray, tmax, other)
     }
 
@@ -239,7 +230,7 @@ impl WideBvh {
         ray: &TraversalRay,
         tmax: f32,
         other: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> Option<WideHit> {
+    ) -> Option<PrimHit> {
         if self.stack_size <= INLINE_STACK {
             let mut stack = [Entry::uninit(); INLINE_STACK];
             self.closest_on::<K>(ray, tmax, other, &mut stack)
@@ -256,11 +247,11 @@ impl WideBvh {
         tmax: f32,
         mut other: impl FnMut(u32, f32) -> Option<f32>,
         stack: &mut [Entry],
-    ) -> Option<WideHit> {
+    ) -> Option<PrimHit> {
         let kray = K::prepare(ray);
         // Slot 0 with t = tmax: the tie rule (equal t, lower slot) never accepts t = tmax.
-        let mut best = WideHit {
-            slot: 0,
+        let mut best = PrimHit {
+            prim: 0,
             t: tmax,
             b1: 0.0,
             b2: 0.0,
@@ -299,9 +290,9 @@ impl WideBvh {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
                     let (slot, t) = (packet.slot[lane], hits.t[lane]);
-                    if t < best.t || (t == best.t && slot < best.slot) {
-                        best = WideHit {
-                            slot,
+                    if t < best.t || (t == best.t && slot < best.prim) {
+                        best = PrimHit {
+                            prim: slot,
                             t,
                             b1: hits.b1[lane],
                             b2: hits.b2[lane],
@@ -316,9 +307,9 @@ impl WideBvh {
                         let slot = packet.slot[lane];
                         // The bound just above best.t lets an equal t reach the tie rule.
                         if let Some(t) = other(slot, best.t.next_up()) {
-                            if t < best.t || (t == best.t && slot < best.slot) {
-                                best = WideHit {
-                                    slot,
+                            if t < best.t || (t == best.t && slot < best.prim) {
+                                best = PrimHit {
+                                    prim: slot,
                                     t,
                                     b1: 0.0,
                                     b2: 0.0,

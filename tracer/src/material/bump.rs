@@ -59,8 +59,7 @@ impl Bump {
         } else {
             DEFAULT_SAMPLE_DISTANCE
         };
-        let map = params.tex_float("bumpmap", 0.0)?;
-        Ok(match ctx.tex(map, false, Vec3::ZERO) {
+        Ok(match ctx.float_param(params, "bumpmap", 0.0)? {
             Tex::Texture(map) => Some(Self {
                 map,
                 sample_distance,

@@ -27,6 +27,7 @@ use super::eval::{texture_ids, TextureEval};
 use crate::bxdf::coated::Coat;
 use crate::bxdf::coating::Coating;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
+use crate::bxdf::microfacet::TrowbridgeReitz;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::{Tex, TextureId};
@@ -107,14 +108,11 @@ impl CoatParams {
 
     /// The coat at a hit.
     pub fn coat(&self, eval: &TextureEval) -> Coat {
-        let distrib = eval.roughness(self.uroughness, self.vroughness);
-        let multibounce_alpha = match (self.multibounce, distrib) {
-            (true, Some(_)) => {
-                let (u, v) = (eval.float(self.uroughness), eval.float(self.vroughness));
-                Some((u.max(0.0) * v.max(0.0)).sqrt().clamp(0.0, 1.0))
-            }
-            _ => None,
-        };
+        // Each roughness texture is read once: the lobe and the multibounce term share it.
+        let (u, v) = (eval.float(self.uroughness), eval.float(self.vroughness));
+        let distrib = TrowbridgeReitz::from_roughness(u, v);
+        let multibounce_alpha = (self.multibounce && distrib.is_some())
+            .then(|| (u.max(0.0) * v.max(0.0)).sqrt().clamp(0.0, 1.0));
         Coat::single(
             eval.color(self.ks),
             distrib,

@@ -47,6 +47,9 @@ use super::unit::{WorkUnit, BLOCK_SIZE, MAX_MASKED_SIDE};
 /// say something about a block of 64 pixels.
 pub const DEFAULT_MIN_SPP: u32 = 16;
 
+// A mask covers a plan tile.
+const _: () = assert!(TILE_SIZE == MAX_MASKED_SIDE);
+
 /// Black and dark pixels are compared with this fraction of the image's mean brightness.
 pub const DARK_FRACTION: f64 = 0.01;
 
@@ -196,7 +199,6 @@ impl Round {
         let (start, end) = self.range(settings, adaptive);
         let grid = BlockGrid::of(settings);
         let per_tile = MAX_MASKED_SIDE / BLOCK_SIZE;
-        debug_assert_eq!(TILE_SIZE, MAX_MASKED_SIDE);
         let mut tiles = Vec::new();
         for y0 in (0..settings.height).step_by(TILE_SIZE as usize) {
             for x0 in (0..settings.width).step_by(TILE_SIZE as usize) {

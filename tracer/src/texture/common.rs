@@ -63,11 +63,10 @@ impl Declared<'_> {
         name: &str,
         default: f32,
     ) -> Result<Tex, ParseError> {
-        let v = if self.is_color {
-            params.tex_color(name, Vec3::splat(default))?
+        if self.is_color {
+            ctx.color_param(params, name, default, false)
         } else {
-            params.tex_float(name, default)?
-        };
-        Ok(ctx.tex(v, self.is_color, Vec3::splat(default)))
+            ctx.float_param(params, name, default)
+        }
     }
 }

@@ -55,7 +55,8 @@ impl RenderLoop<'_> {
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         let result = loop {
             if checkpoint.is_complete() {
-                if !checkpoint.advance(settings, adaptive) {
+                // The next round's decision reads the whole film: off the async workers.
+                if !tokio::task::block_in_place(|| checkpoint.advance(settings, adaptive)) {
                     self.shared.schedule.finish();
                     break Ok(());
                 }

@@ -93,19 +93,7 @@ pub fn read_hard(
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
 ) -> Result<bool, ParseError> {
-    Ok(
-        match params.string_or("noisetype", "soft_noise")?.as_str() {
-            "soft_noise" => false,
-            "hard_noise" => true,
-            other => {
-                ctx.warn(
-                    pos,
-                    format!("unknown noise type \"{other}\"; using soft_noise"),
-                );
-                false
-            }
-        },
-    )
+    Ok(read_choice(params, "noisetype", &["soft_noise", "hard_noise"], pos, ctx)? == 1)
 }
 
 /// A string parameter that picks one of `names` (the first is the default); an unknown name

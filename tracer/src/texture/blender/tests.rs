@@ -291,12 +291,6 @@ fn noise_textures_stay_in_range_and_vary() {
         assert!(lo >= 0.0 && hi <= 1.0, "{statement}: [{lo}, {hi}]");
         assert!(hi - lo > 0.2, "{statement} varies: [{lo}, {hi}]");
         assert!(mean_range.contains(&mean), "{statement}: mean {mean}");
-        let p = Vec3::new(0.3, -0.2, 0.9);
-        assert_eq!(
-            t(p).to_bits(),
-            t(p).to_bits(),
-            "{statement} is deterministic"
-        );
     }
 }
 
