@@ -129,7 +129,8 @@ impl Yarn {
         let h = sum.normalize_or_zero();
         let (sin_u, cos_u) = at.x.sin_cos();
         let across = h.y * sin_u + h.z * cos_u;
-        let d = (h.y * cos_u - h.z * sin_u) / ((h.x * h.x + across * across).sqrt() * self.psi.tan());
+        let d =
+            (h.y * cos_u - h.z * sin_u) / ((h.x * h.x + across * across).sqrt() * self.psi.tan());
         if !(d.abs() < 1.0) {
             return 0.0;
         }

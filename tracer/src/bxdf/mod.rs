@@ -54,7 +54,9 @@ impl Bxdf {
             Bxdf::PassThrough => true,
             Bxdf::Conductor(c) => c.is_specular(),
             Bxdf::Dielectric(d) => d.is_specular(),
-            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Velvet(_)
+            Bxdf::Diffuse(_)
+            | Bxdf::Translucent(_)
+            | Bxdf::Velvet(_)
             | Bxdf::Scatter(_)
             | Bxdf::Cloth(_) => false,
         }

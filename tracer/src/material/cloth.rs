@@ -78,7 +78,14 @@ const fn deg(d: f32) -> f32 {
 
 /// A yarn segment from LuxRender's table: twist and inclination in degrees, curvature, width,
 /// length and centre (u, v) in tile units.
-const fn yarn(kind: YarnKind, psi: f32, umax: f32, kappa: f32, size: [f32; 2], c: [f32; 2]) -> Yarn {
+const fn yarn(
+    kind: YarnKind,
+    psi: f32,
+    umax: f32,
+    kappa: f32,
+    size: [f32; 2],
+    c: [f32; 2],
+) -> Yarn {
     Yarn {
         kind,
         psi: deg(psi),
@@ -132,8 +139,8 @@ pub static PRESETS: [Preset; 6] = [
         width: 5,
         height: 10,
         pattern: &[
-            10, 2, 4, 6, 8, 1, 2, 4, 6, 8, 1, 2, 4, 13, 8, 1, 2, 4, 7, 8, 1, 11, 4, 7, 8, 1, 3,
-            4, 7, 8, 1, 3, 4, 7, 14, 1, 3, 4, 7, 9, 1, 3, 12, 7, 9, 1, 3, 5, 7, 9,
+            10, 2, 4, 6, 8, 1, 2, 4, 6, 8, 1, 2, 4, 13, 8, 1, 2, 4, 7, 8, 1, 11, 4, 7, 8, 1, 3, 4,
+            7, 8, 1, 3, 4, 7, 14, 1, 3, 4, 7, 9, 1, 3, 12, 7, 9, 1, 3, 5, 7, 9,
         ],
         yarns: &[
             yarn(W, 0.0, 40.0, 2.0, [1.0, 9.0], [0.1, 0.45]),
@@ -163,8 +170,8 @@ pub static PRESETS: [Preset; 6] = [
         width: 6,
         height: 8,
         pattern: &[
-            3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 4, 1, 1, 5,
-            5, 5, 4, 1, 1, 5, 5, 5, 4, 1, 1, 5, 5, 5, 4, 1, 1, 5, 5, 5,
+            3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 3, 3, 3, 3, 2, 2, 4, 1, 1, 5, 5,
+            5, 4, 1, 1, 5, 5, 5, 4, 1, 1, 5, 5, 5, 4, 1, 1, 5, 5, 5,
         ],
         yarns: &[
             yarn(W, 0.0, 50.0, -0.5, [2.0, 4.0], [0.3333, 0.25]),
@@ -185,8 +192,8 @@ pub static PRESETS: [Preset; 6] = [
         width: 4,
         height: 8,
         pattern: &[
-            7, 2, 4, 6, 7, 2, 4, 6, 1, 8, 4, 6, 1, 8, 4, 6, 1, 3, 9, 6, 1, 3, 9, 6, 1, 3, 5, 10,
-            1, 3, 5, 10,
+            7, 2, 4, 6, 7, 2, 4, 6, 1, 8, 4, 6, 1, 8, 4, 6, 1, 3, 9, 6, 1, 3, 9, 6, 1, 3, 5, 10, 1,
+            3, 5, 10,
         ],
         yarns: &[
             yarn(W, -30.0, 24.0, 0.0, [1.0, 6.0], [0.125, 0.375]),
@@ -212,8 +219,8 @@ pub static PRESETS: [Preset; 6] = [
         width: 6,
         height: 9,
         pattern: &[
-            1, 1, 2, 2, 7, 7, 1, 1, 2, 2, 7, 7, 1, 1, 2, 2, 7, 7, 1, 1, 6, 6, 4, 4, 1, 1, 6, 6,
-            4, 4, 1, 1, 6, 6, 4, 4, 5, 5, 3, 3, 4, 4, 5, 5, 3, 3, 4, 4, 5, 5, 3, 3, 4, 4,
+            1, 1, 2, 2, 7, 7, 1, 1, 2, 2, 7, 7, 1, 1, 2, 2, 7, 7, 1, 1, 6, 6, 4, 4, 1, 1, 6, 6, 4,
+            4, 1, 1, 6, 6, 4, 4, 5, 5, 3, 3, 4, 4, 5, 5, 3, 3, 4, 4, 5, 5, 3, 3, 4, 4,
         ],
         yarns: &[
             yarn(W, 30.0, 30.0, 0.0, [2.0, 6.0], [0.167, 0.667]),
@@ -262,10 +269,14 @@ fn tea(v0: u32, v1: u32) -> u64 {
     for _ in 0..TEA_ROUNDS {
         sum = sum.wrapping_add(0x9e37_79b9);
         v0 = v0.wrapping_add(
-            (v1 << 4).wrapping_add(0xa341_316c) ^ v1.wrapping_add(sum) ^ (v1 >> 5).wrapping_add(0xc801_3ea4),
+            (v1 << 4).wrapping_add(0xa341_316c)
+                ^ v1.wrapping_add(sum)
+                ^ (v1 >> 5).wrapping_add(0xc801_3ea4),
         );
         v1 = v1.wrapping_add(
-            (v0 << 4).wrapping_add(0xad90_777d) ^ v0.wrapping_add(sum) ^ (v0 >> 5).wrapping_add(0x7e95_761e),
+            (v0 << 4).wrapping_add(0xad90_777d)
+                ^ v0.wrapping_add(sum)
+                ^ (v0 >> 5).wrapping_add(0x7e95_761e),
         );
     }
     (u64::from(v1) << 32) + u64::from(v0)
@@ -291,7 +302,11 @@ impl Preset {
         let base = p.floor();
         let base = if base.is_finite() { base } else { Vec2::ZERO };
         let offset = (p - base).clamp(Vec2::ZERO, Vec2::ONE);
-        let offset = if offset.is_finite() { offset } else { Vec2::ZERO };
+        let offset = if offset.is_finite() {
+            offset
+        } else {
+            Vec2::ZERO
+        };
         let column = ((offset.x * w) as u32).min(self.width - 1);
         // The pattern's rows run from the top of the tile down.
         let row = self.height - 1 - ((offset.y * h) as u32).min(self.height - 1);
@@ -400,4 +415,3 @@ impl Cloth {
         texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
     }
 }
-

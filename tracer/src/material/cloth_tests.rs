@@ -72,7 +72,11 @@ fn preset_normalisations_and_albedo_bounds_match_their_measurement() {
         if (f64::from(p.normalization) / norm - 1.0).abs() >= 0.03 {
             failures.push(format!("{}: normalization off", p.name));
         }
-        if p.albedo_bound.iter().zip(albedo).any(|(b, m)| f64::from(*b) < m) {
+        if p.albedo_bound
+            .iter()
+            .zip(albedo)
+            .any(|(b, m)| f64::from(*b) < m)
+        {
             failures.push(format!("{}: an albedo bound below its measurement", p.name));
         }
     }
@@ -162,7 +166,11 @@ fn cloth_sampling_agrees_with_its_evaluation() {
 #[test]
 fn cloth_is_reciprocal() {
     for p in &PRESETS {
-        let lobe = ClothLobe::new(Vec3::splat(0.1), Vec3::ONE, p.highlight(Vec2::new(0.3, 0.6), repeat()));
+        let lobe = ClothLobe::new(
+            Vec3::splat(0.1),
+            Vec3::ONE,
+            p.highlight(Vec2::new(0.3, 0.6), repeat()),
+        );
         let mut checked = 0;
         for i in 0..4096 {
             let mut s = PixelSampler::new(7, 0, i, 4096, 5);
@@ -179,6 +187,10 @@ fn cloth_is_reciprocal() {
             }
         }
         // The highlight (beyond the diffuse 0.1 / pi) shows in a good part of the pairs.
-        assert!(checked > 100, "{}: {checked} pairs with a highlight", p.name);
+        assert!(
+            checked > 100,
+            "{}: {checked} pairs with a highlight",
+            p.name
+        );
     }
 }

@@ -175,7 +175,11 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
     let mut cases: Vec<(&'static str, Vec<MaterialDesc>)> = carpaint::PRESETS
         .iter()
         .map(|p| (p.name, vec![carpaint_preset(p.name)]))
-        .chain(cloth::PRESETS.iter().map(|p| (p.name, vec![cloth_preset(p)])))
+        .chain(
+            cloth::PRESETS
+                .iter()
+                .map(|p| (p.name, vec![cloth_preset(p)])),
+        )
         .collect();
     cases.extend([
         (

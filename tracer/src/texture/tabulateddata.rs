@@ -32,6 +32,8 @@ use crate::spectra::spectrum_rgb;
 
 /// The most samples a data file may hold (measured spectra have hundreds to thousands).
 pub const MAX_SAMPLES: usize = 1 << 16;
+/// The largest magnitude a sample's value keeps (far beyond any measured spectrum).
+pub const MAX_VALUE: f64 = 1e9;
 /// Wavelengths LuxRender renders, nm: data entirely outside them is unusable.
 const VISIBLE_NM: (f64, f64) = (380.0, 720.0);
 
@@ -43,12 +45,16 @@ pub struct Tabulated {
 }
 
 impl Tabulated {
-    /// The samples put in increasing order of wavelength (files may list them decreasing);
-    /// None when fewer than two, or none in the visible range.
-    pub fn new(mut wavelengths: Vec<f64>, mut values: Vec<f64>) -> Option<Self> {
+    /// The samples put in increasing order of wavelength (files may list them decreasing),
+    /// values bounded by [`MAX_VALUE`] so the colour stays finite; None when fewer than two,
+    /// or none in the visible range.
+    pub fn new(mut wavelengths: Vec<f64>, values: Vec<f64>) -> Option<Self> {
         let n = wavelengths.len().min(values.len());
         wavelengths.truncate(n);
-        values.truncate(n);
+        let mut values: Vec<f64> = values[..n]
+            .iter()
+            .map(|v| v.clamp(-MAX_VALUE, MAX_VALUE))
+            .collect();
         if n < 2 {
             return None;
         }
@@ -76,7 +82,11 @@ impl Tabulated {
             return 0.0;
         }
         let (l0, l1) = (w[i - 1], w[i]);
-        let t = if l1 > l0 { (lambda - l0) / (l1 - l0) } else { 1.0 };
+        let t = if l1 > l0 {
+            (lambda - l0) / (l1 - l0)
+        } else {
+            1.0
+        };
         self.values[i - 1] + t * (self.values[i] - self.values[i - 1])
     }
 
@@ -127,7 +137,10 @@ fn sample(line: &str) -> Option<(f64, f64)> {
     let end = line.find(is_sep)?;
     let second = line[end..].trim_start_matches(is_sep);
     let end2 = second.find(is_sep).unwrap_or(second.len());
-    let (a, b) = (line[..end].parse::<f64>().ok()?, second[..end2].parse::<f64>().ok()?);
+    let (a, b) = (
+        line[..end].parse::<f64>().ok()?,
+        second[..end2].parse::<f64>().ok()?,
+    );
     (a.is_finite() && b.is_finite() && a > 0.0).then_some((a, b))
 }
 
@@ -167,7 +180,10 @@ pub fn read_file(
     ctx: &mut dyn ParseContext,
 ) -> Result<Constant, ParseError> {
     let Some(path) = params.string("filename")? else {
-        ctx.warn(pos, "tabulateddata: no \"filename\"; using a flat spectrum of 1".into());
+        ctx.warn(
+            pos,
+            "tabulateddata: no \"filename\"; using a flat spectrum of 1".into(),
+        );
         return Ok(flat());
     };
     let bytes = ctx.read_asset(&path, AssetKind::Spectrum, pos)?;

@@ -87,7 +87,10 @@ fn sodium_lamps_are_orange_and_daylight_is_white() {
     }
     assert!(day.max_element() / day.min_element() < 1.3, "{day}");
     // The default and an unknown name are LuxRender's Incandescent2: a 2900 K blackbody.
-    assert!((inc - blackbody_rgb(2900.0)).abs().max_element() < 1e-6, "{inc}");
+    assert!(
+        (inc - blackbody_rgb(2900.0)).abs().max_element() < 1e-6,
+        "{inc}"
+    );
     assert_eq!(bad, inc);
     assert!(warnings.contains("Sodium9000"), "{warnings}");
 }
@@ -120,7 +123,10 @@ fn tabulated_spectra_from_files_and_inline() {
     }
     // Only long wavelengths pass: red, little green, no blue.
     let step = c[1];
-    assert!(step.x > 0.8 && step.y < 0.5 && step.z < 0.05 && step.min_element() >= 0.0, "{step}");
+    assert!(
+        step.x > 0.8 && step.y < 0.5 && step.z < 0.05 && step.min_element() >= 0.0,
+        "{step}"
+    );
     // One sample is too few: a flat spectrum of 1, with a warning naming the file.
     assert_eq!(c[3], Vec3::ONE);
     assert!(warnings.contains("short.txt"), "{warnings}");
