@@ -240,9 +240,11 @@ fn luxrender_extras_map_to_luxcore_materials() {
     assert_eq!(floats(&key(&cloth, "weft_kd")), [0.0; 3]);
     assert_eq!(floats(&key(&cloth, "repeat_u")), [40.0]);
     assert_eq!(floats(&key(&cloth, "repeat_v")), [100.0]);
-    // The lamp's spectrum went out as its constant colour (orange, clamped to [0, 1]).
-    let warp = floats(&key(&cloth, "warp_kd"));
-    assert!(warp[0] > warp[1] && warp[1] > warp[2], "{warp:?}");
+    // The lamp's spectrum went out as a constant texture of its (orange) colour.
+    let lamp = format!("scene.textures.{}", key(&cloth, "warp_kd").trim_matches('"'));
+    assert_eq!(value(scn, &format!("{lamp}.type")), "\"constfloat3\"");
+    let warp = floats(value(scn, &format!("{lamp}.value")));
+    assert!(warp[0] > 3.0 * warp[1] && warp[1] > warp[2], "{warp:?}");
 }
 
 #[test]
