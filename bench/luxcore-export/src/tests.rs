@@ -241,7 +241,10 @@ fn luxrender_extras_map_to_luxcore_materials() {
     assert_eq!(floats(&key(&cloth, "repeat_u")), [40.0]);
     assert_eq!(floats(&key(&cloth, "repeat_v")), [100.0]);
     // The lamp's spectrum went out as a constant texture of its (orange) colour.
-    let lamp = format!("scene.textures.{}", key(&cloth, "warp_kd").trim_matches('"'));
+    let lamp = format!(
+        "scene.textures.{}",
+        key(&cloth, "warp_kd").trim_matches('"')
+    );
     assert_eq!(value(scn, &format!("{lamp}.type")), "\"constfloat3\"");
     let warp = floats(value(scn, &format!("{lamp}.value")));
     assert!(warp[0] > 3.0 * warp[1] && warp[1] > warp[2], "{warp:?}");

@@ -131,7 +131,8 @@ impl Yarn {
         let across = h.y * sin_u + h.z * cos_u;
         let d =
             (h.y * cos_u - h.z * sin_u) / ((h.x * h.x + across * across).sqrt() * self.psi.tan());
-        if !(d.abs() < 1.0) {
+        // NaN (a degenerate half vector) fails too.
+        if d.is_nan() || d.abs() >= 1.0 {
             return 0.0;
         }
         let v_h = (-across).atan2(h.x) + d.acos();
@@ -195,7 +196,7 @@ fn von_mises(cos_x: f32, b: f32) -> f32 {
     } else {
         let t = 3.75 / b;
         // I0(b) = exp(b) / sqrt(b) * poly(t).
-        let poly = 0.398_942_28
+        let poly = 0.398_942_3
             + t * (0.013_285_92
                 + t * (0.002_253_19
                     + t * (-0.001_575_65

@@ -111,7 +111,7 @@ fn unit(name: &str) -> Option<fn(f64) -> f64> {
         "nm" => |x| x,
         "um" => |x| x * 1000.0,
         // lambda = h c / E, with h c in eV nm.
-        "eV" => |x| 1239.841_98 / x,
+        "eV" => |x| 1_239.841_98 / x,
         "cm-1" => |x| 1e7 / x,
         _ => return None,
     })
