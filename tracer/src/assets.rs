@@ -15,6 +15,8 @@ pub enum AssetKind {
     Image,
     /// A metal's refractive-index data (`.nk`), which `Material "metal"` may name.
     Nk,
+    /// A tabulated spectrum (`Texture ... "tabulateddata"`).
+    Spectrum,
 }
 
 /// A file the scene depends on, keyed by its path as written (relative to the main file's

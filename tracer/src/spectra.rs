@@ -26,17 +26,21 @@ pub fn metal_preset(name: &str) -> Option<(Vec3, Vec3)> {
 /// sets a hue; the light's gain sets the brightness).
 pub fn blackbody_rgb(kelvin: f32) -> Vec3 {
     let t = f64::from(kelvin.max(100.0));
-    let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
-    let mut lambda = 380.0f64;
-    while lambda <= 780.0 {
-        let b = planck(lambda, t);
-        let (cx, cy, cz) = cie_1931(lambda);
-        x += b * cx;
-        y += b * cy;
-        z += b * cz;
-        lambda += 5.0;
-    }
-    let rgb = xyz_to_linear_srgb(DVec3::new(x, y, z)).max(Vec3::ZERO);
+    let xyz = cie_xyz(|l| planck(l, t), VISIBLE_NM, 5.0);
+    hue_rgb(xyz)
+}
+
+/// The hue of an emitted spectrum (nm -> relative radiance) as LuxRender's film sees it (1 nm
+/// steps over its wavelengths): linear sRGB scaled to luminance 1, as [`blackbody_rgb`]. What
+/// the lamp spectra of the `lampspectrum` texture reduce to.
+pub fn emission_hue(spectrum: impl Fn(f64) -> f64) -> Vec3 {
+    hue_rgb(cie_xyz(spectrum, FILM_NM, 1.0))
+}
+
+/// The linear sRGB hue of an emitted XYZ colour, negative channels clipped, scaled to
+/// luminance 1 (white when it has none).
+fn hue_rgb(xyz: DVec3) -> Vec3 {
+    let rgb = xyz_to_linear_srgb(xyz).max(Vec3::ZERO);
     let yl = luminance(rgb);
     if yl > 0.0 {
         rgb / yl
@@ -57,13 +61,7 @@ const LUMENS_PER_WATT: f64 = 683.0;
 /// wavelengths (1 nm steps), then the sRGB (D65) matrix. Y, and so the luminance of the
 /// result, is in cd/m^2, the scale on which an RGB light colour of 1 has luminance 1.
 pub fn emission_rgb(spectrum: impl Fn(f64) -> f64) -> Vec3 {
-    let mut xyz = DVec3::ZERO;
-    let mut lambda = FILM_NM.0;
-    while lambda <= FILM_NM.1 {
-        let (cx, cy, cz) = cie_1931(lambda);
-        xyz += spectrum(lambda) * DVec3::new(cx, cy, cz);
-        lambda += 1.0;
-    }
+    let xyz = cie_xyz(spectrum, FILM_NM, 1.0);
     xyz_to_linear_srgb(xyz * LUMENS_PER_WATT)
 }
 
@@ -85,17 +83,25 @@ fn xyz_to_srgb(xyz: DVec3) -> DVec3 {
 /// equal-energy light, in linear sRGB, divided channel by channel by that of the constant
 /// spectrum 1, so that a flat spectrum of value v is exactly (v, v, v).
 pub fn spectrum_rgb(f: impl Fn(f64) -> f64) -> Vec3 {
-    let rgb = |f: &dyn Fn(f64) -> f64| {
-        let mut xyz = DVec3::ZERO;
-        let mut lambda = 380.0f64;
-        while lambda <= 780.0 {
-            let (cx, cy, cz) = cie_1931(lambda);
-            xyz += f(lambda) * DVec3::new(cx, cy, cz);
-            lambda += 5.0;
-        }
-        xyz_to_srgb(xyz)
-    };
+    let rgb = |f: &dyn Fn(f64) -> f64| xyz_to_srgb(cie_xyz(f, VISIBLE_NM, 5.0));
     (rgb(&f) / rgb(&|_| 1.0)).as_vec3()
+}
+
+/// The wavelengths a reflectance or a hue is integrated over, in nm.
+const VISIBLE_NM: (f64, f64) = (380.0, 780.0);
+
+/// CIE 1931 XYZ of `spectrum` (nm -> value): the sum of spectrum x the colour matching
+/// functions at `step` nm from `range.0` to `range.1` (both included). The one integration
+/// loop every conversion here shares.
+fn cie_xyz(spectrum: impl Fn(f64) -> f64, range: (f64, f64), step: f64) -> DVec3 {
+    let count = ((range.1 - range.0) / step).round() as u32;
+    (0..=count)
+        .map(|i| {
+            let lambda = range.0 + f64::from(i) * step;
+            let (x, y, z) = cie_1931(lambda);
+            spectrum(lambda) * DVec3::new(x, y, z)
+        })
+        .sum()
 }
 
 /// Planck's law, spectral radiance up to a constant factor (normalised away by the caller).

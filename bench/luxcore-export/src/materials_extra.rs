@@ -1,11 +1,11 @@
 //! The LuxRender 1.x materials beyond the course's set, as LuxCore's equivalents: carpaint,
-//! velvet, glossycoating and glossytranslucent have LuxCore materials of the same name and
-//! parameters; shinymetal, layered and scatter have none and go out by their name (LuxCore
+//! velvet, cloth, glossycoating and glossytranslucent have LuxCore materials of the same name
+//! and parameters (cloth's `presetname` is LuxCore's `preset`); shinymetal, layered and scatter have none and go out by their name (LuxCore
 //! then shows its default), which bench/RESULTS.md explains.
 
 use yat_tracer::desc::MaterialDesc;
 use yat_tracer::material::glossy::CoatParams;
-use yat_tracer::material::{CarPaint, GlossyCoating, GlossyTranslucent, Velvet};
+use yat_tracer::material::{CarPaint, Cloth, GlossyCoating, GlossyTranslucent, Velvet};
 
 use crate::props::{mat_name, quoted, tex_value, Props};
 
@@ -62,6 +62,21 @@ pub fn write(p: &mut Props, prefix: &str, m: &MaterialDesc) -> bool {
                 set(&format!("p{}", i + 1), tex_value(c, false));
             }
             set("thickness", tex_value(thickness, false));
+        }
+        MaterialDesc::Cloth(Cloth {
+            preset,
+            warp,
+            weft,
+            repeat,
+        }) => {
+            set("type", quoted("cloth"));
+            set("preset", quoted(preset.name));
+            set("warp_kd", tex_value(&warp[0], true));
+            set("warp_ks", tex_value(&warp[1], true));
+            set("weft_kd", tex_value(&weft[0], true));
+            set("weft_ks", tex_value(&weft[1], true));
+            set("repeat_u", repeat.x.to_string());
+            set("repeat_v", repeat.y.to_string());
         }
         MaterialDesc::GlossyCoating(GlossyCoating { base, coat }) => {
             set("type", quoted("glossycoating"));

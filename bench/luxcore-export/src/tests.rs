@@ -190,7 +190,9 @@ fn luxrender_extras_map_to_luxcore_materials() {
          MakeNamedMaterial \"base\" \"string type\" \"matte\"\n\
          MakeNamedMaterial \"c\" \"string type\" \"glossycoating\" \"string basematerial\" \"base\" \"float uroughness\" [0.3]\n\
          NamedMaterial \"c\"\nShape \"sphere\"\n\
-         Material \"glossytranslucent\" \"bool onesided\" \"false\" \"color backface_Ks\" [0.2 0.2 0.2]\nShape \"sphere\"",
+         Material \"glossytranslucent\" \"bool onesided\" \"false\" \"color backface_Ks\" [0.2 0.2 0.2]\nShape \"sphere\"\n\
+         Texture \"lamp\" \"color\" \"lampspectrum\" \"string name\" \"LPS\"\n\
+         Material \"cloth\" \"string presetname\" \"silk_shantung\" \"texture warp_Kd\" \"lamp\" \"color weft_Ks\" [0.1 0.2 0.3] \"float repeat_u\" [40]\nShape \"sphere\"",
     );
     let scn = &lux.scene;
     let key = |m: &str, k: &str| value(scn, &format!("scene.materials.{m}.{k}")).to_string();
@@ -204,6 +206,7 @@ fn luxrender_extras_map_to_luxcore_materials() {
         "velvet",
         "glossycoating",
         "glossytranslucent",
+        "cloth",
         "matte",
     ] {
         assert!(types.iter().any(|x| x == t), "{t} missing from {types:?}");
@@ -231,6 +234,20 @@ fn luxrender_extras_map_to_luxcore_materials() {
     let leaf = find("glossytranslucent");
     assert_eq!(floats(&key(&leaf, "ks_bf")), [0.2; 3]);
     assert_eq!(floats(&key(&leaf, "uroughness_bf")), [0.0]);
+    let cloth = find("cloth");
+    assert_eq!(key(&cloth, "preset"), "\"silk_shantung\"");
+    assert_eq!(floats(&key(&cloth, "weft_ks")), [0.1, 0.2, 0.3]);
+    assert_eq!(floats(&key(&cloth, "weft_kd")), [0.0; 3]);
+    assert_eq!(floats(&key(&cloth, "repeat_u")), [40.0]);
+    assert_eq!(floats(&key(&cloth, "repeat_v")), [100.0]);
+    // The lamp's spectrum went out as a constant texture of its (orange) colour.
+    let lamp = format!(
+        "scene.textures.{}",
+        key(&cloth, "warp_kd").trim_matches('"')
+    );
+    assert_eq!(value(scn, &format!("{lamp}.type")), "\"constfloat3\"");
+    let warp = floats(value(scn, &format!("{lamp}.value")));
+    assert!(warp[0] > 3.0 * warp[1] && warp[1] > warp[2], "{warp:?}");
 }
 
 #[test]

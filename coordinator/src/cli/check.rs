@@ -183,6 +183,7 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         AssetKind::Ply => "ply",
         AssetKind::Image => "image",
         AssetKind::Nk => "nk",
+        AssetKind::Spectrum => "spectrum",
     }));
     let _ = writeln!(s, "assets       {} ({assets})", d.assets.len());
     let _ = writeln!(s, "parse time   {:.1} ms", seconds * 1e3);

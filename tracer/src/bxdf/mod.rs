@@ -9,6 +9,7 @@
 //! [`coated`] layer and [`coating`] (a coat over any lobe), and [`bsdf`] (world frame).
 
 pub mod bsdf;
+pub mod cloth;
 pub mod coated;
 pub mod coating;
 pub mod conductor;
@@ -26,6 +27,7 @@ use glam::{Vec2, Vec3};
 
 pub use sample::LocalSample;
 
+use cloth::Cloth;
 use conductor::Conductor;
 use dielectric::Dielectric;
 use diffuse::{DiffuseReflection, DiffuseTranslucent};
@@ -43,6 +45,7 @@ pub enum Bxdf {
     Dielectric(Dielectric),
     Velvet(Velvet),
     Scatter(Scatter),
+    Cloth(Cloth),
 }
 
 impl Bxdf {
@@ -51,7 +54,11 @@ impl Bxdf {
             Bxdf::PassThrough => true,
             Bxdf::Conductor(c) => c.is_specular(),
             Bxdf::Dielectric(d) => d.is_specular(),
-            Bxdf::Diffuse(_) | Bxdf::Translucent(_) | Bxdf::Velvet(_) | Bxdf::Scatter(_) => false,
+            Bxdf::Diffuse(_)
+            | Bxdf::Translucent(_)
+            | Bxdf::Velvet(_)
+            | Bxdf::Scatter(_)
+            | Bxdf::Cloth(_) => false,
         }
     }
 
@@ -66,6 +73,7 @@ impl Bxdf {
             Bxdf::Dielectric(d) => d.kr.max(d.kt),
             Bxdf::Velvet(v) => v.albedo_hint(),
             Bxdf::Scatter(s) => s.albedo_hint(),
+            Bxdf::Cloth(c) => c.albedo_hint(),
         }
     }
 
@@ -89,6 +97,7 @@ impl Bxdf {
             Bxdf::Dielectric(d) => d.f(wo, wi),
             Bxdf::Velvet(v) => v.f(wo, wi),
             Bxdf::Scatter(s) => s.f(wo, wi),
+            Bxdf::Cloth(c) => c.f(wo, wi),
         }
     }
 
@@ -106,6 +115,7 @@ impl Bxdf {
             Bxdf::Dielectric(d) => d.pdf(wo, wi),
             Bxdf::Velvet(v) => v.pdf(wo, wi),
             Bxdf::Scatter(s) => s.pdf(wo, wi),
+            Bxdf::Cloth(c) => c.pdf(wo, wi),
         }
     }
 
@@ -120,6 +130,7 @@ impl Bxdf {
             Bxdf::Dielectric(d) => d.sample(wo, u_lobe, u),
             Bxdf::Velvet(v) => v.sample(wo, u),
             Bxdf::Scatter(s) => s.sample(wo, u),
+            Bxdf::Cloth(c) => c.sample(wo, u),
         }?;
         Some(if mirrored {
             LocalSample {

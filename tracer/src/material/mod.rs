@@ -3,7 +3,7 @@
 //! defaults, its reading and its evaluation: [`matte`], [`glossy`] (glossy, glossy2),
 //! [`mirror`], [`glass`] (glass, roughglass, glass2), [`metal`] (metal, metal2),
 //! [`mattetranslucent`], [`null`], [`mix`], [`carpaint`], [`velvet`], [`shinymetal`],
-//! [`glossycoating`], [`glossytranslucent`], [`layered`], [`scatter`]. They compose the lobes
+//! [`glossycoating`], [`glossytranslucent`], [`layered`], [`scatter`], [`cloth`]. They compose the lobes
 //! of [`crate::bxdf`]; [`eval`] is what they see of the textures at a hit.
 //!
 //! A material is resolved per hit into a [`Bsdf`]: textures are evaluated at the hit, `mix`
@@ -19,6 +19,7 @@
 
 pub mod bump;
 pub mod carpaint;
+pub mod cloth;
 pub mod eval;
 pub mod glass;
 pub mod glossy;
@@ -37,6 +38,8 @@ pub mod shinymetal;
 pub mod velvet;
 
 #[cfg(test)]
+mod cloth_tests;
+#[cfg(test)]
 mod tests;
 
 use glam::Affine3A;
@@ -44,6 +47,7 @@ use glam::Affine3A;
 pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
 pub use bump::Bump;
 pub use carpaint::CarPaint;
+pub use cloth::Cloth;
 pub use glass::Glass;
 pub use glossy::Glossy;
 pub use glossycoating::GlossyCoating;
@@ -90,6 +94,7 @@ pub enum MaterialDesc {
     GlossyTranslucent(GlossyTranslucent),
     Layered(Layered),
     Scatter(Scatter),
+    Cloth(Cloth),
     /// A material with a bump or normal map (never a mix or null: LuxRender's take none).
     Bumped(Box<MaterialDesc>, Bump),
 }
@@ -146,6 +151,7 @@ impl MaterialDesc {
             }
             "layered" => Self::Layered(Layered::read(params, pos, ctx)?),
             "scatter" => Self::Scatter(Scatter::read(params, pos, ctx)?),
+            "cloth" => Self::Cloth(Cloth::read(params, pos, ctx)?),
             other => {
                 ctx.warn(pos, format!("material \"{other}\" is not supported; using matte (with its Kd when given)"));
                 let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
@@ -179,6 +185,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(_) => "glossytranslucent",
             Self::Layered(_) => "layered",
             Self::Scatter(_) => "scatter",
+            Self::Cloth(_) => "cloth",
             Self::Bumped(m, _) => m.name(),
         }
     }
@@ -201,6 +208,7 @@ impl MaterialDesc {
             Self::GlossyTranslucent(m) => m.textures(),
             Self::Layered(m) => m.textures(),
             Self::Scatter(m) => m.textures(),
+            Self::Cloth(m) => m.textures(),
             Self::Bumped(m, bump) => m.textures().into_iter().chain([bump.map]).collect(),
         }
     }
@@ -234,6 +242,7 @@ impl MaterialDesc {
             Self::ShinyMetal(m) => m.bxdf(eval, u),
             Self::GlossyTranslucent(m) => m.bxdf(eval),
             Self::Scatter(m) => m.bxdf(eval),
+            Self::Cloth(m) => m.bxdf(eval),
             Self::Mix(_) | Self::Layered(_) | Self::GlossyCoating(_) => Matte::default_bxdf(),
             Self::Bumped(m, _) => m.bxdf(eval, u),
         }

@@ -21,7 +21,8 @@ fn hit_with(ng: Vec3, ns: Vec3) -> SurfaceHit {
         p: Vec3::ZERO,
         ng,
         ns,
-        uv: Vec2::ZERO,
+        // Inside a yarn of every cloth weave (the origin is on the edge of one).
+        uv: Vec2::new(0.37, 0.61),
         dpdu: Vec3::X,
         dpdv: Vec3::Y,
         shape: 0,
@@ -110,6 +111,16 @@ fn carpaint_preset(name: &str) -> MaterialDesc {
     MaterialDesc::CarPaint(CarPaint::from_preset(p, c(0.0), c(0.0)))
 }
 
+/// A cloth preset with bright highlights (the cap on its glints binds) on a white surface.
+fn cloth_preset(p: &'static cloth::Preset) -> MaterialDesc {
+    MaterialDesc::Cloth(Cloth {
+        preset: p,
+        warp: [rgb(0.3, 0.2, 0.1), c(1.0)],
+        weft: [c(0.5), rgb(1.0, 0.5, 0.8)],
+        repeat: glam::Vec2::splat(cloth::DEFAULT_REPEAT),
+    })
+}
+
 fn velvet(kd: f32, p: [f32; 3], thickness: f32) -> MaterialDesc {
     MaterialDesc::Velvet(Velvet {
         kd: c(kd),
@@ -164,6 +175,11 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
     let mut cases: Vec<(&'static str, Vec<MaterialDesc>)> = carpaint::PRESETS
         .iter()
         .map(|p| (p.name, vec![carpaint_preset(p.name)]))
+        .chain(
+            cloth::PRESETS
+                .iter()
+                .map(|p| (p.name, vec![cloth_preset(p)])),
+        )
         .collect();
     cases.extend([
         (
@@ -605,6 +621,7 @@ fn extras_are_reciprocal() {
             vec![carpaint_preset("polaris silber")],
         ),
         ("velvet", vec![velvet(0.8, [-2.0, 20.0, 2.0], 0.3)]),
+        ("cloth denim", vec![cloth_preset(&cloth::PRESETS[0])]),
         (
             "glossytranslucent two coats",
             vec![glossytranslucent(

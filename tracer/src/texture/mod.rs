@@ -3,7 +3,7 @@
 //! [`constant`], [`scale`], [`arithmetic`] (add, subtract), [`mix`], [`band`], [`bilerp`],
 //! [`uv`], [`harlequin`], [`dots`], [`brick`], [`fbm`], [`wrinkled`], [`windy`], [`marble`],
 //! the [`blender`] family (blender_clouds, _wood, _marble, _musgrave, _stucci, _noise,
-//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`] and [`equalenergy`] (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in).
+//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`], [`equalenergy`], [`lampspectrum`] and [`tabulateddata`] (tabulateddata, irregulardata) (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in).
 //! [`mapping`] holds the 2D mappings (uv, spherical, cylindrical, planar) and the 3D mapping
 //! (global, local, uv coordinates with scale, rotate, translate); [`noise`] the Perlin noise,
 //! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator
@@ -37,12 +37,14 @@ pub mod fresnel;
 pub mod gaussian;
 pub mod harlequin;
 pub mod imagemap;
+pub mod lampspectrum;
 pub mod mapping;
 pub mod marble;
 pub mod mix;
 pub mod noise;
 pub mod normalmap;
 pub mod scale;
+pub mod tabulateddata;
 pub mod uv;
 pub mod windy;
 pub mod wrinkled;
@@ -199,6 +201,9 @@ impl TextureKind {
             "blackbody" => Self::Constant(blackbody::read(params)?),
             "gaussian" => Self::Constant(gaussian::read(params)?),
             "equalenergy" => Self::Constant(equalenergy::read(params)?),
+            "lampspectrum" => Self::Constant(lampspectrum::read(params, pos, ctx)?),
+            "tabulateddata" => Self::Constant(tabulateddata::read_file(params, pos, ctx)?),
+            "irregulardata" => Self::Constant(tabulateddata::read_inline(params, pos, ctx)?),
             _ => match blender::Blender::read(class, decl, params, pos, ctx)? {
                 Some(b) => Self::Blender(b),
                 None => return Ok(None),

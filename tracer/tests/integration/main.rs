@@ -17,5 +17,6 @@ mod render;
 mod scene;
 mod seed_renders;
 mod seed_scenes;
+mod spectral_textures;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
