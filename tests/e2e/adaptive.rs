@@ -174,3 +174,86 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
         .fold(0f32, f32::max);
     assert!(worst < 1e-4, "relative difference {worst}");
 }
+
+/// The round `--time-limit` stopped at, from the render's stderr.
+fn round_written(output: &std::process::Output) -> u32 {
+    assert_success(output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let (_, rest) = stderr
+        .split_once("--time-limit reached: writing the image of round ")
+        .unwrap_or_else(|| panic!("no time limit reached: {stderr}"));
+    rest.split(' ').next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn a_time_limit_writes_the_last_round_and_the_same_command_goes_on() {
+    // A threshold no block reaches and up to 2^20 samples per pixel: rounds double for far
+    // longer than the limit, which lands after round 0 (a few thousand samples).
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let settings = |spp: &str| -> Vec<String> {
+        [
+            "--spp",
+            spp,
+            "--resolution",
+            "32x24",
+            "--noise-threshold",
+            "0.00001",
+            "--min-spp",
+            "4",
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let limited_settings = settings("1048576");
+    let limited_settings: Vec<&str> = limited_settings.iter().map(String::as_str).collect();
+    let out = dir.path().join("limited.png");
+    let checkpoint = out.with_extension("resume");
+    let limited = |limit: &str| {
+        render_command_with(
+            &scene,
+            &out,
+            &limited_settings,
+            &[
+                "--threads",
+                "2",
+                "--time-limit",
+                limit,
+                "--checkpoint-every",
+                "1000",
+            ],
+        )
+        .output()
+        .unwrap()
+    };
+    // The image written is the render that ends at that round: the same settings with --spp
+    // the round's end (4 x 2^k samples).
+    let assert_round_image = |round: u32, what: &str| {
+        let capped = dir.path().join(format!("capped-{round}.png"));
+        let capped_settings = settings(&(4u32 << round).to_string());
+        let capped_settings: Vec<&str> = capped_settings.iter().map(String::as_str).collect();
+        let output = render_command_with(
+            &scene,
+            &capped,
+            &capped_settings,
+            &["--quiet", "--checkpoint-every", "0", "--threads", "1"],
+        )
+        .output()
+        .unwrap();
+        assert_success(&output);
+        assert_same(&out, &image_bytes(&capped), what);
+    };
+
+    let first = round_written(&limited("1.5"));
+    assert!(first >= 1, "round {first}");
+    assert!(checkpoint.exists(), "the checkpoint is kept for the rest");
+    assert_round_image(first, "the first time-limited run");
+
+    // The same command goes on from every sample merged, and stops at a later round.
+    let output = limited("4");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("resuming from"), "{stderr}");
+    let second = round_written(&output);
+    assert!(second > first, "round {second} after {first}");
+    assert_round_image(second, "the resumed time-limited run");
+}
