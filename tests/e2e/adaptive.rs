@@ -187,73 +187,78 @@ fn round_written(output: &std::process::Output) -> u32 {
 
 #[test]
 fn a_time_limit_writes_the_last_round_and_the_same_command_goes_on() {
-    // A threshold no block reaches and up to 2^20 samples per pixel: rounds double for far
-    // longer than the limit, which lands after round 0 (a few thousand samples).
+    // A threshold no block reaches and up to 8192 samples per pixel in 12 rounds: the limit
+    // lands after round 0 (1,536 samples) and long before the last (3 million samples).
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let settings = |spp: &str| -> Vec<String> {
-        [
-            "--spp",
-            spp,
-            "--resolution",
-            "32x24",
-            "--noise-threshold",
-            "0.00001",
-            "--min-spp",
-            "4",
-        ]
-        .map(String::from)
-        .to_vec()
-    };
-    let limited_settings = settings("1048576");
-    let limited_settings: Vec<&str> = limited_settings.iter().map(String::as_str).collect();
+    let settings = [
+        "--spp",
+        "8192",
+        "--resolution",
+        "24x16",
+        "--noise-threshold",
+        "0.00001",
+        "--min-spp",
+        "4",
+    ];
     let out = dir.path().join("limited.png");
+    let map = dir.path().join("map.png");
     let checkpoint = out.with_extension("resume");
-    let limited = |limit: &str| {
-        render_command_with(
-            &scene,
-            &out,
-            &limited_settings,
-            &[
-                "--threads",
-                "2",
-                "--time-limit",
-                limit,
-                "--checkpoint-every",
-                "1000",
-            ],
-        )
-        .output()
-        .unwrap()
-    };
-    // The image written is the render that ends at that round: the same settings with --spp
-    // the round's end (4 x 2^k samples).
-    let assert_round_image = |round: u32, what: &str| {
-        let capped = dir.path().join(format!("capped-{round}.png"));
-        let capped_settings = settings(&(4u32 << round).to_string());
-        let capped_settings: Vec<&str> = capped_settings.iter().map(String::as_str).collect();
-        let output = render_command_with(
-            &scene,
-            &capped,
-            &capped_settings,
-            &["--quiet", "--checkpoint-every", "0", "--threads", "1"],
-        )
+    let limited = render_command_with(
+        &scene,
+        &out,
+        &settings,
+        &[
+            "--threads",
+            "2",
+            "--time-limit",
+            "1",
+            "--checkpoint-every",
+            "1000",
+            "--sample-map",
+            map.to_str().unwrap(),
+        ],
+    )
+    .output()
+    .unwrap();
+    let round = round_written(&limited);
+    assert!(round < 11, "round {round} is the last: no limit reached");
+    assert!(checkpoint.exists(), "the checkpoint is kept for the rest");
+    // The map is the round's: the most samples any pixel has are the round's end, 4 x 2^k.
+    assert!(map.exists());
+    let stdout = String::from_utf8_lossy(&limited.stdout);
+    assert!(
+        stdout.contains(&format!("to {} (white)", 4u32 << round)),
+        "round {round}: {stdout}"
+    );
+    let stopped = image_bytes(&out);
+
+    // The same command without the limit goes on from every sample merged, to the image of a
+    // render never stopped.
+    let resumed = render_command_with(&scene, &out, &settings, &["--threads", "1"])
         .output()
         .unwrap();
-        assert_success(&output);
-        assert_same(&out, &image_bytes(&capped), what);
-    };
-
-    let first = round_written(&limited("1.5"));
-    assert!(first >= 1, "round {first}");
-    assert!(checkpoint.exists(), "the checkpoint is kept for the rest");
-    assert_round_image(first, "the first time-limited run");
-
-    // The same command goes on from every sample merged, and stops at a later round.
-    let output = limited("4");
-    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_success(&resumed);
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
     assert!(stderr.contains("resuming from"), "{stderr}");
-    let second = round_written(&output);
-    assert!(second > first, "round {second} after {first}");
-    assert_round_image(second, "the resumed time-limited run");
+    assert!(
+        !checkpoint.exists(),
+        "a finished render removes its checkpoint"
+    );
+    let whole = dir.path().join("whole.png");
+    let output = render_command_with(
+        &scene,
+        &whole,
+        &settings,
+        &["--threads", "2", "--checkpoint-every", "0", "--quiet"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    let expected = image_bytes(&whole);
+    assert_same(&out, &expected, "a time-limited render resumed");
+    assert!(
+        stopped.1 != expected.1,
+        "round {round}'s image is the final one"
+    );
 }
