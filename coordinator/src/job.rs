@@ -2,7 +2,7 @@
 //! image, the interim preview and checkpoint); and what rendering it yields, whoever renders it.
 
 use std::path::{Component, Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use yat_tracer::film::Film;
@@ -32,6 +32,21 @@ pub struct RenderJob {
     pub interim: InterimOutputs,
     /// Set by Ctrl-C or SIGTERM when checkpoints are on: the render stops, saved.
     pub interrupt: Interrupt,
+    /// `--time-limit`: when an adaptive render stops at a round boundary.
+    pub deadline: Option<Instant>,
+}
+
+/// Why a render with `--time-limit` stopped short (its executor's error, turned into an
+/// outcome by [`RenderJob::timed_out`]).
+#[derive(Debug, thiserror::Error)]
+#[error("the time limit was reached")]
+pub struct TimeLimitReached;
+
+/// An adaptive render's last completed round, kept when the render has a time limit: the image
+/// it writes if the limit comes in the middle of the next round.
+pub struct CompletedRound {
+    film: Film,
+    round: Round,
 }
 
 /// The endings of the files a render writes beside its output `X.png`: `X.preview.png`,
@@ -84,6 +99,8 @@ pub struct RenderOutcome {
     pub build: Option<SceneBuild>,
     /// An adaptive render's last round: each block's samples per pixel.
     pub round: Option<Round>,
+    /// False for a render stopped by its time limit: its checkpoint stays for the rest.
+    pub complete: bool,
 }
 
 /// What building the scene cost.
@@ -102,9 +119,71 @@ impl RenderJob {
         }
     }
 
+    /// Whether the render's time limit has passed.
+    pub fn out_of_time(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// At a round boundary (every unit of the checkpoint's round merged) of a render with a time
+    /// limit: the round's film and samples, to write if the limit comes before the next one is
+    /// complete.
+    pub fn keep_round(&self, checkpoint: &Checkpoint) -> Option<CompletedRound> {
+        let round = checkpoint.round()?;
+        (self.deadline.is_some() && checkpoint.is_complete()).then(|| CompletedRound {
+            film: checkpoint.film().clone(),
+            round: round.clone(),
+        })
+    }
+
+    /// The outcome of a render its time limit stopped: the checkpoint saved with everything
+    /// merged, and the image of the last round completed (an error when none was).
+    pub fn timed_out(
+        &self,
+        checkpoint: &Checkpoint,
+        completed: Option<CompletedRound>,
+        stats: UnitStats,
+        build: Option<SceneBuild>,
+    ) -> anyhow::Result<RenderOutcome> {
+        let kept = self
+            .keep(checkpoint)
+            .unwrap_or_else(|| "checkpoints are off: nothing is kept".into());
+        let Some(completed) = completed else {
+            anyhow::bail!("--time-limit reached before a round was complete: no image; {kept}");
+        };
+        if !self.quiet {
+            eprintln!(
+                "--time-limit reached: writing the image of round {} (the render ending there); \
+                 {kept}",
+                completed.round.index
+            );
+        }
+        Ok(RenderOutcome {
+            film: completed.film,
+            stats,
+            build,
+            round: Some(completed.round),
+            complete: false,
+        })
+    }
+
     /// The error of a render that stopped short, after saving what it merged and saying how to
     /// resume it.
     pub fn stopped(&self, checkpoint: &Checkpoint, why: anyhow::Error) -> anyhow::Error {
+        let kept = self.keep(checkpoint);
+        match (self.interrupt.is_set(), kept) {
+            (true, kept) => Interrupted {
+                kept: kept.unwrap_or_else(|| "nothing had been rendered yet".into()),
+            }
+            .into(),
+            (false, Some(kept)) => anyhow::anyhow!("{why:#}\n{kept}"),
+            (false, None) => why,
+        }
+    }
+
+    /// Saves what a render that stops short merged, for the same command to resume: the
+    /// checkpoint and the preview (every merged unit in it); says where, or None when there is
+    /// nothing to keep or checkpoints are off.
+    fn keep(&self, checkpoint: &Checkpoint) -> Option<String> {
         let something =
             checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
         // The best image so far, every merged unit in it: the preview, when previews are on.
@@ -120,7 +199,7 @@ impl RenderJob {
         {
             eprintln!("{e:#}");
         }
-        let kept = match &self.interim.checkpoint {
+        match &self.interim.checkpoint {
             Some(file) if something => Some(match file.save(checkpoint) {
                 Ok(()) => {
                     let (done, total) = checkpoint.samples(&self.settings, self.adaptive.as_ref());
@@ -134,20 +213,12 @@ impl RenderJob {
                 Err(e) => format!("{e:#}"),
             }),
             _ => None,
-        };
-        match (self.interrupt.is_set(), kept) {
-            (true, kept) => Interrupted {
-                kept: kept.unwrap_or_else(|| "nothing had been rendered yet".into()),
-            }
-            .into(),
-            (false, Some(kept)) => anyhow::anyhow!("{why:#}\n{kept}"),
-            (false, None) => why,
         }
     }
 
     /// Writes the final image, the PNG (and the linear EXR when asked) exactly the same way for
     /// every executor, and the sample map when asked; then removes the interim outputs they
-    /// replace.
+    /// replace (but the checkpoint of a render its time limit stopped).
     pub fn write_final(&self, outcome: &RenderOutcome) -> anyhow::Result<()> {
         let film = &outcome.film;
         film.write_png(&self.output_png, &self.scene.desc.film)
@@ -169,7 +240,9 @@ impl RenderJob {
                 );
             }
         }
-        self.interim.remove();
+        if outcome.complete {
+            self.interim.remove();
+        }
         Ok(())
     }
 }

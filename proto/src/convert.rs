@@ -4,7 +4,7 @@
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{SampleBuffer, MAX_SUM};
-use yat_tracer::render::unit::{BLOCK_SIZE, MAX_MASKED_SIDE};
+use yat_tracer::render::unit::MAX_MASKED_SIDE;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::pb;
@@ -132,24 +132,7 @@ pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<Wor
     if pixels > MAX_UNIT_PIXELS {
         return Err(invalid(format!("{pixels} pixels exceed {MAX_UNIT_PIXELS}")));
     }
-    if let Some(mask) = u.block_mask {
-        let (w, h) = (u.x1 - u.x0, u.y1 - u.y0);
-        if w > MAX_MASKED_SIDE || h > MAX_MASKED_SIDE {
-            return Err(invalid(format!(
-                "a {w}x{h} tile with a block mask (at most {MAX_MASKED_SIDE} a side)"
-            )));
-        }
-        let (columns, rows) = (w.div_ceil(BLOCK_SIZE), h.div_ceil(BLOCK_SIZE));
-        let inside = (0..rows)
-            .flat_map(|by| (0..columns).map(move |bx| 1u64 << (by * 8 + bx)))
-            .fold(0, |all, bit| all | bit);
-        if mask == 0 || mask & !inside != 0 {
-            return Err(invalid(format!(
-                "block mask {mask:#018x} is empty or names blocks outside the tile"
-            )));
-        }
-    }
-    Ok(WorkUnit {
+    let unit = WorkUnit {
         index: u.index,
         x0: u.x0,
         y0: u.y0,
@@ -158,7 +141,22 @@ pub fn unit_from_wire(u: &pb::WorkUnit, settings: &RenderSettings) -> Result<Wor
         sample_start: u.sample_start,
         sample_end: u.sample_end,
         mask: u.block_mask,
-    })
+    };
+    if let Some(mask) = u.block_mask {
+        let (w, h) = (u.x1 - u.x0, u.y1 - u.y0);
+        if w > MAX_MASKED_SIDE || h > MAX_MASKED_SIDE {
+            return Err(invalid(format!(
+                "a {w}x{h} tile with a block mask (at most {MAX_MASKED_SIDE} a side)"
+            )));
+        }
+        let inside = unit.tile_blocks().fold(0, |all, (_, _, bit)| all | bit);
+        if mask == 0 || mask & !inside != 0 {
+            return Err(invalid(format!(
+                "block mask {mask:#018x} is empty or names blocks outside the tile"
+            )));
+        }
+    }
+    Ok(unit)
 }
 
 impl From<UnitStats> for pb::UnitStats {

@@ -174,3 +174,91 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
         .fold(0f32, f32::max);
     assert!(worst < 1e-4, "relative difference {worst}");
 }
+
+/// The round `--time-limit` stopped at, from the render's stderr.
+fn round_written(output: &std::process::Output) -> u32 {
+    assert_success(output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let (_, rest) = stderr
+        .split_once("--time-limit reached: writing the image of round ")
+        .unwrap_or_else(|| panic!("no time limit reached: {stderr}"));
+    rest.split(' ').next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn a_time_limit_writes_the_last_round_and_the_same_command_goes_on() {
+    // A threshold no block reaches and up to 8192 samples per pixel in 12 rounds: the limit
+    // lands after round 0 (1,536 samples) and long before the last (3 million samples).
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let settings = [
+        "--spp",
+        "8192",
+        "--resolution",
+        "24x16",
+        "--noise-threshold",
+        "0.00001",
+        "--min-spp",
+        "4",
+    ];
+    let out = dir.path().join("limited.png");
+    let map = dir.path().join("map.png");
+    let checkpoint = out.with_extension("resume");
+    let limited = render_command_with(
+        &scene,
+        &out,
+        &settings,
+        &[
+            "--threads",
+            "2",
+            "--time-limit",
+            "1",
+            "--checkpoint-every",
+            "1000",
+            "--sample-map",
+            map.to_str().unwrap(),
+        ],
+    )
+    .output()
+    .unwrap();
+    let round = round_written(&limited);
+    assert!(round < 11, "round {round} is the last: no limit reached");
+    assert!(checkpoint.exists(), "the checkpoint is kept for the rest");
+    // The map is the round's: the most samples any pixel has are the round's end, 4 x 2^k.
+    assert!(map.exists());
+    let stdout = String::from_utf8_lossy(&limited.stdout);
+    assert!(
+        stdout.contains(&format!("to {} (white)", 4u32 << round)),
+        "round {round}: {stdout}"
+    );
+    let stopped = image_bytes(&out);
+
+    // The same command without the limit goes on from every sample merged, to the image of a
+    // render never stopped.
+    let resumed = render_command_with(&scene, &out, &settings, &["--threads", "1"])
+        .output()
+        .unwrap();
+    assert_success(&resumed);
+    let stderr = String::from_utf8_lossy(&resumed.stderr);
+    assert!(stderr.contains("resuming from"), "{stderr}");
+    assert!(
+        !checkpoint.exists(),
+        "a finished render removes its checkpoint"
+    );
+    let whole = dir.path().join("whole.png");
+    let output = render_command_with(
+        &scene,
+        &whole,
+        &settings,
+        &["--threads", "2", "--checkpoint-every", "0", "--quiet"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    let expected = image_bytes(&whole);
+    assert_same(&out, &expected, "a time-limited render resumed");
+    assert!(
+        stopped.1 != expected.1,
+        "round {round}'s image is the final one"
+    );
+}

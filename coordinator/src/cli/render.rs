@@ -45,13 +45,20 @@ pub struct RenderArgs {
     #[arg(long)]
     pub spp: Option<u32>,
     /// Adaptive sampling: render in rounds, each doubling the samples of the 8x8-pixel blocks
-    /// whose estimated relative error is still above this (e.g. 0.02), until none is or --spp
-    /// is reached. The image is the same bytes however and wherever it is rendered.
+    /// that still need them for the image's error to reach E (root-mean-square error over mean
+    /// brightness, e.g. 0.02) at the least cost, until none does or --spp is reached. The
+    /// image is the same bytes however and wherever it is rendered.
     #[arg(long, value_name = "E")]
     pub noise_threshold: Option<f32>,
     /// With --noise-threshold: the samples every pixel gets in the first round (even).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MIN_SPP, requires = "noise_threshold")]
     pub min_spp: u32,
+    /// With --noise-threshold: stop at the first round boundary after this many seconds (from
+    /// the start of the command), writing the image of the last round completed, which is the
+    /// same bytes as the render ending at that round; the checkpoint keeps every sample merged,
+    /// so the same command (with a longer or no limit) goes on from there.
+    #[arg(long, value_name = "SECONDS", requires = "noise_threshold")]
+    pub time_limit: Option<f64>,
     /// With --noise-threshold: write a PNG of the samples each pixel got (grey, log scale).
     #[arg(long, value_name = "PNG", requires = "noise_threshold")]
     pub sample_map: Option<PathBuf>,
@@ -162,6 +169,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
     let preview_every = seconds("preview-every", args.preview_every)?;
     let status_linger = seconds("status-linger", args.status_linger)?;
+    let deadline = args
+        .time_limit
+        .map(|t| seconds("time-limit", t).map(|limit| started + limit))
+        .transpose()?;
     let workers = args.distributed.config()?;
     let status = Arc::new(StatusBoard::new(
         SceneInfo {
@@ -226,6 +237,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         exr: args.exr,
         quiet: args.quiet,
         interrupt,
+        deadline,
     };
 
     let outcome = match (workers, manifest) {

@@ -13,7 +13,7 @@ use yat_tracer::render::{UnitStats, WorkUnit};
 use super::progress::Progress;
 use crate::checkpoint::Checkpoint;
 use crate::interim::InterimClock;
-use crate::job::{RenderJob, RenderOutcome, SceneBuild};
+use crate::job::{RenderJob, RenderOutcome, SceneBuild, TimeLimitReached};
 
 /// The render so far, as the render threads share it.
 struct InProcessState {
@@ -34,15 +34,8 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     let settings = &job.settings;
     let adaptive = job.adaptive.as_ref();
     let start = job.resume();
-    let (done, total) = start.samples(settings, adaptive);
-    let progress = Progress::new(total, done, job.quiet);
+    let progress = Progress::start(job, &start);
     let status = &job.interim.status;
-    status.plan(
-        start.units(settings, adaptive).len(),
-        start.done_count(),
-        total,
-        done,
-    );
     let state = Mutex::new(InProcessState {
         checkpoint: start,
         stats: UnitStats::default(),
@@ -59,6 +52,7 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         .context("cannot start the render threads")?;
     // Round after round (a uniform render has one): the units not yet merged, then the next
     // round decided from the merged film.
+    let mut completed = None;
     let result = pool.install(|| loop {
         let todo: Vec<WorkUnit> = {
             let state = state.lock().map_err(|_| poisoned())?;
@@ -68,20 +62,17 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
                 .into_iter()
                 .filter(|u| !checkpoint.is_done(u))
                 .collect();
-            if let (Some(round), Some(adaptive)) = (checkpoint.round(), adaptive) {
+            if let Some(round) = checkpoint.round() {
                 progress.set_status(format!("| round {}", round.index));
-                status.round(
-                    round.index,
-                    adaptive.round_count(settings.spp),
-                    todo.len(),
-                    checkpoint.samples(settings, Some(adaptive)).1,
-                );
             }
             todo
         };
         todo.par_iter().try_for_each(|unit| {
             if job.interrupt.is_set() {
                 anyhow::bail!("interrupted");
+            }
+            if job.out_of_time() {
+                return Err(TimeLimitReached.into());
             }
             let (buffer, unit_stats) = scene.render_unit(unit);
             let staged = {
@@ -100,8 +91,7 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
                     (guard, staged)
                 })
             };
-            progress.add_samples(unit_stats.samples);
-            status.unit_merged(unit_stats.samples);
+            progress.unit_merged(unit_stats.samples);
             // Encoding and syncing happen with the render's lock released.
             if let Some((_guard, staged)) = staged {
                 for e in staged.finish() {
@@ -111,20 +101,30 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
             anyhow::Ok(())
         })?;
         let mut done = state.lock().map_err(|_| poisoned())?;
+        if let Some(round) = job.keep_round(&done.checkpoint) {
+            completed = Some(round);
+        }
+        if job.out_of_time() {
+            break Err(TimeLimitReached.into());
+        }
         if !done.checkpoint.advance(settings, adaptive) {
             break anyhow::Ok(());
         }
-        progress.set_total(done.checkpoint.samples(settings, adaptive).1);
+        progress.round(job, &done.checkpoint);
     });
     progress.finish();
     let state = state.into_inner().map_err(|_| poisoned())?;
-    if let Err(why) = result {
-        return Err(job.stopped(&state.checkpoint, why));
+    match result {
+        Err(why) if why.is::<TimeLimitReached>() => {
+            job.timed_out(&state.checkpoint, completed, state.stats, Some(build))
+        }
+        Err(why) => Err(job.stopped(&state.checkpoint, why)),
+        Ok(()) => Ok(RenderOutcome {
+            round: state.checkpoint.round().cloned(),
+            film: state.checkpoint.into_film(),
+            stats: state.stats,
+            build: Some(build),
+            complete: true,
+        }),
     }
-    Ok(RenderOutcome {
-        round: state.checkpoint.round().cloned(),
-        film: state.checkpoint.into_film(),
-        stats: state.stats,
-        build: Some(build),
-    })
 }

@@ -1,24 +1,77 @@
-//! A render's progress on the terminal, the same for every executor: a bar over samples that
+//! A render's progress, the same for every executor: on the terminal, a bar over samples that
 //! starts at what a checkpoint holds (its length an estimate an adaptive render updates each
-//! round), a status after the ETA, and lines printed above it.
+//! round), a status after the ETA, and lines printed above it; and the same figures (units,
+//! samples, rounds) on the job's status board.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::checkpoint::Checkpoint;
+use crate::job::RenderJob;
+use crate::status::StatusBoard;
+
 pub struct Progress {
     bar: ProgressBar,
     quiet: bool,
+    board: Arc<StatusBoard>,
 }
 
 impl Progress {
+    /// The bar and the board of `job`, starting from `checkpoint` (what is already rendered
+    /// counts as done); the bar is hidden when quiet.
+    pub fn start(job: &RenderJob, checkpoint: &Checkpoint) -> Self {
+        let (settings, adaptive) = (&job.settings, job.adaptive.as_ref());
+        let (done, total) = checkpoint.samples(settings, adaptive);
+        let board = job.interim.status.clone();
+        board.plan(
+            checkpoint.units(settings, adaptive).len(),
+            checkpoint.done_count(),
+            total,
+            done,
+        );
+        let progress = Self {
+            bar: Self::bar(total, done, job.quiet),
+            quiet: job.quiet,
+            board,
+        };
+        progress.round(job, checkpoint);
+        progress
+    }
+
+    /// The round under way of an adaptive render (nothing for a uniform one): its number and
+    /// units left on the board, and the new estimate of all the samples on both.
+    pub fn round(&self, job: &RenderJob, checkpoint: &Checkpoint) {
+        let settings = &job.settings;
+        let (Some(round), Some(adaptive)) = (checkpoint.round(), job.adaptive.as_ref()) else {
+            return;
+        };
+        let units_left = checkpoint
+            .units(settings, Some(adaptive))
+            .iter()
+            .filter(|u| !checkpoint.is_done(u))
+            .count();
+        let total = checkpoint.samples(settings, Some(adaptive)).1;
+        self.board.round(
+            round.index,
+            adaptive.round_count(settings.spp),
+            units_left,
+            total,
+        );
+        self.bar.set_length(total);
+    }
+
+    /// A unit's result merged.
+    pub fn unit_merged(&self, samples: u64) {
+        self.bar.inc(samples);
+        self.board.unit_merged(samples);
+    }
+
     /// A bar over `total_samples`, `done_samples` of them already rendered; hidden when quiet.
-    pub fn new(total_samples: u64, done_samples: u64, quiet: bool) -> Self {
+    fn bar(total_samples: u64, done_samples: u64, quiet: bool) -> ProgressBar {
         if quiet {
-            return Self {
-                bar: ProgressBar::hidden(),
-                quiet,
-            };
+            return ProgressBar::hidden();
         }
         let bar = ProgressBar::new(total_samples).with_position(done_samples);
         // Records the resumed position, then forgets it, so samples/s and the ETA count this run.
@@ -32,17 +85,7 @@ impl Progress {
             .progress_chars("=> "),
         );
         bar.enable_steady_tick(Duration::from_millis(200));
-        Self { bar, quiet }
-    }
-
-    /// A new estimate of all the samples the render takes (an adaptive render's, per round).
-    pub fn set_total(&self, total_samples: u64) {
-        self.bar.set_length(total_samples);
-    }
-
-    /// Samples rendered since the last call.
-    pub fn add_samples(&self, samples: u64) {
-        self.bar.inc(samples);
+        bar
     }
 
     /// The text after the ETA.

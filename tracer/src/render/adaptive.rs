@@ -5,7 +5,7 @@
 //!
 //! | setting | meaning | default |
 //! |---|---|---|
-//! | `threshold` (`--noise-threshold`) | the error a block of pixels stops at (see below) | none: uniform |
+//! | `threshold` (`--noise-threshold`) | the relative error the image aims at (see below) | none: uniform |
 //! | `min_spp` (`--min-spp`) | samples of round 0, which every pixel gets; even | [`DEFAULT_MIN_SPP`] |
 //! | `spp` (`--spp`) | the most samples any pixel gets | the render's spp |
 //!
@@ -15,27 +15,26 @@
 //! image's grid; the units of a round are the plan's 64-pixel tiles with a mask of their active
 //! blocks ([`WorkUnit::mask`]), tiles with none left out.
 //!
-//! **Error estimate.** A masked unit also sums its odd-index samples, so the film holds per
-//! pixel the mean `m` of all its samples and the mean `h` of the odd half (Cycles' and
-//! Dammertz et al.'s "two buffers", 2010). Since every pixel's sample count is even, `m - h` is
-//! half the difference of two independent half means: its variance is exactly the variance of
-//! `m`, so `|m - h|` estimates the error of the pixel. The error of a pixel is that difference
-//! (channel average) over the square root of the pixel's brightness, both relative to the
-//! image's mean brightness `S`: `e = |m - h| / sqrt(S (|m| + DARK_FRACTION S))`. For a pixel of
-//! average brightness it is the relative error; brighter pixels must get relatively cleaner (as
-//! in Cycles' `|I - A| / sqrt(I)`: they dominate the squared error of a linear image, and the
-//! square root is close to how display encoding spreads brightness), and black pixels are
-//! compared with a small fraction of the mean rather than with zero. Dividing by `S` makes the
-//! threshold independent of the scene's radiance units. A block's error is the mean of its
-//! pixels' (one pixel's `|m - h|` is a single draw; 64 of them make a usable estimate).
+//! **Noise estimate.** A masked unit also sums its odd-index samples, so the film holds per
+//! pixel the mean `m` of all its `n` samples and the mean `h` of the odd half (the "two
+//! buffers" of Cycles and of Dammertz et al. 2010). Since `n` is even, `m - h` is half the
+//! difference of two independent half means: `E[(m - h)^2]` is exactly the variance of `m`,
+//! `sigma^2 / n`. A block's `sigma_b`, the standard deviation of one sample, is so estimated as
+//! `sqrt(n_b x mean of (m - h)^2 over its pixels and channels)` ([`Noise`]).
 //!
-//! **Decision.** A block stays active for the next round only if it was active in this one and
-//! the largest error of it and its eight neighbours exceeds the threshold: the neighbours keep
-//! a block going at the edge of a noisy region (where its own estimate may be lucky). A block
-//! that stops never restarts, so a block's samples are `[0, n)` for the `n` of the last round
-//! it was in, and [`Round::planned`] says each one's `n`. Every number here comes from the
-//! exact film sums in a fixed order, so the decision is the same bits on every machine, for
-//! any number of workers and any order of arrival.
+//! **Decision.** The threshold `E` is the image's error aimed at: its root-mean-square error
+//! (over pixels and channels, linear radiance) over its mean brightness `S`, so it does not
+//! depend on the scene's radiance units. For a number of samples, the squared error
+//! `sum_b P_b sigma_b^2 / n_b` (`P_b` pixels per block) is least when `n_b` is proportional
+//! to `sigma_b`; it is then `(E S)^2` per pixel when `n_b = sigma_b mean(sigma) / (E S)^2`
+//! (`mean(sigma)` over pixels) ([`Noise::samples_wanted`]). A block active in a round goes on
+//! to the next while it wants more than [`GO_ON`] times the samples it has. (Stopping each
+//! block at one relative error instead, `n_b ~ sigma_b^2 / |m_b|^2`, spends the most on dark
+//! noisy corners that add least to the error: no fewer samples than a uniform render for the
+//! same squared error, and often more.) A block that stops never restarts, so a block's samples
+//! are `[0, n)` for the `n` of the last round it was in, and [`Round::planned`] says each one's
+//! `n`. Every number here comes from the exact film sums in a fixed order, so the decision is
+//! the same bits on every machine, for any number of workers and any order of arrival.
 
 use crate::film::Film;
 
@@ -50,8 +49,10 @@ pub const DEFAULT_MIN_SPP: u32 = 16;
 // A mask covers a plan tile.
 const _: () = assert!(TILE_SIZE == MAX_MASKED_SIDE);
 
-/// Black and dark pixels are compared with this fraction of the image's mean brightness.
-pub const DARK_FRACTION: f64 = 0.01;
+/// A block goes on while it wants more than this many times its samples: the geometric middle
+/// of its samples now and after one more round, so it ends as near as doubling allows to what
+/// it wants.
+pub const GO_ON: f64 = std::f64::consts::SQRT_2;
 
 /// A round's unit of a tile takes at most about this many samples (as many sample indices
 /// as fit for the tile's active pixels): a full tile gets 64 per unit, a lone block 4096, so
@@ -198,7 +199,6 @@ impl Round {
     pub fn units(&self, settings: &RenderSettings, adaptive: &AdaptiveSettings) -> Vec<WorkUnit> {
         let (start, end) = self.range(settings, adaptive);
         let grid = BlockGrid::of(settings);
-        let per_tile = MAX_MASKED_SIDE / BLOCK_SIZE;
         let mut tiles = Vec::new();
         for y0 in (0..settings.height).step_by(TILE_SIZE as usize) {
             for x0 in (0..settings.width).step_by(TILE_SIZE as usize) {
@@ -210,20 +210,15 @@ impl Round {
                     y1: (y0 + TILE_SIZE).min(settings.height),
                     sample_start: start,
                     sample_end: end,
-                    mask: Some(0),
+                    mask: None,
                 };
-                let mut mask = 0u64;
-                for by in 0..per_tile {
-                    for bx in 0..per_tile {
-                        let (gx, gy) = (x0 / BLOCK_SIZE + bx, y0 / BLOCK_SIZE + by);
-                        if gx < grid.columns
-                            && gy < grid.rows
-                            && self.is_active((gy * grid.columns + gx) as usize, settings, adaptive)
-                        {
-                            mask |= 1 << (by * per_tile + bx);
-                        }
-                    }
-                }
+                let mask = unit
+                    .tile_blocks()
+                    .filter(|&(x, y, _)| {
+                        let b = y / BLOCK_SIZE * grid.columns + x / BLOCK_SIZE;
+                        self.is_active(b as usize, settings, adaptive)
+                    })
+                    .fold(0, |mask, (_, _, bit)| mask | bit);
                 if mask != 0 && start < end {
                     unit.mask = Some(mask);
                     let pixels = unit.active_pixel_count() as u64;
@@ -298,45 +293,72 @@ fn block_pixels(grid: BlockGrid, b: u32, settings: &RenderSettings) -> u64 {
     u64::from(w) * u64::from(h)
 }
 
-/// Per block (row-major), the mean error of its pixels (see the module doc); 0 for a film
-/// without half sums.
-pub fn block_errors(film: &Film, settings: &RenderSettings) -> Vec<f64> {
-    let grid = BlockGrid::of(settings);
-    let width = film.width() as usize;
-    let brightness = |c: glam::Vec3| f64::from(c.x.abs() + c.y.abs() + c.z.abs()) / 3.0;
-    let pixels = film.width() as usize * film.height() as usize;
-    if !film.has_half() || pixels == 0 {
-        return vec![0.0; grid.len()];
+/// What the merged film says about the noise of each block, read in one pass over its pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Noise {
+    /// Per block (row-major): the estimated standard deviation of one sample of its pixels,
+    /// `sigma_b` (see the module doc).
+    pub sigma: Vec<f64>,
+    /// The image's mean brightness `S` (channel mean of |pixel|); 1 for a black image, whose
+    /// noise is then compared with 1 rather than with nothing.
+    pub brightness: f64,
+}
+
+impl Noise {
+    /// The estimate from the film once `round` is merged (every block has its planned samples);
+    /// no noise for a film without half sums.
+    pub fn of(film: &Film, round: &Round, settings: &RenderSettings) -> Self {
+        let grid = BlockGrid::of(settings);
+        let (width, height) = (film.width(), film.height());
+        let pixels = width as usize * height as usize;
+        let mut variance = vec![0.0f64; grid.len()];
+        let mut brightness = 0.0f64;
+        if film.has_half() {
+            for y in 0..height {
+                for x in 0..width {
+                    let m = film.pixel(x, y).as_dvec3();
+                    let d = m - film.half_pixel((y * width + x) as usize).as_dvec3();
+                    brightness += m.abs().element_sum() / 3.0;
+                    variance[(y / BLOCK_SIZE * grid.columns + x / BLOCK_SIZE) as usize] +=
+                        d.length_squared() / 3.0;
+                }
+            }
+        }
+        let sigma = variance
+            .iter()
+            .enumerate()
+            .map(|(b, &v)| {
+                let n = round.planned.get(b).copied().unwrap_or(0);
+                (f64::from(n) * v / block_pixels(grid, b as u32, settings) as f64).sqrt()
+            })
+            .collect();
+        let mean = brightness / pixels.max(1) as f64;
+        Self {
+            sigma,
+            brightness: if mean > 0.0 { mean } else { 1.0 },
+        }
     }
-    let mean_brightness = (0..pixels)
-        .map(|i| brightness(film.pixel((i % width) as u32, (i / width) as u32)))
-        .sum::<f64>()
-        / pixels as f64;
-    // An all-black image: any noise is relative to nothing; compare with 1 instead.
-    let scale = if mean_brightness > 0.0 {
-        mean_brightness
-    } else {
-        1.0
-    };
-    let mut sums = vec![0.0f64; grid.len()];
-    for i in 0..pixels {
-        let (x, y) = ((i % width) as u32, (i / width) as u32);
-        let m = film.pixel(x, y);
-        let difference = brightness(m - film.half_pixel(i));
-        let error = difference / (scale * (brightness(m) + DARK_FRACTION * scale)).sqrt();
-        let b = (y / BLOCK_SIZE * grid.columns + x / BLOCK_SIZE) as usize;
-        sums[b] += error;
+
+    /// Per block, the samples per pixel that bring the image to the relative error
+    /// `threshold` at the least cost: `sigma_b mean(sigma) / (threshold S)^2` (the module doc).
+    pub fn samples_wanted(&self, threshold: f64, settings: &RenderSettings) -> Vec<f64> {
+        let grid = BlockGrid::of(settings);
+        let pixels = u64::from(settings.width) * u64::from(settings.height);
+        let mean_sigma = self
+            .sigma
+            .iter()
+            .enumerate()
+            .map(|(b, s)| s * block_pixels(grid, b as u32, settings) as f64)
+            .sum::<f64>()
+            / pixels.max(1) as f64;
+        let scale = mean_sigma / (threshold * self.brightness).powi(2);
+        self.sigma.iter().map(|s| s * scale).collect()
     }
-    sums.iter()
-        .enumerate()
-        .map(|(b, sum)| sum / block_pixels(grid, b as u32, settings) as f64)
-        .collect()
 }
 
 /// The round after `round`, decided from the film once every unit of `round` is merged: the
-/// blocks active in `round` whose own or a neighbour's error exceeds the threshold get the
-/// next round's samples. None when no block goes on or the samples are spent: the render is
-/// done.
+/// blocks active in `round` that want more samples than they have (see the module doc) get
+/// the next round's. None when no block goes on or the samples are spent: the render is done.
 pub fn next_round(
     film: &Film,
     round: &Round,
@@ -345,26 +367,14 @@ pub fn next_round(
 ) -> Option<Round> {
     let index = round.index + 1;
     let (_, end) = adaptive.round_range(index, settings.spp)?;
-    let grid = BlockGrid::of(settings);
-    let errors = block_errors(film, settings);
-    let threshold = f64::from(adaptive.threshold);
+    let wanted =
+        Noise::of(film, round, settings).samples_wanted(f64::from(adaptive.threshold), settings);
     let mut planned = round.planned.clone();
     let mut any = false;
-    for by in 0..grid.rows {
-        for bx in 0..grid.columns {
-            let b = (by * grid.columns + bx) as usize;
-            if !round.is_active(b, settings, adaptive) {
-                continue;
-            }
-            let noisy = (by.saturating_sub(1)..(by + 2).min(grid.rows))
-                .flat_map(|y| {
-                    (bx.saturating_sub(1)..(bx + 2).min(grid.columns)).map(move |x| (x, y))
-                })
-                .any(|(x, y)| errors[(y * grid.columns + x) as usize] > threshold);
-            if noisy {
-                planned[b] = end;
-                any = true;
-            }
+    for (b, &want) in wanted.iter().enumerate() {
+        if round.is_active(b, settings, adaptive) && want > GO_ON * f64::from(planned[b]) {
+            planned[b] = end;
+            any = true;
         }
     }
     any.then_some(Round { index, planned })
@@ -542,85 +552,125 @@ mod tests {
         assert!(!wrong.fits(&s, &ADAPTIVE), "20 is no round's end");
     }
 
-    #[test]
-    fn a_flat_region_stops_and_a_noisy_one_goes_on() {
-        // 128 x 64: the left half flat (no noise), the right half very noisy.
-        let s = settings(128, 64, 1024);
-        let mut film = Film::with_half(s.width, s.height);
-        let mut round = Round::first(&s, &ADAPTIVE);
-        let noise = |x: u32| if x < 64 { 0.0 } else { 0.73 };
+    /// Renders round after round until the render is done; returns the last round and the
+    /// active blocks per round.
+    fn render_to_the_end(
+        film: &mut Film,
+        s: &RenderSettings,
+        a: &AdaptiveSettings,
+        mean: impl Fn(u32) -> f64 + Copy,
+        noise: impl Fn(u32) -> f64 + Copy,
+    ) -> (Round, Vec<usize>) {
+        let mut round = Round::first(s, a);
         let mut history = Vec::new();
         loop {
-            render(&mut film, &round.units(&s, &ADAPTIVE), |_| 0.5, noise);
-            history.push(round.active_count(&s, &ADAPTIVE));
-            match next_round(&film, &round, &s, &ADAPTIVE) {
+            render(film, &round.units(s, a), mean, noise);
+            history.push(round.active_count(s, a));
+            match next_round(film, &round, s, a) {
                 Some(next) => round = next,
-                None => break,
+                None => return (round, history),
             }
         }
-        let spp = samples_per_pixel(&round, &s);
-        // The flat blocks away from the noisy half stop after round 0; the noisy ones (and the
-        // flat column beside them) go on until their error is under the threshold.
-        assert_eq!(spp[0], 16, "{history:?}");
-        assert_eq!(spp[(s.width * 10 + 40) as usize], 16);
-        // The pixel standard deviation is 0.73 / sqrt 3 = 0.42 relative to 0.5: the error
-        // estimate (~ 0.73 / sqrt n) falls under 0.05 between 128 and 256 samples (0.059,
-        // 0.042); a block's neighbours may keep it one round more.
-        let noisy: Vec<u32> = (64..128)
-            .step_by(8)
-            .map(|x| spp[(s.width * 30 + x) as usize])
-            .collect();
-        assert!(
-            noisy.iter().all(|n| [256, 512].contains(n)),
-            "{noisy:?} {history:?}"
-        );
-        assert!(
-            noisy.iter().filter(|&&n| n == 256).count() >= 4,
-            "{noisy:?}"
-        );
-        assert!(spp[(s.width * 10 + 60) as usize] >= 128, "dilated");
-        assert!(history.windows(2).all(|w| w[1] <= w[0]), "{history:?}");
     }
 
     #[test]
-    fn the_estimate_follows_the_known_standard_error() {
-        // One flat-mean block of noise with a known standard deviation: the block's error
-        // estimate is the mean of |m - h|, whose expected value for Gaussian-ish noise is
-        // sqrt(2 / pi) x sigma / sqrt(n); uniform noise is close (the ratio is checked at 15%).
+    fn samples_follow_the_noise_and_the_image_reaches_the_threshold() {
+        // 128 x 64 of mean 0.5: columns [0, 16) exact, [16, 64) noisy, [64, 128) four times as
+        // noisy (standard deviations 0.2 / sqrt 3 and 0.8 / sqrt 3, mean sigma 0.274). The
+        // cheapest samples for a relative error E are n ~ sigma: with E = 0.0445 (E S = 0.02224)
+        // the noisy blocks want 64, the noisier 256, each the geometric middle of the rounds
+        // around it (a margin of sqrt 2 against the estimate's noise).
+        let s = settings(128, 64, 1 << 14);
+        let a = AdaptiveSettings {
+            threshold: 0.0445,
+            min_spp: 16,
+        };
+        let noise = |x: u32| match x {
+            0..16 => 0.0,
+            16..64 => 0.2,
+            _ => 0.8,
+        };
+        let mut film = Film::with_half(s.width, s.height);
+        let (round, history) = render_to_the_end(&mut film, &s, &a, |_| 0.5, noise);
+        let spp = samples_per_pixel(&round, &s);
+        let at = |x: u32| -> Vec<u32> {
+            (0..64)
+                .step_by(8)
+                .map(|y| spp[(y * s.width + x) as usize])
+                .collect()
+        };
+        assert!(at(3).iter().all(|&n| n == 16), "{:?} {history:?}", at(3));
+        assert!(at(40).iter().all(|&n| n == 64), "{:?} {history:?}", at(40));
+        assert!(
+            at(100).iter().all(|&n| n == 256),
+            "{:?} {history:?}",
+            at(100)
+        );
+        assert!(history.windows(2).all(|w| w[1] <= w[0]), "{history:?}");
+        // The image's error (against the exact 0.5) is the threshold, relative to its mean
+        // brightness, and well under a uniform render's with as many samples.
+        let squared: f64 = film
+            .radiance()
+            .iter()
+            .map(|p| (f64::from(p.x) - 0.5).powi(2))
+            .sum::<f64>()
+            / f64::from(s.width * s.height);
+        let relative = squared.sqrt() / 0.5;
+        assert!(
+            (0.9 * 0.0445..1.1 * 0.0445).contains(&relative),
+            "relative error {relative}"
+        );
+        let mean_spp = spp.iter().map(|&n| f64::from(n)).sum::<f64>() / spp.len() as f64;
+        let uniform = (3.0 / 8.0 * 0.04 / 3.0 + 0.5 * 0.64 / 3.0) / mean_spp;
+        assert!(
+            squared < 0.75 * uniform,
+            "{squared} vs uniform {uniform} at {mean_spp} spp"
+        );
+    }
+
+    #[test]
+    fn the_estimate_follows_the_known_standard_deviation() {
+        // Flat noise of a known standard deviation: E[(m - h)^2] is the variance of m, so
+        // sigma = sqrt(n mean (m - h)^2) estimates amplitude / sqrt 3 whatever n is.
         for (n, amplitude) in [(16u32, 0.3f64), (64, 0.3), (256, 0.6)] {
             let s = settings(64, 64, n);
+            let a = AdaptiveSettings {
+                min_spp: n,
+                ..ADAPTIVE
+            };
             let mut film = Film::with_half(64, 64);
-            let round = Round::first(
-                &s,
-                &AdaptiveSettings {
-                    min_spp: n,
-                    ..ADAPTIVE
-                },
-            );
-            render(
-                &mut film,
-                &round.units(
-                    &s,
-                    &AdaptiveSettings {
-                        min_spp: n,
-                        ..ADAPTIVE
-                    },
-                ),
-                |_| 1.0,
-                |_| amplitude,
-            );
-            let errors = block_errors(&film, &s);
-            let mean_error = errors.iter().sum::<f64>() / errors.len() as f64;
-            let sigma = amplitude / 3f64.sqrt();
-            let expected = (2.0 / std::f64::consts::PI).sqrt() * sigma
-                / f64::from(n).sqrt()
-                / (1.0 + DARK_FRACTION).sqrt();
-            let ratio = mean_error / expected;
+            let round = Round::first(&s, &a);
+            render(&mut film, &round.units(&s, &a), |_| 1.0, |_| amplitude);
+            let noise = Noise::of(&film, &round, &s);
+            assert_eq!(noise.sigma.len(), 64);
+            let mean = noise.sigma.iter().sum::<f64>() / 64.0;
+            let expected = amplitude / 3f64.sqrt();
             assert!(
-                (0.85..1.15).contains(&ratio),
-                "n {n}: {mean_error} vs {expected}"
+                (0.95..1.05).contains(&(mean / expected)),
+                "n {n}: {mean} vs {expected}"
+            );
+            // One block's estimate (64 pixels) is within 30% of it.
+            assert!(
+                noise
+                    .sigma
+                    .iter()
+                    .all(|&b| (0.7..1.3).contains(&(b / expected))),
+                "n {n}: {:?}",
+                noise.sigma
+            );
+            assert!(
+                (noise.brightness - 1.0).abs() < 0.02,
+                "{}",
+                noise.brightness
             );
         }
+        // A black image has no noise: the render stops after round 0.
+        let s = settings(16, 16, 64);
+        let mut film = Film::with_half(16, 16);
+        let round = Round::first(&s, &ADAPTIVE);
+        render(&mut film, &round.units(&s, &ADAPTIVE), |_| 0.0, |_| 0.0);
+        assert_eq!(Noise::of(&film, &round, &s).brightness, 1.0);
+        assert_eq!(next_round(&film, &round, &s, &ADAPTIVE), None);
     }
 
     #[test]

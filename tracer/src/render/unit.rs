@@ -40,19 +40,31 @@ impl WorkUnit {
         })
     }
 
+    /// The blocks of the tile, row by row: each one's top-left pixel and its bit in a mask (the
+    /// one owner of the mask's layout; blocks in the last column and row may be cut short by
+    /// the tile's edge).
+    pub fn tile_blocks(&self) -> impl Iterator<Item = (u32, u32, u64)> + '_ {
+        (self.y0..self.y1)
+            .step_by(BLOCK_SIZE as usize)
+            .flat_map(move |y| {
+                (self.x0..self.x1)
+                    .step_by(BLOCK_SIZE as usize)
+                    .map(move |x| (x, y))
+            })
+            .map(|(x, y)| {
+                let bit = (y - self.y0) / BLOCK_SIZE * 8 + (x - self.x0) / BLOCK_SIZE;
+                (x, y, 1u64.checked_shl(bit).unwrap_or(0))
+            })
+    }
+
     /// Pixels the unit renders: the tile's, or those of its active blocks.
     pub fn active_pixel_count(&self) -> usize {
         match self.mask {
             None => self.pixel_count(),
-            Some(_) => (self.y0..self.y1)
-                .step_by(BLOCK_SIZE as usize)
-                .flat_map(|y| {
-                    (self.x0..self.x1)
-                        .step_by(BLOCK_SIZE as usize)
-                        .map(move |x| (x, y))
-                })
-                .filter(|&(x, y)| self.renders(x, y))
-                .map(|(x, y)| {
+            Some(mask) => self
+                .tile_blocks()
+                .filter(|&(_, _, bit)| mask & bit != 0)
+                .map(|(x, y, _)| {
                     ((self.x1 - x).min(BLOCK_SIZE) * (self.y1 - y).min(BLOCK_SIZE)) as usize
                 })
                 .sum(),

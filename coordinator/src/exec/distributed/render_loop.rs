@@ -14,7 +14,7 @@ use super::shared::{Event, Shared};
 use crate::checkpoint::Checkpoint;
 use crate::exec::progress::Progress;
 use crate::interim::InterimClock;
-use crate::job::{RenderJob, RenderOutcome};
+use crate::job::{RenderJob, RenderOutcome, TimeLimitReached};
 
 /// How long the render waits without any worker before saying so (and again after each such
 /// period).
@@ -38,15 +38,8 @@ impl RenderLoop<'_> {
         mut events: mpsc::UnboundedReceiver<Event>,
     ) -> anyhow::Result<RenderOutcome> {
         let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
-        let (done, total) = checkpoint.samples(settings, adaptive);
-        let progress = Progress::new(total, done, self.job.quiet);
-        self.job.interim.status.plan(
-            checkpoint.units(settings, adaptive).len(),
-            checkpoint.done_count(),
-            total,
-            done,
-        );
-        self.publish_round(&checkpoint);
+        let progress = Progress::start(self.job, &checkpoint);
+        let mut completed = None;
         let mut stats = UnitStats::default();
         let mut clock = InterimClock::default();
         let mut alone_since = Some(Instant::now());
@@ -55,7 +48,16 @@ impl RenderLoop<'_> {
         let mut tick = tokio::time::interval(Duration::from_millis(250));
         let result = loop {
             if checkpoint.is_complete() {
-                // The next round's decision reads the whole film: off the async workers.
+                // The next round's decision (and the copy of this round's film a time limit
+                // keeps) reads the whole film: off the async workers.
+                if let Some(round) =
+                    tokio::task::block_in_place(|| self.job.keep_round(&checkpoint))
+                {
+                    completed = Some(round);
+                }
+                if self.job.out_of_time() {
+                    break Err(TimeLimitReached.into());
+                }
                 if !tokio::task::block_in_place(|| checkpoint.advance(settings, adaptive)) {
                     self.shared.schedule.finish();
                     break Ok(());
@@ -63,9 +65,8 @@ impl RenderLoop<'_> {
                 self.shared
                     .schedule
                     .start_round(checkpoint.units(settings, adaptive));
-                progress.set_total(checkpoint.samples(settings, adaptive).1);
+                progress.round(self.job, &checkpoint);
                 progress.set_status(self.status(&checkpoint));
-                self.publish_round(&checkpoint);
                 continue;
             }
             tokio::select! {
@@ -76,8 +77,7 @@ impl RenderLoop<'_> {
                         }
                         stats += unit_stats;
                         last_merged = Instant::now();
-                        progress.add_samples(unit_stats.samples);
-                        self.job.interim.status.unit_merged(unit_stats.samples);
+                        progress.unit_merged(unit_stats.samples);
                         progress.set_status(self.status(&checkpoint));
                     }
                     Event::Notice(line) => progress.say(&line),
@@ -85,6 +85,9 @@ impl RenderLoop<'_> {
                 _ = tick.tick() => {
                     if self.job.interrupt.is_set() {
                         break Err(anyhow::anyhow!("interrupted"));
+                    }
+                    if self.job.out_of_time() {
+                        break Err(TimeLimitReached.into());
                     }
                     progress.set_status(self.status(&checkpoint));
                     self.publish_workers();
@@ -124,32 +127,18 @@ impl RenderLoop<'_> {
         self.roster.stop_all();
         self.publish_workers();
         progress.finish();
-        if let Err(why) = result {
-            return Err(self.job.stopped(&checkpoint, why));
-        }
-        Ok(RenderOutcome {
-            round: checkpoint.round().cloned(),
-            film: checkpoint.into_film(),
-            stats,
-            build: None,
-        })
-    }
-
-    /// An adaptive render's round on the status page: its number and the units it has left.
-    fn publish_round(&self, checkpoint: &Checkpoint) {
-        let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
-        if let (Some(round), Some(adaptive)) = (checkpoint.round(), adaptive) {
-            let units_left = checkpoint
-                .units(settings, Some(adaptive))
-                .iter()
-                .filter(|u| !checkpoint.is_done(u))
-                .count();
-            self.job.interim.status.round(
-                round.index,
-                adaptive.round_count(settings.spp),
-                units_left,
-                checkpoint.samples(settings, Some(adaptive)).1,
-            );
+        match result {
+            Err(why) if why.is::<TimeLimitReached>() => {
+                self.job.timed_out(&checkpoint, completed, stats, None)
+            }
+            Err(why) => Err(self.job.stopped(&checkpoint, why)),
+            Ok(()) => Ok(RenderOutcome {
+                round: checkpoint.round().cloned(),
+                film: checkpoint.into_film(),
+                stats,
+                build: None,
+                complete: true,
+            }),
         }
     }
 
