@@ -182,7 +182,7 @@ impl Distribution2D {
                 .map(|row| row.iter().map(|&f| f.max(0.0)).sum::<f32>() / width as f32)
                 .collect(),
         );
-        let cells = rows.into_iter().flat_map(|row| alias_row(row)).collect();
+        let cells = rows.into_iter().flat_map(alias_row).collect();
         Self {
             width: if height == 0 { 0 } else { width },
             cells,
@@ -233,7 +233,13 @@ fn alias_row(row: &[f32]) -> Vec<AliasCell> {
     let n = row.len();
     let mut weight: Vec<f64> = row
         .iter()
-        .map(|&f| if f.is_finite() { f64::from(f.max(0.0)) } else { 0.0 })
+        .map(|&f| {
+            if f.is_finite() {
+                f64::from(f.max(0.0))
+            } else {
+                0.0
+            }
+        })
         .collect();
     let mut total: f64 = weight.iter().sum();
     if total <= 0.0 {
@@ -241,7 +247,10 @@ fn alias_row(row: &[f32]) -> Vec<AliasCell> {
         total = n as f64;
     }
     // The density over [0, 1) is f / mean(f), as Distribution1D's func / integral.
-    let pdf: Vec<f32> = weight.iter().map(|&w| (w * n as f64 / total) as f32).collect();
+    let pdf: Vec<f32> = weight
+        .iter()
+        .map(|&w| (w * n as f64 / total) as f32)
+        .collect();
     // Each slot holds one unit of probability mass (times n); Vose's algorithm fills the slots
     // of light columns with mass from heavy ones.
     let mut mass: Vec<f64> = weight.iter().map(|&w| w * n as f64 / total).collect();
@@ -350,12 +359,18 @@ mod tests {
         for (i, &f) in row.iter().enumerate() {
             let expected = f / total;
             let got = counts[i] as f32 / m as f32;
-            assert!((got - expected).abs() <= 20.0 / m as f32, "column {i}: {got} vs {expected}");
+            assert!(
+                (got - expected).abs() <= 20.0 / m as f32,
+                "column {i}: {got} vs {expected}"
+            );
             if f == 0.0 {
                 assert_eq!(counts[i], 0, "zero-weight column {i} picked");
             } else if counts[i] > 1000 {
                 let mean = within[i] / counts[i] as f64;
-                assert!((mean - 0.5).abs() < 0.01, "column {i}: mean position {mean}");
+                assert!(
+                    (mean - 0.5).abs() < 0.01,
+                    "column {i}: mean position {mean}"
+                );
             }
         }
         // The all-zero row is never chosen and the uniform one has density 1 along x.
