@@ -14,8 +14,8 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 
-#[cfg(target_arch = "x86_64")]
 use super::hit::PrimHit;
+#[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Sse};
 use super::simd::{Isa, Scalar};
 use super::triangle::TriangleEdges;

@@ -144,45 +144,149 @@ fn guide_table(cdf: &[f32]) -> Vec<u32> {
 }
 
 /// A piecewise-constant density on [0, 1)^2 over a `width` x `height` grid of cells, sampled
-/// by choosing a row from the marginal and then a column from the row's conditional.
+/// by choosing a row from the marginal and then a column from the row's alias table.
+///
+/// The rows are what a large environment map makes slow: a sample picks one at random, so
+/// whatever it reads of the row is a cache miss. A row's inverse CDF needs two dependent reads
+/// (the guide, then the search around it); its alias table needs one record, which holds the
+/// densities of both bins it can pick. The marginal stays an inverse CDF (it is small and
+/// stays in cache), so samples remain stratified across rows.
 #[derive(Clone, Debug)]
 pub(crate) struct Distribution2D {
-    rows: Vec<Distribution1D>,
+    width: usize,
+    /// `height` rows of `width` records, row 0 at v = 0.
+    cells: Vec<AliasCell>,
     marginal: Distribution1D,
+}
+
+/// One column of a row's alias table (Walker's method, built by Vose's algorithm): a sample
+/// landing in this column's slot keeps the column with probability `keep`, else takes `alias`.
+/// Aligned so that a record never straddles two cache lines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
+struct AliasCell {
+    keep: f32,
+    alias: u32,
+    /// The row's density (over x in [0, 1)) in this column and in the alias's.
+    pdf: f32,
+    alias_pdf: f32,
 }
 
 impl Distribution2D {
     /// `func` holds `height` rows of `width` values, row 0 at v = 0.
     pub fn new(func: &[f32], width: usize, height: usize) -> Self {
-        let rows: Vec<&[f32]> = func.chunks_exact(width).take(height).collect();
+        let rows: Vec<&[f32]> = func.chunks_exact(width.max(1)).take(height).collect();
         // From the rows' own sums: an all-zero row samples uniformly but must weigh nothing.
         let marginal = Distribution1D::new(
             rows.iter()
                 .map(|row| row.iter().map(|&f| f.max(0.0)).sum::<f32>() / width as f32)
                 .collect(),
         );
-        let rows = rows
-            .into_iter()
-            .map(|row| Distribution1D::new(row.to_vec()))
-            .collect();
-        Self { rows, marginal }
+        let cells = rows.into_iter().flat_map(alias_row).collect();
+        Self {
+            width: if height == 0 { 0 } else { width },
+            cells,
+            marginal,
+        }
     }
 
     /// A point in [0, 1)^2 (x along the row, y across rows) and its density.
     pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
+        if self.width == 0 {
+            return None;
+        }
         let (y, pdf_y, row) = self.marginal.sample_continuous(u.y)?;
-        let (x, pdf_x, _) = self.rows[row].sample_continuous(u.x)?;
+        let n = self.width;
+        let scaled = u.x.clamp(0.0, ONE_MINUS_EPSILON) * n as f32;
+        let slot = (scaled as usize).min(n - 1);
+        let cell = self.cells[row * n + slot];
+        let within = (scaled - slot as f32).clamp(0.0, ONE_MINUS_EPSILON);
+        let (column, pdf_x, du) = if within < cell.keep {
+            (slot, cell.pdf, within / cell.keep)
+        } else {
+            (
+                cell.alias as usize,
+                cell.alias_pdf,
+                (within - cell.keep) / (1.0 - cell.keep),
+            )
+        };
+        let du = du.clamp(0.0, ONE_MINUS_EPSILON);
+        let x = ((column as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
         Some((Vec2::new(x, y), pdf_x * pdf_y))
     }
 
     pub fn pdf(&self, p: Vec2) -> f32 {
-        let height = self.rows.len();
-        if height == 0 {
+        let height = self.marginal.len();
+        if self.width == 0 || height == 0 {
             return 0.0;
         }
         let row = ((p.y * height as f32) as usize).min(height - 1);
-        self.rows[row].pdf(p.x) * self.marginal.pdf(p.y)
+        let column = ((p.x * self.width as f32) as usize).min(self.width - 1);
+        self.cells[row * self.width + column].pdf * self.marginal.pdf(p.y)
     }
+}
+
+/// A row's alias table. Densities as [`Distribution1D`] gives them: negative and non-finite
+/// values count as zero, and an all-zero row is uniform. A column of zero weight is never
+/// picked: its `keep` is 0 and its slot goes to a column that has weight.
+fn alias_row(row: &[f32]) -> Vec<AliasCell> {
+    let n = row.len();
+    let mut weight: Vec<f64> = row
+        .iter()
+        .map(|&f| {
+            if f.is_finite() {
+                f64::from(f.max(0.0))
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut total: f64 = weight.iter().sum();
+    if total <= 0.0 {
+        weight.iter_mut().for_each(|w| *w = 1.0);
+        total = n as f64;
+    }
+    // The density over [0, 1) is f / mean(f), as Distribution1D's func / integral.
+    let pdf: Vec<f32> = weight
+        .iter()
+        .map(|&w| (w * n as f64 / total) as f32)
+        .collect();
+    // Each slot holds one unit of probability mass (times n); Vose's algorithm fills the slots
+    // of light columns with mass from heavy ones.
+    let mut mass: Vec<f64> = weight.iter().map(|&w| w * n as f64 / total).collect();
+    let mut cells: Vec<AliasCell> = (0..n)
+        .map(|i| AliasCell {
+            keep: 1.0,
+            alias: i as u32,
+            pdf: pdf[i],
+            alias_pdf: pdf[i],
+        })
+        .collect();
+    let (mut light, mut heavy): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| mass[i] < 1.0);
+    while let (Some(&l), Some(&h)) = (light.last(), heavy.last()) {
+        light.pop();
+        cells[l].keep = mass[l] as f32;
+        cells[l].alias = h as u32;
+        cells[l].alias_pdf = pdf[h];
+        mass[h] -= 1.0 - mass[l];
+        if mass[h] < 1.0 {
+            heavy.pop();
+            light.push(h);
+        }
+    }
+    // What is left holds a whole slot up to rounding, and keeps it (keep = 1 from above); a
+    // column of zero weight cannot be among it, as the slots of the heavy ones take all the
+    // rest of the mass.
+    for i in light {
+        if weight[i] == 0.0 {
+            // Unreachable up to rounding of the f64 sums; never let it be picked.
+            let donor = weight.iter().position(|&w| w > 0.0).unwrap_or(i);
+            cells[i].keep = 0.0;
+            cells[i].alias = donor as u32;
+            cells[i].alias_pdf = pdf[donor];
+        }
+    }
+    cells
 }
 
 #[cfg(test)]
@@ -227,5 +331,53 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A row's alias table picks each column with the probability its density gives, never a
+    /// column of zero weight, spreads the samples evenly inside the column, and reports the
+    /// density that `pdf` gives at the point. Over an even grid of u.x the counts are exact up
+    /// to one sample per slot boundary.
+    #[test]
+    fn alias_rows_sample_their_density() {
+        let row = [0.0, 3.0, 0.5, 0.0, 7.0, 1e-3, 2.5, 0.0, 0.0, 4.0];
+        let rows = [row.to_vec(), vec![0.0; 10], vec![1.0; 10]].concat();
+        let d = Distribution2D::new(&rows, 10, 3);
+        let total: f32 = row.iter().sum();
+        let m = 200_000;
+        let mut counts = [0usize; 10];
+        let mut within = [0.0f64; 10];
+        // u.y = 0.1 lands in row 0, which holds most of the weight.
+        for j in 0..m {
+            let u = Vec2::new((j as f32 + 0.5) / m as f32, 0.1);
+            let (p, density) = d.sample(u).expect("a sample");
+            assert_eq!((p.y * 3.0) as usize, 0);
+            assert_eq!(density, d.pdf(p), "at {p}");
+            let column = (p.x * 10.0) as usize;
+            counts[column] += 1;
+            within[column] += f64::from(p.x * 10.0 - column as f32);
+        }
+        for (i, &f) in row.iter().enumerate() {
+            let expected = f / total;
+            let got = counts[i] as f32 / m as f32;
+            assert!(
+                (got - expected).abs() <= 20.0 / m as f32,
+                "column {i}: {got} vs {expected}"
+            );
+            if f == 0.0 {
+                assert_eq!(counts[i], 0, "zero-weight column {i} picked");
+            } else if counts[i] > 1000 {
+                let mean = within[i] / counts[i] as f64;
+                assert!(
+                    (mean - 0.5).abs() < 0.01,
+                    "column {i}: mean position {mean}"
+                );
+            }
+        }
+        // The all-zero row is never chosen and the uniform one has density 1 along x.
+        let marginal_zero = d.pdf(Vec2::new(0.5, 0.5));
+        assert_eq!(marginal_zero, 0.0);
+        let uniform = d.pdf(Vec2::new(0.37, 0.9));
+        let row_weight = 1.0 / (total / 10.0 + 1.0);
+        assert!((uniform - 3.0 * row_weight).abs() < 1e-5, "{uniform}");
     }
 }

@@ -21,16 +21,17 @@ pub enum Isa {
 impl Isa {
     /// The instruction sets this CPU runs, slowest first.
     pub fn available() -> Vec<Isa> {
-        let mut isas = vec![Isa::Scalar];
         #[cfg(target_arch = "x86_64")]
         {
             // SSE2 is part of x86-64.
-            isas.push(Isa::Sse);
+            let mut isas = vec![Isa::Scalar, Isa::Sse];
             if std::arch::is_x86_feature_detected!("avx2") {
                 isas.push(Isa::Avx2);
             }
+            isas
         }
-        isas
+        #[cfg(not(target_arch = "x86_64"))]
+        vec![Isa::Scalar]
     }
 
     /// The fastest instruction set this CPU runs.
