@@ -19,3 +19,4 @@ mod seed_renders;
 mod seed_scenes;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
+mod volumes;
