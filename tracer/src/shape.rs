@@ -19,7 +19,7 @@ use std::sync::Arc;
 use glam::{Mat3, Mat4, Vec3};
 
 use crate::diag::SourcePos;
-use crate::medium::ShapeMedia;
+use crate::medium::common::ShapeMedia;
 use crate::mesh::{inline, TriangleMesh};
 use crate::param::MaterialId;
 use crate::parse::context::ParseContext;

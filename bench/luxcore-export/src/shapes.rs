@@ -16,8 +16,8 @@ use crate::error::ExportError;
 use crate::materials::write_material;
 use crate::options::ExportOptions;
 use crate::ply::ply_bytes;
-use crate::volumes::set_material_volumes;
 use crate::props::{mat_name, quoted, Props};
+use crate::volumes::set_material_volumes;
 
 /// Half the side of the quad an infinite plane becomes (scene units).
 pub const PLANE_HALF_SIZE: f32 = 1.0e4;

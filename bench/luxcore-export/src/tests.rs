@@ -287,13 +287,16 @@ AttributeEnd
 Material "null"
 Interior "smoke"
 Shape "sphere" "float radius" [0.5]
-Interior ""
-Exterior ""
-Shape "sphere" "float radius" [0.25]"#,
+AttributeBegin
+  Interior ""
+  Exterior ""
+  Shape "sphere" "float radius" [0.25]
+AttributeEnd"#,
     );
     let scn = &scene.scene;
     assert_eq!(value(scn, "scene.volumes.vol0.type"), "\"clear\"");
-    assert_eq!(value(scn, "scene.volumes.vol0.ior"), "1.0002926");
+    let air_ior: f32 = value(scn, "scene.volumes.vol0.ior").parse().unwrap();
+    assert_eq!(air_ior, 1.000_292_6);
     assert_eq!(value(scn, "scene.volumes.vol1.absorption"), "0.5 1 2");
     assert_eq!(value(scn, "scene.volumes.vol2.type"), "\"homogeneous\"");
     assert_eq!(value(scn, "scene.volumes.vol2.scattering"), "2 2 2");
@@ -301,14 +304,31 @@ Shape "sphere" "float radius" [0.25]"#,
     assert_eq!(value(scn, "scene.volumes.vol2.multiscattering"), "1");
     assert_eq!(value(scn, "scene.camera.volume"), "\"vol0\"");
     let material = value(scn, "scene.objects.object0.material").trim_matches('"');
-    assert_eq!(value(scn, &format!("scene.materials.{material}.volume.interior")), "\"vol1\"");
-    assert_eq!(value(scn, &format!("scene.materials.{material}.volume.exterior")), "\"vol0\"");
+    assert_eq!(
+        value(scn, &format!("scene.materials.{material}.volume.interior")),
+        "\"vol1\""
+    );
+    assert_eq!(
+        value(scn, &format!("scene.materials.{material}.volume.exterior")),
+        "\"vol0\""
+    );
     // glass2's index is the interior's over the exterior's.
-    let ior: f32 = value(scn, &format!("scene.materials.{material}.interiorior")).parse().unwrap();
+    let ior: f32 = value(scn, &format!("scene.materials.{material}.interiorior"))
+        .parse()
+        .unwrap();
     assert!((ior - 1.2 / 1.000_292_6).abs() < 1e-6, "{ior}");
     let smoke = value(scn, "scene.objects.object1.material").trim_matches('"');
-    assert_eq!(value(scn, &format!("scene.materials.{smoke}.type")), "\"null\"");
-    assert_eq!(value(scn, &format!("scene.materials.{smoke}.volume.interior")), "\"vol2\"");
+    assert_eq!(
+        value(scn, &format!("scene.materials.{smoke}.type")),
+        "\"null\""
+    );
+    assert_eq!(
+        value(scn, &format!("scene.materials.{smoke}.volume.interior")),
+        "\"vol2\""
+    );
     let plain = value(scn, "scene.objects.object2.material").trim_matches('"');
-    assert!(!scn.contains(&format!("scene.materials.{plain}.volume")), "{scn}");
+    assert!(
+        !scn.contains(&format!("scene.materials.{plain}.volume")),
+        "{scn}"
+    );
 }

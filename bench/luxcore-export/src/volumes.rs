@@ -37,9 +37,15 @@ pub fn write_volumes(desc: &SceneDesc, p: &mut Props) {
 /// Sets the volumes of material `name` (written for one shape only).
 pub fn set_material_volumes(p: &mut Props, name: &str, media: ShapeMedia) {
     if let Some(v) = media.interior {
-        p.set(format!("scene.materials.{name}.volume.interior"), quoted(&vol_name(v)));
+        p.set(
+            format!("scene.materials.{name}.volume.interior"),
+            quoted(&vol_name(v)),
+        );
     }
     if let Some(v) = media.exterior {
-        p.set(format!("scene.materials.{name}.volume.exterior"), quoted(&vol_name(v)));
+        p.set(
+            format!("scene.materials.{name}.volume.exterior"),
+            quoted(&vol_name(v)),
+        );
     }
 }

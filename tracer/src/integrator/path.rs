@@ -257,7 +257,9 @@ fn shadow_transmittance<S: PathScene>(
         *rays += 1;
         let ray = Ray::new(origin, dir);
         let hit = scene.geometry().intersect(&ray, tmax);
-        let sides = hit.as_ref().map(|h| scene.shape_media(h.shape).met_by(dir, h.ng, medium));
+        let sides = hit
+            .as_ref()
+            .map(|h| scene.shape_media(h.shape).met_by(dir, h.ng, medium));
         if let (Some(h), Some(sides), None) = (&hit, sides, medium) {
             medium = sides.toward(-dir, h.ng);
         }

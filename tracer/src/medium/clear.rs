@@ -41,7 +41,14 @@ impl Clear {
         let statement = "MakeNamedVolume \"clear\"";
         Ok(Self {
             index: read_index(params, statement, pos, ctx)?,
-            absorption: read_color(params, "absorption", DEFAULT_ABSORPTION, statement, pos, ctx)?,
+            absorption: read_color(
+                params,
+                "absorption",
+                DEFAULT_ABSORPTION,
+                statement,
+                pos,
+                ctx,
+            )?,
         })
     }
 
@@ -67,7 +74,10 @@ mod tests {
         for d in [0.0f32, 0.1, 0.37, 1.0, 2.2] {
             let t = clear.transmittance(d);
             let expected = Vec3::new(1.0, (-0.7f32 * d).exp(), (-2.5f32 * d).exp());
-            assert!((t - expected).abs().max_element() < 1e-4, "d {d}: {t} vs {expected}");
+            assert!(
+                (t - expected).abs().max_element() < 1e-4,
+                "d {d}: {t} vs {expected}"
+            );
         }
         // exp(-0.7 * 2) = 0.2466
         assert!((clear.transmittance(2.0).y - 0.246_597).abs() < 1e-4);

@@ -72,7 +72,9 @@ pub fn read_index(
         TexValue::Const(c) => Some(c.x),
         TexValue::Named { name, pos: at } => {
             let found = match ctx.find_texture(&name, false) {
-                Some(TexBinding::Texture(id)) => ctx.uniform_texture(crate::param::Tex::Texture(id)),
+                Some(TexBinding::Texture(id)) => {
+                    ctx.uniform_texture(crate::param::Tex::Texture(id))
+                }
                 Some(TexBinding::Fresnel(Fresnel::Index(t))) => ctx.uniform_texture(t),
                 _ => None,
             };
@@ -90,7 +92,9 @@ pub fn read_index(
         Some(i) => {
             ctx.warn(
                 pos,
-                format!("{statement}: fresnel {i} is not a positive index; using {DEFAULT_FRESNEL}"),
+                format!(
+                    "{statement}: fresnel {i} is not a positive index; using {DEFAULT_FRESNEL}"
+                ),
             );
             DEFAULT_FRESNEL
         }
@@ -123,7 +127,10 @@ pub fn read_color(
     Ok(if value.is_finite() {
         value.max(Vec3::ZERO)
     } else {
-        ctx.warn(pos, format!("{statement}: \"{name}\" is not finite; using {default}"));
+        ctx.warn(
+            pos,
+            format!("{statement}: \"{name}\" is not finite; using {default}"),
+        );
         Vec3::splat(default)
     })
 }

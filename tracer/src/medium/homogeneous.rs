@@ -61,7 +61,12 @@ impl Homogeneous {
         let g = match ctx.uniform_texture(g) {
             Some(g) if g.is_finite() => g,
             _ => {
-                ctx.warn(pos, format!("{statement}: \"g\" must be a uniform finite asymmetry; using {DEFAULT_G}"));
+                ctx.warn(
+                    pos,
+                    format!(
+                        "{statement}: \"g\" must be a uniform finite asymmetry; using {DEFAULT_G}"
+                    ),
+                );
                 Vec3::splat(DEFAULT_G)
             }
         };
@@ -151,7 +156,10 @@ mod tests {
         let st = medium.sigma_t();
         let tr = medium.transmittance(length);
         let expected_scatter = medium.sigma_s / st * (Vec3::ONE - tr);
-        assert!((pass / n as f32 - tr).abs().max_element() < 2e-3, "{pass} vs {tr}");
+        assert!(
+            (pass / n as f32 - tr).abs().max_element() < 2e-3,
+            "{pass} vs {tr}"
+        );
         assert!(
             (scatter / n as f32 - expected_scatter).abs().max_element() < 2e-3,
             "{scatter} vs {expected_scatter}"

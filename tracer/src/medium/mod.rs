@@ -45,7 +45,8 @@ impl Volumes {
 
     /// The index of refraction of a side of a surface: its volume's `fresnel`, 1 with none.
     pub fn index(&self, id: Option<MediumId>) -> f32 {
-        id.and_then(|id| self.get(id)).map_or(1.0, MediumDesc::index)
+        id.and_then(|id| self.get(id))
+            .map_or(1.0, MediumDesc::index)
     }
 }
 

@@ -78,7 +78,11 @@ mod tests {
     use super::*;
 
     fn unit(theta: f32, phi: f32) -> Vec3 {
-        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
     }
 
     /// The phase function integrates to 1 over the sphere (midpoint rule in theta and phi),
@@ -108,7 +112,10 @@ mod tests {
             for c in sum.to_array() {
                 assert!((c - 1.0).abs() < 2e-3, "g {g}: integral {sum}");
             }
-            assert!((pdf_sum - 1.0).abs() < 2e-3, "g {g}: pdf integral {pdf_sum}");
+            assert!(
+                (pdf_sum - 1.0).abs() < 2e-3,
+                "g {g}: pdf integral {pdf_sum}"
+            );
         }
     }
 

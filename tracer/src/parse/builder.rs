@@ -475,7 +475,10 @@ impl<'s> Builder<'s> {
                     match self.named_volumes.get(&name) {
                         Some(&m) => m,
                         None => {
-                            self.warn(pos, format!("{keyword}: no volume named \"{name}\"; using none"));
+                            self.warn(
+                                pos,
+                                format!("{keyword}: no volume named \"{name}\"; using none"),
+                            );
                             None
                         }
                     }

@@ -9,7 +9,6 @@ use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::{MaterialDesc, SceneDesc};
-use crate::medium::{ShapeMedia, Volumes};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::FilterSampler;
 use crate::geometry::{SceneGeometry, SurfaceHit};
@@ -17,6 +16,7 @@ use crate::integrator::options::IntegratorDesc;
 use crate::integrator::path::{trace_path, PathScene};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
+use crate::medium::{ShapeMedia, Volumes};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
