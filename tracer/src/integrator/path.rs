@@ -240,6 +240,25 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
 /// volume is seen by light sampling as it is by BSDF sampling.
 fn shadow_transmittance<S: PathScene>(
     scene: &S,
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+    medium: Option<MediumId>,
+    rays: &mut u32,
+) -> Vec3 {
+    if scene.volumes().media.is_empty() {
+        *rays += 1;
+        let blocked = scene.geometry().occluded(&Ray::new(origin, dir), tmax);
+        return if blocked { Vec3::ZERO } else { Vec3::ONE };
+    }
+    shadow_walk(scene, origin, dir, tmax, medium, rays)
+}
+
+/// [`shadow_transmittance`] in a scene with volumes: surface by surface. Kept out of line so
+/// that the path loop of a scene without volumes stays as small as it was.
+#[inline(never)]
+fn shadow_walk<S: PathScene>(
+    scene: &S,
     mut origin: Vec3,
     dir: Vec3,
     mut tmax: f32,
@@ -247,11 +266,6 @@ fn shadow_transmittance<S: PathScene>(
     rays: &mut u32,
 ) -> Vec3 {
     let volumes = scene.volumes();
-    if volumes.media.is_empty() {
-        *rays += 1;
-        let blocked = scene.geometry().occluded(&Ray::new(origin, dir), tmax);
-        return if blocked { Vec3::ZERO } else { Vec3::ONE };
-    }
     let mut tr = Vec3::ONE;
     for _ in 0..=MAX_PASS_THROUGH {
         *rays += 1;
@@ -334,6 +348,7 @@ fn direct_light<S: PathScene>(
 
 /// One light sample at a scattering event inside a volume, weighted against phase-function
 /// sampling by the power heuristic.
+#[inline(never)]
 fn direct_light_in_medium<S: PathScene>(
     scene: &S,
     p: Vec3,

@@ -262,6 +262,7 @@ WorldEnd
     assert!(sky.min_element() > 0.5, "{sky}");
     let expected = (-sigma * d).exp();
     let got = mean(&render(&scene(true), 4), 0, 8, 0, 8) / sky;
+    println!("slab: {got} vs exp(-sigma d) = {expected}");
     assert!(
         (got - expected).abs().max_element() < 1e-3,
         "{got} vs exp(-sigma d) = {expected}"
@@ -329,6 +330,7 @@ WorldEnd
     let film = render(&scene(0.0), 256);
     // The centre pixels look through the sphere's middle (about 3 optical depths).
     let centre = mean(&film, 6, 10, 6, 10);
+    println!("furnace: centre {centre} vs sky 0.5");
     for c in centre.to_array() {
         assert!((c - 0.5).abs() < 0.005, "furnace: {centre}");
     }
