@@ -6,7 +6,7 @@
 //! [`crate::camera`], the film in [`crate::film`], the pixel filter in [`crate::filter`], the
 //! surface integrator in [`crate::integrator::options`], the sampler in [`crate::sampler`],
 //! shapes in [`crate::shape`], materials in [`crate::material`], textures in [`crate::texture`],
-//! lights in [`crate::lights`]; the families' enums and the shared leaf types are re-exported
+//! lights in [`crate::lights`], volumes in [`crate::medium`]; the families' enums and the shared leaf types are re-exported
 //! here.
 
 pub use crate::assets::{AssetKind, AssetRef};
@@ -17,6 +17,7 @@ pub use crate::filter::{FilterDesc, FilterKind};
 pub use crate::integrator::options::{IntegratorDesc, RussianRoulette};
 pub use crate::lights::{EnvMapDesc, LatLongConvention, LightDesc};
 pub use crate::material::MaterialDesc;
+pub use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 pub use crate::mesh::TriangleMesh;
 pub use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 pub use crate::sampler::SamplerDesc;
@@ -34,6 +35,8 @@ pub struct SceneDesc {
     pub materials: Vec<MaterialDesc>,
     pub shapes: Vec<ShapeDesc>,
     pub lights: Vec<LightDesc>,
+    /// Named volumes (`MakeNamedVolume`) and the camera's.
+    pub volumes: Volumes,
     pub warnings: Vec<Warning>,
     /// Every file read or referenced besides the main file, in first-use order, no repeats.
     pub assets: Vec<AssetRef>,

@@ -34,6 +34,7 @@ pub mod integrator;
 pub mod lights;
 pub mod material;
 pub mod math;
+pub mod medium;
 pub mod mesh;
 pub mod param;
 pub mod parse;

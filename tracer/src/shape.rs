@@ -19,6 +19,7 @@ use std::sync::Arc;
 use glam::{Mat3, Mat4, Vec3};
 
 use crate::diag::SourcePos;
+use crate::medium::common::ShapeMedia;
 use crate::mesh::{inline, TriangleMesh};
 use crate::param::MaterialId;
 use crate::parse::context::ParseContext;
@@ -80,6 +81,8 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
+    /// The `Interior` and `Exterior` volumes current when the shape was defined.
+    pub media: ShapeMedia,
 }
 
 impl Geometry {
@@ -239,6 +242,7 @@ mod tests {
             reverse_orientation: false,
             material: MaterialId(0),
             area_light: None,
+            media: Default::default(),
         }
     }
 

@@ -12,7 +12,8 @@
 //! It reads only the scene description ([`yat_tracer::desc`]) and the tracer's mesh helpers.
 //! One file per part of the output: `props` (the SDL text and the names of things), `camera`
 //! (camera and `render.cfg`), `textures`, `materials`, `bake` (mappings baked into vertex
-//! uvs), `shapes` (meshes and objects), `ply` (the PLY files), `lights`; `options` and `error`
+//! uvs), `shapes` (meshes and objects), `ply` (the PLY files), `lights`, `volumes` (clear and
+//! homogeneous volumes, the camera's, a shape's interior and exterior); `options` and `error`
 //! are the leaves they share.
 
 mod bake;
@@ -28,6 +29,7 @@ mod procedural;
 mod props;
 mod shapes;
 mod textures;
+mod volumes;
 
 use std::path::Path;
 
@@ -80,6 +82,7 @@ pub fn export(
     }
     let mut p = props::Props::default();
     camera::write_camera(desc, &mut p)?;
+    volumes::write_volumes(desc, &mut p);
     textures::write_textures(desc, scene_dir, &mut p, &mut notes)?;
     for (i, m) in desc.materials.iter().enumerate() {
         materials::write_material(&mut p, &props::mat_name(MaterialId(i as u32)), m, None);

@@ -55,6 +55,7 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
             architectural,
             uroughness,
             vroughness,
+            ..
         }) => {
             let rough = *uroughness != Tex::float(0.0) || *vroughness != Tex::float(0.0);
             let kind = match (architectural, rough) {

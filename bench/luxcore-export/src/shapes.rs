@@ -1,6 +1,7 @@
 //! Shapes (`scene.shapes.shape<N>`, `scene.objects.object<N>`): every shape as a world-space
 //! PLY mesh with its material; analytic shapes are tessellated, infinite planes become large
-//! squares, and an emitting shape gets its own material carrying the emission.
+//! squares, and an emitting shape (or one with volumes) gets its own material carrying the
+//! emission (and the volumes).
 
 use std::sync::Arc;
 
@@ -16,6 +17,7 @@ use crate::materials::write_material;
 use crate::options::ExportOptions;
 use crate::ply::ply_bytes;
 use crate::props::{mat_name, quoted, Props};
+use crate::volumes::set_material_volumes;
 
 /// Half the side of the quad an infinite plane becomes (scene units).
 pub const PLANE_HALF_SIZE: f32 = 1.0e4;
@@ -48,8 +50,17 @@ pub fn write_shapes(
                 );
                 name
             }
+            None if !shape.media.is_empty() => {
+                // LuxCore keeps volumes on materials: this shape's own copy.
+                let name = format!("{}_shape{i}", mat_name(shape.material));
+                if let Some(m) = desc.materials.get(shape.material.0 as usize) {
+                    write_material(p, &name, m, None);
+                }
+                name
+            }
             None => mat_name(shape.material),
         };
+        set_material_volumes(p, &material, shape.media);
         p.set(
             format!("scene.objects.object{i}.shape"),
             quoted(&format!("shape{i}")),

@@ -285,3 +285,67 @@ fn sun_and_sky_become_luxcores_sun_and_sky2() {
         lux.notes
     );
 }
+
+/// Clear and homogeneous volumes become LuxCore's, the camera's volume is set, and a shape
+/// with volumes gets its own copy of its material carrying them (a shape without keeps the
+/// shared material).
+#[test]
+fn volumes_map_to_luxcore_volumes() {
+    let scene = export_world(
+        r#"MakeNamedVolume "air" "clear" "float fresnel" [1.0002926]
+MakeNamedVolume "ink" "clear" "float fresnel" [1.2] "color absorption" [0.5 1 2]
+MakeNamedVolume "smoke" "homogeneous" "color sigma_a" [0.1 0.2 0.3] "color sigma_s" [2 2 2] "float g" [0.4]
+Exterior "air"
+Material "glass2"
+AttributeBegin
+  Interior "ink"
+  Shape "sphere" "float radius" [1]
+AttributeEnd
+Material "null"
+Interior "smoke"
+Shape "sphere" "float radius" [0.5]
+AttributeBegin
+  Interior ""
+  Exterior ""
+  Shape "sphere" "float radius" [0.25]
+AttributeEnd"#,
+    );
+    let scn = &scene.scene;
+    assert_eq!(value(scn, "scene.volumes.vol0.type"), "\"clear\"");
+    let air_ior: f32 = value(scn, "scene.volumes.vol0.ior").parse().unwrap();
+    assert_eq!(air_ior, 1.000_292_6);
+    assert_eq!(value(scn, "scene.volumes.vol1.absorption"), "0.5 1 2");
+    assert_eq!(value(scn, "scene.volumes.vol2.type"), "\"homogeneous\"");
+    assert_eq!(value(scn, "scene.volumes.vol2.scattering"), "2 2 2");
+    assert_eq!(value(scn, "scene.volumes.vol2.asymmetry"), "0.4 0.4 0.4");
+    assert_eq!(value(scn, "scene.volumes.vol2.multiscattering"), "1");
+    assert_eq!(value(scn, "scene.camera.volume"), "\"vol0\"");
+    let material = value(scn, "scene.objects.object0.material").trim_matches('"');
+    assert_eq!(
+        value(scn, &format!("scene.materials.{material}.volume.interior")),
+        "\"vol1\""
+    );
+    assert_eq!(
+        value(scn, &format!("scene.materials.{material}.volume.exterior")),
+        "\"vol0\""
+    );
+    // glass2's index is the interior's over the exterior's.
+    let ior: f32 = value(scn, &format!("scene.materials.{material}.interiorior"))
+        .parse()
+        .unwrap();
+    assert!((ior - 1.2 / 1.000_292_6).abs() < 1e-6, "{ior}");
+    let smoke = value(scn, "scene.objects.object1.material").trim_matches('"');
+    assert_eq!(
+        value(scn, &format!("scene.materials.{smoke}.type")),
+        "\"null\""
+    );
+    assert_eq!(
+        value(scn, &format!("scene.materials.{smoke}.volume.interior")),
+        "\"vol2\""
+    );
+    let plain = value(scn, "scene.objects.object2.material").trim_matches('"');
+    assert!(
+        !scn.contains(&format!("scene.materials.{plain}.volume")),
+        "{scn}"
+    );
+}

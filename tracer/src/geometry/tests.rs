@@ -44,6 +44,7 @@ pub(crate) fn shape(geometry: Geometry, object_to_world: Mat4) -> ShapeDesc {
         reverse_orientation: false,
         material: MaterialId(0),
         area_light: None,
+        media: Default::default(),
     }
 }
 

@@ -1,5 +1,13 @@
 //! The path tracer: unidirectional path tracing with next-event estimation, multiple importance sampling of
-//! light and BSDF samples (power heuristic), and Russian roulette.
+//! light and BSDF samples (power heuristic), and Russian roulette; through participating
+//! media (LuxRender's named volumes) with Beer-Lambert transmittance, free-flight sampling,
+//! phase-function scattering and next-event estimation at scattering events.
+//!
+//! The volume a ray travels in follows LuxRender's rule: after a surface, the side of it the
+//! ray leaves into (a shape's `Interior` or `Exterior`; a side with no volume is the ray's
+//! own when the ray came from it, else no volume). A ray in no volume takes, for its segment,
+//! the volume on the near side of the surface it hits. A scene without volumes takes none of
+//! these steps and draws no extra random numbers, so it renders as it did before volumes.
 
 use glam::Vec3;
 
@@ -8,6 +16,7 @@ use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::lights::Lights;
 use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
+use crate::medium::{Flight, MediumId, Phase, ShapeMedia, Volumes};
 use crate::sampler::PixelSampler;
 
 /// What the path tracer needs from the scene. The renderer's built scene implements it, so the
@@ -21,6 +30,12 @@ pub trait PathScene {
     fn lights(&self) -> &Lights;
     /// The BSDF at a hit; `u_mix` resolves mix materials.
     fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf;
+    /// The scene's volumes and the camera's.
+    fn volumes(&self) -> &Volumes;
+    /// The volumes on the two sides of shape `shape`.
+    fn shape_media(&self, shape: u32) -> ShapeMedia;
+    /// Whether shape `shape` is `null` (shadow rays in scenes with volumes cross it).
+    fn is_pass_through(&self, shape: u32) -> bool;
 }
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
@@ -52,10 +67,33 @@ struct PrevScatter {
     specular: bool,
 }
 
+/// Russian roulette after a bounce: false ends the path; else the throughput is divided by
+/// the survival probability.
+fn survives(integrator: &IntegratorDesc, depth: u32, u_rr: f32, throughput: &mut Vec3) -> bool {
+    if depth >= RR_MIN_DEPTH {
+        let continue_prob = match integrator.rr_strategy {
+            RussianRoulette::None => 1.0,
+            RussianRoulette::Probability => integrator.rr_continue_prob,
+            // The largest channel, not luminance: a path along a saturated red wall
+            // has a small luminance but a large red throughput, and dividing that by a
+            // small survival probability is what makes coloured fireflies.
+            RussianRoulette::Efficiency => throughput.max_element().clamp(0.05, 1.0),
+        };
+        if u_rr >= continue_prob {
+            return false;
+        }
+        *throughput /= continue_prob;
+    }
+    true
+}
+
 pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSampler) -> PathResult {
     let integrator = scene.integrator();
     let max_depth = scene.max_depth();
     let lights = scene.lights();
+    let volumes = scene.volumes();
+    let has_media = !volumes.media.is_empty();
+    let mut medium = volumes.camera;
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut rays = 0u32;
@@ -70,7 +108,59 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
 
     loop {
         rays += 1;
-        let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else {
+        let hit = scene.geometry().intersect(&ray, f32::INFINITY);
+        // The sides of the surface hit as this ray meets them (no volumes: nothing to do).
+        let sides = match &hit {
+            Some(hit) if has_media => {
+                let sides = scene.shape_media(hit.shape).met_by(ray.dir, hit.ng, medium);
+                // A ray in no volume crosses the one on the near side of what it hits.
+                if medium.is_none() {
+                    medium = sides.toward(-ray.dir, hit.ng);
+                }
+                sides
+            }
+            _ => ShapeMedia::default(),
+        };
+        if let Some(m) = medium.and_then(|m| volumes.get(m)) {
+            let length = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
+            let u = if m.scatters() { sampler.get_1d() } else { 0.0 };
+            match m.flight(length, u) {
+                Flight::Pass { weight } => throughput *= weight,
+                Flight::Scatter { distance, weight } => {
+                    throughput *= weight;
+                    if depth >= max_depth {
+                        break;
+                    }
+                    depth += 1;
+                    let p = ray.at(distance);
+                    let wo = -ray.dir;
+                    let phase = m.phase();
+                    radiance += throughput
+                        * direct_light_in_medium(scene, p, wo, &phase, medium, sampler, &mut rays);
+                    let wi = phase.sample(wo, sampler.get_2d());
+                    let pdf = phase.pdf(wo, wi);
+                    if pdf.is_nan() || pdf <= 0.0 {
+                        break;
+                    }
+                    throughput *= phase.eval(wo, wi) / pdf;
+                    if !survives(integrator, depth, sampler.get_1d(), &mut throughput) {
+                        break;
+                    }
+                    prev = PrevScatter {
+                        p,
+                        pdf,
+                        specular: false,
+                    };
+                    ray = Ray::new(p, wi);
+                    continue;
+                }
+            }
+            if throughput == Vec3::ZERO {
+                break;
+            }
+        }
+
+        let Some(hit) = hit else {
             if depth > 0 || integrator.include_environment {
                 let (le, weight) = if prev.specular {
                     (lights.environment(ray.dir), 1.0)
@@ -100,6 +190,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             if pass_through > MAX_PASS_THROUGH {
                 break;
             }
+            medium = sides.toward(ray.dir, hit.ng);
             ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
             continue;
         }
@@ -110,7 +201,8 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         depth += 1;
 
         if !bsdf.is_specular() {
-            radiance += throughput * direct_light(scene, &hit, wo, &bsdf, sampler, &mut rays);
+            radiance +=
+                throughput * direct_light(scene, &hit, wo, &bsdf, sides, sampler, &mut rays);
         } else {
             // Keep the dimension layout of a vertex fixed whatever the material.
             sampler.get_1d();
@@ -126,20 +218,8 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         let cos = bs.wi.dot(hit.ns).abs();
         throughput *= bs.f * (cos / bs.pdf);
 
-        let u_rr = sampler.get_1d();
-        if depth >= RR_MIN_DEPTH {
-            let continue_prob = match integrator.rr_strategy {
-                RussianRoulette::None => 1.0,
-                RussianRoulette::Probability => integrator.rr_continue_prob,
-                // The largest channel, not luminance: a path along a saturated red wall
-                // has a small luminance but a large red throughput, and dividing that by a
-                // small survival probability is what makes coloured fireflies.
-                RussianRoulette::Efficiency => throughput.max_element().clamp(0.05, 1.0),
-            };
-            if u_rr >= continue_prob {
-                break;
-            }
-            throughput /= continue_prob;
+        if !survives(integrator, depth, sampler.get_1d(), &mut throughput) {
+            break;
         }
 
         prev = PrevScatter {
@@ -147,17 +227,95 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             pdf: bs.pdf,
             specular: bs.specular,
         };
+        medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
     }
     PathResult { radiance, rays }
 }
 
-/// One light sample, weighted against BSDF sampling by the power heuristic.
+/// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
+/// a surface blocks the way, else the volumes' transmittance. In a scene without volumes
+/// every surface blocks; with volumes, `null` surfaces let the ray through into the volume
+/// behind them (as LuxRender's shadow rays cross them), so a light inside a null-bounded
+/// volume is seen by light sampling as it is by BSDF sampling.
+fn shadow_transmittance<S: PathScene>(
+    scene: &S,
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+    medium: Option<MediumId>,
+    rays: &mut u32,
+) -> Vec3 {
+    if scene.volumes().media.is_empty() {
+        *rays += 1;
+        let blocked = scene.geometry().occluded(&Ray::new(origin, dir), tmax);
+        return if blocked { Vec3::ZERO } else { Vec3::ONE };
+    }
+    shadow_walk(scene, origin, dir, tmax, medium, rays)
+}
+
+/// [`shadow_transmittance`] in a scene with volumes: surface by surface. Kept out of line so
+/// that the path loop of a scene without volumes stays as small as it was.
+#[inline(never)]
+fn shadow_walk<S: PathScene>(
+    scene: &S,
+    mut origin: Vec3,
+    dir: Vec3,
+    mut tmax: f32,
+    mut medium: Option<MediumId>,
+    rays: &mut u32,
+) -> Vec3 {
+    let volumes = scene.volumes();
+    let mut tr = Vec3::ONE;
+    for _ in 0..=MAX_PASS_THROUGH {
+        *rays += 1;
+        let ray = Ray::new(origin, dir);
+        let hit = scene.geometry().intersect(&ray, tmax);
+        let sides = hit
+            .as_ref()
+            .map(|h| scene.shape_media(h.shape).met_by(dir, h.ng, medium));
+        if let (Some(h), Some(sides), None) = (&hit, sides, medium) {
+            medium = sides.toward(-dir, h.ng);
+        }
+        let length = hit.as_ref().map_or(tmax, |h| h.t);
+        if let Some(m) = medium.and_then(|m| volumes.get(m)) {
+            tr *= m.transmittance(length);
+        }
+        let (Some(h), Some(sides)) = (hit, sides) else {
+            return tr;
+        };
+        if !scene.is_pass_through(h.shape) || tr == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        medium = sides.toward(dir, h.ng);
+        let next = offset_origin(h.p, h.ng, dir);
+        tmax -= (next - origin).length();
+        origin = next;
+        if tmax <= 0.0 {
+            return tr;
+        }
+    }
+    Vec3::ZERO
+}
+
+/// The distance a shadow ray from `origin` travels to a light sampled at `dist` from `p`:
+/// stopped short of the light's own surface.
+fn shadow_tmax(p: Vec3, origin: Vec3, dist: f32) -> f32 {
+    if dist.is_finite() {
+        (origin - p).length().mul_add(-1.0, dist) * (1.0 - 1e-3)
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// One light sample, weighted against BSDF sampling by the power heuristic. `sides` are the
+/// volumes around the surface (the shadow ray starts in the one on the light's side).
 fn direct_light<S: PathScene>(
     scene: &S,
     hit: &SurfaceHit,
     wo: Vec3,
     bsdf: &Bsdf,
+    sides: ShapeMedia,
     sampler: &mut PixelSampler,
     rays: &mut u32,
 ) -> Vec3 {
@@ -174,14 +332,10 @@ fn direct_light<S: PathScene>(
         return Vec3::ZERO;
     }
     let origin = offset_origin(hit.p, hit.ng, ls.wi);
-    // Stop short of the light's own surface.
-    let tmax = if ls.dist.is_finite() {
-        (origin - hit.p).length().mul_add(-1.0, ls.dist) * (1.0 - 1e-3)
-    } else {
-        f32::INFINITY
-    };
-    *rays += 1;
-    if scene.geometry().occluded(&Ray::new(origin, ls.wi), tmax) {
+    let tmax = shadow_tmax(hit.p, origin, ls.dist);
+    let medium = sides.toward(ls.wi, hit.ng);
+    let tr = shadow_transmittance(scene, origin, ls.wi, tmax, medium, rays);
+    if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
     let weight = if ls.delta {
@@ -189,5 +343,37 @@ fn direct_light<S: PathScene>(
     } else {
         power_heuristic(ls.pdf, bsdf.pdf(wo, ls.wi))
     };
-    f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
+    tr * f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
+}
+
+/// One light sample at a scattering event inside a volume, weighted against phase-function
+/// sampling by the power heuristic.
+#[inline(never)]
+fn direct_light_in_medium<S: PathScene>(
+    scene: &S,
+    p: Vec3,
+    wo: Vec3,
+    phase: &Phase,
+    medium: Option<MediumId>,
+    sampler: &mut PixelSampler,
+    rays: &mut u32,
+) -> Vec3 {
+    let u_select = sampler.get_1d();
+    let u_light = sampler.get_2d();
+    let Some(ls) = scene.lights().sample(p, u_select, u_light) else {
+        return Vec3::ZERO;
+    };
+    if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let tr = shadow_transmittance(scene, p, ls.wi, shadow_tmax(p, p, ls.dist), medium, rays);
+    if tr == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let weight = if ls.delta {
+        1.0
+    } else {
+        power_heuristic(ls.pdf, phase.pdf(wo, ls.wi))
+    };
+    tr * phase.eval(wo, ls.wi) * ls.li * (weight / ls.pdf)
 }

@@ -42,6 +42,7 @@ fn build(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> (SceneGeometry, Ligh
 fn emitter(geometry: Geometry, m: Mat4, radiance: Vec3) -> ShapeDesc {
     ShapeDesc {
         area_light: Some(AreaLightDesc { radiance }),
+        media: Default::default(),
         ..shape(geometry, m)
     }
 }

@@ -10,7 +10,7 @@
 //! |---|---|---|
 //! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
 //! | `Kt` | color texture (likewise) | 1 ([`DEFAULT_KT`]) |
-//! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 always uses 1.5 (its index comes from volumes, which are not rendered: a warning) |
+//! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 has none: its index is its shape's `Interior` volume's `fresnel` over its `Exterior`'s, 1 for a side with no volume ([`GLASS2_INDEX_WITHOUT_VOLUMES`] when it has neither), set per shape by the parser |
 //! | `architectural` | bool | false |
 //! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
 //! | `film`, `cauchyb` | float | 0; not supported (a warning otherwise) |
@@ -30,6 +30,9 @@ use crate::parse::params::ParamList;
 pub const DEFAULT_KR: f32 = 1.0;
 pub const DEFAULT_KT: f32 = 1.0;
 pub const DEFAULT_INDEX: f32 = 1.5;
+/// glass2 on a shape with no volumes: LuxRender's Glass2 falls back to a vacuum-to-vacuum
+/// interface, index 1 (no refraction, no reflection).
+pub const GLASS2_INDEX_WITHOUT_VOLUMES: f32 = 1.0;
 /// roughglass's default roughness (glass and glass2 are smooth: roughness 0).
 pub const DEFAULT_ROUGHGLASS_ROUGHNESS: f32 = 0.001;
 
@@ -42,40 +45,41 @@ pub struct Glass {
     pub architectural: bool,
     pub uroughness: Tex,
     pub vroughness: Tex,
+    /// glass2: `index` is replaced, per shape, by its volumes' (see the table above).
+    pub index_from_volumes: bool,
 }
 
 impl Glass {
     /// `Material "glass"`.
     pub fn read(
         params: &ParamList,
-        pos: &SourcePos,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        Self::read_as("glass", params, pos, ctx)
+        Self::read_as("glass", params, ctx)
     }
 
     /// `Material "roughglass"`.
     pub fn read_rough(
         params: &ParamList,
-        pos: &SourcePos,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        Self::read_as("roughglass", params, pos, ctx)
+        Self::read_as("roughglass", params, ctx)
     }
 
     /// `Material "glass2"`.
     pub fn read_glass2(
         params: &ParamList,
-        pos: &SourcePos,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        Self::read_as("glass2", params, pos, ctx)
+        Self::read_as("glass2", params, ctx)
     }
 
     fn read_as(
         ty: &str,
         params: &ParamList,
-        pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         let rough = if ty == "roughglass" {
@@ -85,20 +89,15 @@ impl Glass {
         };
         ctx.unsupported_unless(params, "film", 0.0);
         ctx.unsupported_unless(params, "cauchyb", 0.0);
-        if ty == "glass2" {
-            ctx.warn_once(
-                "glass2".into(),
-                pos,
-                "glass2 takes its index from volumes, which are not rendered; using index 1.5"
-                    .into(),
-            );
+        let glass2 = ty == "glass2";
+        if glass2 {
             params.ignore("dispersion");
         }
         Ok(Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
             kt: ctx.color_param(params, "Kt", DEFAULT_KT, false)?,
-            index: if ty == "glass2" {
-                Tex::float(DEFAULT_INDEX)
+            index: if glass2 {
+                Tex::float(GLASS2_INDEX_WITHOUT_VOLUMES)
             } else {
                 ctx.float_param(params, "index", DEFAULT_INDEX)?
             },
@@ -113,6 +112,7 @@ impl Glass {
             } else {
                 Tex::float(0.0)
             },
+            index_from_volumes: glass2,
         })
     }
 

@@ -81,6 +81,7 @@ fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
         architectural,
         uroughness: c(roughness),
         vroughness: c(roughness),
+        index_from_volumes: false,
     })
 }
 

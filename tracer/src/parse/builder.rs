@@ -19,7 +19,8 @@ use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, Te
 use crate::diag::SourcePos as Pos;
 use crate::diag::Warning;
 use crate::lights::AreaLightParams;
-use crate::material::Matte;
+use crate::material::{Glass, Matte};
+use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::shape::Geometry;
@@ -33,6 +34,8 @@ struct GraphicsState {
     material: Option<MaterialId>,
     area_light: Option<AreaLightParams>,
     reverse_orientation: bool,
+    /// `Interior` and `Exterior`.
+    media: ShapeMedia,
 }
 
 #[derive(Clone, Debug)]
@@ -107,6 +110,11 @@ pub struct Builder<'s> {
     pub(super) materials: Vec<MaterialDesc>,
     shapes: Vec<ShapeDesc>,
     pub(super) lights: Vec<LightDesc>,
+    /// `MakeNamedVolume` names; None for a kind that is not rendered (a warning).
+    named_volumes: HashMap<String, Option<MediumId>>,
+    volumes: Volumes,
+    /// glass2 materials with the index of a shape's volumes, by (glass2, volumes).
+    glass2_with_index: HashMap<(MaterialId, ShapeMedia), MaterialId>,
     warnings: Vec<Warning>,
     warned: HashSet<String>,
     assets: Vec<AssetRef>,
@@ -168,6 +176,9 @@ impl<'s> Builder<'s> {
             materials: Vec::new(),
             shapes: Vec::new(),
             lights: Vec::new(),
+            named_volumes: HashMap::new(),
+            volumes: Volumes::default(),
+            glass2_with_index: HashMap::new(),
             warnings: Vec::new(),
             warned: HashSet::new(),
             assets: Vec::new(),
@@ -321,6 +332,8 @@ impl<'s> Builder<'s> {
                 for f in std::mem::take(&mut self.stack) {
                     self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
                 }
+                // LuxRender gives the camera the Exterior current at WorldEnd.
+                self.volumes.camera = self.gs.media.exterior;
                 self.block = Block::Ended;
             }
             "Include" => {
@@ -345,17 +358,17 @@ impl<'s> Builder<'s> {
             }
             "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath"
             | "PortalShape" => r.skip_statement()?,
-            "Volume" | "MakeNamedVolume" | "Exterior" | "Interior" => {
+            "Volume" => {
                 r.skip_statement()?;
                 self.warn_once(
-                    "volumes".into(),
+                    "volume regions".into(),
                     pos,
-                    format!("{keyword}: participating media are not rendered; volume statements are ignored"),
+                    "Volume: volume regions are not rendered (named volumes given as Interior and Exterior are); ignored".into(),
                 );
             }
             "Texture" | "Material" | "MakeNamedMaterial" | "NamedMaterial" | "LightSource"
             | "AreaLightSource" | "Shape" | "ReverseOrientation" | "ObjectBegin" | "ObjectEnd"
-            | "ObjectInstance" => {
+            | "ObjectInstance" | "MakeNamedVolume" | "Interior" | "Exterior" => {
                 if self.block == Block::Options {
                     r.skip_statement()?;
                     self.warn(pos, format!("{keyword} before WorldBegin is ignored"));
@@ -440,6 +453,42 @@ impl<'s> Builder<'s> {
                 self.warn_unused(&params);
             }
             "ReverseOrientation" => self.gs.reverse_orientation = !self.gs.reverse_orientation,
+            "MakeNamedVolume" => {
+                let name = r.string("the volume name")?;
+                let ty = r.string("the volume type")?;
+                let params = r.params(format!("MakeNamedVolume \"{ty}\""))?;
+                let medium = MediumDesc::read(&ty, &params, pos, self)?.map(|m| {
+                    self.volumes.media.push(m);
+                    MediumId(self.volumes.media.len() as u32 - 1)
+                });
+                if self.named_volumes.insert(name.clone(), medium).is_some() {
+                    self.warn(pos, format!("MakeNamedVolume: volume \"{name}\" redefined; later shapes use the new one"));
+                }
+                self.warn_unused(&params);
+            }
+            "Interior" | "Exterior" => {
+                let name = r.string("the volume name")?;
+                // The empty name is LuxRender's "no volume".
+                let medium = if name.is_empty() {
+                    None
+                } else {
+                    match self.named_volumes.get(&name) {
+                        Some(&m) => m,
+                        None => {
+                            self.warn(
+                                pos,
+                                format!("{keyword}: no volume named \"{name}\"; using none"),
+                            );
+                            None
+                        }
+                    }
+                };
+                if keyword == "Interior" {
+                    self.gs.media.interior = medium;
+                } else {
+                    self.gs.media.exterior = medium;
+                }
+            }
             "ObjectBegin" => {
                 let name = r.string("the object name")?;
                 if let Some((open, _)) = &self.current_object {
@@ -465,7 +514,13 @@ impl<'s> Builder<'s> {
                 match self.objects.get(&name) {
                     Some(shapes) => {
                         let shapes = shapes.clone();
-                        for s in shapes {
+                        for mut s in shapes {
+                            // LuxRender: an instance's volumes, where set, override its shapes'.
+                            let own = s.desc.media;
+                            s.desc.media = ShapeMedia {
+                                interior: self.gs.media.interior.or(own.interior),
+                                exterior: self.gs.media.exterior.or(own.exterior),
+                            };
                             self.emit_shape(s, self.ctm, pos)?;
                         }
                     }
@@ -614,6 +669,7 @@ impl<'s> Builder<'s> {
                 reverse_orientation: self.gs.reverse_orientation,
                 material,
                 area_light: None,
+                media: self.gs.media,
             },
             emitter: self.gs.area_light.clone(),
         };
@@ -645,8 +701,53 @@ impl<'s> Builder<'s> {
             });
         }
         desc.area_light = shape.emitter.map(|e| e.desc(desc.world_area()));
+        desc.material = self.glass2_index(desc.material, desc.media, pos);
         self.shapes.push(desc);
         Ok(())
+    }
+
+    /// glass2 refracts with its volumes' indices (LuxRender's Glass2::GetBSDF): the shape's
+    /// interior index over its exterior's, 1 for a side with no volume. Returns the material
+    /// a shape with `media` uses in place of `material`.
+    fn glass2_index(&mut self, material: MaterialId, media: ShapeMedia, pos: &Pos) -> MaterialId {
+        let glass2 = |g: &Glass| g.index_from_volumes;
+        let takes_index = match self.materials.get(material.0 as usize) {
+            Some(MaterialDesc::Glass(g)) => glass2(g),
+            Some(MaterialDesc::Bumped(inner, _)) => {
+                matches!(inner.as_ref(), MaterialDesc::Glass(g) if glass2(g))
+            }
+            _ => false,
+        };
+        if !takes_index {
+            return material;
+        }
+        if media.interior.is_none() {
+            self.warn_once(
+                "glass2 without interior".into(),
+                pos,
+                "glass2 on a shape with no Interior volume has index 1, as in LuxRender: it does not refract".into(),
+            );
+        }
+        if media.is_empty() {
+            return material;
+        }
+        if let Some(&id) = self.glass2_with_index.get(&(material, media)) {
+            return id;
+        }
+        let index = self.volumes.index(media.interior) / self.volumes.index(media.exterior);
+        let mut desc = self.materials[material.0 as usize].clone();
+        match &mut desc {
+            MaterialDesc::Glass(g) => g.index = Tex::float(index),
+            MaterialDesc::Bumped(inner, _) => {
+                if let MaterialDesc::Glass(g) = inner.as_mut() {
+                    g.index = Tex::float(index);
+                }
+            }
+            _ => {}
+        }
+        let id = self.add_material(desc);
+        self.glass2_with_index.insert((material, media), id);
+        id
     }
 
     // -----------------------------------------------------------------------------------------
@@ -658,6 +759,10 @@ impl<'s> Builder<'s> {
         }
         if self.block == Block::Options {
             self.warn(&end, "no WorldBegin: the scene is empty".into());
+        }
+        if self.block == Block::World {
+            // No WorldEnd: the camera's volume is the Exterior current at the end.
+            self.volumes.camera = self.gs.media.exterior;
         }
         let options = std::mem::take(&mut self.options);
         let (camera, film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
@@ -671,6 +776,7 @@ impl<'s> Builder<'s> {
             materials: self.materials,
             shapes: self.shapes,
             lights: self.lights,
+            volumes: self.volumes,
             warnings: self.warnings,
             assets: self.assets,
         })

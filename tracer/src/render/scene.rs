@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
-use crate::desc::SceneDesc;
+use crate::desc::{MaterialDesc, SceneDesc};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::FilterSampler;
 use crate::geometry::{SceneGeometry, SurfaceHit};
@@ -16,6 +16,7 @@ use crate::integrator::options::IntegratorDesc;
 use crate::integrator::path::{trace_path, PathScene};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
+use crate::medium::{ShapeMedia, Volumes};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
@@ -228,5 +229,24 @@ impl PathScene for RenderScene {
 
     fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
         RenderScene::bsdf_at(self, hit, u_mix)
+    }
+
+    fn volumes(&self) -> &Volumes {
+        &self.desc.volumes
+    }
+
+    fn shape_media(&self, shape: u32) -> ShapeMedia {
+        self.desc
+            .shapes
+            .get(shape as usize)
+            .map_or_else(ShapeMedia::default, |s| s.media)
+    }
+
+    fn is_pass_through(&self, shape: u32) -> bool {
+        let material = self.desc.shapes.get(shape as usize).map(|s| s.material);
+        matches!(
+            material.and_then(|m| self.desc.materials.get(m.0 as usize)),
+            Some(MaterialDesc::Null(_))
+        )
     }
 }

@@ -20,3 +20,4 @@ mod seed_scenes;
 mod spectral_textures;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
+mod volumes;

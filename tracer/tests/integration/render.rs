@@ -46,6 +46,7 @@ fn add_sphere(desc: &mut SceneDesc, centre: Vec3, radius: f32, material: Materia
         reverse_orientation: false,
         material: MaterialId(desc.materials.len() as u32 - 1),
         area_light: None,
+        media: Default::default(),
     });
 }
 
@@ -381,6 +382,7 @@ fn planar_mapping_follows_the_object_space() {
         reverse_orientation: false,
         material: MaterialId(0),
         area_light: None,
+        media: Default::default(),
     });
     constant_sky(&mut desc, Vec3::ONE);
     let film = render(&desc, &MemorySource::new(), 4);
