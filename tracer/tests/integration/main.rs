@@ -17,5 +17,6 @@ mod render;
 mod scene;
 mod seed_renders;
 mod seed_scenes;
+mod shapes;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
