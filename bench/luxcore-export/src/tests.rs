@@ -285,9 +285,10 @@ fn subdivided_heightfield_and_quadric_shapes_export_as_their_meshes() {
         .map(|(_, bytes)| read_mesh(bytes).expect("our PLY reads back"))
         .collect();
     let triangles: Vec<usize> = meshes.iter().map(|m| m.indices.len()).collect();
-    // The subdivided cube, 2 x 2 heightfield cells, 64 x 32 quads per quadric less the
-    // triangles that collapse at the cone's apex and the paraboloid's.
-    assert_eq!(triangles, [192, 4, 4032, 4032, 4096]);
+    // The subdivided cube, 2 x 2 heightfield cells, 64 x 32 quads per quadric less the 64
+    // triangles that collapse where each default quadric meets the axis (the cone's apex, the
+    // paraboloid's, the hyperboloid's p1 = origin).
+    assert_eq!(triangles, [192, 4, 4032, 4032, 4032]);
     // Smooth normals and the quadrics' (u, v) travel with them; the cone sits 2 units up.
     assert!(meshes[0].normals.is_some() && meshes[2].uvs.is_some());
     let lowest = meshes[2]

@@ -242,10 +242,12 @@ pub enum TopologyError {
     NonManifoldVertex,
 }
 
+/// A float texture's values at (object-space position, uv) points, in order.
+pub type TextureLookup<'a> = dyn FnMut(&[(Vec3, Vec2)]) -> Vec<f32> + 'a;
+
 /// The displacement of [`subdivide`]: a float texture's values at points, and its scale.
 pub struct Displacement<'a> {
-    /// The texture at each (object-space position, uv), in order.
-    pub texture: &'a mut dyn FnMut(&[(Vec3, Vec2)]) -> Vec<f32>,
+    pub texture: &'a mut TextureLookup<'a>,
     pub scale: f32,
     pub offset: f32,
     /// Displacements are world lengths along the world normal, as LuxRender's meshes live in
