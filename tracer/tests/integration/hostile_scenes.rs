@@ -208,15 +208,15 @@ fn huge_coordinates_are_skipped_not_a_panic() {
 #[test]
 fn overflowing_transforms_and_bad_meshes_are_errors_with_positions() {
     let cases = [
-        ("Scale 1e30 1e30 1e30\nScale 1e30 1e30 1e30", "main.lxs:6:1:", "overflows"),
+        ("Scale 1e30 1e30 1e30\nScale 1e30 1e30 1e30", "main.lxs:7:1:", "overflows"),
         (
             "Scale 1e30 1e30 1e30\nTranslate 1e38 1e38 1e38",
-            "main.lxs:6:1:",
+            "main.lxs:7:1:",
             "overflows",
         ),
         (
             "ConcatTransform [3e38 0 0 0  0 3e38 0 0  0 0 3e38 0  0 0 0 1]\nConcatTransform [3e38 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1]",
-            "main.lxs:6:1:",
+            "main.lxs:7:1:",
             "overflows",
         ),
         (
