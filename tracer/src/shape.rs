@@ -5,14 +5,19 @@
 //!
 //! | type | parameters (defaults) |
 //! |---|---|
-//! | `trianglemesh`, `mesh` | see [`crate::mesh::inline`] |
-//! | `plymesh` | `filename` (required; the file is read once and shared), `smooth` (ignored) |
+//! | `trianglemesh`, `mesh`, `loopsubdiv` | see [`crate::mesh::inline`]; subdivision and displacement: [`crate::mesh::subdiv`] |
+//! | `plymesh` | `filename` (required; the file is read once and shared), `smooth` (ignored); subdivision as above |
+//! | `heightfield` | see [`crate::mesh::heightfield`] |
+//! | `cone`, `paraboloid`, `hyperboloid` | see [`crate::mesh::quadric`] (tessellated) |
 //! | `sphere` | `radius` (1), `zmin` (-radius), `zmax` (radius), `phimax` (360) |
 //! | `disk` | `height` (0), `radius` (1), `innerradius` (0), `phimax` (360) |
 //! | `cylinder` | `radius` (1), `zmin` (-1), `zmax` (1), `phimax` (360) |
 //! | `plane` (the course's) | `n` or `N` (0 0 1), the infinite plane's normal |
 //!
-//! Every shape also takes `name`. Other types are a warning and the shape is skipped.
+//! Every shape also takes `name`. Other types are a warning and the shape is skipped. The
+//! shapes YAT has no exact intersection for (subdivision surfaces, heightfields, the quadrics
+//! other than spheres, disks and cylinders) become triangle meshes here, so everything after
+//! the parser sees meshes.
 
 use std::sync::Arc;
 
@@ -20,7 +25,8 @@ use glam::{Mat3, Mat4, Vec3};
 
 use crate::diag::SourcePos;
 use crate::medium::common::ShapeMedia;
-use crate::mesh::{inline, TriangleMesh};
+use crate::mesh::quadric::Quadric;
+use crate::mesh::{heightfield, inline, subdiv, TriangleMesh};
 use crate::param::MaterialId;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -128,7 +134,10 @@ impl Geometry {
         pos: &SourcePos,
     ) -> Result<Option<Geometry>, ParseError> {
         Ok(Some(match ty {
-            "trianglemesh" | "mesh" => Geometry::Mesh(Arc::new(inline::read_inline(params, pos)?)),
+            "trianglemesh" | "mesh" | "loopsubdiv" => {
+                let mesh = Arc::new(inline::read_inline(params, pos)?);
+                Geometry::Mesh(subdiv::apply(ctx, params, mesh, pos)?)
+            }
             "plymesh" => {
                 let Some(filename) = params.string("filename")? else {
                     return Err(ParseError::Invalid {
@@ -137,7 +146,8 @@ impl Geometry {
                     });
                 };
                 params.ignore("smooth");
-                Geometry::Mesh(ctx.ply_mesh(&filename, pos)?)
+                let mesh = ctx.ply_mesh(&filename, pos)?;
+                Geometry::Mesh(subdiv::apply(ctx, params, mesh, pos)?)
             }
             "sphere" => {
                 let radius = params.float("radius", DEFAULT_RADIUS)?;
@@ -160,6 +170,11 @@ impl Geometry {
                 zmax: params.float("zmax", DEFAULT_CYLINDER_ZMAX)?,
                 phimax: params.float("phimax", DEFAULT_PHIMAX)?,
             },
+            "heightfield" => Geometry::Mesh(Arc::new(heightfield::read_heightfield(params, pos)?)),
+            "cone" | "paraboloid" | "hyperboloid" => {
+                let quadric = Quadric::read(ty, params)?.expect("a quadric's name");
+                Geometry::Mesh(Arc::new(quadric.tessellate()))
+            }
             "plane" => {
                 let name = if params.count("n").is_some() {
                     "n"

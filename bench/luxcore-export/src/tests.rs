@@ -349,3 +349,38 @@ AttributeEnd"#,
         "{scn}"
     );
 }
+
+#[test]
+fn subdivided_heightfield_and_quadric_shapes_export_as_their_meshes() {
+    let cube = "\"integer indices\" [0 1 2 0 2 3 4 5 6 4 6 7 0 4 7 0 7 1 2 6 5 2 5 3 0 3 5 0 5 4 1 7 6 1 6 2] \
+                \"point P\" [-1 -1 -1 -1 1 -1 1 1 -1 1 -1 -1 -1 -1 1 1 -1 1 1 1 1 -1 1 1]";
+    let lux = export_world(&format!(
+        "Shape \"loopsubdiv\" \"integer nlevels\" [2] {cube}\n\
+         Shape \"heightfield\" \"integer nu\" [2] \"integer nv\" [3] \"float Pz\" [0 0 1 1 0 0]\n\
+         Translate 0 0 2\nShape \"cone\" \"float radius\" [0.5]\n\
+         Shape \"paraboloid\"\nShape \"hyperboloid\""
+    ));
+    let meshes: Vec<_> = lux
+        .meshes
+        .iter()
+        .map(|(_, bytes)| read_mesh(bytes).expect("our PLY reads back"))
+        .collect();
+    let triangles: Vec<usize> = meshes.iter().map(|m| m.indices.len()).collect();
+    // The subdivided cube, 2 x 2 heightfield cells, 64 x 32 quads per quadric less the 64
+    // triangles that collapse where each default quadric meets the axis (the cone's apex, the
+    // paraboloid's, the hyperboloid's p1 = origin).
+    assert_eq!(triangles, [192, 4, 4032, 4032, 4032]);
+    // Smooth normals and the quadrics' (u, v) travel with them; the cone sits 2 units up.
+    assert!(meshes[0].normals.is_some() && meshes[2].uvs.is_some());
+    let lowest = meshes[2]
+        .positions
+        .iter()
+        .map(|p| p.z)
+        .fold(f32::MAX, f32::min);
+    assert!((lowest - 2.0).abs() < 1e-6, "{lowest}");
+    assert!(
+        lux.notes.iter().all(|n| !n.contains("tessellated")),
+        "{:?}",
+        lux.notes
+    );
+}

@@ -1,9 +1,15 @@
 //! Triangle meshes: the data every mesh-like shape becomes, reading them from inline shape
-//! parameters ([`inline`]) and from PLY files ([`ply`]), and making them from the analytic
-//! shapes ([`tessellate`]).
+//! parameters ([`inline`]) and from PLY files ([`ply`]), Loop subdivision and displacement
+//! ([`subdiv`]), heightfields ([`heightfield`]), the swept quadrics ([`quadric`]), and
+//! making them from the analytic shapes ([`tessellate`]) on the shared parametric grid
+//! ([`grid`]).
 
+pub mod grid;
+pub mod heightfield;
 pub mod inline;
 pub mod ply;
+pub mod quadric;
+pub mod subdiv;
 pub mod tessellate;
 
 use glam::Vec3;

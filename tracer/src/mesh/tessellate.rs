@@ -1,21 +1,19 @@
 //! Triangle meshes for the analytic shapes: spheres, disks and cylinders become grids of
 //! triangles ([`tessellate`]), an infinite plane a large square ([`plane_quad`]). For consumers
 //! that only take triangles (the LuxCore exporter); the renderer intersects the shapes exactly.
+//! (Cones, paraboloids and hyperboloids are meshes from the start: [`super::quadric`].)
 
 use glam::Vec3;
 
+use crate::mesh::grid::{grid_mesh, SurfacePoint};
 use crate::mesh::TriangleMesh;
 use crate::shape::Geometry;
-
-/// Position and outward normal at parameters (u, v) in [0, 1]^2.
-type SurfacePoint = dyn Fn(f32, f32) -> (Vec3, Vec3);
 
 /// Object-space triangles of an analytic shape, wound so the outward side is the front, with
 /// YAT's uv parameterisation: `segments` around (at least 3), half as many from pole to pole
 /// on a sphere. `None` for meshes and planes.
 pub fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
     let n_phi = segments.max(3);
-    let mut mesh = TriangleMesh::default();
     let (rows, grid): (u32, Box<SurfacePoint>) = match *geometry {
         Geometry::Sphere { radius, phimax, .. } => {
             let (z0, z1) = geometry.sphere_z_range()?;
@@ -61,39 +59,7 @@ pub fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
         }
         Geometry::Mesh(_) | Geometry::Plane { .. } => return None,
     };
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    for j in 0..=rows {
-        for i in 0..=n_phi {
-            let (u, v) = (i as f32 / n_phi as f32, j as f32 / rows as f32);
-            let (p, n) = grid(u, v);
-            mesh.positions.push(p);
-            normals.push(n);
-            uvs.push([u, v]);
-        }
-    }
-    let at = |i: u32, j: u32| j * (n_phi + 1) + i;
-    for j in 0..rows {
-        for i in 0..n_phi {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            for tri in [[a, b, c], [a, c, d]] {
-                let [p0, p1, p2] = tri.map(|k| mesh.positions[k as usize]);
-                let cross = (p1 - p0).cross(p2 - p0);
-                if cross.length_squared() <= 0.0 {
-                    continue;
-                }
-                let outward = normals[tri[0] as usize] + normals[tri[1] as usize];
-                mesh.indices.push(if cross.dot(outward) >= 0.0 {
-                    tri
-                } else {
-                    [tri[0], tri[2], tri[1]]
-                });
-            }
-        }
-    }
-    mesh.normals = Some(normals);
-    mesh.uvs = Some(uvs);
-    Some(mesh)
+    Some(grid_mesh(n_phi, rows, &*grid))
 }
 
 /// A square of side 2 x `half_size` through the object-space origin, front towards `normal`;

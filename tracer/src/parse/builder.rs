@@ -911,6 +911,40 @@ impl ParseContext for Builder<'_> {
         }
     }
 
+    fn check_primitives(&self, count: u64, pos: &Pos) -> Result<(), ParseError> {
+        // A copy of the meter: checking spends nothing.
+        self.spent
+            .clone()
+            .spend(self.guard.budget, Limit::Primitives, count)
+            .map(|_| ())
+            .map_err(|exceeded| ParseError::OverBudget {
+                pos: pos.clone(),
+                exceeded,
+            })
+    }
+
+    fn eval_float_texture(
+        &mut self,
+        tex: Tex,
+        points: &[(Vec3, glam::Vec2)],
+        pos: &Pos,
+    ) -> Result<Vec<f32>, ParseError> {
+        let textures = texture::Textures::new(&self.textures, self.source).map_err(|e| {
+            ParseError::Invalid {
+                pos: pos.clone(),
+                message: e.to_string(),
+            }
+        })?;
+        Ok(points
+            .iter()
+            .map(|&(p, uv)| {
+                let mut at = texture::TexturePoint::new(p, uv);
+                at.p_world = self.ctm.transform_point3(p);
+                textures.eval(tex, &at).element_sum() / 3.0
+            })
+            .collect())
+    }
+
     fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
         let already = self.asset_set.contains(&AssetRef {
             path: path.to_string(),

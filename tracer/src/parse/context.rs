@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::error::ParseError;
 use super::params::{ParamList, ParamType, TexValue, Values};
@@ -66,6 +66,20 @@ pub trait ParseContext {
     /// The triangle mesh of a PLY file, read, validated and recorded as an asset on first use
     /// and shared by every later shape that names the same file.
     fn ply_mesh(&mut self, path: &str, pos: &SourcePos) -> Result<Arc<TriangleMesh>, ParseError>;
+
+    /// Fails (naming the limit and `pos`) unless `count` more primitives fit the build budget:
+    /// what a shape that multiplies its input (subdivision) checks before making them.
+    fn check_primitives(&self, count: u64, pos: &SourcePos) -> Result<(), ParseError>;
+
+    /// The float texture `tex` (a colour texture gives the mean of its channels) at
+    /// object-space points of the current object with their (u, v): what a displacement map
+    /// reads while the shape is built. Fails if an image the textures read does not decode.
+    fn eval_float_texture(
+        &mut self,
+        tex: Tex,
+        points: &[(Vec3, Vec2)],
+        pos: &SourcePos,
+    ) -> Result<Vec<f32>, ParseError>;
 
     /// Warns (once per statement type and parameter) about parameters nothing read, except
     /// the exporter parameters that change nothing.

@@ -244,3 +244,82 @@ fn degenerate_triangles_are_skipped() {
     let body = "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 0 0 0 1 1] \"point P\" [0 0 0 1 0 0 2 0 0]";
     render(body).unwrap();
 }
+
+/// Shapes that multiply their input: a subdivision asking for more triangles than the budget
+/// is refused before any is made, naming the statement; heightfield and subdivision counts
+/// that do not match their data are errors naming the parameter. Never a panic, never a
+/// 4^30-triangle allocation.
+#[test]
+fn subdivision_and_heightfield_bombs_are_refused_with_their_position() {
+    const CUBE: &str = "\"integer indices\" [0 1 2 0 2 3 4 5 6 4 6 7 0 4 7 0 7 1 2 6 5 2 5 3 0 3 5 0 5 4 1 7 6 1 6 2] \
+        \"point P\" [-1 -1 -1 -1 1 -1 1 1 -1 1 -1 -1 -1 -1 1 1 -1 1 1 1 1 -1 1 1]";
+    let refuse = |body: String| -> ParseError {
+        refused(&vec![(
+            "main.lxs".into(),
+            hostile::scene(&body).into_bytes(),
+        )])
+    };
+    // 12 x 4^12 = 201 million triangles: over the default 2^26, counted before subdividing.
+    let err = refuse(format!(
+        "Shape \"loopsubdiv\" \"integer nlevels\" [12] {CUBE}"
+    ));
+    let (over, pos) = over_budget(&err);
+    assert_eq!(over.limit, Limit::Primitives);
+    assert_eq!(over.reached, 12 * 4u64.pow(12));
+    assert!(pos.starts_with("main.lxs:6:1"), "{pos}");
+    // 30 levels: refused at the parameter before anything is counted.
+    let e = refuse(format!(
+        "Shape \"loopsubdiv\" \"integer nlevels\" [30] {CUBE}"
+    ))
+    .to_string();
+    assert!(
+        e.starts_with("main.lxs:6:")
+            && e.contains("\"integer nlevels\"")
+            && e.contains("at most 16"),
+        "{e}"
+    );
+    // The same through a plain mesh's nsubdivlevels, as LuxRender 1.x reads it.
+    let e = refuse(format!(
+        "Shape \"trianglemesh\" \"integer nsubdivlevels\" [14] {CUBE}"
+    ));
+    assert_eq!(over_budget(&e).0.limit, Limit::Primitives);
+    // nu x nv overflows 32 bits: an error about the count, not an allocation.
+    let e = refuse(
+        "Shape \"heightfield\" \"integer nu\" [2147483647] \"integer nv\" [2147483647] \"float Pz\" [0 0 0 0]".into(),
+    )
+    .to_string();
+    assert!(
+        e.starts_with("main.lxs:6:")
+            && e.contains("\"float Pz\"")
+            && e.contains("4611686014132420609"),
+        "{e}"
+    );
+    let e = refuse(
+        "Shape \"heightfield\" \"integer nu\" [1] \"integer nv\" [2] \"float Pz\" [0 0]".into(),
+    )
+    .to_string();
+    assert!(
+        e.contains("\"integer nu\"") && e.contains("at least 2"),
+        "{e}"
+    );
+    let e =
+        refuse("Shape \"heightfield\" \"integer nu\" [2] \"float Pz\" [0 0]".into()).to_string();
+    assert!(
+        e.starts_with("main.lxs:6:1") && e.contains("missing \"integer nv\""),
+        "{e}"
+    );
+    // A P list that is not whole points.
+    let e = refuse(
+        "Shape \"loopsubdiv\" \"integer nlevels\" [2] \"integer indices\" [0 1 2] \"point P\" [0 0 0 1 0 0 0 1]".into(),
+    )
+    .to_string();
+    assert!(
+        e.starts_with("main.lxs:6:") && e.contains("\"point P\"") && e.contains("multiple of 3"),
+        "{e}"
+    );
+    let e = refuse("Shape \"paraboloid\" \"float zmax\" [0]".into()).to_string();
+    assert!(
+        e.starts_with("main.lxs:6:") && e.contains("\"float zmax\""),
+        "{e}"
+    );
+}

@@ -18,6 +18,7 @@ mod scene;
 mod seed_renders;
 mod seed_scenes;
 mod spectral_textures;
+mod shapes;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
 mod volumes;
