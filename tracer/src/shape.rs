@@ -133,8 +133,15 @@ impl Geometry {
                         message: "Shape \"plymesh\" needs \"string filename\"".into(),
                     });
                 };
-                params.ignore("smooth");
-                Geometry::Mesh(ctx.ply_mesh(&filename, pos)?)
+                let mesh = ctx.ply_mesh(&filename, pos)?;
+                // LuxRender computes vertex normals for a smooth mesh whose file has none.
+                if params.bool("smooth", false)? && mesh.normals.is_none() {
+                    ctx.warn(
+                        pos,
+                        "Shape \"plymesh\": \"smooth\" normals for a file without normals are not computed; the mesh is shaded flat".into(),
+                    );
+                }
+                Geometry::Mesh(mesh)
             }
             "sphere" => {
                 let radius = params.float("radius", DEFAULT_RADIUS)?;
