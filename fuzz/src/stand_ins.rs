@@ -1,6 +1,6 @@
 //! Small asset files made at start-up, so every fuzz input can reference meshes and images
-//! whatever scene it grew from: PLY meshes (ASCII and binary) and 4x4 images in each format
-//! the tracer decodes. They also stand in for a seed scene's files that are too large to
+//! whatever scene it grew from: PLY meshes (ASCII and binary), 4x4 images in each format
+//! the tracer decodes, and metal index files (`.nk`, both formats). They also stand in for a seed scene's files that are too large to
 //! mutate usefully or missing.
 
 use std::io::Cursor;
@@ -16,11 +16,13 @@ pub fn files() -> Vec<(String, Vec<u8>)> {
         ("tex.jpg".into(), image_bytes(ImageFormat::Jpeg)),
         ("tex.exr".into(), image_bytes(ImageFormat::OpenExr)),
         ("env.hdr".into(), image_bytes(ImageFormat::Hdr)),
+        ("sopra.nk".into(), SOPRA_NK.to_vec()),
+        ("luxpop.nk".into(), LUXPOP_NK.to_vec()),
     ]
 }
 
-/// A stand-in for a file named `written`, chosen by its extension: a mesh, an image, or an
-/// empty scene file.
+/// A stand-in for a file named `written`, chosen by its extension: a mesh, an image, a metal
+/// index file, or an empty scene file.
 pub fn for_name(written: &str) -> Vec<u8> {
     let extension = written
         .rsplit('.')
@@ -33,14 +35,33 @@ pub fn for_name(written: &str) -> Vec<u8> {
         "jpg" | "jpeg" => image_bytes(ImageFormat::Jpeg),
         "exr" => image_bytes(ImageFormat::OpenExr),
         "hdr" => image_bytes(ImageFormat::Hdr),
+        "nk" => SOPRA_NK.to_vec(),
         _ => Vec::new(),
     }
 }
 
-/// Whether a file of this name is binary (a mesh or an image), not scene text.
+/// Whether a file of this name is binary (a mesh or an image), not text: scene files and
+/// `.nk` files are lines of numbers, mutated as text.
 pub fn is_binary(written: &str) -> bool {
-    !for_name(written).is_empty()
+    !written.to_ascii_lowercase().ends_with(".nk") && !for_name(written).is_empty()
 }
+
+/// A SOPRA `.nk` file: unit 2 (micrometres) from 0.4 to 0.7 in 4 samples, then `n k` lines.
+const SOPRA_NK: &[u8] = b"2 0.4 0.7 4
+0.47 2.37
+0.37 2.82
+0.27 3.23
+0.18 3.64
+";
+
+/// A Luxpop `.nk` file: comments, then `wavelength(angstrom) n k` lines.
+const LUXPOP_NK: &[u8] = b"; a stand-in metal, Luxpop format
+; wavelength n k
+4000 1.5 1.9
+5000 0.9 2.4
+6000 0.3 3.0
+7000 0.2 3.6
+";
 
 /// A unit quad as two triangles with normals and uvs, plus a quad face.
 fn ascii_ply() -> Vec<u8> {
@@ -144,6 +165,14 @@ mod tests {
                 .len(),
             4
         );
+        for name in ["sopra.nk", "luxpop.nk"] {
+            let bytes = &files().into_iter().find(|(n, _)| n == name).unwrap().1;
+            let (eta, k) = yat_tracer::material::nk::read(bytes).unwrap();
+            assert!(
+                eta.min_element() > 0.0 && k.min_element() > 1.5,
+                "{name}: {eta} {k}"
+            );
+        }
         for (name, bytes) in files() {
             if name.starts_with("tex") || name.ends_with(".hdr") {
                 let image = image::load_from_memory(&bytes).unwrap();

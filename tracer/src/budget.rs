@@ -21,9 +21,10 @@ pub const DEFAULT_MAX_INCLUDE_VISITS: u64 = 10_000;
 /// Primitives (triangles, spheres, disks, cylinders, planes) placed in the world, counting
 /// every instance, when the command line does not say: 2^26, some 16 GiB of built geometry.
 pub const DEFAULT_MAX_PRIMITIVES: u64 = 1 << 26;
-/// Texels of the distinct image files decoded when the command line does not say: 2^29, for
-/// example eight 8k x 8k maps (1.5 GiB as 8-bit RGB). One image is also held to the `image`
-/// crate's own decoding limit of 512 MiB.
+/// Texels of the distinct image files decoded, and of the tables sky lights are tabulated on
+/// (each [`SkyLight::TABLE_TEXELS`](crate::lights::SkyLight::TABLE_TEXELS)), when the command line
+/// does not say: 2^29, for example eight 8k x 8k maps (1.5 GiB as 8-bit RGB). One image is also
+/// held to the `image` crate's own decoding limit of 512 MiB.
 pub const DEFAULT_MAX_TEXELS: u64 = 1 << 29;
 
 /// What a scene may cost to parse and build; every figure counts the whole scene.
@@ -76,7 +77,7 @@ impl Limit {
             Limit::ParsedBytes => "bytes of scene files parsed",
             Limit::IncludeVisits => "Include visits",
             Limit::Primitives => "primitives (triangles and shapes, every instance counted)",
-            Limit::Texels => "image texels",
+            Limit::Texels => "texels of images and sky tables",
         }
     }
 

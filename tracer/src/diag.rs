@@ -27,14 +27,69 @@ impl fmt::Display for SourcePos {
     }
 }
 
+/// How a warning bears on the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Severity {
+    /// The statement or parameter is not rendered as LuxRender would render it: an
+    /// unsupported feature, an approximation, a fallback where LuxRender does something else.
+    Differs,
+    /// Something about the file that does not change the image compared with LuxRender's: a
+    /// parameter LuxRender ignores too, a dangling name both replace by the same default.
+    Note,
+}
+
+/// Later occurrences of a warning are kept as positions up to this many; beyond, only counted.
+pub const MAX_REPEAT_POSITIONS: usize = 32;
+
+/// A warning at its first occurrence, with where it occurs again (a warning of one kind is
+/// given once, so a scene repeating it thousands of times prints it once).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Warning {
     pub pos: SourcePos,
     pub message: String,
+    pub severity: Severity,
+    /// Later occurrences, at most [`MAX_REPEAT_POSITIONS`].
+    pub also_at: Vec<SourcePos>,
+    /// Later occurrences beyond those in `also_at`.
+    pub unlisted: u64,
+}
+
+impl Warning {
+    pub fn new(severity: Severity, pos: SourcePos, message: String) -> Self {
+        Self {
+            pos,
+            message,
+            severity,
+            also_at: Vec::new(),
+            unlisted: 0,
+        }
+    }
+
+    /// One more occurrence at `pos`.
+    pub fn repeat(&mut self, pos: &SourcePos) {
+        if self.also_at.len() < MAX_REPEAT_POSITIONS {
+            self.also_at.push(pos.clone());
+        } else {
+            self.unlisted += 1;
+        }
+    }
+
+    /// How many times the warning occurs.
+    pub fn occurrences(&self) -> u64 {
+        1 + self.also_at.len() as u64 + self.unlisted
+    }
 }
 
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: warning: {}", self.pos, self.message)
+        let label = match self.severity {
+            Severity::Differs => "warning",
+            Severity::Note => "note",
+        };
+        write!(f, "{}: {label}: {}", self.pos, self.message)?;
+        match self.occurrences() {
+            1 => Ok(()),
+            n => write!(f, " ({n} times)"),
+        }
     }
 }

@@ -145,8 +145,14 @@ impl Geometry {
                         message: "Shape \"plymesh\" needs \"string filename\"".into(),
                     });
                 };
-                params.ignore("smooth");
                 let mesh = ctx.ply_mesh(&filename, pos)?;
+                // LuxRender computes vertex normals for a smooth mesh whose file has none.
+                if params.bool("smooth", false)? && mesh.normals.is_none() {
+                    ctx.warn(
+                        pos,
+                        "Shape \"plymesh\": \"smooth\" normals for a file without normals are not computed; the mesh is shaded flat".into(),
+                    );
+                }
                 Geometry::Mesh(subdiv::apply(ctx, params, mesh, pos)?)
             }
             "sphere" => {

@@ -1,4 +1,9 @@
-//! `yat check`: parse a scene and print a summary.
+//! `yat check`: parse a scene and print a summary, then every statement or parameter that is
+//! not rendered as LuxRender would (each occurrence, with file:line:col), the notes about the
+//! file that leave the image as LuxRender's, and the count of the former.
+//!
+//! Exit status: 0 when the scene parses (whatever the count), 1 when it does not; with
+//! `--strict`, also 1 when the count is not 0.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -7,6 +12,7 @@ use std::path::PathBuf;
 use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
+use yat_tracer::diag::{Severity, Warning};
 
 use super::budget::BudgetArgs;
 use crate::scene::{ParsedScene, Warnings};
@@ -17,7 +23,14 @@ pub struct CheckArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub budget: BudgetArgs,
+    /// Exit with status 1 when any statement or parameter is not rendered as LuxRender would
+    /// (without it, the status is 0 whenever the scene parses).
+    #[arg(long)]
+    pub strict: bool,
 }
+
+/// Occurrences of one warning listed with their positions; the rest are counted.
+const LISTED_PER_WARNING: usize = 10;
 
 pub fn run(args: CheckArgs) -> anyhow::Result<()> {
     let scene = ParsedScene::load_within(&args.scene, Warnings::Keep, args.budget.budget())?;
@@ -29,7 +42,56 @@ pub fn run(args: CheckArgs) -> anyhow::Result<()> {
             scene.parse_time.as_secs_f64()
         )
     );
+    let differences = differences(&scene.desc.warnings);
+    print!("{}", listing(&scene.desc.warnings, differences));
+    if args.strict && differences > 0 {
+        anyhow::bail!(
+            "--strict: {differences} statements or parameters not rendered as LuxRender would"
+        );
+    }
     Ok(())
+}
+
+/// How many statements or parameters are not rendered as LuxRender would: every occurrence.
+fn differences(warnings: &[Warning]) -> u64 {
+    warnings
+        .iter()
+        .filter(|w| w.severity == Severity::Differs)
+        .map(Warning::occurrences)
+        .sum()
+}
+
+/// The differences, then the notes, each occurrence with its position (the first
+/// [`LISTED_PER_WARNING`] of a warning; "and N more" for the rest), then the count.
+fn listing(warnings: &[Warning], differences: u64) -> String {
+    let mut s = String::new();
+    for (severity, title) in [
+        (Severity::Differs, "not rendered as LuxRender would"),
+        (Severity::Note, "notes (rendered as LuxRender would)"),
+    ] {
+        let of_kind: Vec<&Warning> = warnings.iter().filter(|w| w.severity == severity).collect();
+        if of_kind.is_empty() {
+            continue;
+        }
+        let n: u64 = of_kind.iter().map(|w| w.occurrences()).sum();
+        let _ = writeln!(s, "{title}: {n}");
+        for w in of_kind {
+            let _ = writeln!(s, "  {}: {}", w.pos, w.message);
+            let listed = w.also_at.iter().take(LISTED_PER_WARNING - 1);
+            for pos in listed.clone() {
+                let _ = writeln!(s, "  {pos}: the same");
+            }
+            let more = w.occurrences() - 1 - listed.len() as u64;
+            if more > 0 {
+                let _ = writeln!(s, "  ... and {more} more");
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "{differences} statements or parameters not rendered as LuxRender would"
+    );
+    s
 }
 
 /// Numbers as a person reads them: LuxRender's "infinite" 1e30 stays short.
@@ -187,13 +249,5 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
     }));
     let _ = writeln!(s, "assets       {} ({assets})", d.assets.len());
     let _ = writeln!(s, "parse time   {:.1} ms", seconds * 1e3);
-    if d.warnings.is_empty() {
-        let _ = writeln!(s, "warnings     none");
-    } else {
-        let _ = writeln!(s, "warnings     {}", d.warnings.len());
-        for w in &d.warnings {
-            let _ = writeln!(s, "  {w}");
-        }
-    }
     s
 }

@@ -100,10 +100,10 @@ impl IntegratorDesc {
                 ] {
                     params.ignore(name);
                 }
-                ctx.warn_once(
+                ctx.note_once(
                     "bidirectional".into(),
                     pos,
-                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth)"),
+                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth): the same image once converged, except caustics of point, spot and distant lights, which path tracing cannot carry"),
                 );
                 Ok(IntegratorDesc {
                     max_depth,

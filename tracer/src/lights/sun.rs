@@ -89,7 +89,7 @@ impl SunLight {
             gain,
         };
         if sun.radiance() == Vec3::ZERO && gain != 0.0 {
-            ctx.warn(
+            ctx.note(
                 pos,
                 "LightSource \"sun\": the sun is below the horizon and gives no light".into(),
             );

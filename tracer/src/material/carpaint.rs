@@ -180,10 +180,11 @@ impl CarPaint {
             });
             // LuxRender reads no layer parameter when a preset is named.
             for n in layer_names {
-                if params.find(n).is_some() {
+                if let Some(p) = params.find(n) {
+                    let pos = p.pos.clone();
                     params.ignore(n);
-                    ctx.warn(
-                        pos,
+                    ctx.note(
+                        &pos,
                         format!("carpaint: \"{n}\" is ignored when a preset \"name\" is given"),
                     );
                 }

@@ -9,7 +9,7 @@
 //! | `Kr` | color texture, clamped to [0, 1] | 1 ([`DEFAULT_KR`]) |
 //! | `Kt` | color texture, clamped to [0, 1] | 1 ([`DEFAULT_KT`]) |
 //! | `sigma` | float texture, degrees | 0 ([`DEFAULT_SIGMA`]) |
-//! | `energyconserving` | bool | ignored: always on (Kt is scaled by 1 - Kr) |
+//! | `energyconserving` | bool | false in LuxRender, which then transmits Kt unscaled; YAT always scales Kt by 1 - Kr, so false (or absent) with both Kr and Kt non-zero is a warning |
 
 use glam::Vec3;
 
@@ -37,15 +37,24 @@ pub struct MatteTranslucent {
 impl MatteTranslucent {
     pub fn read(
         params: &ParamList,
-        _pos: &SourcePos,
+        pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        params.ignore("energyconserving");
-        Ok(Self {
+        let m = Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, true)?,
             kt: ctx.color_param(params, "Kt", DEFAULT_KT, true)?,
             sigma: ctx.float_param(params, "sigma", DEFAULT_SIGMA)?,
-        })
+        };
+        // Scaling by 1 - Kr changes nothing only when either colour is black.
+        let black = |t: &Tex| matches!(t, Tex::Const(c) if *c == Vec3::ZERO);
+        if !params.bool("energyconserving", false)? && !black(&m.kr) && !black(&m.kt) {
+            let pos = params.find("energyconserving").map_or(pos, |p| &p.pos);
+            ctx.warn(
+                pos,
+                "Material \"mattetranslucent\": without \"energyconserving\" LuxRender transmits Kt as given; YAT always scales it by 1 - Kr".into(),
+            );
+        }
+        Ok(m)
     }
 
     pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {

@@ -114,7 +114,7 @@ fn read_nk(
     let bytes = match ctx.read_asset(name, AssetKind::Nk, pos) {
         Ok(bytes) => bytes,
         Err(ParseError::Asset { error, .. }) => {
-            ctx.warn(
+            ctx.note(
                 pos,
                 format!("metal data file \"{name}\" cannot be read ({error}); using aluminium"),
             );

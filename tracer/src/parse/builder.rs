@@ -2,6 +2,7 @@
 //! the current transform, attribute stack, named textures, materials and objects, and collects
 //! the scene description.
 
+use std::collections::hash_map::Entry;
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
@@ -9,6 +10,7 @@ use glam::{Mat4, Vec3};
 
 use super::context::{ParseContext, TexBinding};
 use super::error::ParseError;
+use super::luxrender_ignores::luxrender_ignores;
 use super::options::OptionsState;
 use super::params::ParamList;
 use super::reader::Reader;
@@ -17,8 +19,8 @@ use crate::assets::{AssetKind, AssetRef};
 use crate::budget::{BudgetMeter, BuildGuard, Limit};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::SourcePos as Pos;
-use crate::diag::Warning;
-use crate::lights::AreaLightParams;
+use crate::diag::{Severity, Warning};
+use crate::lights::{AreaLightParams, SkyLight};
 use crate::material::{Glass, Matte};
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
@@ -116,7 +118,8 @@ pub struct Builder<'s> {
     /// glass2 materials with the index of a shape's volumes, by (glass2, volumes).
     glass2_with_index: HashMap<(MaterialId, ShapeMedia), MaterialId>,
     warnings: Vec<Warning>,
-    warned: HashSet<String>,
+    /// The index in `warnings` of each kind's first occurrence.
+    warned: HashMap<String, usize>,
     assets: Vec<AssetRef>,
     asset_set: HashSet<AssetRef>,
 }
@@ -180,7 +183,7 @@ impl<'s> Builder<'s> {
             volumes: Volumes::default(),
             glass2_with_index: HashMap::new(),
             warnings: Vec::new(),
-            warned: HashSet::new(),
+            warned: HashMap::new(),
             assets: Vec::new(),
             asset_set: HashSet::new(),
         }
@@ -245,7 +248,7 @@ impl<'s> Builder<'s> {
     fn statement(&mut self, keyword: &str, pos: &Pos, r: &mut Reader) -> Result<(), ParseError> {
         if self.block == Block::Ended {
             r.skip_statement()?;
-            self.warn_once(
+            self.note_once(
                 "after WorldEnd".into(),
                 pos,
                 format!("{keyword} after WorldEnd: statements after WorldEnd are ignored"),
@@ -299,7 +302,7 @@ impl<'s> Builder<'s> {
                 let name = r.string("a coordinate system name")?;
                 match self.named_coords.get(&name) {
                     Some(m) => self.ctm = *m,
-                    None => self.warn(
+                    None => self.note(
                         pos,
                         format!("CoordSysTransform: no coordinate system named \"{name}\""),
                     ),
@@ -321,7 +324,7 @@ impl<'s> Builder<'s> {
             "TransformEnd" => self.pop(FrameKind::Transform, pos),
             "WorldBegin" => {
                 if self.block == Block::World {
-                    self.warn(pos, "WorldBegin inside the world block ignored".into());
+                    self.note(pos, "WorldBegin inside the world block ignored".into());
                 } else {
                     self.block = Block::World;
                     self.ctm = Mat4::IDENTITY;
@@ -330,7 +333,7 @@ impl<'s> Builder<'s> {
             }
             "WorldEnd" => {
                 for f in std::mem::take(&mut self.stack) {
-                    self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
+                    self.note(&f.pos, format!("{} is never closed", f.kind.begin()));
                 }
                 // LuxRender gives the camera the Exterior current at WorldEnd.
                 self.volumes.camera = self.gs.media.exterior;
@@ -344,7 +347,7 @@ impl<'s> Builder<'s> {
                 let ty = r.string(&format!("the {keyword} type"))?;
                 let params = r.params(format!("{keyword} \"{ty}\""))?;
                 if self.block == Block::World {
-                    self.warn(pos, format!("{keyword} inside the world block is ignored (it belongs before WorldBegin)"));
+                    self.note(pos, format!("{keyword} inside the world block is ignored (it belongs before WorldBegin)"));
                     return Ok(());
                 }
                 if keyword == "Camera" {
@@ -371,7 +374,7 @@ impl<'s> Builder<'s> {
             | "ObjectInstance" | "MakeNamedVolume" | "Interior" | "Exterior" => {
                 if self.block == Block::Options {
                     r.skip_statement()?;
-                    self.warn(pos, format!("{keyword} before WorldBegin is ignored"));
+                    self.note(pos, format!("{keyword} before WorldBegin is ignored"));
                     return Ok(());
                 }
                 self.world_statement(keyword, pos, r)?;
@@ -427,7 +430,7 @@ impl<'s> Builder<'s> {
                 let name = r.string("the material name")?;
                 match self.named_materials.get(&name) {
                     Some(&id) => self.gs.material = Some(id),
-                    None => self.warn(pos, format!("NamedMaterial: no material named \"{name}\"; the current material stays")),
+                    None => self.note(pos, format!("NamedMaterial: no material named \"{name}\"; the current material stays")),
                 }
             }
             "LightSource" => {
@@ -437,6 +440,11 @@ impl<'s> Builder<'s> {
                     self.warn_once("light in object".into(), pos, "LightSource inside ObjectBegin is not instanced; it is added once where defined".into());
                 }
                 let lights = crate::lights::read(&ty, &params, pos, self)?;
+                let skies = lights
+                    .iter()
+                    .filter(|l| matches!(l, LightDesc::Sky(_)))
+                    .count();
+                self.spend(Limit::Texels, skies as u64 * SkyLight::TABLE_TEXELS, pos)?;
                 self.lights.extend(lights);
                 self.warn_unused(&params);
             }
@@ -504,7 +512,7 @@ impl<'s> Builder<'s> {
             }
             "ObjectEnd" => {
                 if self.current_object.is_none() {
-                    self.warn(pos, "ObjectEnd without ObjectBegin ignored".into());
+                    self.note(pos, "ObjectEnd without ObjectBegin ignored".into());
                 } else {
                     self.pop(FrameKind::Object, pos);
                 }
@@ -524,7 +532,7 @@ impl<'s> Builder<'s> {
                             self.emit_shape(s, self.ctm, pos)?;
                         }
                     }
-                    None => self.warn(pos, format!("ObjectInstance: no object named \"{name}\"")),
+                    None => self.note(pos, format!("ObjectInstance: no object named \"{name}\"")),
                 }
             }
             _ => unreachable!("dispatched world statements only"),
@@ -576,11 +584,11 @@ impl<'s> Builder<'s> {
             FrameKind::Object => "ObjectEnd",
         };
         let Some(frame) = self.stack.pop() else {
-            self.warn(pos, format!("{end} without a matching begin ignored"));
+            self.note(pos, format!("{end} without a matching begin ignored"));
             return;
         };
         if frame.kind != kind {
-            self.warn(
+            self.note(
                 pos,
                 format!("{end} closes the {} at {}", frame.kind.begin(), frame.pos),
             );
@@ -755,10 +763,10 @@ impl<'s> Builder<'s> {
     pub fn finish(mut self) -> Result<SceneDesc, ParseError> {
         let end = Pos::new(&self.main, 0, 0);
         for f in std::mem::take(&mut self.stack) {
-            self.warn(&f.pos, format!("{} is never closed", f.kind.begin()));
+            self.note(&f.pos, format!("{} is never closed", f.kind.begin()));
         }
         if self.block == Block::Options {
-            self.warn(&end, "no WorldBegin: the scene is empty".into());
+            self.note(&end, "no WorldBegin: the scene is empty".into());
         }
         if self.block == Block::World {
             // No WorldEnd: the camera's volume is the Exterior current at the end.
@@ -784,16 +792,14 @@ impl<'s> Builder<'s> {
 }
 
 impl ParseContext for Builder<'_> {
-    fn warn(&mut self, pos: &Pos, message: String) {
-        self.warnings.push(Warning {
-            pos: pos.clone(),
-            message,
-        });
-    }
-
-    fn warn_once(&mut self, key: String, pos: &Pos, message: String) {
-        if self.warned.insert(key) {
-            self.warn(pos, message);
+    fn diagnose(&mut self, severity: Severity, key: String, pos: &Pos, message: String) {
+        match self.warned.entry(key) {
+            Entry::Occupied(first) => self.warnings[*first.get()].repeat(pos),
+            Entry::Vacant(slot) => {
+                slot.insert(self.warnings.len());
+                self.warnings
+                    .push(Warning::new(severity, pos.clone(), message));
+            }
         }
     }
 
@@ -897,17 +903,25 @@ impl ParseContext for Builder<'_> {
     }
 
     fn warn_unused(&mut self, params: &ParamList) {
-        let unused: Vec<(String, Pos)> = params
+        let unused: Vec<(bool, String, Pos)> = params
             .unused()
             .filter(|p| !is_exporter_param(&p.name))
-            .map(|p| (p.decl(), p.pos.clone()))
+            .map(|p| {
+                let ignored = luxrender_ignores(&params.statement, &p.name);
+                (ignored, p.decl(), p.pos.clone())
+            })
             .collect();
-        for (decl, pos) in unused {
-            self.warn_once(
-                format!("param|{}|{decl}", params.statement),
-                &pos,
-                format!("{}: unknown parameter \"{decl}\" ignored", params.statement),
-            );
+        for (luxrender_ignores_it, decl, pos) in unused {
+            let key = format!("param|{}|{decl}", params.statement);
+            let statement = &params.statement;
+            if luxrender_ignores_it {
+                let message =
+                    format!("{statement}: \"{decl}\" is ignored, as LuxRender ignores it");
+                self.note_once(key, &pos, message);
+            } else {
+                let message = format!("{statement}: unknown parameter \"{decl}\" ignored");
+                self.warn_once(key, &pos, message);
+            }
         }
     }
 

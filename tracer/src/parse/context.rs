@@ -10,7 +10,7 @@ use glam::{Mat4, Vec2, Vec3};
 use super::error::ParseError;
 use super::params::{ParamList, ParamType, TexValue, Values};
 use crate::assets::AssetKind;
-use crate::diag::SourcePos;
+use crate::diag::{Severity, SourcePos};
 use crate::mesh::TriangleMesh;
 use crate::param::{Fresnel, MaterialId, Tex, TextureId};
 use crate::spectra::metal_preset;
@@ -24,10 +24,38 @@ pub enum TexBinding {
 }
 
 pub trait ParseContext {
-    fn warn(&mut self, pos: &SourcePos, message: String);
+    /// Records a warning of kind `key`: the first occurrence of a kind with its message, later
+    /// ones as positions of it (so `yat check` lists and counts every occurrence while a render
+    /// prints each kind once).
+    fn diagnose(&mut self, severity: Severity, key: String, pos: &SourcePos, message: String);
 
-    /// A warning given once per `key` for the whole scene.
-    fn warn_once(&mut self, key: String, pos: &SourcePos, message: String);
+    /// Something not rendered as LuxRender would; occurrences with the same message are one
+    /// kind.
+    fn warn(&mut self, pos: &SourcePos, message: String) {
+        self.diagnose(
+            Severity::Differs,
+            format!("message|{message}"),
+            pos,
+            message,
+        );
+    }
+
+    /// Something not rendered as LuxRender would, of kind `key`: its message is the first
+    /// occurrence's, later ones are listed as positions.
+    fn warn_once(&mut self, key: String, pos: &SourcePos, message: String) {
+        self.diagnose(Severity::Differs, key, pos, message);
+    }
+
+    /// Something about the file that leaves the image as LuxRender would render it (the same
+    /// fallback, a parameter it ignores too); occurrences with the same message are one kind.
+    fn note(&mut self, pos: &SourcePos, message: String) {
+        self.diagnose(Severity::Note, format!("note|{message}"), pos, message);
+    }
+
+    /// A note of kind `key`.
+    fn note_once(&mut self, key: String, pos: &SourcePos, message: String) {
+        self.diagnose(Severity::Note, key, pos, message);
+    }
 
     /// The current transformation matrix (object, light or texture space to world).
     fn ctm(&self) -> Mat4;
@@ -96,8 +124,9 @@ pub trait ParseContext {
                     self.warn(&pos, format!("texture \"{name}\" is a fresnel texture, usable only as metal2's fresnel; using the default"));
                     Tex::Const(default)
                 }
+                // LuxRender's fallback too: a constant of the parameter's default.
                 None => {
-                    self.warn(
+                    self.note(
                         &pos,
                         format!("no texture named \"{name}\"; using the default"),
                     );
@@ -114,7 +143,7 @@ pub trait ParseContext {
         if let Some(p) = metal_preset(name) {
             return p;
         }
-        self.warn(
+        self.note(
             pos,
             format!("metal \"{name}\" is not a built-in preset or an .nk file; using aluminium"),
         );

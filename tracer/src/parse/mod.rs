@@ -23,6 +23,7 @@ mod builder;
 pub(crate) mod context;
 pub(crate) mod error;
 mod lexer;
+mod luxrender_ignores;
 mod options;
 pub(crate) mod params;
 mod reader;

@@ -93,7 +93,7 @@ impl OptionsState {
                 desc
             }
             None => {
-                ctx.warn(end, "no Camera statement: using a perspective camera at the origin looking along +z".into());
+                ctx.note(end, "no Camera statement: using a perspective camera at the origin looking along +z".into());
                 let params = ParamList::new("Camera \"perspective\"".into(), Vec::new());
                 CameraDesc::read(ctx, DEFAULT_CAMERA, &params, Mat4::IDENTITY, end, &film)?
             }

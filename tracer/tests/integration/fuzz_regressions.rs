@@ -146,3 +146,41 @@ ObjectInstance \"ball\"
         &[],
     );
 }
+
+/// The fuzzer's slow inputs (this session): scenes with several sky lights, each tabulated on
+/// a 1024 x 512 grid when built (some 0.1 s and 10 MB each). Nothing bounded their number, so
+/// a small file repeating `LightSource "sky"` could ask for minutes and gigabytes; the tables
+/// now count against the texel budget at parse time, before anything is built.
+#[test]
+fn repeated_sky_lights_are_refused_by_the_texel_budget() {
+    use yat_tracer::budget::{Limit, DEFAULT_MAX_TEXELS};
+    use yat_tracer::lights::SkyLight;
+    use yat_tracer::parse::ParseError;
+
+    let allowed = DEFAULT_MAX_TEXELS / SkyLight::TABLE_TEXELS;
+    let scene = |skies: u64| {
+        let mut text = String::from("WorldBegin\n");
+        for _ in 0..skies {
+            text.push_str("LightSource \"sky2\" \"vector sundir\" [0 0.3 1]\n");
+        }
+        let mut source = MemorySource::new();
+        source.insert("main.lxs", Arc::from(text.as_bytes()));
+        parse_scene("main.lxs", &source)
+    };
+    assert_eq!(scene(allowed).unwrap().lights.len() as u64, allowed);
+    match scene(allowed + 1) {
+        Err(ParseError::OverBudget { pos, exceeded }) => {
+            assert_eq!(exceeded.limit, Limit::Texels);
+            assert_eq!(
+                pos.line as u64,
+                allowed + 2,
+                "the first sky over the budget"
+            );
+        }
+        other => panic!(
+            "{} skies accepted: {:?}",
+            allowed + 1,
+            other.map(|d| d.lights.len())
+        ),
+    }
+}

@@ -73,6 +73,11 @@ pub struct SkyLight {
 }
 
 impl SkyLight {
+    /// Texels of the table a sky is tabulated on when the scene is built (RGB f32, plus its
+    /// sampling distribution): counted against the build budget like an image map's, so a
+    /// small file repeating `LightSource "sky"` cannot ask for gigabytes.
+    pub const TABLE_TEXELS: u64 = TABLE_WIDTH as u64 * TABLE_HEIGHT as u64;
+
     /// Reads `sky` (`hosek` false) or `sky2` (`hosek` true).
     pub(crate) fn read(
         hosek: bool,
