@@ -406,6 +406,7 @@ pub fn sample_map(round: &Round, settings: &RenderSettings) -> (image::GrayImage
 mod tests {
     use super::*;
     use crate::film::SampleBuffer;
+    use crate::render::unit::FilmFrame;
 
     fn settings(width: u32, height: u32, spp: u32) -> RenderSettings {
         RenderSettings::for_tests(width, height, spp)
@@ -433,7 +434,7 @@ mod tests {
         noise: impl Fn(u32) -> f64,
     ) {
         for unit in units {
-            let mut buffer = SampleBuffer::new(*unit);
+            let mut buffer = SampleBuffer::new(*unit, &film.frame());
             let w = unit.x1 - unit.x0;
             for y in unit.y0..unit.y1 {
                 for x in unit.x0..unit.x1 {
@@ -546,7 +547,7 @@ mod tests {
     fn a_flat_region_stops_and_a_noisy_one_goes_on() {
         // 128 x 64: the left half flat (no noise), the right half very noisy.
         let s = settings(128, 64, 1024);
-        let mut film = Film::with_half(s.width, s.height);
+        let mut film = Film::with_half(FilmFrame::unbordered(s.width, s.height));
         let mut round = Round::first(&s, &ADAPTIVE);
         let noise = |x: u32| if x < 64 { 0.0 } else { 0.73 };
         let mut history = Vec::new();
@@ -589,7 +590,7 @@ mod tests {
         // sqrt(2 / pi) x sigma / sqrt(n); uniform noise is close (the ratio is checked at 15%).
         for (n, amplitude) in [(16u32, 0.3f64), (64, 0.3), (256, 0.6)] {
             let s = settings(64, 64, n);
-            let mut film = Film::with_half(64, 64);
+            let mut film = Film::with_half(FilmFrame::unbordered(64, 64));
             let round = Round::first(
                 &s,
                 &AdaptiveSettings {
