@@ -659,7 +659,9 @@ fn seed_sessions() -> Vec<Session> {
             sample_end: spp.min(8),
             block_mask: None,
         };
-        let pixels = ((tile.2 - tile.0) * (tile.3 - tile.1)) as usize;
+        // The tile and the border, clipped to the image.
+        let side = |lo: u32, hi: u32, end: u32| ((hi + BORDER[0]).min(end) - lo.saturating_sub(BORDER[0])) as usize;
+        let pixels = side(tile.0, tile.2, width) * side(tile.1, tile.3, height);
         let reply = pb::RenderUnitReply {
             index: 3,
             pixels: (0..pixels * BYTES_PER_PIXEL)
