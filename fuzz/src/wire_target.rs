@@ -660,7 +660,9 @@ fn seed_sessions() -> Vec<Session> {
             block_mask: None,
         };
         // The tile and the border, clipped to the image.
-        let side = |lo: u32, hi: u32, end: u32| ((hi + BORDER[0]).min(end) - lo.saturating_sub(BORDER[0])) as usize;
+        let side = |lo: u32, hi: u32, end: u32| {
+            ((hi + BORDER[0]).min(end) - lo.saturating_sub(BORDER[0])) as usize
+        };
         let pixels = side(tile.0, tile.2, width) * side(tile.1, tile.3, height);
         let reply = pb::RenderUnitReply {
             index: 3,

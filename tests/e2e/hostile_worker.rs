@@ -159,7 +159,11 @@ impl yat_proto::RenderNode for FakeNode {
         // The buffer covers the tile and the filter's border, clipped to the image.
         let (width, height) = *self.0.image.lock().unwrap();
         let side = |lo: u32, hi: u32, end: u32| {
-            u64::from(hi.saturating_add(BORDER).min(end).saturating_sub(lo.saturating_sub(BORDER)))
+            u64::from(
+                hi.saturating_add(BORDER)
+                    .min(end)
+                    .saturating_sub(lo.saturating_sub(BORDER)),
+            )
         };
         let pixels = side(unit.x0, unit.x1, width) * side(unit.y0, unit.y1, height);
         let reply = |rgb: f32, weight: f32, pixels: u64| pb::RenderUnitReply {
