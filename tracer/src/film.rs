@@ -310,13 +310,16 @@ impl Film {
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
         let u = &buffer.unit;
         let region = buffer.region;
-        let n = region.pixel_count();
+        let tile_fits =
+            u.x0 < u.x1 && u.y0 < u.y1 && u.x1 <= self.frame.width && u.y1 <= self.frame.height;
+        // The region is only measured once it is known to be the tile's, grown and clipped.
+        let n = if tile_fits && region == self.frame.region(u) {
+            region.pixel_count()
+        } else {
+            usize::MAX
+        };
         let half_len = if self.has_half() { n } else { 0 };
-        let fits = u.x0 < u.x1
-            && u.y0 < u.y1
-            && u.x1 <= self.frame.width
-            && u.y1 <= self.frame.height
-            && region == self.frame.region(u)
+        let fits = n != usize::MAX
             && buffer.rgb.len() == n
             && buffer.weight.len() == n
             && buffer.half_rgb.len() == half_len

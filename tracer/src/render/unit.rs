@@ -105,7 +105,7 @@ impl PixelRect {
     }
 
     pub fn pixel_count(&self) -> usize {
-        ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
+        (self.x1 - self.x0) as usize * (self.y1 - self.y0) as usize
     }
 }
 
