@@ -26,6 +26,7 @@ use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
 use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
 use yat_tracer::render::adaptive::{self, AdaptiveSettings, BlockGrid, Round};
+use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{plan_units, RenderSettings, WorkUnit, PLAN_VERSION};
 
 use yat_tracer::private_file::{read_regular_file, ReadFileError, StagedFile};
@@ -83,14 +84,21 @@ pub struct Checkpoint {
 }
 
 impl Checkpoint {
-    /// Nothing rendered yet: the plan's units to do, or an adaptive render's round 0.
-    pub fn new(settings: &RenderSettings, adaptive: Option<&AdaptiveSettings>) -> Self {
+    /// Nothing rendered yet: the plan's units to do, or an adaptive render's round 0; the film
+    /// takes units' buffers of the scene's filter `border` (`FilterDesc::border`).
+    pub fn new(
+        settings: &RenderSettings,
+        border: [u32; 2],
+        adaptive: Option<&AdaptiveSettings>,
+    ) -> Self {
+        let frame = FilmFrame {
+            width: settings.width,
+            height: settings.height,
+            border,
+        };
         let (film, round) = match adaptive {
-            Some(a) => (
-                Film::with_half(settings.width, settings.height),
-                Some(Round::first(settings, a)),
-            ),
-            None => (Film::new(settings.width, settings.height), None),
+            Some(a) => (Film::with_half(frame), Some(Round::first(settings, a))),
+            None => (Film::new(frame), None),
         };
         let mut checkpoint = Self {
             film,
@@ -289,6 +297,7 @@ impl Checkpoint {
         bytes: &[u8],
         identity: &RenderIdentity,
         settings: &RenderSettings,
+        border: [u32; 2],
         adaptive: Option<&AdaptiveSettings>,
     ) -> Result<Self, CheckpointError> {
         if bytes.len() < HEADER_LEN + DIGEST_LEN || &bytes[..MAGIC.len()] != MAGIC {
@@ -313,7 +322,7 @@ impl Checkpoint {
         {
             return Err(CheckpointError::OtherRender);
         }
-        let mut checkpoint = Self::new(settings, adaptive);
+        let mut checkpoint = Self::new(settings, border, adaptive);
         let pixels = width as usize * height as usize;
         let bitmap_len = checkpoint.bitmap_bits.div_ceil(8);
         let blocks = BlockGrid::of(settings).len();
@@ -337,7 +346,7 @@ impl Checkpoint {
             .collect();
         let half = sums.split_off(pixels);
         checkpoint.film =
-            Film::from_sums(width, height, sums, half).ok_or(CheckpointError::Corrupt)?;
+            Film::from_sums(checkpoint.film.frame(), sums, half).ok_or(CheckpointError::Corrupt)?;
         if let (Some(a), Some(_)) = (adaptive, &checkpoint.round) {
             let words: Vec<u32> = round_bytes
                 .chunks_exact(4)
@@ -407,13 +416,14 @@ impl CheckpointFile {
     pub fn load(
         &self,
         settings: &RenderSettings,
+        border: [u32; 2],
         adaptive: Option<&AdaptiveSettings>,
     ) -> Result<Option<Checkpoint>, CheckpointError> {
         let expected = Checkpoint::file_len(settings, adaptive);
         let Some(bytes) = read_regular_file(&self.path, expected)? else {
             return Ok(None);
         };
-        Checkpoint::decode(&bytes, &self.identity, settings, adaptive).map(Some)
+        Checkpoint::decode(&bytes, &self.identity, settings, border, adaptive).map(Some)
     }
 
     /// The checkpoint to start from: the one on disk when it belongs to this render, else an
@@ -421,10 +431,11 @@ impl CheckpointFile {
     pub fn resume(
         &self,
         settings: &RenderSettings,
+        border: [u32; 2],
         adaptive: Option<&AdaptiveSettings>,
         quiet: bool,
     ) -> Checkpoint {
-        match self.load(settings, adaptive) {
+        match self.load(settings, border, adaptive) {
             Ok(Some(checkpoint)) => {
                 if !quiet {
                     let (done, total) = checkpoint.samples(settings, adaptive);
@@ -442,13 +453,13 @@ impl CheckpointFile {
                 }
                 checkpoint
             }
-            Ok(None) => Checkpoint::new(settings, adaptive),
+            Ok(None) => Checkpoint::new(settings, border, adaptive),
             Err(e) => {
                 eprintln!(
                     "not resuming from {}: it is {e}; starting afresh",
                     self.path.display()
                 );
-                Checkpoint::new(settings, adaptive)
+                Checkpoint::new(settings, border, adaptive)
             }
         }
     }
@@ -515,6 +526,17 @@ mod tests {
         }
     }
 
+    /// The border of a 2-pixel-wide filter's buffers (blackmanharris as the seed scenes use it).
+    const BORDER: [u32; 2] = [2, 2];
+
+    fn frame() -> FilmFrame {
+        FilmFrame {
+            width: settings().width,
+            height: settings().height,
+            border: BORDER,
+        }
+    }
+
     fn encode(checkpoint: &Checkpoint, identity: &RenderIdentity) -> Vec<u8> {
         let mut bytes = Vec::new();
         checkpoint.encode_to(identity, &mut bytes).unwrap();
@@ -538,9 +560,9 @@ mod tests {
     /// A checkpoint holding every third unit of the plan, with distinct sums per unit.
     fn partial() -> (Checkpoint, Vec<WorkUnit>) {
         let units = plan_units(&settings());
-        let mut checkpoint = Checkpoint::new(&settings(), None);
+        let mut checkpoint = Checkpoint::new(&settings(), BORDER, None);
         for unit in units.iter().step_by(3) {
-            let mut buffer = SampleBuffer::new(*unit);
+            let mut buffer = SampleBuffer::new(*unit, &frame());
             for (i, (rgb, w)) in buffer.rgb.iter_mut().zip(&mut buffer.weight).enumerate() {
                 *rgb = [i as f32 * 0.25, unit.index as f32, -1.5];
                 *w = 0.75;
@@ -555,7 +577,7 @@ mod tests {
     fn a_checkpoint_reads_back_exactly() {
         let (checkpoint, units) = partial();
         let id = identity("a.lxs");
-        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), None)
+        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), BORDER, None)
             .expect("own checkpoint");
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.done, checkpoint.done);
@@ -571,7 +593,7 @@ mod tests {
             min_spp: 2,
         };
         let s = settings();
-        let mut checkpoint = Checkpoint::new(&s, Some(&a));
+        let mut checkpoint = Checkpoint::new(&s, BORDER, Some(&a));
         // Round 0, then round 1 after a noisy film, then part of round 1.
         let fill = |checkpoint: &mut Checkpoint, every: usize| {
             for (n, unit) in checkpoint
@@ -580,7 +602,7 @@ mod tests {
                 .enumerate()
                 .step_by(every)
             {
-                let mut buffer = SampleBuffer::new(*unit);
+                let mut buffer = SampleBuffer::new(*unit, &frame());
                 for i in 0..buffer.weight.len() {
                     let v = ((i * 7919 + n * 104_729) % 97) as f32 / 9.0;
                     buffer.rgb[i] = [v, v * 0.5, 1.0];
@@ -603,7 +625,7 @@ mod tests {
         );
         let bytes = encode(&checkpoint, &id);
         assert_eq!(bytes.len() as u64, Checkpoint::file_len(&s, Some(&a)));
-        let back = Checkpoint::decode(&bytes, &id, &s, Some(&a)).unwrap();
+        let back = Checkpoint::decode(&bytes, &id, &s, BORDER, Some(&a)).unwrap();
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.film().half_sums(), checkpoint.film().half_sums());
         assert_eq!(back.round(), Some(&round));
@@ -614,7 +636,7 @@ mod tests {
         forged.round.as_mut().unwrap().planned[0] = 3;
         let bytes = encode(&forged, &id);
         assert!(matches!(
-            Checkpoint::decode(&bytes, &id, &s, Some(&a)),
+            Checkpoint::decode(&bytes, &id, &s, BORDER, Some(&a)),
             Err(CheckpointError::Corrupt)
         ));
     }
@@ -625,7 +647,7 @@ mod tests {
         let id = identity("a.lxs");
         let bytes = encode(&checkpoint, &id);
         let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
-            Checkpoint::decode(bytes, id, settings, None).err()
+            Checkpoint::decode(bytes, id, settings, BORDER, None).err()
         };
         assert!(matches!(
             decode(&bytes, &identity("b.lxs"), &settings()),
@@ -665,11 +687,12 @@ mod tests {
         let output = dir.path().join("out.png");
         let file = CheckpointFile::beside(&output, identity("a.lxs"), Duration::from_secs(1));
         assert_eq!(file.path(), dir.path().join("out.resume"));
-        assert!(file.load(&settings(), None).unwrap().is_none());
+        assert!(file.load(&settings(), BORDER, None).unwrap().is_none());
         let (checkpoint, _) = partial();
-        file.save(&Checkpoint::new(&settings(), None)).unwrap();
+        file.save(&Checkpoint::new(&settings(), BORDER, None))
+            .unwrap();
         file.save(&checkpoint).unwrap();
-        let loaded = file.resume(&settings(), None, true);
+        let loaded = file.resume(&settings(), BORDER, None, true);
         assert_eq!(loaded.film().sums(), checkpoint.film().sums());
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
@@ -678,7 +701,12 @@ mod tests {
         );
 
         let stranger = CheckpointFile::beside(&output, identity("b.lxs"), Duration::ZERO);
-        assert_eq!(stranger.resume(&settings(), None, true).done_count(), 0);
+        assert_eq!(
+            stranger
+                .resume(&settings(), BORDER, None, true)
+                .done_count(),
+            0
+        );
         file.remove();
         assert!(!file.path().exists());
     }

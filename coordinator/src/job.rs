@@ -110,12 +110,17 @@ pub struct SceneBuild {
 }
 
 impl RenderJob {
+    /// The border of every unit's sample buffer: the scene's pixel filter's.
+    pub fn border(&self) -> [u32; 2] {
+        self.scene.desc.filter.border()
+    }
+
     /// The render to start from: the checkpoint a previous run of this render left, or nothing.
     pub fn resume(&self) -> Checkpoint {
         let adaptive = self.adaptive.as_ref();
         match &self.interim.checkpoint {
-            Some(file) => file.resume(&self.settings, adaptive, self.quiet),
-            None => Checkpoint::new(&self.settings, adaptive),
+            Some(file) => file.resume(&self.settings, self.border(), adaptive, self.quiet),
+            None => Checkpoint::new(&self.settings, self.border(), adaptive),
         }
     }
 

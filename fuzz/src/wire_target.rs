@@ -32,6 +32,7 @@ use yat_proto::hash::{is_sha256_hex, sha256_hex, Sha256Stream};
 use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::desc::{FilmDesc, ToneMap};
 use yat_tracer::film::Film;
+use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::campaign::{Outcome, Target};
@@ -333,12 +334,14 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
             }
         }),
         Kind::RenderUnitReply => decoded(pb::RenderUnitReply::decode(bytes), |reply| {
-            let Some(unit) = state.unit else { return 1 };
+            let (Some(unit), Some(settings)) = (state.unit, &state.settings) else {
+                return 1;
+            };
             if reply.index != unit.index {
                 return 2;
             }
             let _stats = UnitStats::from(reply.stats.unwrap_or_default());
-            let Ok(buffer) = decode_pixels(unit, &reply.pixels) else {
+            let Ok(buffer) = decode_pixels(unit, &frame_for(settings), &reply.pixels) else {
                 return 3;
             };
             let Some(film) = &mut state.film else {
@@ -409,10 +412,23 @@ fn decoded<M>(message: Result<M, prost::DecodeError>, then: impl FnOnce(M) -> u6
     message.map_or(0, |m| 1 + then(m))
 }
 
+/// The border of the buffers a session's coordinator expects: a 2-pixel-wide filter's (as the
+/// seed scenes' blackmanharris), so replies exercise overlapping borders.
+const BORDER: [u32; 2] = [2, 2];
+
+/// The frame of the settings' film.
+fn frame_for(settings: &RenderSettings) -> FilmFrame {
+    FilmFrame {
+        width: settings.width,
+        height: settings.height,
+        border: BORDER,
+    }
+}
+
 /// A film for the settings, if small enough to allocate per input.
 fn film_for(settings: &RenderSettings) -> Option<Film> {
     let pixels = u64::from(settings.width) * u64::from(settings.height);
-    (pixels <= MAX_FILM_PIXELS).then(|| Film::new(settings.width, settings.height))
+    (pixels <= MAX_FILM_PIXELS).then(|| Film::new(frame_for(settings)))
 }
 
 /// Values that break arithmetic and bounds, as varints.
@@ -643,7 +659,11 @@ fn seed_sessions() -> Vec<Session> {
             sample_end: spp.min(8),
             block_mask: None,
         };
-        let pixels = ((tile.2 - tile.0) * (tile.3 - tile.1)) as usize;
+        // The tile and the border, clipped to the image.
+        let side = |lo: u32, hi: u32, end: u32| {
+            ((hi + BORDER[0]).min(end) - lo.saturating_sub(BORDER[0])) as usize
+        };
+        let pixels = side(tile.0, tile.2, width) * side(tile.1, tile.3, height);
         let reply = pb::RenderUnitReply {
             index: 3,
             pixels: (0..pixels * BYTES_PER_PIXEL)

@@ -4,7 +4,7 @@
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{SampleBuffer, MAX_SUM};
-use yat_tracer::render::unit::MAX_MASKED_SIDE;
+use yat_tracer::render::unit::{FilmFrame, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::pb;
@@ -12,7 +12,8 @@ use crate::pb;
 /// Bytes per pixel in a sample buffer: RGB sums and the weight sum, four f32.
 pub const BYTES_PER_PIXEL: usize = 16;
 
-/// Largest unit a worker renders: its reply stays at 4 MiB, under every message limit.
+/// Largest unit a worker renders, in pixels of its tile: its reply (the tile and a border of at
+/// most `MAX_BORDER` pixels) stays under 4.5 MiB, under every message limit.
 pub const MAX_UNIT_PIXELS: u64 = 1 << 18;
 
 /// More rays than any camera sample traces: a path has at most MAX_DEPTH (4096) scattering
@@ -179,8 +180,8 @@ impl From<pb::UnitStats> for UnitStats {
     }
 }
 
-/// The wire form of a sample buffer: per pixel, r, g, b, weight as little-endian f32; then,
-/// for a masked unit, the same for its odd-index samples.
+/// The wire form of a sample buffer: per pixel of its region, r, g, b, weight as little-endian
+/// f32; then, for a masked unit, the same for its odd-index samples.
 pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
     let len = buffer.weight.len() + buffer.half_weight.len();
     let mut out = BytesMut::with_capacity(len * BYTES_PER_PIXEL);
@@ -193,21 +194,29 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
     out.freeze()
 }
 
-/// Bytes of a unit's sample buffer on the wire.
-pub fn pixels_len(unit: &WorkUnit) -> usize {
+/// Bytes of a unit's sample buffer on the wire: its region of `frame` (the tile and the
+/// filter's border), twice for a masked unit.
+pub fn pixels_len(unit: &WorkUnit, frame: &FilmFrame) -> usize {
     let sums = if unit.mask.is_some() { 2 } else { 1 };
-    unit.pixel_count() * BYTES_PER_PIXEL * sums
+    frame.region(unit).pixel_count() * BYTES_PER_PIXEL * sums
 }
 
 /// Reads a sample buffer of `unit` back from its wire form, checking what an honest render can
-/// produce: the length of the tile (twice for a masked unit); finite values; sums the film can
-/// hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums of at most the unit's
-/// samples per pixel in magnitude (each sample weighs +1 or -1, see `filter.rs`; the odd half
-/// at most half of them, rounded up); zeros for the pixels a mask leaves out. Radiance has no
-/// bound short of the film's: a bright but finite sum is indistinguishable from a firefly.
-/// Negative sums are honest (filters with negative lobes give samples the weight -1).
-pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireError> {
-    let expected = pixels_len(&unit);
+/// produce: the length of its region of `frame` (twice for a masked unit); finite values; sums
+/// the film can hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums no
+/// larger than every sample that can reach the pixel weighing 1 (a sample gives each pixel a
+/// weight of at most 1 in magnitude, see `filter.rs`: the unit's samples per pixel times the
+/// pixels within the border, the odd half at most half of them, rounded up); zeros for the
+/// pixels no sample of the unit reaches (beyond the border of the blocks a mask leaves on).
+/// Radiance has no bound short of the film's: a bright but finite sum is indistinguishable from
+/// a firefly. Negative sums are honest (filters with negative lobes weigh some samples
+/// negatively).
+pub fn decode_pixels(
+    unit: WorkUnit,
+    frame: &FilmFrame,
+    bytes: &[u8],
+) -> Result<SampleBuffer, WireError> {
+    let expected = pixels_len(&unit, frame);
     if bytes.len() != expected {
         return Err(WireError::PixelsLength {
             index: unit.index,
@@ -215,11 +224,14 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
             expected,
         });
     }
-    let samples = unit.sample_end - unit.sample_start;
-    let odd = (unit.sample_end / 2).saturating_sub(unit.sample_start / 2);
-    let mut buffer = SampleBuffer::new(unit);
-    let tile_width = (unit.x1 - unit.x0) as usize;
-    let n = unit.pixel_count();
+    let [bx, by] = frame.border;
+    let reach = f64::from(2 * bx + 1) * f64::from(2 * by + 1);
+    let samples = f64::from(unit.sample_end - unit.sample_start) * reach;
+    let odd = f64::from((unit.sample_end / 2).saturating_sub(unit.sample_start / 2)) * reach;
+    let mut buffer = SampleBuffer::new(unit, frame);
+    let region = buffer.region;
+    let region_width = region.width() as usize;
+    let n = region.pixel_count();
     for (pixel, px) in bytes.chunks_exact(BYTES_PER_PIXEL).enumerate() {
         let values: [f32; 4] =
             std::array::from_fn(|i| f32::from_le_bytes(px[4 * i..4 * i + 4].try_into().unwrap()));
@@ -238,21 +250,21 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
             }
         }
         let (half, i) = (pixel >= n, pixel % n);
-        let max_weight = if half { odd } else { samples } as f32;
-        if values[3].abs() > max_weight {
+        let max_weight = if half { odd } else { samples };
+        if f64::from(values[3].abs()) > max_weight {
             return Err(refuse(
                 values[3],
                 "exceeds the unit's samples per pixel as a weight sum",
             ));
         }
         let (x, y) = (
-            unit.x0 + (i % tile_width) as u32,
-            unit.y0 + (i / tile_width) as u32,
+            region.x0 + (i % region_width) as u32,
+            region.y0 + (i / region_width) as u32,
         );
-        if !unit.renders(x, y) && values.iter().any(|&v| v != 0.0) {
+        if !unit.reaches(x, y, frame.border) && values.iter().any(|&v| v != 0.0) {
             return Err(refuse(
                 values[3],
-                "belongs to a block the unit's mask leaves out",
+                "lies beyond the reach of the blocks the unit's mask leaves on",
             ));
         }
         let (rgb, weight) = if half {
@@ -271,6 +283,7 @@ pub fn decode_pixels(unit: WorkUnit, bytes: &[u8]) -> Result<SampleBuffer, WireE
 /// samples, no more dropped than taken, rays within [`MAX_RAYS_PER_SAMPLE`] per sample).
 pub fn result_from_wire(
     unit: WorkUnit,
+    frame: &FilmFrame,
     reply: &pb::RenderUnitReply,
 ) -> Result<(SampleBuffer, UnitStats), WireError> {
     if reply.index != unit.index {
@@ -279,7 +292,7 @@ pub fn result_from_wire(
             got: reply.index,
         });
     }
-    let buffer = decode_pixels(unit, &reply.pixels)?;
+    let buffer = decode_pixels(unit, frame, &reply.pixels)?;
     let stats = UnitStats::from(reply.stats.unwrap_or_default());
     let samples = unit.sample_count();
     let wrong = |reason: String| WireError::Stats {
@@ -383,8 +396,10 @@ mod tests {
             sample_end: 4,
             mask: None,
         };
+        let frame = FilmFrame::unbordered(3, 2);
         let buffer = SampleBuffer {
             unit,
+            region: frame.region(&unit),
             rgb: (0..6)
                 .map(|i| [i as f32 * 0.1, -0.0, f32::MIN_POSITIVE / (i + 1) as f32])
                 .collect(),
@@ -394,7 +409,7 @@ mod tests {
         };
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 6 * BYTES_PER_PIXEL);
-        let back = decode_pixels(unit, &bytes).unwrap();
+        let back = decode_pixels(unit, &frame, &bytes).unwrap();
         let bits = |b: &SampleBuffer| {
             b.rgb
                 .iter()
@@ -404,7 +419,46 @@ mod tests {
                 .collect::<Vec<_>>()
         };
         assert_eq!(bits(&back), bits(&buffer));
-        assert!(decode_pixels(unit, &bytes[1..]).is_err());
+        assert!(decode_pixels(unit, &frame, &bytes[1..]).is_err());
+    }
+
+    /// A unit's buffer covers its tile and the filter's border, clipped to the film: the tile's
+    /// length alone is refused, and so is a border's worth beyond what the film clips away.
+    #[test]
+    fn buffers_cover_the_border_clipped_to_the_film() {
+        let unit = WorkUnit {
+            index: 1,
+            x0: 2,
+            y0: 0,
+            x1: 5,
+            y1: 2,
+            sample_start: 0,
+            sample_end: 4,
+            mask: None,
+        };
+        let frame = FilmFrame {
+            width: 6,
+            height: 8,
+            border: [2, 1],
+        };
+        // Columns 0..6 (7 clipped to the film), rows 0..3 (-1 clipped).
+        assert_eq!(pixels_len(&unit, &frame), 6 * 3 * BYTES_PER_PIXEL);
+        let mut buffer = SampleBuffer::new(unit, &frame);
+        // A corner pixel of the border: up to 4 samples from each of 5 x 3 pixels, weight < 1.
+        buffer.rgb[2 * 6] = [1.0, 2.0, 3.0];
+        buffer.weight[2 * 6] = 30.0;
+        let bytes = encode_pixels(&buffer);
+        assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
+        let tile_only = 3 * 2 * BYTES_PER_PIXEL;
+        assert!(decode_pixels(unit, &frame, &bytes[..tile_only]).is_err());
+        let unclipped = FilmFrame {
+            width: 100,
+            ..frame
+        };
+        assert!(decode_pixels(unit, &unclipped, &bytes).is_err());
+        // More weight than every sample within the border weighing 1 is a lie.
+        buffer.weight[2 * 6] = 4.0 * 15.0 + 1.0;
+        assert!(decode_pixels(unit, &frame, &encode_pixels(&buffer)).is_err());
     }
 
     #[test]
@@ -443,7 +497,8 @@ mod tests {
 
         // Samples 16..21: 5 in all, 2 odd (17, 19). Pixel (64, 0) is in block 0, (70, 10) in
         // no active block.
-        let mut buffer = SampleBuffer::new(unit);
+        let frame = FilmFrame::unbordered(s.width, s.height);
+        let mut buffer = SampleBuffer::new(unit, &frame);
         assert_eq!(buffer.half_rgb.len(), 36 * 50);
         buffer.rgb[0] = [1.0, 2.0, 3.0];
         buffer.weight[0] = 5.0;
@@ -451,20 +506,45 @@ mod tests {
         buffer.half_weight[0] = 2.0;
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 2 * 36 * 50 * BYTES_PER_PIXEL);
-        assert_eq!(decode_pixels(unit, &bytes).unwrap(), buffer);
-        assert!(decode_pixels(unit, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
+        assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
+        assert!(decode_pixels(unit, &frame, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
         let mut heavy_half = buffer.clone();
         heavy_half.half_weight[0] = 3.0;
         assert!(
-            decode_pixels(unit, &encode_pixels(&heavy_half)).is_err(),
+            decode_pixels(unit, &frame, &encode_pixels(&heavy_half)).is_err(),
             "3 of 2 odd samples"
         );
         let mut outside = buffer.clone();
         outside.rgb[10 * 36 + 6] = [0.1, 0.0, 0.0];
         assert!(
-            decode_pixels(unit, &encode_pixels(&outside)).is_err(),
+            decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
             "a masked-out pixel"
         );
+
+        // With a 2-pixel border, active blocks splat into their neighbours: pixels within 2 of
+        // block 0 may hold sums, those farther from every active block may not.
+        let frame = FilmFrame {
+            border: [2, 2],
+            ..frame
+        };
+        let region = frame.region(&unit);
+        assert_eq!(
+            (region.x0, region.x1, region.y0, region.y1),
+            (62, 100, 0, 50)
+        );
+        let at = |x: u32, y: u32| ((y - region.y0) * region.width() + x - region.x0) as usize;
+        for (x, y, reached) in [
+            (62, 3, true),
+            (73, 9, true),
+            (74, 3, false),
+            (70, 10, false),
+        ] {
+            let mut buffer = SampleBuffer::new(unit, &frame);
+            buffer.rgb[at(x, y)] = [0.1, 0.0, 0.0];
+            buffer.weight[at(x, y)] = 0.5;
+            let decoded = decode_pixels(unit, &frame, &encode_pixels(&buffer));
+            assert_eq!(decoded.is_ok(), reached, "({x}, {y})");
+        }
     }
 
     /// A 2x1 tile of 4 samples per pixel whose second pixel's values are `values`, encoded.
@@ -481,6 +561,7 @@ mod tests {
         };
         let buffer = SampleBuffer {
             unit,
+            region: FilmFrame::unbordered(2, 1).region(&unit),
             rgb: vec![[0.5, 0.25, 0.0], [values[0], values[1], values[2]]],
             weight: vec![4.0, values[3]],
             half_rgb: Vec::new(),
@@ -509,7 +590,8 @@ mod tests {
             [-0.0, f32::MIN_POSITIVE, 0.0, 0.0],
         ] {
             let (unit, reply) = reply_with(values);
-            let (buffer, stats) = result_from_wire(unit, &reply).unwrap();
+            let (buffer, stats) =
+                result_from_wire(unit, &FilmFrame::unbordered(2, 1), &reply).unwrap();
             assert_eq!(buffer.rgb[1], [values[0], values[1], values[2]]);
             assert_eq!(buffer.weight[1], values[3]);
             assert_eq!(stats.samples, 8);
@@ -531,7 +613,7 @@ mod tests {
             [1.0, 1.0, 1.0, 1e30],
         ] {
             let (unit, reply) = reply_with(values);
-            let error = result_from_wire(unit, &reply).unwrap_err();
+            let error = result_from_wire(unit, &FilmFrame::unbordered(2, 1), &reply).unwrap_err();
             assert!(
                 matches!(
                     error,
@@ -554,7 +636,7 @@ mod tests {
             ..reply.clone()
         };
         assert!(matches!(
-            result_from_wire(unit, &other),
+            result_from_wire(unit, &FilmFrame::unbordered(2, 1), &other),
             Err(WireError::OtherUnit { asked: 5, got: 6 })
         ));
         let short = pb::RenderUnitReply {
@@ -562,7 +644,7 @@ mod tests {
             ..reply.clone()
         };
         assert!(matches!(
-            result_from_wire(unit, &short),
+            result_from_wire(unit, &FilmFrame::unbordered(2, 1), &short),
             Err(WireError::PixelsLength { .. })
         ));
         for (samples, rays, dropped) in [(7, 40, 0), (9, 40, 0), (8, 40, 9), (8, u64::MAX, 0)] {
@@ -575,7 +657,10 @@ mod tests {
                 ..reply.clone()
             };
             assert!(
-                matches!(result_from_wire(unit, &lying), Err(WireError::Stats { .. })),
+                matches!(
+                    result_from_wire(unit, &FilmFrame::unbordered(2, 1), &lying),
+                    Err(WireError::Stats { .. })
+                ),
                 "{samples} {rays} {dropped}"
             );
         }
@@ -583,6 +668,6 @@ mod tests {
             stats: None,
             ..reply
         };
-        assert!(result_from_wire(unit, &without_stats).is_err());
+        assert!(result_from_wire(unit, &FilmFrame::unbordered(2, 1), &without_stats).is_err());
     }
 }

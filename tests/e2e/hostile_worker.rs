@@ -42,8 +42,13 @@ enum Misbehaviour {
 
 const ESCAPES: &str = "\x1b]0;pwn\x07\x1b[2J";
 
+/// The border of the bench scene's units' buffers: its blackmanharris filter is 2 pixels wide.
+const BORDER: u32 = 2;
+
 struct FakeState {
     misbehaviour: Mutex<Misbehaviour>,
+    /// The image size of the scene loaded last.
+    image: Mutex<(u32, u32)>,
     requests: AtomicU64,
     units_in_flight: AtomicU64,
     max_units_in_flight: AtomicU64,
@@ -127,9 +132,11 @@ impl yat_proto::RenderNode for FakeNode {
 
     async fn load_scene(
         &self,
-        _: Request<pb::LoadSceneRequest>,
+        request: Request<pb::LoadSceneRequest>,
     ) -> Result<Response<pb::LoadSceneReply>, Status> {
         self.0.count();
+        let settings = request.into_inner().settings.unwrap_or_default();
+        *self.0.image.lock().unwrap() = (settings.width, settings.height);
         if let Misbehaviour::LoadFails = self.0.misbehaviour() {
             return Err(Status::internal("out of luck"));
         }
@@ -146,9 +153,19 @@ impl yat_proto::RenderNode for FakeNode {
         self.0.count();
         let _in_flight = InFlight::new(&self.0);
         let unit = request.into_inner().unit.unwrap_or_default();
-        let pixels =
+        let tile =
             u64::from(unit.x1.saturating_sub(unit.x0)) * u64::from(unit.y1.saturating_sub(unit.y0));
-        let samples = pixels * u64::from(unit.sample_end.saturating_sub(unit.sample_start));
+        let samples = tile * u64::from(unit.sample_end.saturating_sub(unit.sample_start));
+        // The buffer covers the tile and the filter's border, clipped to the image.
+        let (width, height) = *self.0.image.lock().unwrap();
+        let side = |lo: u32, hi: u32, end: u32| {
+            u64::from(
+                hi.saturating_add(BORDER)
+                    .min(end)
+                    .saturating_sub(lo.saturating_sub(BORDER)),
+            )
+        };
+        let pixels = side(unit.x0, unit.x1, width) * side(unit.y0, unit.y1, height);
         let reply = |rgb: f32, weight: f32, pixels: u64| pb::RenderUnitReply {
             index: unit.index,
             pixels: (0..pixels)
@@ -209,6 +226,7 @@ impl FakeWorker {
     fn start(misbehaviour: Misbehaviour) -> Self {
         let state = Arc::new(FakeState {
             misbehaviour: Mutex::new(misbehaviour),
+            image: Mutex::new((0, 0)),
             requests: AtomicU64::new(0),
             units_in_flight: AtomicU64::new(0),
             max_units_in_flight: AtomicU64::new(0),

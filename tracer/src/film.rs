@@ -27,7 +27,7 @@ use crate::math::luminance;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::render::unit::WorkUnit;
+use crate::render::unit::{FilmFrame, PixelRect, WorkUnit};
 
 /// The film type every `Film` statement is read as.
 pub const FILM_TYPE: &str = "fleximage";
@@ -163,13 +163,15 @@ impl FilmDesc {
     }
 }
 
-/// A unit's result: per pixel of its tile (row-major), the sum of sample radiance and the sum
-/// of sample weights (16 bytes per pixel); for an adaptive unit (one with a block mask) the
-/// same sums over its odd-index samples too, the half the adaptive error estimate compares
-/// with the whole.
+/// A unit's result: per pixel of its region (its tile and the filter's border around it,
+/// [`FilmFrame::region`], row-major), the sum of filter-weighted sample radiance and the sum of
+/// the weights (16 bytes per pixel); for an adaptive unit (one with a block mask) the same sums
+/// over its odd-index samples too, the half the adaptive error estimate compares with the whole.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleBuffer {
     pub unit: WorkUnit,
+    /// The pixels the sums are of.
+    pub region: PixelRect,
     pub rgb: Vec<[f32; 3]>,
     pub weight: Vec<f32>,
     /// Sums of the odd-index samples: as long as `rgb` for a masked unit, else empty.
@@ -178,11 +180,14 @@ pub struct SampleBuffer {
 }
 
 impl SampleBuffer {
-    pub fn new(unit: WorkUnit) -> Self {
-        let n = unit.pixel_count();
+    /// Zero sums over `unit`'s region of `frame`.
+    pub fn new(unit: WorkUnit, frame: &FilmFrame) -> Self {
+        let region = frame.region(&unit);
+        let n = region.pixel_count();
         let half = if unit.mask.is_some() { n } else { 0 };
         Self {
             unit,
+            region,
             rgb: vec![[0.0; 3]; n],
             weight: vec![0.0; n],
             half_rgb: vec![[0.0; 3]; half],
@@ -222,8 +227,8 @@ fn to_fixed(v: f32) -> i64 {
 /// the image does not depend on the order in which units arrive.
 #[derive(Clone, Debug)]
 pub struct Film {
-    width: u32,
-    height: u32,
+    /// The size, and the border every unit's buffer has around its tile.
+    frame: FilmFrame,
     /// Per pixel: R, G, B and weight sums in fixed point.
     sums: Vec<[i64; 4]>,
     /// The same sums over the odd-index samples, kept only by an adaptive render's film (which
@@ -240,21 +245,21 @@ pub struct BufferMismatch {
 }
 
 impl Film {
-    pub fn new(width: u32, height: u32) -> Self {
+    /// An empty film of `frame`'s size, taking buffers of `frame`'s border.
+    pub fn new(frame: FilmFrame) -> Self {
         Self {
-            width,
-            height,
-            sums: vec![[0; 4]; width as usize * height as usize],
+            frame,
+            sums: vec![[0; 4]; frame.width as usize * frame.height as usize],
             half: Vec::new(),
         }
     }
 
     /// The film of an adaptive render: it also keeps the sums of the odd-index samples, and
     /// takes only buffers of masked units.
-    pub fn with_half(width: u32, height: u32) -> Self {
+    pub fn with_half(frame: FilmFrame) -> Self {
         Self {
-            half: vec![[0; 4]; width as usize * height as usize],
-            ..Self::new(width, height)
+            half: vec![[0; 4]; frame.width as usize * frame.height as usize],
+            ..Self::new(frame)
         }
     }
 
@@ -264,11 +269,15 @@ impl Film {
     }
 
     pub fn width(&self) -> u32 {
-        self.width
+        self.frame.width
     }
 
     pub fn height(&self) -> u32 {
-        self.height
+        self.frame.height
+    }
+
+    pub fn frame(&self) -> FilmFrame {
+        self.frame
     }
 
     /// Per pixel (rows top to bottom): the R, G, B and weight sums in fixed point, exactly as
@@ -283,50 +292,52 @@ impl Film {
         &self.half
     }
 
-    /// A film holding these sums (and half sums: empty, or as many); None unless there are
-    /// width x height of them.
-    pub fn from_sums(
-        width: u32,
-        height: u32,
-        sums: Vec<[i64; 4]>,
-        half: Vec<[i64; 4]>,
-    ) -> Option<Self> {
-        let pixels = width as usize * height as usize;
+    /// A film of `frame` holding these sums (and half sums: empty, or as many); None unless
+    /// there are width x height of them.
+    pub fn from_sums(frame: FilmFrame, sums: Vec<[i64; 4]>, half: Vec<[i64; 4]>) -> Option<Self> {
+        let pixels = frame.width as usize * frame.height as usize;
         (sums.len() == pixels && (half.is_empty() || half.len() == pixels)).then_some(Self {
-            width,
-            height,
+            frame,
             sums,
             half,
         })
     }
 
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
-    /// gives the same bits. A buffer that does not fit (wrong tile or length, half sums where
-    /// the film keeps none or none where it does) is refused.
+    /// gives the same bits, overlapping borders included. A buffer that does not fit (a tile
+    /// outside the film, another region than the film's border gives the tile, a length not
+    /// the region's, half sums where the film keeps none or none where it does) is refused.
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
         let u = &buffer.unit;
-        let half_len = if self.has_half() { u.pixel_count() } else { 0 };
-        let fits = u.x0 < u.x1
-            && u.y0 < u.y1
-            && u.x1 <= self.width
-            && u.y1 <= self.height
-            && buffer.rgb.len() == u.pixel_count()
-            && buffer.weight.len() == u.pixel_count()
+        let region = buffer.region;
+        let tile_fits =
+            u.x0 < u.x1 && u.y0 < u.y1 && u.x1 <= self.frame.width && u.y1 <= self.frame.height;
+        // The region is only measured once it is known to be the tile's, grown and clipped.
+        let n = if tile_fits && region == self.frame.region(u) {
+            region.pixel_count()
+        } else {
+            usize::MAX
+        };
+        let half_len = if self.has_half() { n } else { 0 };
+        let fits = n != usize::MAX
+            && buffer.rgb.len() == n
+            && buffer.weight.len() == n
             && buffer.half_rgb.len() == half_len
             && buffer.half_weight.len() == half_len;
         if !fits {
             return Err(BufferMismatch {
                 index: u.index,
-                width: self.width,
-                height: self.height,
+                width: self.frame.width,
+                height: self.frame.height,
             });
         }
-        add_tile(&mut self.sums, self.width, u, &buffer.rgb, &buffer.weight);
+        let width = self.frame.width;
+        add_region(&mut self.sums, width, &region, &buffer.rgb, &buffer.weight);
         if half_len > 0 {
-            add_tile(
+            add_region(
                 &mut self.half,
-                self.width,
-                u,
+                width,
+                &region,
                 &buffer.half_rgb,
                 &buffer.half_weight,
             );
@@ -342,13 +353,13 @@ impl Film {
 
     /// The pixel's radiance estimate (weighted mean of its samples; black without samples).
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
-        mean(&self.sums[(y * self.width + x) as usize])
+        mean(&self.sums[(y * self.frame.width + x) as usize])
     }
 
     /// Linear radiance of every pixel, rows top to bottom.
     pub fn radiance(&self) -> Vec<Vec3> {
-        (0..self.height)
-            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+        (0..self.frame.height)
+            .flat_map(|y| (0..self.frame.width).map(move |x| (x, y)))
             .map(|(x, y)| self.pixel(x, y))
             .collect()
     }
@@ -358,7 +369,7 @@ impl Film {
         let mut mapped = self.radiance();
         tone_map(&mut mapped, &film.tonemap, film.gamma);
         let inv_gamma = 1.0 / film.gamma.max(1e-3);
-        let mut img = image::RgbImage::new(self.width, self.height);
+        let mut img = image::RgbImage::new(self.frame.width, self.frame.height);
         for (px, c) in img.pixels_mut().zip(mapped) {
             let encode = |v: f32| (v.clamp(0.0, 1.0).powf(inv_gamma) * 255.0 + 0.5) as u8;
             *px = image::Rgb([encode(c.x), encode(c.y), encode(c.z)]);
@@ -378,21 +389,27 @@ impl Film {
             .into_iter()
             .flat_map(|c| [c.x, c.y, c.z])
             .collect();
-        let img = image::Rgb32FImage::from_raw(self.width, self.height, data)
+        let img = image::Rgb32FImage::from_raw(self.frame.width, self.frame.height, data)
             .expect("buffer has width x height pixels");
         image::DynamicImage::ImageRgb32F(img).save_with_format(path, image::ImageFormat::OpenExr)
     }
 }
 
-/// Adds a tile's f32 sums into rows of fixed-point sums.
-fn add_tile(sums: &mut [[i64; 4]], width: u32, u: &WorkUnit, rgb: &[[f32; 3]], weight: &[f32]) {
-    let tile_width = (u.x1 - u.x0) as usize;
+/// Adds a region's f32 sums into rows of fixed-point sums.
+fn add_region(
+    sums: &mut [[i64; 4]],
+    width: u32,
+    region: &PixelRect,
+    rgb: &[[f32; 3]],
+    weight: &[f32],
+) {
+    let region_width = region.width() as usize;
     let rows = rgb
-        .chunks_exact(tile_width)
-        .zip(weight.chunks_exact(tile_width));
-    for ((rgb, weight), y) in rows.zip(u.y0..u.y1) {
-        let start = y as usize * width as usize + u.x0 as usize;
-        let film_row = &mut sums[start..start + tile_width];
+        .chunks_exact(region_width)
+        .zip(weight.chunks_exact(region_width));
+    for ((rgb, weight), y) in rows.zip(region.y0..region.y1) {
+        let start = y as usize * width as usize + region.x0 as usize;
+        let film_row = &mut sums[start..start + region_width];
         for ((sum, &[r, g, b]), &w) in film_row.iter_mut().zip(rgb).zip(weight) {
             for (s, v) in sum.iter_mut().zip([r, g, b, w]) {
                 *s = s.saturating_add(to_fixed(v));
@@ -489,8 +506,8 @@ mod tests {
         }
     }
 
-    fn buffer(u: WorkUnit, seed: u32) -> SampleBuffer {
-        let mut b = SampleBuffer::new(u);
+    fn buffer(u: WorkUnit, frame: &FilmFrame, seed: u32) -> SampleBuffer {
+        let mut b = SampleBuffer::new(u, frame);
         for (i, (c, w)) in b.rgb.iter_mut().zip(&mut b.weight).enumerate() {
             let v = ((i as u32).wrapping_mul(2_654_435_761) ^ seed) as f32 / u32::MAX as f32;
             *c = [v * 1e3, v * 1e-4, 0.1 + v];
@@ -501,11 +518,12 @@ mod tests {
 
     #[test]
     fn merging_is_order_independent_and_exact() {
+        let frame = FilmFrame::unbordered(4, 3);
         let bufs: Vec<_> = (0..5)
-            .map(|i| buffer(unit(i, 0, 0, 4, 3), i * 977))
+            .map(|i| buffer(unit(i, 0, 0, 4, 3), &frame, i * 977))
             .collect();
-        let mut forward = Film::new(4, 3);
-        let mut backward = Film::new(4, 3);
+        let mut forward = Film::new(frame);
+        let mut backward = Film::new(frame);
         bufs.iter().for_each(|b| forward.add(b).unwrap());
         bufs.iter().rev().for_each(|b| backward.add(b).unwrap());
         assert_eq!(forward.sums, backward.sums);
@@ -513,14 +531,93 @@ mod tests {
         assert!((forward.pixel(1, 1).z - expected).abs() < 1e-6);
     }
 
+    /// Neighbouring tiles' borders overlap: every order of adding them gives the same bits, and
+    /// a pixel under several borders holds the sum of what each buffer gave it.
+    #[test]
+    fn overlapping_borders_merge_in_any_order() {
+        let frame = FilmFrame {
+            width: 10,
+            height: 7,
+            border: [2, 1],
+        };
+        let tiles = [
+            (0, 0, 4, 4),
+            (4, 0, 8, 4),
+            (8, 0, 10, 4),
+            (0, 4, 4, 7),
+            (4, 4, 10, 7),
+        ];
+        let bufs: Vec<_> = tiles
+            .iter()
+            .enumerate()
+            .map(|(i, &(x0, y0, x1, y1))| {
+                buffer(unit(i as u32, x0, y0, x1, y1), &frame, 31 * i as u32)
+            })
+            .collect();
+        assert_eq!(
+            bufs[1].region,
+            PixelRect {
+                x0: 2,
+                y0: 0,
+                x1: 10,
+                y1: 5
+            }
+        );
+        let orders = [[0, 1, 2, 3, 4], [4, 3, 2, 1, 0], [2, 4, 0, 3, 1]];
+        let films: Vec<_> = orders
+            .iter()
+            .map(|order| {
+                let mut film = Film::new(frame);
+                order.iter().for_each(|&i| film.add(&bufs[i]).unwrap());
+                film.sums
+            })
+            .collect();
+        assert!(films.iter().all(|f| *f == films[0]));
+        // Pixel (3, 4) lies in every region but the third's.
+        let weight: i64 = [0, 1, 3, 4]
+            .iter()
+            .map(|&i| {
+                let b = &bufs[i];
+                let r = b.region;
+                to_fixed(b.weight[((4 - r.y0) * r.width() + 3 - r.x0) as usize])
+            })
+            .sum();
+        assert_eq!(films[0][4 * 10 + 3][3], weight);
+        assert_eq!(weight, 4 * to_fixed(3.0));
+    }
+
     #[test]
     fn a_misfit_buffer_is_refused() {
-        let mut film = Film::new(4, 4);
-        let mut b = buffer(unit(0, 2, 2, 6, 4), 1);
+        let frame = FilmFrame::unbordered(4, 4);
+        let mut film = Film::new(frame);
+        let mut b = buffer(unit(0, 2, 2, 6, 4), &FilmFrame::unbordered(6, 4), 1);
         assert!(film.add(&b).is_err());
-        b.unit = unit(0, 0, 0, 4, 2);
+        b = buffer(unit(0, 0, 0, 4, 2), &frame, 1);
         b.weight.pop();
         assert!(film.add(&b).is_err());
+    }
+
+    /// A buffer whose border is not the film's (a worker whose filter reaches further, or less
+    /// far) is refused, though its tile fits.
+    #[test]
+    fn a_buffer_of_another_border_is_refused() {
+        let frame = FilmFrame {
+            width: 16,
+            height: 16,
+            border: [2, 2],
+        };
+        let mut film = Film::new(frame);
+        let u = unit(0, 4, 4, 8, 8);
+        assert!(film.add(&buffer(u, &frame, 1)).is_ok());
+        for border in [[0, 0], [1, 2], [2, 3]] {
+            let other = FilmFrame { border, ..frame };
+            assert!(film.add(&buffer(u, &other, 1)).is_err(), "{border:?}");
+        }
+        // The right region but one pixel short.
+        let mut short = buffer(u, &frame, 1);
+        short.rgb.pop();
+        short.weight.pop();
+        assert!(film.add(&short).is_err());
     }
 
     #[test]

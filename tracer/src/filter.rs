@@ -11,14 +11,14 @@
 //! | `blackmanharris` | | 4 |
 //! | `sinc` | `tau` (3) | 4 |
 //!
-//! Every type also takes `xwidth` and `ywidth` (positive half-widths in pixels). An unknown
-//! type is a warning and renders with the default mitchell.
+//! Every type also takes `xwidth` and `ywidth` (positive half-widths in pixels, at most
+//! [`MAX_WIDTH`]: a wider one is a warning and renders at that width). An unknown type is a
+//! warning and renders with the default mitchell.
 //!
-//! The filters are used by filter importance sampling: a sample's offset from its pixel centre
-//! is drawn from |f| and carries weight sign(f), so every sample belongs to exactly one pixel
-//! and tiles need no borders (docs/architecture.md).
-
-use glam::Vec2;
+//! Samples are splatted through the filter ([`PixelFilter`]): each one adds its radiance,
+//! weighted, to every pixel whose centre lies within the filter's half-widths, so a unit's
+//! buffer covers its tile and a border of [`FilterDesc::border`] pixels around it
+//! (docs/architecture.md). A pixel is the filter-weighted mean of the samples around it.
 
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
@@ -34,6 +34,11 @@ pub const DEFAULT_BOX_WIDTH: f32 = 0.5;
 pub const DEFAULT_WIDTH: f32 = 2.0;
 /// Half-width of the blackmanharris and sinc filters when the file does not say.
 pub const DEFAULT_WIDE_WIDTH: f32 = 4.0;
+/// The widest half-width rendered, in pixels: it bounds a unit's border (and the splat's cost
+/// per sample) whatever a file says. LuxRender's widest default is 4.
+pub const MAX_WIDTH: f32 = 8.0;
+/// The widest border of a unit's buffer, in pixels: that of a [`MAX_WIDTH`] filter.
+pub const MAX_BORDER: u32 = 8;
 /// The gaussian's falloff when the file does not say.
 pub const DEFAULT_GAUSSIAN_ALPHA: f32 = 2.0;
 /// The sinc's tau when the file does not say.
@@ -121,10 +126,17 @@ impl FilterDesc {
                 )
             }
         };
-        let width = |name: &str| -> Result<f32, ParseError> {
+        let mut width = |name: &str| -> Result<f32, ParseError> {
             let w = params.float(name, width)?;
             match params.find(name) {
-                Some(p) if w <= 0.0 => Err(params.error(p, "the filter width must be positive")),
+                Some(p) if !(w > 0.0) => Err(params.error(p, "the filter width must be positive")),
+                Some(_) if w > MAX_WIDTH => {
+                    ctx.warn(
+                        pos,
+                        format!("PixelFilter {name} {w} is rendered as {MAX_WIDTH}, the widest"),
+                    );
+                    Ok(MAX_WIDTH)
+                }
                 _ => Ok(w),
             }
         };
@@ -136,82 +148,149 @@ impl FilterDesc {
     }
 }
 
+/// Intervals of the table each axis's weights are read from (linear interpolation between its
+/// ends): within 1e-4 of the filter, with no transcendental function per sample.
 const TABLE_SIZE: usize = 256;
 
-/// Samples one axis of a separable filter from a tabulated |f|.
+/// Pixels a filter's weights reach per axis at most: a sample's own and [`MAX_BORDER`] each
+/// side.
+pub const MAX_TAPS: usize = 2 * MAX_BORDER as usize + 1;
+
+/// One axis of a separable filter: |offset| in [0, radius] to the weight, tabulated, the peak
+/// scaled to 1 (a pixel's weights are a ratio, so the scale cancels; the peak at 1 bounds every
+/// weight a sample gives a pixel by 1 in magnitude).
 #[derive(Clone, Debug)]
-struct AxisSampler {
+struct AxisWeights {
     radius: f32,
-    /// Cumulative |f| at the right edge of each bin, normalised to end at 1.
-    cdf: Vec<f32>,
-    /// sign(f) over each bin.
-    sign: Vec<f32>,
+    border: u32,
+    /// TABLE_SIZE / radius: table steps per pixel of offset.
+    steps_per_pixel: f32,
+    /// The weight at i x radius / TABLE_SIZE, i in 0..=TABLE_SIZE.
+    table: Vec<f32>,
 }
 
-impl AxisSampler {
+impl AxisWeights {
     fn new(radius: f32, f: impl Fn(f32) -> f32) -> Self {
-        let radius = if radius.is_finite() && radius > 0.0 {
-            radius
-        } else {
-            0.5
-        };
-        let bin = 2.0 * radius / TABLE_SIZE as f32;
-        let values: Vec<f32> = (0..TABLE_SIZE)
-            .map(|i| f(-radius + (i as f32 + 0.5) * bin))
-            .collect();
-        let mut cdf = Vec::with_capacity(TABLE_SIZE);
-        let mut sum = 0.0;
-        for v in &values {
-            sum += v.abs();
-            cdf.push(sum);
-        }
-        if sum > 0.0 {
-            cdf.iter_mut().for_each(|c| *c /= sum);
+        let step = radius / TABLE_SIZE as f32;
+        let mut table: Vec<f32> = (0..=TABLE_SIZE).map(|i| f(i as f32 * step)).collect();
+        let peak = table.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        if peak > 0.0 && peak.is_finite() {
+            table.iter_mut().for_each(|v| *v /= peak);
         } else {
             // A filter that is zero everywhere degenerates to a box.
-            cdf = (1..=TABLE_SIZE)
-                .map(|i| i as f32 / TABLE_SIZE as f32)
-                .collect();
+            table.fill(1.0);
         }
-        let sign = values
-            .iter()
-            .map(|&v| if v < 0.0 { -1.0 } else { 1.0 })
-            .collect();
-        Self { radius, cdf, sign }
+        Self {
+            radius,
+            border: border(radius),
+            steps_per_pixel: TABLE_SIZE as f32 / radius,
+            table,
+        }
     }
 
-    /// An offset in [-radius, radius] and its weight.
-    fn sample(&self, u: f32) -> (f32, f32) {
-        let i = self.cdf.partition_point(|&c| c <= u).min(TABLE_SIZE - 1);
-        let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
-        let width = self.cdf[i] - lo;
-        let within = if width > 0.0 { (u - lo) / width } else { 0.5 };
-        let bin = 2.0 * self.radius / TABLE_SIZE as f32;
-        (-self.radius + (i as f32 + within) * bin, self.sign[i])
+    fn weight(&self, offset: f32) -> f32 {
+        let t = (offset.abs() * self.steps_per_pixel).min(TABLE_SIZE as f32);
+        let i = (t as usize).min(TABLE_SIZE - 1);
+        let (a, b) = (self.table[i], self.table[i + 1]);
+        a + (t - i as f32) * (b - a)
+    }
+
+    /// The pixels of `lo..hi` a sample at `pixel + u` (u in [0, 1)) reaches: those whose centre
+    /// lies within (-radius, radius] of it, and their weights.
+    fn taps(&self, pixel: u32, u: f32, lo: u32, hi: u32) -> Taps {
+        let b = self.border as i64;
+        // Offsets k of the pixels pixel + k reached, k in [-border, border] (clamped: f32
+        // rounding of u + radius may reach one further when u is just under 1).
+        let first = ((u - self.radius - 0.5).floor() as i64 + 1).clamp(-b, b);
+        let last = ((u + self.radius - 0.5).floor() as i64).clamp(-b, b);
+        let start = (i64::from(pixel) + first).max(i64::from(lo));
+        let end = (i64::from(pixel) + last + 1).min(i64::from(hi));
+        let mut taps = Taps {
+            first: start.max(0) as u32,
+            len: 0,
+            weights: [0.0; MAX_TAPS],
+        };
+        for p in start..end {
+            let offset = (p - i64::from(pixel)) as f32 + 0.5 - u;
+            taps.weights[taps.len] = self.weight(offset);
+            taps.len += 1;
+        }
+        taps
     }
 }
 
+/// The weights one sample gives a run of pixels along one axis.
+#[derive(Clone, Copy, Debug)]
+pub struct Taps {
+    /// The first pixel reached.
+    pub first: u32,
+    len: usize,
+    weights: [f32; MAX_TAPS],
+}
+
+impl Taps {
+    /// The weight of pixels `first`, `first + 1`, ...
+    pub fn weights(&self) -> &[f32] {
+        &self.weights[..self.len]
+    }
+}
+
+/// Pixels beyond its own that a filter of this half-width reaches: a sample at offset u in
+/// [0, 1) of its pixel reaches the pixels whose centres lie within (-radius, radius] of it.
+fn border(radius: f32) -> u32 {
+    (radius - 0.5).ceil().max(0.0) as u32
+}
+
+/// A filter's half-width as rendered: at most [`MAX_WIDTH`]; a value that is not a positive
+/// number (only a hand-made description has one: the parser refuses it) renders as a box's.
+fn clamp_width(width: f32) -> f32 {
+    if width > 0.0 {
+        width.min(MAX_WIDTH)
+    } else {
+        DEFAULT_BOX_WIDTH
+    }
+}
+
+/// The pixel filter as samples are splatted through it: every sample adds `w(p - x) L` and
+/// `w(p - x)` to each pixel p it reaches (LuxRender's film does the same), `w` the product of
+/// the two axes' weights (negative in mitchell's and sinc's lobes).
 #[derive(Clone, Debug)]
-pub struct FilterSampler {
-    x: AxisSampler,
-    y: AxisSampler,
+pub struct PixelFilter {
+    x: AxisWeights,
+    y: AxisWeights,
 }
 
-impl FilterSampler {
+impl PixelFilter {
     pub fn new(desc: &FilterDesc) -> Self {
         let kind = desc.kind;
-        let axis = |radius: f32| AxisSampler::new(radius, |x| filter_1d(kind, x, radius));
+        let axis = |width: f32| {
+            let radius = clamp_width(width);
+            AxisWeights::new(radius, |x| filter_1d(kind, x, radius))
+        };
         Self {
             x: axis(desc.xwidth),
             y: axis(desc.ywidth),
         }
     }
 
-    /// Offset from the pixel centre and the sample's weight (+1 or -1).
-    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
-        let (dx, wx) = self.x.sample(u.x);
-        let (dy, wy) = self.y.sample(u.y);
-        (Vec2::new(dx, dy), wx * wy)
+    /// The weights a sample at `(x, y) + u` gives the columns `lo..hi`.
+    pub fn taps_x(&self, x: u32, u: f32, lo: u32, hi: u32) -> Taps {
+        self.x.taps(x, u, lo, hi)
+    }
+
+    /// The weights a sample at `(x, y) + u` gives the rows `lo..hi`.
+    pub fn taps_y(&self, y: u32, u: f32, lo: u32, hi: u32) -> Taps {
+        self.y.taps(y, u, lo, hi)
+    }
+}
+
+impl FilterDesc {
+    /// Pixels a sample reaches beyond its own, per axis: the border of every unit's buffer.
+    pub fn border(&self) -> [u32; 2] {
+        [
+            border(clamp_width(self.xwidth)),
+            border(clamp_width(self.ywidth)),
+        ]
     }
 }
 
@@ -267,49 +346,91 @@ fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
 mod tests {
     use super::*;
 
-    #[test]
-    fn samples_follow_the_filter_shape() {
-        let desc = FilterDesc {
-            kind: FilterKind::BlackmanHarris,
-            xwidth: 2.0,
-            ywidth: 2.0,
-        };
-        let sampler = FilterSampler::new(&desc);
-        let n = 10_000;
-        let (mut inner, mut mean) = (0, Vec2::ZERO);
-        for i in 0..n {
-            let u = Vec2::new(
-                (i as f32 + 0.5) / n as f32,
-                ((i * 7919) % n) as f32 / n as f32,
-            );
-            let (d, w) = sampler.sample(u);
-            assert_eq!(w, 1.0);
-            assert!(d.x.abs() <= 2.0 && d.y.abs() <= 2.0);
-            mean += d;
-            if d.x.abs() < 0.5 {
-                inner += 1;
-            }
-        }
-        assert!((mean / n as f32).length() < 0.01);
-        // Blackman-Harris over [-2, 2] puts 62.1% of its mass within half a pixel.
-        let frac = inner as f32 / n as f32;
-        assert!((frac - 0.621).abs() < 0.01, "{frac}");
+    fn filter(kind: FilterKind, width: f32) -> PixelFilter {
+        PixelFilter::new(&FilterDesc {
+            kind,
+            xwidth: width,
+            ywidth: width,
+        })
     }
 
     #[test]
-    fn mitchell_has_negative_lobes() {
-        let desc = FilterDesc {
-            kind: FilterKind::Mitchell {
-                b: 1.0 / 3.0,
-                c: 1.0 / 3.0,
+    fn a_half_pixel_box_gives_each_sample_to_its_own_pixel_alone() {
+        let f = filter(FilterKind::Box, 0.5);
+        for i in 0..1000 {
+            let u = i as f32 / 1000.0;
+            let taps = f.taps_x(7, u, 0, 20);
+            assert_eq!((taps.first, taps.weights()), (7, &[1.0][..]), "{u}");
+        }
+    }
+
+    #[test]
+    fn weights_follow_the_filter_within_the_radius() {
+        let kind = FilterKind::BlackmanHarris;
+        let f = filter(kind, 2.0);
+        for i in 0..100 {
+            let u = (i as f32 + 0.5) / 100.0;
+            let taps = f.taps_x(10, u, 0, 20);
+            // Pixel centres within (-2, 2] of the sample: always four pixels.
+            assert_eq!(taps.weights().len(), 4, "{u}");
+            for (k, &w) in taps.weights().iter().enumerate() {
+                let offset = (taps.first + k as u32) as f32 + 0.5 - (10.0 + u);
+                assert!(offset.abs() <= 2.0, "{offset}");
+                let exact = filter_1d(kind, offset, 2.0) / filter_1d(kind, 0.0, 2.0);
+                assert!((w - exact).abs() < 1e-4, "{offset}: {w} against {exact}");
+            }
+        }
+    }
+
+    #[test]
+    fn mitchell_weights_have_negative_lobes() {
+        let f = filter(
+            FilterKind::Mitchell {
+                b: DEFAULT_MITCHELL_B,
+                c: DEFAULT_MITCHELL_C,
             },
-            xwidth: 2.0,
-            ywidth: 2.0,
-        };
-        let sampler = FilterSampler::new(&desc);
-        let negatives = (0..1000)
-            .filter(|&i| sampler.sample(Vec2::new(i as f32 / 1000.0, 0.5)).1 < 0.0)
-            .count();
-        assert!(negatives > 0 && negatives < 100, "{negatives}");
+            2.0,
+        );
+        // A sample at 10.3 reaches the centres 8.5 to 11.5; those beyond half the radius
+        // (offsets -1.8 and 1.2) weigh less than nothing.
+        let taps = f.taps_x(10, 0.3, 0, 20);
+        assert_eq!(taps.first, 8);
+        let w = taps.weights();
+        assert_eq!(w.len(), 4);
+        assert!(
+            w[0] < 0.0 && w[3] < 0.0 && w[1] > 0.0 && w[2] > 0.0,
+            "{w:?}"
+        );
+        assert!(w.iter().all(|w| w.abs() <= 1.0));
+    }
+
+    #[test]
+    fn taps_stay_within_the_border_and_the_given_range() {
+        for width in [0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 4.0, MAX_WIDTH] {
+            let f = filter(FilterKind::Triangle, width);
+            let b = FilterDesc {
+                kind: FilterKind::Triangle,
+                xwidth: width,
+                ywidth: width,
+            }
+            .border()[0];
+            for u in [0.0, 0.25, 0.5, 0.999_999_94] {
+                let taps = f.taps_x(20, u, 0, 100);
+                let n = taps.weights().len() as u32;
+                assert!(
+                    taps.first >= 20 - b && taps.first + n <= 21 + b,
+                    "{width} {u}"
+                );
+                let clipped = f.taps_x(20, u, 19, 21);
+                assert!(
+                    clipped.first >= 19 && clipped.first + clipped.weights().len() as u32 <= 21
+                );
+            }
+        }
+        assert_eq!(border(0.5), 0);
+        assert_eq!(border(1.0), 1);
+        assert_eq!(border(1.5), 1);
+        assert_eq!(border(2.0), 2);
+        assert_eq!(border(MAX_WIDTH), MAX_BORDER);
     }
 }

@@ -416,6 +416,7 @@ pub fn sample_map(round: &Round, settings: &RenderSettings) -> (image::GrayImage
 mod tests {
     use super::*;
     use crate::film::SampleBuffer;
+    use crate::render::unit::FilmFrame;
 
     fn settings(width: u32, height: u32, spp: u32) -> RenderSettings {
         RenderSettings::for_tests(width, height, spp)
@@ -443,7 +444,7 @@ mod tests {
         noise: impl Fn(u32) -> f64,
     ) {
         for unit in units {
-            let mut buffer = SampleBuffer::new(*unit);
+            let mut buffer = SampleBuffer::new(*unit, &film.frame());
             let w = unit.x1 - unit.x0;
             for y in unit.y0..unit.y1 {
                 for x in unit.x0..unit.x1 {
@@ -590,7 +591,7 @@ mod tests {
             16..64 => 0.2,
             _ => 0.8,
         };
-        let mut film = Film::with_half(s.width, s.height);
+        let mut film = Film::with_half(FilmFrame::unbordered(s.width, s.height));
         let (round, history) = render_to_the_end(&mut film, &s, &a, |_| 0.5, noise);
         let spp = samples_per_pixel(&round, &s);
         let at = |x: u32| -> Vec<u32> {
@@ -638,7 +639,7 @@ mod tests {
                 min_spp: n,
                 ..ADAPTIVE
             };
-            let mut film = Film::with_half(64, 64);
+            let mut film = Film::with_half(FilmFrame::unbordered(64, 64));
             let round = Round::first(&s, &a);
             render(&mut film, &round.units(&s, &a), |_| 1.0, |_| amplitude);
             let noise = Noise::of(&film, &round, &s);
@@ -666,7 +667,7 @@ mod tests {
         }
         // A black image has no noise: the render stops after round 0.
         let s = settings(16, 16, 64);
-        let mut film = Film::with_half(16, 16);
+        let mut film = Film::with_half(FilmFrame::unbordered(16, 16));
         let round = Round::first(&s, &ADAPTIVE);
         render(&mut film, &round.units(&s, &ADAPTIVE), |_| 0.0, |_| 0.0);
         assert_eq!(Noise::of(&film, &round, &s).brightness, 1.0);

@@ -23,7 +23,8 @@ pub const FINE_FINAL_PASS_SAMPLES: u64 = 1 << 18;
 /// Changes whenever the same settings would give another plan. A unit's buffer is summed in
 /// f32 before it reaches the exact film, so another plan gives slightly different image bits:
 /// a checkpoint of another plan must not be resumed (it is part of the render's identity).
-pub const PLAN_VERSION: u32 = 2;
+/// Version 3: samples are splatted through the pixel filter into their neighbours.
+pub const PLAN_VERSION: u32 = 3;
 
 /// The unit plan: tiles of `TILE_SIZE` in scanline order, and `PASSES` sample ranges, ordered
 /// by sample range first so that any prefix of the plan covers the whole image; the last range

@@ -10,7 +10,7 @@ use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::{MaterialDesc, SceneDesc};
 use crate::film::{unit_sum, SampleBuffer};
-use crate::filter::FilterSampler;
+use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::path::{trace_path, PathScene};
@@ -21,7 +21,7 @@ use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
 use super::settings::RenderSettings;
-use super::unit::{UnitStats, WorkUnit};
+use super::unit::{FilmFrame, UnitStats, WorkUnit};
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
@@ -43,7 +43,8 @@ pub struct RenderScene {
     desc: SceneDesc,
     settings: RenderSettings,
     camera: Camera,
-    filter: FilterSampler,
+    filter: PixelFilter,
+    frame: FilmFrame,
     geometry: SceneGeometry,
     textures: Textures,
     materials: Materials,
@@ -91,7 +92,12 @@ impl RenderScene {
         guard.check_cancel()?;
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
-            filter: FilterSampler::new(&desc.filter),
+            filter: PixelFilter::new(&desc.filter),
+            frame: FilmFrame {
+                width: settings.width,
+                height: settings.height,
+                border: desc.filter.border(),
+            },
             textures,
             materials: Materials::new(desc.materials.clone()),
             geometry,
@@ -118,6 +124,12 @@ impl RenderScene {
         &self.geometry
     }
 
+    /// The film's size and the border of every unit's buffer: what a film merging this
+    /// scene's units is made with.
+    pub fn frame(&self) -> FilmFrame {
+        self.frame
+    }
+
     pub fn lights(&self) -> &Lights {
         &self.lights
     }
@@ -139,8 +151,19 @@ impl RenderScene {
     }
 
     /// Renders one unit on the calling thread. Deterministic: the same unit gives the same
-    /// buffer bytes on any machine and thread. An adaptive unit renders only the pixels of its
-    /// active blocks (the others stay zero) and sums its odd-index samples apart as well.
+    /// buffer bytes on any machine and thread (one thread sums a unit, pixel by pixel and
+    /// sample by sample in a fixed order). Its samples lie uniformly in its tile's pixels and
+    /// are splatted through the pixel filter into the tile and the border around it
+    /// ([`FilmFrame::region`]). An adaptive unit takes samples only in the pixels of its active
+    /// blocks (they still splat into their neighbours, active or not) and sums its odd-index
+    /// samples apart as well.
+    ///
+    /// Where an adaptive render's sample density changes (at the edge of a block that goes on
+    /// beside one that stopped), a pixel's samples are no longer spread evenly under its filter:
+    /// the denser side weighs more in its mean. The pixel is still a weighted mean of radiance
+    /// near it, only with a slightly lopsided filter, a bias of the order of the radiance's
+    /// change across the filter's width in those edge pixels, and none in flat regions (which
+    /// are what stops early).
     pub fn render_unit(&self, unit: &WorkUnit) -> (SampleBuffer, UnitStats) {
         self.render_unit_cancellable(unit, &AtomicBool::new(false))
             .expect("never cancelled")
@@ -156,19 +179,14 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
-        let mut buffer = SampleBuffer::new(*unit);
+        let mut buffer = SampleBuffer::new(*unit, &self.frame);
         let mut stats = UnitStats::default();
-        let tile_width = unit.x1 - unit.x0;
         let keep_half = unit.mask.is_some();
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
                 if !unit.renders(x, y) {
                     continue;
                 }
-                let i = ((y - unit.y0) * tile_width + (x - unit.x0)) as usize;
-                // [all samples, odd-index samples]: the second only for adaptive units.
-                let mut rgb = [Vec3::ZERO; 2];
-                let mut weight = [0.0f32; 2];
                 for chunk in (unit.sample_start..unit.sample_end).step_by(CANCEL_CHECK_SAMPLES) {
                     if cancel.load(Ordering::Relaxed) {
                         return None;
@@ -177,36 +195,66 @@ impl RenderScene {
                     for index in chunk..chunk_end.min(unit.sample_end) {
                         let mut sampler =
                             PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed);
-                        let (offset, w) = self.filter.sample(sampler.get_2d());
+                        let u = sampler.get_2d();
                         let lens = sampler.get_2d();
-                        let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                        let film = Vec2::new(x as f32 + u.x, y as f32 + u.y);
                         stats.samples += 1;
-                        let parts = if keep_half && index % 2 == 1 { 2 } else { 1 };
-                        let Some(ray) = self.camera.generate_ray(film, lens) else {
-                            weight[..parts].iter_mut().for_each(|s| *s += w);
-                            continue;
+                        // A sample without a camera ray (outside a fisheye's circle) is black.
+                        let radiance = match self.camera.generate_ray(film, lens) {
+                            None => Vec3::ZERO,
+                            Some(ray) => {
+                                let path = trace_path(self, ray, &mut sampler);
+                                stats.rays += u64::from(path.rays);
+                                if !path.radiance.is_finite() {
+                                    stats.dropped += 1;
+                                    continue;
+                                }
+                                path.radiance
+                            }
                         };
-                        let path = trace_path(self, ray, &mut sampler);
-                        stats.rays += u64::from(path.rays);
-                        if path.radiance.is_finite() {
-                            rgb[..parts]
-                                .iter_mut()
-                                .for_each(|s| *s += path.radiance * w);
-                            weight[..parts].iter_mut().for_each(|s| *s += w);
-                        } else {
-                            stats.dropped += 1;
-                        }
+                        let half = keep_half && index % 2 == 1;
+                        self.splat(&mut buffer, (x, y), u, radiance, half);
                     }
-                }
-                buffer.rgb[i] = unit_sum(rgb[0]);
-                buffer.weight[i] = weight[0];
-                if keep_half {
-                    buffer.half_rgb[i] = unit_sum(rgb[1]);
-                    buffer.half_weight[i] = weight[1];
                 }
             }
         }
+        for rgb in buffer.rgb.iter_mut().chain(&mut buffer.half_rgb) {
+            *rgb = unit_sum(Vec3::from_array(*rgb));
+        }
         Some((buffer, stats))
+    }
+
+    /// Adds a sample at `pixel + u` with `radiance` to every pixel of the buffer's region its
+    /// filter reaches, and to the half sums too when `half`.
+    fn splat(
+        &self,
+        buffer: &mut SampleBuffer,
+        (x, y): (u32, u32),
+        u: Vec2,
+        radiance: Vec3,
+        half: bool,
+    ) {
+        let region = buffer.region;
+        let columns = self.filter.taps_x(x, u.x, region.x0, region.x1);
+        let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
+        let width = region.width() as usize;
+        let first_column = (columns.first - region.x0) as usize;
+        for (row, &wy) in rows.weights().iter().enumerate() {
+            let start = (rows.first - region.y0) as usize * width + row * width + first_column;
+            for (i, &wx) in (start..).zip(columns.weights()) {
+                let w = wx * wy;
+                let add = |rgb: &mut [f32; 3], weight: &mut f32| {
+                    for (s, c) in rgb.iter_mut().zip(radiance.to_array()) {
+                        *s += c * w;
+                    }
+                    *weight += w;
+                };
+                add(&mut buffer.rgb[i], &mut buffer.weight[i]);
+                if half {
+                    add(&mut buffer.half_rgb[i], &mut buffer.half_weight[i]);
+                }
+            }
+        }
     }
 }
 

@@ -27,7 +27,8 @@ pub struct WorkUnit {
 }
 
 impl WorkUnit {
-    /// Pixels of the tile: the length of the unit's sample buffer.
+    /// Pixels of the tile (its sample buffer covers the tile and the filter's border around
+    /// it: [`FilmFrame::region`]).
     pub fn pixel_count(&self) -> usize {
         ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
     }
@@ -57,6 +58,30 @@ impl WorkUnit {
             })
     }
 
+    /// Whether a sample the unit takes can reach the pixel (x, y) through a filter reaching
+    /// `border` pixels: a pixel it renders lies within the border of it.
+    pub fn reaches(&self, x: u32, y: u32, border: [u32; 2]) -> bool {
+        let [bx, by] = border;
+        let (x0, x1) = (
+            x.saturating_sub(bx).max(self.x0),
+            x.saturating_add(bx).saturating_add(1).min(self.x1),
+        );
+        let (y0, y1) = (
+            y.saturating_sub(by).max(self.y0),
+            y.saturating_add(by).saturating_add(1).min(self.y1),
+        );
+        if x0 >= x1 || y0 >= y1 {
+            return false;
+        }
+        // The window's pixels are rendered block by block: look at one pixel of each block it
+        // overlaps.
+        let blocks = |lo: u32, hi: u32, origin: u32| {
+            ((lo - origin) / BLOCK_SIZE..=(hi - 1 - origin) / BLOCK_SIZE)
+                .map(move |b| (origin + b * BLOCK_SIZE).max(lo))
+        };
+        blocks(y0, y1, self.y0).any(|py| blocks(x0, x1, self.x0).any(|px| self.renders(px, py)))
+    }
+
     /// Pixels the unit renders: the tile's, or those of its active blocks.
     pub fn active_pixel_count(&self) -> usize {
         match self.mask {
@@ -74,6 +99,62 @@ impl WorkUnit {
     /// Camera samples the unit takes.
     pub fn sample_count(&self) -> u64 {
         self.active_pixel_count() as u64 * u64::from(self.sample_end - self.sample_start)
+    }
+}
+
+/// A rectangle of film pixels, [x0, x1) x [y0, y1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+
+    pub fn pixel_count(&self) -> usize {
+        (self.x1 - self.x0) as usize * (self.y1 - self.y0) as usize
+    }
+}
+
+/// What decides which pixels a unit's samples reach: the film's size and how many pixels the
+/// pixel filter reaches beyond the pixel a sample lies in, per axis (`filter.rs`). Every node
+/// derives it from the settings and the scene alike, so a unit's buffer has the same extent
+/// everywhere and a peer's buffer length is checked exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FilmFrame {
+    pub width: u32,
+    pub height: u32,
+    /// Pixels a sample's filter reaches to the left and right (`border[0]`), above and below
+    /// (`border[1]`) of its own pixel.
+    pub border: [u32; 2],
+}
+
+impl FilmFrame {
+    /// A frame whose filter reaches no neighbour (a box of half-width 0.5, or a synthetic
+    /// film in tests).
+    pub fn unbordered(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            border: [0, 0],
+        }
+    }
+
+    /// The pixels `unit`'s samples reach: its tile grown by the border, clipped to the film;
+    /// its sample buffer covers exactly these.
+    pub fn region(&self, unit: &WorkUnit) -> PixelRect {
+        let [bx, by] = self.border;
+        PixelRect {
+            x0: unit.x0.saturating_sub(bx),
+            y0: unit.y0.saturating_sub(by),
+            x1: unit.x1.saturating_add(bx).min(self.width),
+            y1: unit.y1.saturating_add(by).min(self.height),
+        }
     }
 }
 

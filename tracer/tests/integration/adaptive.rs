@@ -58,7 +58,7 @@ fn build(settings: &RenderSettings) -> RenderScene {
 fn uniform(spp: u32, seed: u64) -> (Film, u64) {
     let s = settings(spp, seed);
     let scene = build(&s);
-    let mut film = Film::new(s.width, s.height);
+    let mut film = Film::new(scene.frame());
     let mut samples = 0;
     for unit in plan_units(&s) {
         let (buffer, stats) = scene.render_unit(&unit);
@@ -72,7 +72,7 @@ fn uniform(spp: u32, seed: u64) -> (Film, u64) {
 fn adaptive(max_spp: u32, adaptive: &AdaptiveSettings) -> (Film, u64) {
     let s = settings(max_spp, 0);
     let scene = build(&s);
-    let mut film = Film::with_half(s.width, s.height);
+    let mut film = Film::with_half(scene.frame());
     let mut round = Round::first(&s, adaptive);
     let mut samples = 0;
     loop {

@@ -22,7 +22,7 @@ fn render(text: &str, spp: u32) -> Film {
         latlong: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
-    let mut film = Film::new(settings.width, settings.height);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         film.add(&scene.render_unit(&unit).0).unwrap();
     }

@@ -31,7 +31,7 @@ fn render(desc: &SceneDesc, source: &dyn yat_tracer::assets::AssetSource, spp: u
         },
     );
     let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
-    let mut film = Film::new(settings.width, settings.height);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         let (buffer, stats) = scene.render_unit(&unit);
         assert_eq!(stats.dropped, 0, "NaN samples");
@@ -166,7 +166,7 @@ fn the_daylight_scene_renders_lit() {
         },
     );
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
-    let mut film = Film::new(64, 36);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         film.add(&scene.render_unit(&unit).0).unwrap();
     }
@@ -205,7 +205,7 @@ WorldEnd
         },
     );
     let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).expect("builds");
-    let mut film = Film::new(1, 1);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         let (buffer, _) = scene.render_unit(&unit);
         for &[r, g, b] in &buffer.rgb {

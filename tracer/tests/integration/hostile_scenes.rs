@@ -173,7 +173,7 @@ fn render(body: &str) -> Result<Film, String> {
     let desc = parse_scene("main.lxs", &source).map_err(|e| e.to_string())?;
     let settings = settings(&desc);
     let scene = RenderScene::build(&desc, &source, &settings).map_err(|e| e.to_string())?;
-    let mut film = Film::new(settings.width, settings.height);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         film.add(&scene.render_unit(&unit).0).unwrap();
     }

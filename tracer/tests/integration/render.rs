@@ -7,9 +7,11 @@ use glam::{Mat4, Vec3, Vec4};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
 use yat_tracer::film::Film;
+use yat_tracer::filter::PixelFilter;
 use yat_tracer::lights::InfiniteLight;
 use yat_tracer::material::Matte;
-use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
+use yat_tracer::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
+use yat_tracer::sampler::PixelSampler;
 use yat_tracer::texture::Checkerboard2D;
 
 use crate::scene::empty_scene as scene;
@@ -72,7 +74,7 @@ fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
 fn render(desc: &SceneDesc, source: &MemorySource, spp: u32) -> Film {
     let settings = settings(desc, spp);
     let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
-    let mut film = Film::new(settings.width, settings.height);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         film.add(&scene.render_unit(&unit).0).unwrap();
     }
@@ -281,7 +283,7 @@ fn environment_marker_shows_up_in_the_convention_direction() {
         let mut settings = settings(&desc, 4);
         settings.latlong = convention;
         let scene = RenderScene::build(&desc, &source, &settings).unwrap();
-        let mut film = Film::new(8, 8);
+        let mut film = Film::new(scene.frame());
         for unit in plan_units(&settings) {
             film.add(&scene.render_unit(&unit).0).unwrap();
         }
@@ -321,8 +323,8 @@ fn rendering_is_deterministic_in_any_order() {
     let units = plan_units(&settings);
     let buffers: Vec<_> = units.iter().map(|u| scene.render_unit(u).0).collect();
     assert_eq!(buffers[0], scene.render_unit(&units[0]).0);
-    let mut forward = Film::new(24, 24);
-    let mut backward = Film::new(24, 24);
+    let mut forward = Film::new(scene.frame());
+    let mut backward = Film::new(scene.frame());
     buffers.iter().for_each(|b| forward.add(b).unwrap());
     buffers.iter().rev().for_each(|b| backward.add(b).unwrap());
     assert_eq!(forward.radiance(), backward.radiance());
@@ -390,4 +392,145 @@ fn planar_mapping_follows_the_object_space() {
     // put it in check (1, 0), black. World (-1.5, 0.5) is object (-0.3, 0.1): black.
     assert!(film.pixel(23, 19).x > 0.9, "{}", film.pixel(23, 19));
     assert!(film.pixel(17, 19).x < 0.1, "{}", film.pixel(17, 19));
+}
+
+/// A sky of constant radiance seen through a pinhole: every camera sample's radiance is the
+/// sky's, whatever the filter.
+fn sky_only(size: u32, filter: FilterDesc) -> SceneDesc {
+    let mut desc = scene(
+        camera(CameraKind::Perspective { fov: 40.0 }, Vec3::ZERO, 0.0, 1e30),
+        size,
+    );
+    desc.film.xresolution = size + 2 * 33;
+    desc.filter = filter;
+    constant_sky(&mut desc, Vec3::new(0.3, 0.5, 0.9));
+    desc
+}
+
+fn mitchell(width: f32) -> FilterDesc {
+    FilterDesc {
+        kind: FilterKind::Mitchell {
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0,
+        },
+        xwidth: width,
+        ywidth: width,
+    }
+}
+
+fn blackman_harris(width: f32) -> FilterDesc {
+    FilterDesc {
+        kind: FilterKind::BlackmanHarris,
+        xwidth: width,
+        ywidth: width,
+    }
+}
+
+/// Each sample splats its whole filter weight into the unit's buffer: away from the film's
+/// edges the buffer's weights add up to every sample's own weights (its taps over the two axes,
+/// unclipped), and on average to the filter's integral (Blackman-Harris over [-2, 2], its peak
+/// scaled to 1: 0.35875 x 4 per axis).
+#[test]
+fn a_unit_splats_every_samples_whole_filter_weight() {
+    let desc = sky_only(64, blackman_harris(2.0));
+    let settings = settings(&desc, 4);
+    let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).unwrap();
+    let filter = PixelFilter::new(&desc.filter);
+    // A unit inside the film: its border is not clipped.
+    let unit = WorkUnit {
+        index: 0,
+        x0: 40,
+        y0: 20,
+        x1: 60,
+        y1: 36,
+        sample_start: 1,
+        sample_end: 4,
+        mask: None,
+    };
+    let (buffer, stats) = scene.render_unit(&unit);
+    assert_eq!(buffer.region.pixel_count(), 24 * 20);
+    assert_eq!(stats.samples, 20 * 16 * 3);
+    let mut expected = 0.0f64;
+    for y in unit.y0..unit.y1 {
+        for x in unit.x0..unit.x1 {
+            for index in unit.sample_start..unit.sample_end {
+                let mut sampler = PixelSampler::new(x, y, index, settings.spp, settings.seed);
+                let u = sampler.get_2d();
+                let sum = |t: &[f32]| t.iter().map(|&w| f64::from(w)).sum::<f64>();
+                let wx = sum(filter.taps_x(x, u.x, 0, u32::MAX).weights());
+                let wy = sum(filter.taps_y(y, u.y, 0, u32::MAX).weights());
+                expected += wx * wy;
+            }
+        }
+    }
+    let total: f64 = buffer.weight.iter().map(|&w| f64::from(w)).sum();
+    assert!(
+        (total - expected).abs() < 1e-5 * expected,
+        "{total} against {expected}"
+    );
+    let integral = (0.35875f64 * 4.0).powi(2);
+    let per_sample = total / stats.samples as f64;
+    assert!(
+        (per_sample - integral).abs() < 0.01 * integral,
+        "{per_sample} against {integral}"
+    );
+}
+
+/// A uniform sky renders as exactly its radiance in every pixel, the film's edges (where part of
+/// each filter falls outside) and the overlaps of units' borders included, through filters with
+/// negative lobes too; the units merge to the same bits in any order.
+#[test]
+fn a_constant_sky_renders_exactly_constant_through_every_filter() {
+    let sky = Vec3::new(0.3, 0.5, 0.9);
+    for filter in [
+        mitchell(2.0),
+        blackman_harris(2.0),
+        mitchell(3.3),
+        FilterDesc {
+            kind: FilterKind::Sinc { tau: 3.0 },
+            xwidth: 4.0,
+            ywidth: 1.5,
+        },
+    ] {
+        let desc = sky_only(70, filter);
+        let settings = settings(&desc, 2);
+        let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).unwrap();
+        let units = plan_units(&settings);
+        assert!(units.len() >= 8, "tiles meet inside the film");
+        let buffers: Vec<_> = units.iter().map(|u| scene.render_unit(u).0).collect();
+        let mut forward = Film::new(scene.frame());
+        let mut backward = Film::new(scene.frame());
+        buffers.iter().for_each(|b| forward.add(b).unwrap());
+        buffers.iter().rev().for_each(|b| backward.add(b).unwrap());
+        assert_eq!(forward.sums(), backward.sums(), "{filter:?}");
+        for (i, c) in forward.radiance().into_iter().enumerate() {
+            assert!(
+                (c - sky).abs().max_element() < 2e-6,
+                "{filter:?}: pixel {i} is {c}"
+            );
+        }
+    }
+}
+
+/// A box of half-width 0.5 gives each sample to its own pixel with weight 1, as filter
+/// importance sampling did: a pixel's weight sum is its sample count.
+#[test]
+fn a_half_pixel_box_keeps_every_sample_in_its_pixel() {
+    let desc = sky_only(
+        20,
+        FilterDesc {
+            kind: FilterKind::Box,
+            xwidth: 0.5,
+            ywidth: 0.5,
+        },
+    );
+    let settings = settings(&desc, 5);
+    let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).unwrap();
+    assert_eq!(scene.frame().border, [0, 0]);
+    for unit in plan_units(&settings) {
+        let buffer = scene.render_unit(&unit).0;
+        assert_eq!(buffer.region.pixel_count(), unit.pixel_count());
+        let samples = (unit.sample_end - unit.sample_start) as f32;
+        assert!(buffer.weight.iter().all(|&w| w == samples));
+    }
 }

@@ -63,7 +63,7 @@ fn render_small(scene: &Path, width: u32, height: u32) -> image::RgbImage {
         },
     );
     let built = RenderScene::build(&desc, &source, &settings).expect("seed scene builds");
-    let mut film = Film::new(width, height);
+    let mut film = Film::new(built.frame());
     for unit in plan_units(&settings) {
         let (buffer, stats) = built.render_unit(&unit);
         assert_eq!(stats.dropped, 0, "{name}: NaN samples");

@@ -40,7 +40,7 @@ fn render_sized(
         },
     );
     let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
-    let mut film = Film::new(settings.width, settings.height);
+    let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {
         let (buffer, stats) = scene.render_unit(&unit);
         assert_eq!(stats.dropped, 0, "NaN samples");

@@ -556,6 +556,7 @@ mod tests {
                 blobs: Default::default(),
             },
             load_request: Default::default(),
+            frame: yat_tracer::render::unit::FilmFrame::unbordered(1, 1),
             events: tokio::sync::mpsc::unbounded_channel().0,
         }))
     }

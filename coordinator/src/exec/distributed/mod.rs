@@ -85,6 +85,7 @@ pub fn render(
         schedule: Schedule::new(units, |u| start.is_done(u), job.adaptive.is_none()),
         deadline: UnitDeadline::new(config.unit_deadline),
         load_request: manifest.load_request(&job.settings),
+        frame: start.film().frame(),
         manifest,
         events,
     });

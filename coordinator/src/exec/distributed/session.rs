@@ -13,6 +13,7 @@ use tokio::sync::watch;
 use tokio::task::JoinSet;
 use yat_proto::convert::{result_from_wire, BYTES_PER_PIXEL};
 use yat_proto::{pb, PROTOCOL_VERSION};
+use yat_tracer::filter::MAX_BORDER;
 use yat_tracer::render::{WorkUnit, TILE_SIZE};
 
 use super::client::{WorkerClient, MIN_CHUNK_BYTES};
@@ -48,9 +49,11 @@ const MAX_SCENE_ID_BYTES: usize = 256;
 const REPLY_OVERHEAD_BYTES: u64 = 1024;
 
 /// The smallest message limit a worker may advertise: two of the smallest blob chunk, and the
-/// reply to the largest unit of any plan (an adaptive unit's: its sums and its half sums).
+/// reply to the largest unit of any plan (an adaptive unit's: its sums and its half sums, over
+/// its tile and the widest filter's border).
 pub fn min_message_bytes() -> u64 {
-    let unit_reply = 2 * u64::from(TILE_SIZE * TILE_SIZE) * BYTES_PER_PIXEL as u64;
+    let side = u64::from(TILE_SIZE + 2 * MAX_BORDER);
+    let unit_reply = 2 * side * side * BYTES_PER_PIXEL as u64;
     (2 * MIN_CHUNK_BYTES as u64).max(unit_reply + REPLY_OVERHEAD_BYTES)
 }
 
@@ -446,8 +449,8 @@ fn accept(
     (reply, took): (pb::RenderUnitReply, Duration),
 ) -> Result<(), SessionError> {
     let received = reply.encoded_len() as u64;
-    let (buffer, stats) =
-        result_from_wire(unit, &reply).map_err(|e| SessionError::BadReply(e.to_string()))?;
+    let (buffer, stats) = result_from_wire(unit, &shared.frame, &reply)
+        .map_err(|e| SessionError::BadReply(e.to_string()))?;
     shared.deadline.observe(took);
     let first = shared.schedule.complete(&unit);
     node.update(|r| {

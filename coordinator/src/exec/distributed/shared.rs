@@ -4,6 +4,7 @@
 use tokio::sync::mpsc::UnboundedSender;
 use yat_proto::pb;
 use yat_tracer::film::SampleBuffer;
+use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::UnitStats;
 
 use super::schedule::{Schedule, UnitDeadline};
@@ -26,6 +27,8 @@ pub struct Shared {
     pub deadline: UnitDeadline,
     pub manifest: SceneManifest,
     pub load_request: pb::LoadSceneRequest,
+    /// The film's size and the border of every unit's buffer: what a reply must cover.
+    pub frame: FilmFrame,
     pub events: UnboundedSender<Event>,
 }
 
