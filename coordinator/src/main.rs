@@ -15,8 +15,8 @@ fn main() -> ExitCode {
         .with_writer(std::io::stderr)
         .init();
     let result = match Cli::parse().command {
-        Command::Render(args) => cli::render::run(args),
-        Command::Worker(args) => cli::worker::run(args),
+        Command::Render(args) => cli::render::run(*args),
+        Command::Worker(args) => cli::worker::run(*args),
         Command::Check(args) => cli::check::run(args),
         Command::ExportLuxcore(args) => cli::export::run(args),
     };

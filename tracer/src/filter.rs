@@ -129,7 +129,9 @@ impl FilterDesc {
         let mut width = |name: &str| -> Result<f32, ParseError> {
             let w = params.float(name, width)?;
             match params.find(name) {
-                Some(p) if !(w > 0.0) => Err(params.error(p, "the filter width must be positive")),
+                Some(p) if w.is_nan() || w <= 0.0 => {
+                    Err(params.error(p, "the filter width must be positive"))
+                }
                 Some(_) if w > MAX_WIDTH => {
                     ctx.warn(
                         pos,

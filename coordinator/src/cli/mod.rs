@@ -25,9 +25,9 @@ pub struct Cli {
 #[derive(Subcommand)]
 pub enum Command {
     /// Render a scene in-process, or over gRPC workers with --workers / --local-workers.
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Serve renders to a coordinator over gRPC.
-    Worker(worker::WorkerArgs),
+    Worker(Box<worker::WorkerArgs>),
     /// Parse a scene and report what it contains, without rendering.
     Check(check::CheckArgs),
     /// Write a scene as LuxCoreRender SDL and PLY meshes (for side-by-side benchmarks).

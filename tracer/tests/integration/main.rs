@@ -17,8 +17,8 @@ mod render;
 mod scene;
 mod seed_renders;
 mod seed_scenes;
-mod spectral_textures;
 mod shapes;
+mod spectral_textures;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;
 mod volumes;
