@@ -15,6 +15,16 @@
 //! Each pair of dimensions uses the first two Sobol dimensions (well stratified in 2D) with
 //! sample indices permuted and values Owen-scrambled per (pixel, dimension, seed), which keeps
 //! every 2D projection stratified while decorrelating the pairs from each other.
+//!
+//! Where the indices are permuted depends on how the samples are used. A uniform render takes
+//! all `spp` samples of a pixel, so they are permuted over `[0, spp)`. An adaptive render
+//! stops a pixel after any round, so every prefix it may stop at must be stratified on its
+//! own: its samples are permuted only within the dyadic blocks `[0, 16)`, `[16, 32)`,
+//! `[32, 64)`, ... (see [`PixelSampler::nested`]), each of which holds the Sobol points of an
+//! elementary net, so the first 16 x 2^k samples are the first 16 x 2^k Sobol points. (Permuted
+//! over the whole `[0, spp)`, a pixel stopped at n samples had a random subset of the points
+//! and an error falling like independent sampling's: 1.6x the squared error of a stratified
+//! prefix, measured on Captain Falcon and metal-mario-bg1.)
 
 use glam::Vec2;
 
@@ -62,30 +72,59 @@ const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 pub struct PixelSampler {
     pixel_hash: u64,
     index: u32,
-    spp: u32,
+    /// The indices are permuted over `first..first + len`, which holds `index`.
+    first: u32,
+    len: u32,
     dimension: u32,
 }
 
+/// The first block of [`PixelSampler::nested`]'s indices: the default first round of an
+/// adaptive render, so that rounds of that default are exactly the blocks.
+pub const NESTED_FIRST_BLOCK: u32 = 16;
+
 impl PixelSampler {
+    /// Sample `index` of a pixel that takes all of `spp` samples (`index < spp`).
     pub fn new(x: u32, y: u32, index: u32, spp: u32, seed: u64) -> Self {
+        Self::over(x, y, index, 0, spp.max(1), seed)
+    }
+
+    /// Sample `index` of a pixel that may stop at any power of two times
+    /// [`NESTED_FIRST_BLOCK`] samples: each prefix of that length is stratified.
+    pub fn nested(x: u32, y: u32, index: u32, seed: u64) -> Self {
+        let (first, len) = if index < NESTED_FIRST_BLOCK {
+            (0, NESTED_FIRST_BLOCK)
+        } else {
+            let first = 1 << index.ilog2();
+            (first, first)
+        };
+        Self::over(x, y, index, first, len, seed)
+    }
+
+    fn over(x: u32, y: u32, index: u32, first: u32, len: u32, seed: u64) -> Self {
         let pixel_hash = mix64(seed ^ mix64((u64::from(x) << 32) | u64::from(y)));
         Self {
             pixel_hash,
             index,
-            spp: spp.max(1),
+            first,
+            len,
             dimension: 0,
         }
     }
 
+    /// The Sobol index this sample uses in the dimension whose hash is `p`.
+    fn sobol_index(&self, p: u32) -> u32 {
+        self.first + permutation_element(self.index - self.first, self.len, p)
+    }
+
     pub fn get_1d(&mut self) -> f32 {
         let hash = self.next_dimension_hash();
-        let index = permutation_element(self.index, self.spp, hash as u32);
+        let index = self.sobol_index(hash as u32);
         to_unit_float(owen_scramble(van_der_corput(index), (hash >> 32) as u32))
     }
 
     pub fn get_2d(&mut self) -> Vec2 {
         let hash = self.next_dimension_hash();
-        let index = permutation_element(self.index, self.spp, hash as u32);
+        let index = self.sobol_index(hash as u32);
         let scramble_x = (hash >> 32) as u32;
         let scramble_y = mix64(hash) as u32;
         Vec2::new(
@@ -267,6 +306,37 @@ mod tests {
                 cells[(u.y * 8.0) as usize * 8 + (u.x * 8.0) as usize] += 1;
             }
             assert!(cells.iter().all(|&c| c == 1), "pair {pair}: {cells:?}");
+        }
+    }
+
+    /// Every prefix of a nested pixel's samples that an adaptive render may stop at (16, 32,
+    /// 64, 128, 256) puts one sample in each elementary interval of its size in every 2D pair:
+    /// checked on the square grids (4x4, 8x8, 16x16) and the 2:1 ones (8x4, 16x8).
+    #[test]
+    fn nested_prefixes_are_stratified_in_each_2d_pair() {
+        for (n, cols, rows) in [
+            (16u32, 4u32, 4u32),
+            (32, 8, 4),
+            (64, 8, 8),
+            (128, 16, 8),
+            (256, 16, 16),
+        ] {
+            for pair in 0..3 {
+                let mut cells = vec![0u32; n as usize];
+                for i in 0..n {
+                    let mut s = PixelSampler::nested(3, 4, i, 11);
+                    for _ in 0..pair {
+                        s.get_2d();
+                    }
+                    let u = s.get_2d();
+                    let cell = (u.y * rows as f32) as u32 * cols + (u.x * cols as f32) as u32;
+                    cells[cell as usize] += 1;
+                }
+                assert!(
+                    cells.iter().all(|&c| c == 1),
+                    "n {n} pair {pair}: {cells:?}"
+                );
+            }
         }
     }
 

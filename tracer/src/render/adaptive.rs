@@ -37,14 +37,16 @@
 //! the same bits on every machine, for any number of workers and any order of arrival.
 
 use crate::film::Film;
+use crate::sampler::NESTED_FIRST_BLOCK;
 
 use super::plan::TILE_SIZE;
 use super::settings::RenderSettings;
 use super::unit::{WorkUnit, BLOCK_SIZE, MAX_MASKED_SIDE};
 
 /// Samples of round 0 when `--min-spp` is not given: enough for the odd half (8 samples) to
-/// say something about a block of 64 pixels.
-pub const DEFAULT_MIN_SPP: u32 = 16;
+/// say something about a block of 64 pixels, and the sampler's first nested block, so that
+/// every round's samples are stratified on their own.
+pub const DEFAULT_MIN_SPP: u32 = NESTED_FIRST_BLOCK;
 
 // A mask covers a plan tile.
 const _: () = assert!(TILE_SIZE == MAX_MASKED_SIDE);

@@ -193,8 +193,12 @@ impl RenderScene {
                     }
                     let chunk_end = chunk.saturating_add(CANCEL_CHECK_SAMPLES as u32);
                     for index in chunk..chunk_end.min(unit.sample_end) {
-                        let mut sampler =
-                            PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed);
+                        // An adaptive pixel may stop after any round: its samples are nested.
+                        let mut sampler = if unit.mask.is_some() {
+                            PixelSampler::nested(x, y, index, self.settings.seed)
+                        } else {
+                            PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed)
+                        };
                         let u = sampler.get_2d();
                         let lens = sampler.get_2d();
                         let film = Vec2::new(x as f32 + u.x, y as f32 + u.y);

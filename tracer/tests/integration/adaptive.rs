@@ -105,7 +105,9 @@ fn adaptive_sampling_beats_uniform_at_the_same_samples() {
     let (adaptive_film, adaptive_samples) = adaptive(
         512,
         &AdaptiveSettings {
-            threshold: 0.03,
+            // The image's RMS error over its mean brightness: at 0.05 the rounds stop near
+            // 80 spp on average.
+            threshold: 0.05,
             min_spp: 16,
         },
     );
