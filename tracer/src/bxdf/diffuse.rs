@@ -6,7 +6,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::local::{cosine_hemisphere_pdf, flip_z, same_hemisphere, sample_cosine_hemisphere};
-use super::sample::LocalSample;
+use super::sample::{cosine_pdf, LocalSample};
 
 /// The Oren-Nayar roughness terms (pbrt's qualitative model); A = 1, B = 0 is Lambert.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,15 +66,11 @@ impl DiffuseReflection {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(wi.z.abs())
+        cosine_pdf(wo, wi)
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
-        let wi = sample_cosine_hemisphere(u);
-        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
+        LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
     }
 }
 

@@ -17,8 +17,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::local::{cosine_hemisphere_pdf, same_hemisphere, sample_cosine_hemisphere};
-use super::sample::LocalSample;
+use super::local::same_hemisphere;
+use super::sample::{cosine_pdf, LocalSample};
 
 /// Midpoints used to integrate the clamped phase polynomial over the cosine.
 const PHASE_STEPS: usize = 64;
@@ -74,15 +74,11 @@ impl Velvet {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(wi.z.abs())
+        cosine_pdf(wo, wi)
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
-        let wi = sample_cosine_hemisphere(u);
-        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
+        LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
     }
 
     /// What it reflects at most, for lobe selection under a coat.
