@@ -152,11 +152,15 @@ chmod 755 "$tmp/run"
 head -c 1024 /dev/urandom >"$tmp/munge/munge.key"
 chmod 600 "$tmp/munge/munge.key"
 
-# A port nothing on this machine listens on (no connection is accepted there).
+# A port nothing on this machine listens on (no connection is accepted there), below the
+# kernel's ephemeral range: a port inside it can be taken as the source port of an outgoing
+# connection between the probe and the bind ("address already in use", seen once).
 free_port() {
-    local port
+    local port ephemeral_low
+    ephemeral_low=$(cut -f1 /proc/sys/net/ipv4/ip_local_port_range 2>/dev/null || echo 32768)
+    [ "$ephemeral_low" -gt 11000 ] 2>/dev/null || ephemeral_low=32768
     for _ in $(seq 100); do
-        port=$((20000 + RANDOM % 40000))
+        port=$((10000 + RANDOM % (ephemeral_low - 10000)))
         if ! (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
             echo "$port"
             return 0
