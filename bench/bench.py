@@ -114,11 +114,13 @@ def log(msg):
 
 
 def ensure_venv():
-    """Re-runs this script inside bench/.venv, made or brought up to date by SETUP first."""
+    """Re-runs the script that was started (this one, or one importing it such as
+    bench/adaptive.py) inside bench/.venv, made or brought up to date by SETUP first."""
     if Path(sys.prefix).resolve() == VENV.resolve():
         return
     subprocess.run([str(SETUP)], check=True)
-    os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), __file__, *sys.argv[1:]])
+    script = str(Path(sys.argv[0]).resolve())
+    os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), script, *sys.argv[1:]])
 
 
 def run_measured(cmd, what, stats):
