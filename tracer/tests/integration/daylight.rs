@@ -12,8 +12,10 @@ use yat_tracer::film::{Film, MAX_UNIT_SUM};
 use yat_tracer::lights::{PointLight, SkyLight, SunLight};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{blackbody_rgb, parse_scene};
+
 use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings};
 
+use crate::render::render_whole;
 use crate::util::workspace_root;
 
 fn parse(text: &str) -> SceneDesc {
@@ -23,21 +25,7 @@ fn parse(text: &str) -> SceneDesc {
 }
 
 fn render(desc: &SceneDesc, source: &dyn yat_tracer::assets::AssetSource, spp: u32) -> Film {
-    let settings = RenderSettings::resolve(
-        desc,
-        &RenderOverrides {
-            spp: Some(spp),
-            ..Default::default()
-        },
-    );
-    let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
-    let mut film = Film::new(scene.frame());
-    for unit in plan_units(&settings) {
-        let (buffer, stats) = scene.render_unit(&unit);
-        assert_eq!(stats.dropped, 0, "NaN samples");
-        film.add(&buffer).unwrap();
-    }
-    film
+    render_whole(desc, source, spp, None)
 }
 
 /// Irradiance on an upward-facing plane from the sky's upper hemisphere, by quadrature of

@@ -81,6 +81,33 @@ fn render(desc: &SceneDesc, source: &MemorySource, spp: u32) -> Film {
     film
 }
 
+/// Renders every unit of the plan of `desc` at `spp` samples per pixel (at `resolution` when
+/// given) into one film, asserting that no sample was NaN: the whole-render helper of the
+/// daylight and volume tests.
+pub fn render_whole(
+    desc: &SceneDesc,
+    source: &dyn yat_tracer::assets::AssetSource,
+    spp: u32,
+    resolution: Option<(u32, u32)>,
+) -> Film {
+    let settings = RenderSettings::resolve(
+        desc,
+        &yat_tracer::render::RenderOverrides {
+            spp: Some(spp),
+            resolution,
+            ..Default::default()
+        },
+    );
+    let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
+    let mut film = Film::new(scene.frame());
+    for unit in plan_units(&settings) {
+        let (buffer, stats) = scene.render_unit(&unit);
+        assert_eq!(stats.dropped, 0, "NaN samples");
+        film.add(&buffer).unwrap();
+    }
+    film
+}
+
 fn mean(film: &Film, pixels: impl Iterator<Item = (u32, u32)>) -> Vec3 {
     let (sum, n) = pixels.fold((Vec3::ZERO, 0), |(s, n), (x, y)| {
         (s + film.pixel(x, y), n + 1)

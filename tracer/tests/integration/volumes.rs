@@ -11,8 +11,8 @@ use yat_tracer::film::Film;
 use yat_tracer::material::Glass;
 use yat_tracer::medium::{Clear, Homogeneous};
 use yat_tracer::parse::parse_scene;
-use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings};
 
+use crate::render::render_whole;
 use crate::util::workspace_root;
 
 fn parse(text: &str) -> SceneDesc {
@@ -22,31 +22,7 @@ fn parse(text: &str) -> SceneDesc {
 }
 
 fn render(desc: &SceneDesc, spp: u32) -> Film {
-    render_sized(desc, &MemorySource::new(), spp, None)
-}
-
-fn render_sized(
-    desc: &SceneDesc,
-    source: &dyn yat_tracer::assets::AssetSource,
-    spp: u32,
-    resolution: Option<(u32, u32)>,
-) -> Film {
-    let settings = RenderSettings::resolve(
-        desc,
-        &RenderOverrides {
-            spp: Some(spp),
-            resolution,
-            ..Default::default()
-        },
-    );
-    let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
-    let mut film = Film::new(scene.frame());
-    for unit in plan_units(&settings) {
-        let (buffer, stats) = scene.render_unit(&unit);
-        assert_eq!(stats.dropped, 0, "NaN samples");
-        film.add(&buffer).unwrap();
-    }
-    film
+    render_whole(desc, &MemorySource::new(), spp, None)
 }
 
 fn mean(film: &Film, x0: u32, x1: u32, y0: u32, y1: u32) -> Vec3 {
@@ -353,7 +329,7 @@ fn the_volumes_scene_renders_tinted_glass_and_grey_smoke() {
         interiors,
         vec![None, Some(MediumId(0)), Some(MediumId(1)), None]
     );
-    let film = render_sized(&desc, &source, 16, Some((48, 27)));
+    let film = render_whole(&desc, &source, 16, Some((48, 27)));
     let (left, right) = (mean(&film, 4, 16, 4, 24), mean(&film, 32, 44, 4, 24));
     assert!(
         left.is_finite() && right.min_element() > 0.0,
