@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex};
 
 use fastrand::Rng;
 use yat_tracer::assets::{AssetError, AssetSource, FsSource, MemorySource};
-use yat_tracer::desc::{Geometry, LatLongConvention, SceneDesc};
+use yat_tracer::desc::{Geometry, LatLongConvention, LightDesc, SceneDesc};
 use yat_tracer::mesh::tessellate::tessellate;
 use yat_tracer::parse::parse_scene;
 use yat_tracer::render::{RenderScene, RenderSettings, WorkUnit};
@@ -42,6 +42,10 @@ const ERROR_POOL_ODDS: u32 = 16;
 /// slow without finding more (H4's build budgets bound them in the tracer).
 const MAX_BUILD_TRIANGLES: usize = 200_000;
 const MAX_BUILD_SHAPES: usize = 20_000;
+/// Sky lights a built input may hold: each is a 1024x512 table (about 0.1 s of CPU), and the
+/// tracer's texel budget admits a thousand, so inputs that repeat a sky line would spend the
+/// run tabulating skies; their parse is still fuzzed, and one or two skies are built.
+const MAX_BUILD_SKIES: usize = 2;
 
 /// Shapes tessellated per input, and how finely.
 const MAX_TESSELLATED_SHAPES: usize = 64;
@@ -542,7 +546,14 @@ fn is_too_big_to_build(desc: &SceneDesc) -> bool {
             _ => 1,
         })
         .sum();
-    triangles > MAX_BUILD_TRIANGLES || desc.shapes.len() > MAX_BUILD_SHAPES
+    let skies = desc
+        .lights
+        .iter()
+        .filter(|l| matches!(l, LightDesc::Sky(_)))
+        .count();
+    triangles > MAX_BUILD_TRIANGLES
+        || desc.shapes.len() > MAX_BUILD_SHAPES
+        || skies > MAX_BUILD_SKIES
 }
 
 /// A hash of what a message says: its first letters outside quotes and backticks, so
