@@ -245,7 +245,11 @@ pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeEr
         | image::ColorType::Rgb8
         | image::ColorType::Rgba8 => {
             let linear = Box::new(std::array::from_fn(|v| linearise(v as f32 / 255.0)));
-            let codes: Vec<_> = img.to_rgb8().pixels().map(|p| [p[0], p[1], p[2], 0]).collect();
+            let codes: Vec<_> = img
+                .to_rgb8()
+                .pixels()
+                .map(|p| [p[0], p[1], p[2], 0])
+                .collect();
             let tiles = tile(width, height, &codes, [0; 4]);
             Texels::Bytes {
                 tiles: tiles.into_iter().map(ByteTile).collect(),
@@ -337,8 +341,8 @@ mod tests {
         }
         // Halfway between the centres of texels 3 and 4 on both axes (tiles hold 0..=3, 4..=7).
         let got = image.bilinear(Vec2::new(4.0 / 9.0, 4.0 / 6.0), Edge::Clamp, Edge::Clamp);
-        let want = (pixels[3 * 9 + 3] + pixels[3 * 9 + 4] + pixels[4 * 9 + 3] + pixels[4 * 9 + 4])
-            * 0.25;
+        let want =
+            (pixels[3 * 9 + 3] + pixels[3 * 9 + 4] + pixels[4 * 9 + 3] + pixels[4 * 9 + 4]) * 0.25;
         assert!(got.0.abs_diff_eq(want, 1e-4), "{got:?} against {want}");
     }
 
