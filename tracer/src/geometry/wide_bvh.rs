@@ -80,22 +80,24 @@ impl WideBvh {
         let mut max_depth = 0;
         for (n, cw) in bvh.nodes.iter().enumerate() {
             let mut node = Node::EMPTY;
+            let mut slots = 0..WIDTH;
+            let mut leaves = Vec::new();
             for i in (0..WIDTH).filter(|&i| !cw.is_child_empty(i)) {
-                let (b, child) = if cw.is_leaf(i) {
+                if cw.is_leaf(i) {
                     let (start, n) = cw.child_primitives(i);
-                    node.leaves |= 1 << i;
-                    (leaf_box(start, n), wide.push_packet(start, n, triangles))
+                    leaves.push((leaf_box(start, n), (start..start + n).collect()));
                 } else {
                     let c = cw.child_node_index(i) as usize;
                     depth[c] = depth[n] + 1;
                     max_depth = max_depth.max(depth[c]);
-                    (node_box[c], c as u32)
-                };
-                for axis in 0..3 {
-                    node.bounds[axis][i] = b.min[axis];
-                    node.bounds[axis + 3][i] = b.max[axis];
+                    let slot = slots.next().expect("a CWBVH node has at most 8 children");
+                    node.set_child(slot, &node_box[c], c as u32);
                 }
-                node.child[i] = child;
+            }
+            for (b, prims) in merge_leaves(leaves) {
+                let slot = slots.next().expect("merging never adds leaves");
+                node.leaves |= 1 << slot;
+                node.set_child(slot, &b, wide.push_packet(&prims, triangles));
             }
             wide.nodes.push(node);
         }
@@ -103,12 +105,13 @@ impl WideBvh {
         wide
     }
 
-    /// Packs primitives `start..start + n` (leaf order) into one packet; returns the child
-    /// reference. obvhs's CWBVH leaves hold at most 3 primitives.
-    fn push_packet(&mut self, start: u32, n: u32, triangles: &[Option<TriangleEdges>]) -> u32 {
+    /// Packs primitives `prims` (leaf order, at most [`PACKET`]) into one packet; returns the
+    /// child reference.
+    fn push_packet(&mut self, prims: &[u32], triangles: &[Option<TriangleEdges>]) -> u32 {
+        debug_assert!(prims.len() <= PACKET);
         let mut packet = Packet::EMPTY;
         let mut other = 0u8;
-        for (lane, slot) in (start..start + n).take(PACKET).enumerate() {
+        for (lane, &slot) in prims.iter().enumerate() {
             packet.slot[lane] = slot;
             match triangles[slot as usize] {
                 Some(edges) => {
@@ -123,7 +126,7 @@ impl WideBvh {
             }
         }
         let index = self.packets.len() as u32;
-        debug_assert!(index <= MAX_PACKETS && n as usize <= PACKET);
+        debug_assert!(index <= MAX_PACKETS);
         self.packets.push(packet);
         self.other_lanes.push(other);
         LEAF | index | if other != 0 { LEAF_HAS_OTHER } else { 0 }
@@ -395,6 +398,37 @@ impl WideBvh {
             }
         }
         false
+    }
+}
+
+/// A node's leaves, merged pairwise into packets of up to [`PACKET`] primitives while that
+/// lowers the surface-area cost. obvhs's CWBVH leaves hold at most 3 primitives, so a 4-lane
+/// packet per leaf runs partly empty; one packet holding two leaves is tested whenever their
+/// union box is hit, the two leaves whenever either box is, so a pair merges when the union's
+/// area is below the sum of theirs (the best such pair first). Which primitives a ray can hit
+/// does not change, nor the hit returned (see the tie rule).
+fn merge_leaves(mut leaves: Vec<(Aabb, Vec<u32>)>) -> Vec<(Aabb, Vec<u32>)> {
+    loop {
+        let mut best: Option<(f32, usize, usize)> = None;
+        for a in 0..leaves.len() {
+            for b in a + 1..leaves.len() {
+                if leaves[a].1.len() + leaves[b].1.len() > PACKET {
+                    continue;
+                }
+                let union = leaves[a].0.union(&leaves[b].0);
+                let saving = leaves[a].0.half_area() + leaves[b].0.half_area() - union.half_area();
+                if saving > 0.0 && best.is_none_or(|(s, _, _)| saving > s) {
+                    best = Some((saving, a, b));
+                }
+            }
+        }
+        let Some((_, a, b)) = best else {
+            return leaves;
+        };
+        // b > a, so removing b leaves a in place.
+        let (merged_box, prims) = leaves.remove(b);
+        leaves[a].0 = leaves[a].0.union(&merged_box);
+        leaves[a].1.extend(prims);
     }
 }
 

@@ -10,9 +10,12 @@
 //! the scalar, SSE and AVX2 paths return bit-identical results and workers on different CPUs
 //! render the same image bytes.
 
+use obvhs::aabb::Aabb;
+
 /// Children per node.
 pub const WIDTH: usize = 8;
-/// Triangles per leaf packet (obvhs's CWBVH leaves hold at most 3 primitives).
+/// Triangles per leaf packet (obvhs's CWBVH leaves hold at most 3 primitives; sibling leaves
+/// are merged up to this).
 pub const PACKET: usize = 4;
 
 /// Child reference: bit 31 marks a leaf (the low bits index `packets`), otherwise the value
@@ -61,6 +64,15 @@ impl Node {
         child: [EMPTY; WIDTH],
         leaves: 0,
     };
+
+    /// Puts child reference `child` with box `b` in `slot`.
+    pub fn set_child(&mut self, slot: usize, b: &Aabb, child: u32) {
+        for axis in 0..3 {
+            self.bounds[MIN_X + axis][slot] = b.min[axis];
+            self.bounds[MAX_X + axis][slot] = b.max[axis];
+        }
+        self.child[slot] = child;
+    }
 }
 
 /// Up to four triangles as (vertex 0, edge 1, edge 2) in structure-of-arrays order (rows x, y,

@@ -190,8 +190,11 @@ impl Distribution2D {
         }
     }
 
-    /// A point in [0, 1)^2 (x along the row, y across rows) and its density.
-    pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
+    /// A point in [0, 1)^2 (x along the row, y across rows) and its density. `reading(row,
+    /// column)` is called with the record about to be read, the column picked unless its
+    /// alias is: a caller that reads its own data at the picked point can start loading it
+    /// while this record's cache miss is under way.
+    pub fn sample(&self, u: Vec2, reading: impl FnOnce(usize, usize)) -> Option<(Vec2, f32)> {
         if self.width == 0 {
             return None;
         }
@@ -199,6 +202,7 @@ impl Distribution2D {
         let n = self.width;
         let scaled = u.x.clamp(0.0, ONE_MINUS_EPSILON) * n as f32;
         let slot = (scaled as usize).min(n - 1);
+        reading(row, slot);
         let cell = self.cells[row * n + slot];
         let within = (scaled - slot as f32).clamp(0.0, ONE_MINUS_EPSILON);
         let (column, pdf_x, du) = if within < cell.keep {
@@ -349,7 +353,7 @@ mod tests {
         // u.y = 0.1 lands in row 0, which holds most of the weight.
         for j in 0..m {
             let u = Vec2::new((j as f32 + 0.5) / m as f32, 0.1);
-            let (p, density) = d.sample(u).expect("a sample");
+            let (p, density) = d.sample(u, |_, _| {}).expect("a sample");
             assert_eq!((p.y * 3.0) as usize, 0);
             assert_eq!(density, d.pdf(p), "at {p}");
             let column = (p.x * 10.0) as usize;

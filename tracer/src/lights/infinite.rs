@@ -206,7 +206,11 @@ impl Environment {
                 ))
             }
             Some(map) => {
-                let (uv, pdf_uv) = map.distribution.sample(u)?;
+                // The texels looked up below sit at the sampled column nearly always: their
+                // load starts alongside the distribution's own cache miss.
+                let (uv, pdf_uv) = map
+                    .distribution
+                    .sample(u, |row, column| map.image.prefetch(column, row))?;
                 let (d_light, sin_theta) = map.direction(uv);
                 if pdf_uv <= 0.0 || sin_theta <= 0.0 {
                     return None;
