@@ -111,7 +111,10 @@ pub fn write(p: &mut Props, prefix: &str, m: &MaterialDesc) -> bool {
             set("fresnel", quoted(&fresnel));
             set("uroughness", tex_value(uroughness, false));
             set("vroughness", tex_value(vroughness, false));
-            p.set(format!("scene.textures.{fresnel}.type"), quoted("fresnelcolor"));
+            p.set(
+                format!("scene.textures.{fresnel}.type"),
+                quoted("fresnelcolor"),
+            );
             p.set(format!("scene.textures.{fresnel}.kr"), tex_value(ks, true));
         }
         // The top layer over the next by its opacity (LuxCore's mix: amount 1 is material2).
