@@ -27,7 +27,7 @@ use crate::diag::SourcePos;
 use crate::medium::common::ShapeMedia;
 use crate::mesh::quadric::Quadric;
 use crate::mesh::{heightfield, inline, subdiv, TriangleMesh};
-use crate::param::MaterialId;
+use crate::param::{MaterialId, Tex};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -73,10 +73,17 @@ pub enum Geometry {
     Plane { normal: Vec3 },
 }
 
+/// An area light on a shape, as LuxRender defines its radiance: `L` (a colour, or a texture
+/// evaluated where the surface is seen or sampled) times `gain`, the gain scaled by power x
+/// efficacy / (area x pi x mean luminance of `L`) when that is positive (lights/area.rs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLightDesc {
-    /// Emitted radiance: L x gain, already normalised by power x efficacy when given.
-    pub radiance: Vec3,
+    pub l: Tex,
+    pub gain: f32,
+    pub power: f32,
+    pub efficacy: f32,
+    /// The shape's world-space area.
+    pub area: f32,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -51,8 +51,11 @@ pub fn write_light(
             set("coneangle", cone_angle.to_string());
             set("conedeltaangle", cone_delta_angle.to_string());
         }
+        // LuxCore's "distant" spreads its colour over a cone (theta, 10 degrees by default),
+        // which lit the bump scene at about a tenth of LuxRender's delta light; its
+        // "sharpdistant" is the delta light.
         LightDesc::Distant(DistantLight { to_light, radiance }) => {
-            set("type", quoted("distant"));
+            set("type", quoted("sharpdistant"));
             set("direction", v3(-*to_light));
             set("color", v3(*radiance));
             set("gain", "1 1 1".into());

@@ -2,7 +2,7 @@
 //! the emission of an area light when the material is an emitter's.
 
 use glam::Vec3;
-use yat_tracer::desc::{Fresnel, MaterialDesc, Tex};
+use yat_tracer::desc::{AreaLightDesc, Fresnel, MaterialDesc, Tex};
 use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix};
 
@@ -11,7 +11,12 @@ use crate::props::{mat_name, quoted, tex_name, tex_value, v3, Props};
 
 /// Writes material `m` under `name`; `emission` is added for emitting shapes. A null material
 /// that emits becomes clear glass (see [`write_null_emitter`]).
-pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Option<Vec3>) {
+pub fn write_material(
+    p: &mut Props,
+    name: &str,
+    m: &MaterialDesc,
+    emission: Option<&AreaLightDesc>,
+) {
     let prefix = format!("scene.materials.{name}");
     let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
     match m {
@@ -101,6 +106,8 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
             }
         }
         MaterialDesc::MatteTranslucent(MatteTranslucent { kr, kt, .. }) => {
+            // LuxCore always scales kt by 1 - kr (LuxRender 1.x's energyconserving true): a
+            // scene without energyconserving transmits less in LuxCore than in YAT.
             set("type", quoted("mattetranslucent"));
             set("kr", tex_value(kr, true));
             set("kt", tex_value(kt, true));
@@ -131,11 +138,22 @@ pub fn write_material(p: &mut Props, name: &str, m: &MaterialDesc, emission: Opt
             }
         }
     }
-    if let Some(radiance) = emission {
-        p.set(format!("{prefix}.emission"), v3(radiance));
-        p.set(format!("{prefix}.emission.gain"), "1 1 1");
-        p.set(format!("{prefix}.emission.power"), 0);
-        p.set(format!("{prefix}.emission.efficency"), 0);
+    match emission.map(|e| (e, e.radiance())) {
+        Some((_, Some(radiance))) => {
+            p.set(format!("{prefix}.emission"), v3(radiance));
+            p.set(format!("{prefix}.emission.gain"), "1 1 1");
+            p.set(format!("{prefix}.emission.power"), 0);
+            p.set(format!("{prefix}.emission.efficency"), 0);
+        }
+        // A texture's mean luminance needs its decoded images, which the export does not
+        // read: LuxCore normalises power and efficacy by its own mean of the texture.
+        Some((e, None)) => {
+            p.set(format!("{prefix}.emission"), tex_value(&e.l, true));
+            p.set(format!("{prefix}.emission.gain"), v3(Vec3::splat(e.gain)));
+            p.set(format!("{prefix}.emission.power"), e.power);
+            p.set(format!("{prefix}.emission.efficency"), e.efficacy);
+        }
+        None => {}
     }
 }
 

@@ -1,11 +1,16 @@
 //! The LuxRender 1.x materials beyond the course's set, as LuxCore's equivalents: carpaint,
 //! velvet, cloth, glossycoating and glossytranslucent have LuxCore materials of the same name
-//! and parameters (cloth's `presetname` is LuxCore's `preset`); shinymetal, layered and scatter have none and go out by their name (LuxCore
-//! then shows its default), which bench/RESULTS.md explains.
+//! and parameters (cloth's `presetname` is LuxCore's `preset`). Shinymetal, layered and scatter
+//! have none (LuxCore refuses a scene naming them) and go out as the nearest it has, which
+//! bench/RESULTS.md measures: shinymetal as metal2 with Ks as its Fresnel colour (its glossy
+//! lobe; the mirror lobe of Kr is left out), layered as a mix of its top layer over the next by
+//! the top's opacity, scatter as matte of its Kd.
 
 use yat_tracer::desc::MaterialDesc;
 use yat_tracer::material::glossy::CoatParams;
-use yat_tracer::material::{CarPaint, Cloth, GlossyCoating, GlossyTranslucent, Velvet};
+use yat_tracer::material::{
+    CarPaint, Cloth, GlossyCoating, GlossyTranslucent, Layered, Scatter, ShinyMetal, Velvet,
+};
 
 use crate::props::{mat_name, quoted, tex_value, Props};
 
@@ -94,6 +99,38 @@ pub fn write(p: &mut Props, prefix: &str, m: &MaterialDesc) -> bool {
             set("kt", tex_value(kt, true));
             write_coat(p, prefix, "", front);
             write_coat(p, prefix, "_bf", back.as_ref().unwrap_or(front));
+        }
+        MaterialDesc::ShinyMetal(ShinyMetal {
+            ks,
+            uroughness,
+            vroughness,
+            ..
+        }) => {
+            let fresnel = format!("{}_fresnel", prefix.replace('.', "_"));
+            set("type", quoted("metal2"));
+            set("fresnel", quoted(&fresnel));
+            set("uroughness", tex_value(uroughness, false));
+            set("vroughness", tex_value(vroughness, false));
+            p.set(
+                format!("scene.textures.{fresnel}.type"),
+                quoted("fresnelcolor"),
+            );
+            p.set(format!("scene.textures.{fresnel}.kr"), tex_value(ks, true));
+        }
+        // The top layer over the next by its opacity (LuxCore's mix: amount 1 is material2).
+        MaterialDesc::Layered(Layered { layers }) => match &layers[..] {
+            [] => set("type", quoted("null")),
+            [(top, opacity), rest @ ..] => {
+                let below = rest.first().map_or(*top, |(m, _)| *m);
+                set("type", quoted("mix"));
+                set("material1", quoted(&mat_name(below)));
+                set("material2", quoted(&mat_name(*top)));
+                set("amount", tex_value(opacity, false));
+            }
+        },
+        MaterialDesc::Scatter(Scatter { kd, .. }) => {
+            set("type", quoted("matte"));
+            set("kd", tex_value(kd, true));
         }
         _ => return false,
     }

@@ -42,12 +42,7 @@ pub fn write_shapes(
             Some(area) => {
                 let name = format!("emitter{i}");
                 let m = desc.materials.get(shape.material.0 as usize);
-                write_material(
-                    p,
-                    &name,
-                    m.unwrap_or(&MaterialDesc::Null(Null)),
-                    Some(area.radiance),
-                );
+                write_material(p, &name, m.unwrap_or(&MaterialDesc::Null(Null)), Some(area));
                 name
             }
             None if !shape.media.is_empty() => {

@@ -171,6 +171,10 @@ impl WorldMesh {
         TriangleSurface {
             vertices: self.vertices(tri),
             n: self.geometric_normal(tri),
+            uvs: match &self.uvs {
+                Some(uvs) => self.indices[tri as usize].map(|i| uvs[i as usize]),
+                None => DEFAULT_UVS,
+            },
         }
     }
 
@@ -249,6 +253,8 @@ fn uv_tangents([p0, p1, p2]: [Vec3; 3], [uv0, uv1, uv2]: [Vec2; 3], ng: Vec3) ->
 pub struct TriangleSurface {
     pub vertices: [Vec3; 3],
     pub n: Vec3,
+    /// The vertices' uvs, as a ray hit interpolates them (a textured emitter's colour).
+    pub uvs: [Vec2; 3],
 }
 
 impl TriangleSurface {
@@ -267,5 +273,16 @@ impl TriangleSurface {
             n: self.n,
             pdf_area: 1.0 / self.area(),
         }
+    }
+
+    /// The uv at `p`, a point of the triangle, interpolated as [`WorldMesh::hit`] does.
+    pub fn uv_at(&self, p: Vec3) -> Vec2 {
+        let [p0, p1, p2] = self.vertices;
+        let n = (p1 - p0).cross(p2 - p0);
+        let inv = 1.0 / n.length_squared();
+        let b1 = (p - p0).cross(p2 - p0).dot(n) * inv;
+        let b2 = (p1 - p0).cross(p - p0).dot(n) * inv;
+        let [uv0, uv1, uv2] = self.uvs;
+        (1.0 - b1 - b2) * uv0 + b1 * uv1 + b2 * uv2
     }
 }

@@ -1,38 +1,49 @@
-//! Area lights: a shape whose front side emits constant radiance. The statement sets the
-//! emission of every shape that follows in its attribute block:
+//! Area lights: a shape whose front side emits. The statement sets the emission of every
+//! shape that follows in its attribute block:
 //!
 //! ```text
 //! AreaLightSource "area" "color L" [1 1 1] "float gain" [1] "float power" [100] "float efficacy" [17]
+//! AreaLightSource "area" "texture L" "photo" "float power" [0]
 //! ```
 //!
 //! | parameter  | default | meaning                                                          |
 //! |------------|---------|------------------------------------------------------------------|
-//! | `L`        | 1 1 1   | colour                                                           |
+//! | `L`        | 1 1 1   | colour, or a colour texture                                      |
 //! | `gain`     | 1       | multiplies `L`                                                   |
 //! | `power`    | 100     | watts; with `efficacy` > 0 the gain is scaled so the shape emits that many lumens |
 //! | `efficacy` | 17      | lumens per watt                                                  |
 //!
 //! Other types are read as `"area"` with a warning. The radiance is known once the shape's
-//! world-space area is (LuxRender's normalisation divides by it).
+//! world-space area is (LuxRender's normalisation divides by it) and, for a texture, once its
+//! images are decoded (the normalisation divides by the texture's mean luminance, its mean
+//! over the unit uv square here, which for an image map is the image's mean).
+//!
+//! A texture is evaluated where the surface is seen and where a light sample lands, at the
+//! same uv and position either way (MIS weighs the two estimates of one value); a constant
+//! colour costs no evaluation. The primitive a texture sees is always 0 (a harlequin emitter
+//! is one colour): a sampled point does not know its primitive index.
 //!
 //! Points are sampled uniformly by area over the whole shape (triangles chosen by an area
 //! table), except whole spheres, which are sampled inside the cone they subtend (only their
 //! visible cap).
 
 use std::f32::consts::{PI, TAU};
+use std::sync::Arc;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Mat4, Vec2, Vec3, Vec3A};
 
 use crate::diag::SourcePos;
 use crate::geometry::{AnalyticShape, ShapeSurface, SurfaceSample, TriangleSurface};
 use crate::math::{luminance, Frame};
+use crate::param::{Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::shape::AreaLightDesc;
+use crate::texture::{TexturePoint, Textures};
 
 use super::distribution::Distribution1D;
-use super::emission::{light_color, normalised_gain, DEFAULT_GAIN, DEFAULT_L};
+use super::emission::{emits, normalised_gain, surface_color, DEFAULT_GAIN, DEFAULT_L};
 use super::sample::LightSample;
 
 /// `power`, watts.
@@ -44,7 +55,7 @@ pub const DEFAULT_EFFICACY: f32 = 17.0;
 /// world-space area of each shape is.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLightParams {
-    pub l: Vec3,
+    pub l: Tex,
     pub gain: f32,
     pub power: f32,
     pub efficacy: f32,
@@ -65,7 +76,7 @@ impl AreaLightParams {
             );
         }
         Ok(Self {
-            l: light_color(params, "L", DEFAULT_L, ctx)?,
+            l: surface_color(params, "L", DEFAULT_L, ctx)?,
             gain: params.float("gain", DEFAULT_GAIN)?,
             power: params.float("power", DEFAULT_POWER)?,
             efficacy: params.float("efficacy", DEFAULT_EFFICACY)?,
@@ -74,15 +85,88 @@ impl AreaLightParams {
 
     /// The emission of a shape of world-space area `area`.
     pub fn desc(&self, area: f32) -> AreaLightDesc {
-        let gain = normalised_gain(
+        AreaLightDesc {
+            l: self.l,
+            gain: self.gain,
+            power: self.power,
+            efficacy: self.efficacy,
+            area,
+        }
+    }
+}
+
+impl AreaLightDesc {
+    /// Constant radiance `radiance`, without power normalisation.
+    pub fn constant(radiance: Vec3) -> Self {
+        Self {
+            l: Tex::Const(radiance),
+            gain: 1.0,
+            power: 0.0,
+            efficacy: 0.0,
+            area: 0.0,
+        }
+    }
+
+    /// What multiplies `L`: the gain, normalised by power and efficacy for an `L` of mean
+    /// luminance `mean_luminance`.
+    pub fn scale(&self, mean_luminance: f32) -> f32 {
+        normalised_gain(
             self.gain,
             self.power,
             self.efficacy,
-            area * PI * luminance(self.l),
-        );
-        AreaLightDesc {
-            radiance: self.l * gain,
+            self.area * PI * mean_luminance,
+        )
+    }
+
+    /// The radiance of a constant `L`; None for a texture.
+    pub fn radiance(&self) -> Option<Vec3> {
+        match self.l {
+            Tex::Const(l) => Some(l * self.scale(luminance(l))),
+            Tex::Texture(_) => None,
         }
+    }
+}
+
+/// Points per side of the uv grid over which a texture's mean is taken.
+const MEAN_GRID: u32 = 32;
+
+/// A varying `L`, evaluated where the surface is seen or sampled.
+struct EmissionTexture {
+    textures: Arc<Textures>,
+    l: TextureId,
+    scale: f32,
+    /// The shape's, for the object-space position local 3D mappings see.
+    world_to_object: Affine3A,
+}
+
+impl EmissionTexture {
+    /// The radiance at world point `p` with surface coordinates `uv`.
+    fn at(&self, p: Vec3, uv: Vec2) -> Vec3 {
+        let at = TexturePoint {
+            p: self.world_to_object.transform_point3(p),
+            p_world: p,
+            uv,
+            prim: 0,
+        };
+        self.textures
+            .eval(Tex::Texture(self.l), &at)
+            .max(Vec3::ZERO)
+            * self.scale
+    }
+
+    /// The texture's mean over the unit uv square (cell centres; the point is the uv in the
+    /// z = 0 plane, so a 3D texture gives some mean of its pattern).
+    fn mean(textures: &Textures, l: TextureId) -> Vec3 {
+        let n = MEAN_GRID;
+        let mut sum = Vec3::ZERO;
+        for j in 0..n {
+            for i in 0..n {
+                let uv = (Vec2::new(i as f32, j as f32) + 0.5) / n as f32;
+                let at = TexturePoint::new(uv.extend(0.0), uv);
+                sum += textures.eval(Tex::Texture(l), &at).max(Vec3::ZERO);
+            }
+        }
+        sum / (n * n) as f32
     }
 }
 
@@ -98,7 +182,10 @@ const SMALL_CONE_SIN2: f32 = 0.000_685_23;
 
 /// An area light ready to sample.
 pub struct AreaLight {
+    /// The constant radiance, or a texture's mean radiance (what the light's power is
+    /// estimated from).
     radiance: Vec3,
+    texture: Option<EmissionTexture>,
     emitter: Emitter,
 }
 
@@ -117,16 +204,48 @@ enum Emitter {
     Quadric(Box<AnalyticShape>),
 }
 
+/// The surface a light point was sampled on.
+enum On<'a> {
+    Triangle(&'a TriangleSurface),
+    Quadric(&'a AnalyticShape),
+}
+
 /// A point on the light as seen from a shading point.
 pub struct EmitterSample {
     pub wi: Vec3,
     pub dist: f32,
     /// Solid-angle density.
     pub pdf: f32,
+    /// The radiance the point emits towards the shading point.
+    pub li: Vec3,
 }
 
 impl AreaLight {
-    pub fn new(radiance: Vec3, surface: ShapeSurface) -> Self {
+    /// The light `desc` on `surface`, a shape placed by `object_to_world`; None when it emits
+    /// nothing.
+    pub fn new(
+        desc: &AreaLightDesc,
+        object_to_world: Mat4,
+        surface: ShapeSurface,
+        textures: &Arc<Textures>,
+    ) -> Option<Self> {
+        let (radiance, texture) = match desc.l {
+            Tex::Const(l) => (l * desc.scale(luminance(l)), None),
+            Tex::Texture(l) => {
+                let mean = EmissionTexture::mean(textures, l);
+                let scale = desc.scale(luminance(mean));
+                let texture = EmissionTexture {
+                    textures: Arc::clone(textures),
+                    l,
+                    scale,
+                    world_to_object: Affine3A::from_mat4(object_to_world).inverse(),
+                };
+                (mean * scale, Some(texture))
+            }
+        };
+        if !emits(radiance) {
+            return None;
+        }
         let emitter = match surface {
             ShapeSurface::Triangles(triangles) => {
                 let areas: Vec<f32> = triangles.iter().map(TriangleSurface::area).collect();
@@ -146,11 +265,19 @@ impl AreaLight {
                 None => Emitter::Quadric(shape),
             },
         };
-        Self { radiance, emitter }
+        Some(Self {
+            radiance,
+            texture,
+            emitter,
+        })
     }
 
-    pub fn radiance(&self) -> Vec3 {
-        self.radiance
+    /// The radiance the front side emits at `hit`.
+    pub fn radiance_at(&self, p: Vec3, uv: Vec2) -> Vec3 {
+        match &self.texture {
+            None => self.radiance,
+            Some(t) => t.at(p, uv),
+        }
     }
 
     pub fn area(&self) -> f32 {
@@ -167,7 +294,7 @@ impl AreaLight {
 
     /// A point on the light seen from `from`; None when it shows its back (or nothing).
     pub fn sample(&self, from: Vec3, u: Vec2) -> Option<EmitterSample> {
-        let point = match &self.emitter {
+        let (point, on) = match &self.emitter {
             Emitter::Triangles {
                 triangles,
                 by_area,
@@ -175,21 +302,25 @@ impl AreaLight {
             } => {
                 let (i, _, u0) = by_area.sample_discrete(u.x)?;
                 let s = triangles[i].sample(Vec2::new(u0, u.y));
-                SurfaceSample {
+                let s = SurfaceSample {
                     pdf_area: 1.0 / area,
                     ..s
-                }
+                };
+                (s, On::Triangle(&triangles[i]))
             }
-            Emitter::Quadric(shape) => shape.sample(u),
+            Emitter::Quadric(shape) => (shape.sample(u), On::Quadric(shape)),
             Emitter::Sphere {
                 centre,
                 radius,
                 shape,
             } => {
                 if from.distance_squared(*centre) <= radius * radius * ON_SPHERE {
-                    shape.sample(u)
+                    (shape.sample(u), On::Quadric(shape))
                 } else {
-                    return sample_sphere_cone(from, *centre, *radius, shape.orientation(), u);
+                    let (wi, dist, pdf) =
+                        sample_sphere_cone(from, *centre, *radius, shape.orientation(), u)?;
+                    let li = self.li(from, wi, dist, On::Quadric(shape));
+                    return Some(EmitterSample { wi, dist, pdf, li });
                 }
             }
         };
@@ -199,7 +330,30 @@ impl AreaLight {
         let wi = to_light / dist;
         let cos_light = -point.n.dot(wi);
         let pdf = point.pdf_area * dist2 / cos_light;
-        (cos_light > 0.0 && pdf.is_finite()).then_some(EmitterSample { wi, dist, pdf })
+        (cos_light > 0.0 && pdf.is_finite()).then(|| EmitterSample {
+            wi,
+            dist,
+            pdf,
+            li: self.li(from, wi, dist, on),
+        })
+    }
+
+    /// The radiance of the light point `from + dist wi` of surface `on`, at the uv a ray from
+    /// `from` would hit there (interpolated on the triangle, or the quadric's own
+    /// parametrisation of the point).
+    fn li(&self, from: Vec3, wi: Vec3, dist: f32, on: On) -> Vec3 {
+        let Some(texture) = &self.texture else {
+            return self.radiance;
+        };
+        let p = from + wi * dist;
+        let uv = match on {
+            On::Triangle(triangle) => triangle.uv_at(p),
+            On::Quadric(shape) => {
+                let hit = shape.hit_at(Vec3A::from(from), Vec3A::from(wi), dist);
+                shape.hit(hit, 0).uv
+            }
+        };
+        texture.at(p, uv)
     }
 
     /// [`Self::sample`] as a light sample, for a light chosen with probability `pmf`.
@@ -207,7 +361,7 @@ impl AreaLight {
         let s = self.sample(from, u)?;
         Some(LightSample {
             wi: s.wi,
-            li: self.radiance(),
+            li: s.li,
             pdf: pmf * s.pdf,
             dist: s.dist,
             delta: false,
@@ -257,14 +411,15 @@ fn one_minus_cos_max(sin2_max: f32) -> f32 {
 }
 
 /// pbrt-v4's sphere sampling from outside: a direction uniform in the cone of the sphere's
-/// silhouette, turned into the point where it meets the sphere.
+/// silhouette, turned into the point where it meets the sphere: (direction, distance,
+/// solid-angle density).
 fn sample_sphere_cone(
     from: Vec3,
     centre: Vec3,
     radius: f32,
     orientation: f32,
     u: Vec2,
-) -> Option<EmitterSample> {
+) -> Option<(Vec3, f32, f32)> {
     let dc2 = from.distance_squared(centre);
     let sin2_max = radius * radius / dc2;
     let sin_max = sin2_max.sqrt();
@@ -293,11 +448,7 @@ fn sample_sphere_cone(
     let wi = to_light / dist;
     let pdf = 1.0 / (TAU * one_minus_cos_max(sin2_max));
     // Under ReverseOrientation the visible cap shows its back.
-    (orientation * outward.dot(wi) < 0.0 && pdf.is_finite()).then_some(EmitterSample {
-        wi,
-        dist,
-        pdf,
-    })
+    (orientation * outward.dot(wi) < 0.0 && pdf.is_finite()).then_some((wi, dist, pdf))
 }
 
 #[cfg(test)]
@@ -306,24 +457,25 @@ mod tests {
 
     #[test]
     fn area_gain_follows_power_and_efficacy() {
+        let l = Vec3::new(1.0, 0.5, 0.25);
         let e = AreaLightParams {
-            l: Vec3::new(1.0, 0.5, 0.25),
+            l: Tex::Const(l),
             gain: 2.0,
             power: 100.0,
             efficacy: 17.0,
         };
         let area = 0.5;
-        let r = e.desc(area).radiance;
-        let expected_gain = 2.0 * 100.0 * 17.0 / (area * PI * luminance(e.l));
-        assert!((r - e.l * expected_gain).abs().max_element() < 1e-3 * expected_gain);
+        let r = e.desc(area).radiance().unwrap();
+        let expected_gain = 2.0 * 100.0 * 17.0 / (area * PI * luminance(l));
+        assert!((r - l * expected_gain).abs().max_element() < 1e-3 * expected_gain);
         // Emitted luminous power then equals gain x power x efficacy: Y(L x gain) x area x pi.
         assert!((luminance(r) * area * PI - 2.0 * 1700.0).abs() < 0.5);
         let off = AreaLightParams {
             power: 0.0,
             ..e.clone()
         };
-        assert_eq!(off.desc(area).radiance, e.l * 2.0);
+        assert_eq!(off.desc(area).radiance(), Some(l * 2.0));
         // An infinite plane has no finite power: the gain stays as given.
-        assert_eq!(e.desc(f32::INFINITY).radiance, e.l * 2.0);
+        assert_eq!(e.desc(f32::INFINITY).radiance(), Some(l * 2.0));
     }
 }

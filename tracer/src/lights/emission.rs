@@ -4,9 +4,10 @@
 //! import it, it imports none of them.
 //!
 //! `L` may name a texture, as in LuxRender (`"texture L" "name"`, or a colour parameter given
-//! a texture name). The light needs one colour: a texture that is the same everywhere
-//! (constant, blackbody, scale or mix of such) gives it; one that varies over a surface
-//! (an image, a checkerboard) is a warning and the default colour is used.
+//! a texture name). An area light keeps it and evaluates it on its surface
+//! ([`surface_color`]); the other lights need one colour ([`light_color`]): a texture that is
+//! the same everywhere (constant, blackbody, scale or mix of such) gives it; one that varies
+//! over a surface (an image, a checkerboard) is a warning and the default colour is used.
 
 use glam::Vec3;
 
@@ -35,6 +36,23 @@ impl Emission {
             gain: params.float("gain", DEFAULT_GAIN)?,
         })
     }
+}
+
+/// An area light's colour parameter: a constant (a texture with one value everywhere becomes
+/// its value, so that the light costs no texture evaluation), or a varying texture.
+pub(crate) fn surface_color(
+    params: &ParamList,
+    name: &str,
+    default: Vec3,
+    ctx: &mut dyn ParseContext,
+) -> Result<Tex, ParseError> {
+    let value = params.tex_color(name, default)?;
+    Ok(match ctx.tex(value, true, default) {
+        Tex::Texture(id) => ctx
+            .uniform_texture(Tex::Texture(id))
+            .map_or(Tex::Texture(id), Tex::Const),
+        constant => constant,
+    })
 }
 
 /// A light's colour parameter: a colour, or a texture with one value everywhere.

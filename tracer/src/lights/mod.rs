@@ -32,6 +32,7 @@ mod sun;
 mod tests;
 
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -41,7 +42,8 @@ use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::shape::AreaLightDesc;
+use crate::shape::ShapeDesc;
+use crate::texture::Textures;
 
 pub use area::AreaLightParams;
 pub use distant::DistantLight;
@@ -214,36 +216,37 @@ pub struct Lights {
 }
 
 impl Lights {
-    /// The lights of a scene: `shapes` gives, for every shape in order, its name and its area
-    /// light (sampled on `geometry`'s surface of that shape), `lights` the `LightSource`s; maps
-    /// are read from `source` and indexed by `latlong`.
+    /// The lights of a scene: `shapes` are its shapes in order (an area light is sampled on
+    /// `geometry`'s surface of its shape, a textured one evaluates `textures`), `lights` the
+    /// `LightSource`s; maps are read from `source` and indexed by `latlong`.
     pub fn build<'a>(
-        shapes: impl IntoIterator<Item = (&'a str, Option<&'a AreaLightDesc>)>,
+        shapes: impl IntoIterator<Item = &'a ShapeDesc>,
         lights: &[LightDesc],
         geometry: &SceneGeometry,
+        textures: &Arc<Textures>,
         source: &dyn AssetSource,
         latlong: LatLongConvention,
     ) -> Result<Self, LightError> {
         let descs = lights;
         let mut lights = Vec::new();
         let mut shape_light = Vec::new();
-        for (index, (name, area_light)) in shapes.into_iter().enumerate() {
+        for (index, shape) in shapes.into_iter().enumerate() {
             shape_light.push(None);
-            let Some(area_light) = area_light else {
+            let Some(area_light) = &shape.area_light else {
                 continue;
             };
-            if !emission::emits(area_light.radiance) {
-                continue;
-            }
             let Some(surface) = geometry.shape_surface(index as u32) else {
                 tracing::warn!(
                     "shape \"{}\": area light ignored (an infinite plane or a degenerate shape \
                      has no surface to sample)",
-                    name
+                    shape.name
                 );
                 continue;
             };
-            let light = AreaLight::new(area_light.radiance, surface);
+            let Some(light) = AreaLight::new(area_light, shape.object_to_world, surface, textures)
+            else {
+                continue;
+            };
             if light.area() > 0.0 {
                 shape_light[index] = Some(lights.len() as u32);
                 lights.push(Light::Area(light));
@@ -347,7 +350,7 @@ impl Lights {
     /// Radiance an area light emits from `hit` towards `wo` (front face only).
     pub fn emitted(&self, hit: &SurfaceHit, wo: Vec3) -> Vec3 {
         match self.area_light(hit.shape) {
-            Some((_, light)) if hit.ng.dot(wo) > 0.0 => light.radiance(),
+            Some((_, light)) if hit.ng.dot(wo) > 0.0 => light.radiance_at(hit.p, hit.uv),
             _ => Vec3::ZERO,
         }
     }

@@ -6,7 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::*;
 use crate::assets::MemorySource;
-use crate::desc::{AreaLightDesc, Geometry, SceneDesc, ShapeDesc};
+use crate::desc::{AreaLightDesc, Geometry, ShapeDesc};
 use crate::geometry::tests::{mesh, scene_desc, shape, sphere};
 use crate::math::{luminance, Frame, Ray};
 
@@ -18,16 +18,16 @@ fn build_with(
 ) -> (SceneGeometry, Lights) {
     let desc = scene_desc(shapes, lights);
     let geometry = SceneGeometry::build(&desc.shapes);
-    let lights =
-        Lights::build(area_lights(&desc), &desc.lights, &geometry, source, latlong).unwrap();
+    let lights = Lights::build(
+        &desc.shapes,
+        &desc.lights,
+        &geometry,
+        &Arc::default(),
+        source,
+        latlong,
+    )
+    .unwrap();
     (geometry, lights)
-}
-
-/// Each shape's name and area light, as `Lights::build` takes them.
-fn area_lights(desc: &SceneDesc) -> impl Iterator<Item = (&str, Option<&AreaLightDesc>)> {
-    desc.shapes
-        .iter()
-        .map(|s| (s.name.as_str(), s.area_light.as_ref()))
 }
 
 fn build(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> (SceneGeometry, Lights) {
@@ -41,7 +41,7 @@ fn build(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> (SceneGeometry, Ligh
 
 fn emitter(geometry: Geometry, m: Mat4, radiance: Vec3) -> ShapeDesc {
     ShapeDesc {
-        area_light: Some(AreaLightDesc { radiance }),
+        area_light: Some(AreaLightDesc::constant(radiance)),
         media: Default::default(),
         ..shape(geometry, m)
     }
@@ -562,9 +562,10 @@ fn a_missing_env_map_is_an_error_naming_the_file() {
     let desc = scene_desc(vec![], vec![env_light("maps/sky.hdr", Mat4::IDENTITY)]);
     let geometry = SceneGeometry::build(&desc.shapes);
     let err = Lights::build(
-        area_lights(&desc),
+        &desc.shapes,
         &desc.lights,
         &geometry,
+        &Arc::default(),
         &MemorySource::new(),
         LatLongConvention::Seed,
     )
@@ -575,9 +576,10 @@ fn a_missing_env_map_is_an_error_naming_the_file() {
     let mut source = MemorySource::new();
     source.insert("maps/sky.hdr", Arc::from(&b"not an image"[..]));
     let err = Lights::build(
-        area_lights(&desc),
+        &desc.shapes,
         &desc.lights,
         &geometry,
+        &Arc::default(),
         &source,
         LatLongConvention::Seed,
     )

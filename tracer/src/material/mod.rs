@@ -139,7 +139,7 @@ impl MaterialDesc {
             "glass2" => Self::Glass(Glass::read_glass2(params, pos, ctx)?),
             "metal" => Self::Metal(Metal::read(params, pos, ctx)?),
             "metal2" => Self::Metal(Metal::read_metal2(params, pos, ctx)?),
-            "mattetranslucent" => Self::MatteTranslucent(MatteTranslucent::read(params, pos, ctx)?),
+            "mattetranslucent" => Self::MatteTranslucent(MatteTranslucent::read(params, ctx)?),
             "null" => Self::Null(Null),
             "mix" => Self::Mix(Mix::read(params, pos, ctx)?),
             "carpaint" => Self::CarPaint(CarPaint::read(params, pos, ctx)?),

@@ -270,6 +270,7 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
                     kr: c(0.4),
                     kt: c(1.0),
                     sigma: c(0.0),
+                    energy_conserving: true,
                 }),
             ),
         ),
@@ -306,6 +307,7 @@ fn leaf_cases() -> Vec<(&'static str, MaterialDesc)> {
                 kr: c(0.5),
                 kt: c(1.0),
                 sigma: c(0.0),
+                energy_conserving: true,
             }),
         ),
         (
@@ -314,6 +316,7 @@ fn leaf_cases() -> Vec<(&'static str, MaterialDesc)> {
                 kr: c(0.3),
                 kt: c(0.9),
                 sigma: c(30.0),
+                energy_conserving: true,
             }),
         ),
         ("glossy ks .04 r .05", glossy(1.0, 0.04, 0.05, 0.05, false)),
@@ -518,6 +521,28 @@ fn white_lambert_albedo_is_one_and_lossless_bsdfs_keep_all_energy() {
     }
 }
 
+/// LuxRender 1.x's `energyconserving` on mattetranslucent: off, Kt is transmitted as given
+/// (Kr 0.5 + Kt 0.8 returns 1.3 of the light, as LuxRender does); on, Kt is scaled by 1 - Kr
+/// (0.5 reflected + 0.4 transmitted).
+#[test]
+fn mattetranslucent_energyconserving_scales_transmission_by_one_minus_kr() {
+    for (conserving, reflected, transmitted) in [(false, 0.5, 0.8), (true, 0.5, 0.4)] {
+        let bsdf = bsdf_of(MaterialDesc::MatteTranslucent(MatteTranslucent {
+            kr: c(0.5),
+            kt: c(0.8),
+            sigma: c(0.0),
+            energy_conserving: conserving,
+        }));
+        for wo in outgoing() {
+            let (r, t) = reflected_energy(&bsdf, wo);
+            assert!(
+                (r - reflected).abs() < 0.005 && (t - transmitted).abs() < 0.005,
+                "energyconserving {conserving}, wo {wo}: reflected {r:.4}, transmitted {t:.4}"
+            );
+        }
+    }
+}
+
 #[test]
 fn sampling_agrees_with_eval_and_pdf() {
     let mut worst = (0.0f32, "");
@@ -589,6 +614,7 @@ fn reciprocity() {
                 kr: c(0.4),
                 kt: c(0.5),
                 sigma: c(25.0),
+                energy_conserving: true,
             }),
         ),
     ];

@@ -2,6 +2,7 @@
 //! light sampling tables) and rendering one unit into a sample buffer.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -46,7 +47,8 @@ pub struct RenderScene {
     filter: PixelFilter,
     frame: FilmFrame,
     geometry: SceneGeometry,
-    textures: Textures,
+    /// Shared with the area lights whose colour is a texture.
+    textures: Arc<Textures>,
     materials: Materials,
     lights: Lights,
     /// Per shape, for the object-space positions 3D texture mappings use.
@@ -78,17 +80,16 @@ impl RenderScene {
         guard.check_cancel()?;
         let geometry = SceneGeometry::build(&desc.shapes);
         guard.check_cancel()?;
-        let shapes = desc.shapes.iter();
-        let area_lights = shapes.map(|s| (s.name.as_str(), s.area_light.as_ref()));
+        let textures = Arc::new(Textures::new(&desc.textures, source)?);
+        guard.check_cancel()?;
         let lights = Lights::build(
-            area_lights,
+            &desc.shapes,
             &desc.lights,
             &geometry,
+            &textures,
             source,
             settings.latlong,
         )?;
-        guard.check_cancel()?;
-        let textures = Textures::new(&desc.textures, source)?;
         guard.check_cancel()?;
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),

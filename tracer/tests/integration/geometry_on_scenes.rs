@@ -6,6 +6,7 @@
 //! `cargo test --release -p yat-tracer --test integration geometry_on_scenes -- --ignored --nocapture`
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
@@ -16,6 +17,7 @@ use yat_tracer::geometry::SceneGeometry;
 use yat_tracer::lights::Lights;
 use yat_tracer::math::{offset_origin, Frame, Ray};
 use yat_tracer::parse::parse_scene;
+use yat_tracer::texture::Textures;
 
 use crate::util::{seed_scenes, workspace_root};
 
@@ -55,12 +57,15 @@ fn bvh_and_lights_on_real_scenes() {
             }
         };
         let geometry = SceneGeometry::build(&desc.shapes);
-        let area_lights = desc.shapes.iter();
-        let area_lights = area_lights.map(|s| (s.name.as_str(), s.area_light.as_ref()));
+        let textures = Arc::new(
+            Textures::new(&desc.textures, &source)
+                .unwrap_or_else(|e| panic!("{}: {e}", file.display())),
+        );
         let lights = Lights::build(
-            area_lights,
+            &desc.shapes,
             &desc.lights,
             &geometry,
+            &textures,
             &source,
             LatLongConvention::Seed,
         )

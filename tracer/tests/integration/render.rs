@@ -176,7 +176,7 @@ fn saturated_interreflection_converges_without_fireflies() {
     );
     let shape = desc.shapes.last_mut().unwrap();
     shape.reverse_orientation = true;
-    shape.area_light = Some(AreaLightDesc { radiance: le });
+    shape.area_light = Some(AreaLightDesc::constant(le));
     let film = render(&desc, &MemorySource::new(), 16);
     let depth = desc.integrator.max_depth as i32;
     let expected = le * (Vec3::ONE - albedo.powf((depth + 1) as f32)) / (Vec3::ONE - albedo);

@@ -162,7 +162,7 @@ fn cornell_box_contents() {
     let l = Vec3::new(1.0, 0.919_171_9, 0.623_396_5);
     let area = (0.1 * 12.080_707f32).powi(2);
     let expected = l * 2.0 * 100.0 * 17.0 / (area * PI * luminance(l));
-    let r = lamps[0].area_light.as_ref().unwrap().radiance;
+    let r = lamps[0].area_light.as_ref().unwrap().radiance().unwrap();
     assert!(
         ((r - expected) / expected).abs().max_element() < 1e-3,
         "{r} vs {expected}"
