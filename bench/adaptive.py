@@ -78,9 +78,11 @@ def write_results(path, measured, resolution):
     """Fills the seed table's adaptive column: per measured scene (file name to CPU speed-up),
     the row's "ours core-s" over the speed-up."""
     lines = path.read_text().split("\n")
+    in_table = False
     for i, line in enumerate(lines):
+        in_table = line.startswith("|") and (in_table or "core-s to 1000-spp error" in line)
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 9 and cells[0] in measured and re.fullmatch(r"[0-9]+", cells[2]):
+        if in_table and cells[0] in measured and re.fullmatch(r"[0-9]+", cells[2]):
             speedup = measured[cells[0]]
             cells[8] = f"{float(cells[2]) / speedup:.0f} ({speedup:.2f}x at {resolution})"
             lines[i] = "| " + " | ".join(cells) + " |"
