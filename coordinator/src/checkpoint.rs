@@ -7,9 +7,11 @@
 //! height, unit count, a bit per unit of the plan, the film's four i64 sums per pixel, and the
 //! SHA-256 of everything before it. An adaptive render (whose identity says so) keeps its
 //! round's units in the bitmap, which has room for the largest round
-//! ([`adaptive::max_round_units`]) so the file's size is known before it is read; after the
-//! sums come the half sums (four i64 per pixel), the round's number and each block's planned
-//! samples (u32): all the decisions so far, so the next ones are the same on resume.
+//! ([`adaptive::max_round_units`]) so the file's size is known before it is read; its film has
+//! the four sums per pixel once per source plane (`FilmFrame::source_planes`), then come the
+//! half sums (four i64 per pixel), each block's samples so far as the film counted them (u32),
+//! the round's number and each block's planned samples (u32): all the decisions so far, so the
+//! next ones are the same on resume.
 //!
 //! The file is only written through an exclusive temporary file renamed over it, and only read
 //! when it is a regular file of exactly the size this render's checkpoint has
@@ -68,7 +70,7 @@ impl RenderIdentity {
 
 /// Changes whenever the same adaptive settings would decide other rounds (the error estimate,
 /// the decision, the units of a round): part of an adaptive render's identity.
-const ADAPTIVE_VERSION: u32 = 2;
+const ADAPTIVE_VERSION: u32 = 3;
 
 /// The render so far: the merged film and which units of the plan it holds; for an adaptive
 /// render, the round under way (whose units `done` counts) and the half sums in the film.
@@ -97,7 +99,7 @@ impl Checkpoint {
             border,
         };
         let (film, round) = match adaptive {
-            Some(a) => (Film::with_half(frame), Some(Round::first(settings, a))),
+            Some(a) => (Film::adaptive(frame), Some(Round::first(settings, a))),
             None => (Film::new(frame), None),
         };
         let mut checkpoint = Self {
@@ -265,6 +267,9 @@ impl Checkpoint {
             }
             out.write_all(&pixel)?;
         }
+        for samples in self.film.block_samples() {
+            out.write_all(&samples.to_le_bytes())?;
+        }
         if let Some(round) = &self.round {
             out.write_all(&round.index.to_le_bytes())?;
             for planned in &round.planned {
@@ -276,16 +281,27 @@ impl Checkpoint {
     }
 
     /// The size of the file of a checkpoint with these settings.
-    fn file_len(settings: &RenderSettings, adaptive: Option<&AdaptiveSettings>) -> u64 {
+    fn file_len(
+        settings: &RenderSettings,
+        border: [u32; 2],
+        adaptive: Option<&AdaptiveSettings>,
+    ) -> u64 {
         let pixels = u64::from(settings.width) * u64::from(settings.height);
         let fixed = (HEADER_LEN + DIGEST_LEN) as u64;
         match adaptive {
             None => fixed + (plan_units(settings).len() as u64).div_ceil(8) + pixels * 32,
             Some(_) => {
                 let blocks = BlockGrid::of(settings).len() as u64;
+                let frame = FilmFrame {
+                    width: settings.width,
+                    height: settings.height,
+                    border,
+                };
+                let planes = frame.source_planes() as u64;
                 fixed
                     + (adaptive::max_round_units(settings) as u64).div_ceil(8)
-                    + pixels * 64
+                    + pixels * 32 * (planes + 1)
+                    + blocks * 4
                     + 4
                     + blocks * 4
             }
@@ -326,8 +342,9 @@ impl Checkpoint {
         let pixels = width as usize * height as usize;
         let bitmap_len = checkpoint.bitmap_bits.div_ceil(8);
         let blocks = BlockGrid::of(settings).len();
+        let planes = checkpoint.film.frame().source_planes();
         let (sum_count, round_len) = match adaptive {
-            Some(_) => (2 * pixels, 4 + 4 * blocks),
+            Some(_) => ((planes + 1) * pixels, 4 * blocks + 4 + 4 * blocks),
             None => (pixels, 0),
         };
         let rest = &body[HEADER_LEN..];
@@ -344,17 +361,28 @@ impl Checkpoint {
                 })
             })
             .collect();
-        let half = sums.split_off(pixels);
-        checkpoint.film =
-            Film::from_sums(checkpoint.film.frame(), sums, half).ok_or(CheckpointError::Corrupt)?;
+        let words: Vec<u32> = round_bytes
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes")))
+            .collect();
+        let (block_samples, round_words) = match adaptive {
+            Some(_) => {
+                let (samples, round) = words.split_at(blocks);
+                (samples.to_vec(), round)
+            }
+            None => (Vec::new(), &words[..]),
+        };
+        let half = if adaptive.is_some() {
+            sums.split_off(planes * pixels)
+        } else {
+            Vec::new()
+        };
+        checkpoint.film = Film::from_sums(checkpoint.film.frame(), sums, half, block_samples)
+            .ok_or(CheckpointError::Corrupt)?;
         if let (Some(a), Some(_)) = (adaptive, &checkpoint.round) {
-            let words: Vec<u32> = round_bytes
-                .chunks_exact(4)
-                .map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes")))
-                .collect();
             let round = Round {
-                index: words[0],
-                planned: words[1..].to_vec(),
+                index: round_words[0],
+                planned: round_words[1..].to_vec(),
             };
             // Checked as if hostile: a round no decision makes would plan nonsense units.
             if !round.fits(settings, a) {
@@ -419,7 +447,7 @@ impl CheckpointFile {
         border: [u32; 2],
         adaptive: Option<&AdaptiveSettings>,
     ) -> Result<Option<Checkpoint>, CheckpointError> {
-        let expected = Checkpoint::file_len(settings, adaptive);
+        let expected = Checkpoint::file_len(settings, border, adaptive);
         let Some(bytes) = read_regular_file(&self.path, expected)? else {
             return Ok(None);
         };
@@ -603,11 +631,13 @@ mod tests {
                 .step_by(every)
             {
                 let mut buffer = SampleBuffer::new(*unit, &frame());
+                let value = |i: usize| ((i * 7919 + n * 104_729) % 97) as f32 / 9.0;
                 for i in 0..buffer.weight.len() {
-                    let v = ((i * 7919 + n * 104_729) % 97) as f32 / 9.0;
-                    buffer.rgb[i] = [v, v * 0.5, 1.0];
+                    buffer.rgb[i] = [value(i), value(i) * 0.5, 1.0];
                     buffer.weight[i] = 2.0;
-                    buffer.half_rgb[i] = [v * 0.1, 0.0, 0.5];
+                }
+                for i in 0..buffer.half_weight.len() {
+                    buffer.half_rgb[i] = [value(i) * 0.1, 0.0, 0.5];
                     buffer.half_weight[i] = 1.0;
                 }
                 assert!(checkpoint.add(&buffer).unwrap());
@@ -624,10 +654,18 @@ mod tests {
             RenderIdentity::of(&pb::LoadSceneRequest::default(), None)
         );
         let bytes = encode(&checkpoint, &id);
-        assert_eq!(bytes.len() as u64, Checkpoint::file_len(&s, Some(&a)));
+        assert_eq!(
+            bytes.len() as u64,
+            Checkpoint::file_len(&s, BORDER, Some(&a))
+        );
         let back = Checkpoint::decode(&bytes, &id, &s, BORDER, Some(&a)).unwrap();
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.film().half_sums(), checkpoint.film().half_sums());
+        assert_eq!(
+            back.film().block_samples(),
+            checkpoint.film().block_samples()
+        );
+        assert!(back.film().block_samples().iter().any(|&n| n == 4));
         assert_eq!(back.round(), Some(&round));
         assert_eq!(back.done, checkpoint.done);
         assert_eq!(back.samples(&s, Some(&a)), checkpoint.samples(&s, Some(&a)));

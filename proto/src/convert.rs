@@ -181,7 +181,8 @@ impl From<pb::UnitStats> for UnitStats {
 }
 
 /// The wire form of a sample buffer: per pixel of its region, r, g, b, weight as little-endian
-/// f32; then, for a masked unit, the same for its odd-index samples.
+/// f32 (for a masked unit once per source plane); then, for a masked unit, the same for its
+/// odd-index samples.
 pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
     let len = buffer.weight.len() + buffer.half_weight.len();
     let mut out = BytesMut::with_capacity(len * BYTES_PER_PIXEL);
@@ -195,14 +196,18 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
 }
 
 /// Bytes of a unit's sample buffer on the wire: its region of `frame` (the tile and the
-/// filter's border), twice for a masked unit.
+/// filter's border), once per source plane and once more for a masked unit.
 pub fn pixels_len(unit: &WorkUnit, frame: &FilmFrame) -> usize {
-    let sums = if unit.mask.is_some() { 2 } else { 1 };
+    let sums = if unit.mask.is_some() {
+        frame.source_planes() + 1
+    } else {
+        1
+    };
     frame.region(unit).pixel_count() * BYTES_PER_PIXEL * sums
 }
 
 /// Reads a sample buffer of `unit` back from its wire form, checking what an honest render can
-/// produce: the length of its region of `frame` (twice for a masked unit); finite values; sums
+/// produce: the length of its region of `frame` ([`pixels_len`]); finite values; sums
 /// the film can hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums no
 /// larger than every sample that can reach the pixel weighing 1 (a sample gives each pixel a
 /// weight of at most 1 in magnitude, see `filter.rs`: the unit's samples per pixel times the
@@ -249,7 +254,8 @@ pub fn decode_pixels(
                 return Err(refuse(value, "exceeds what the film holds"));
             }
         }
-        let (half, i) = (pixel >= n, pixel % n);
+        let half = pixel >= buffer.weight.len();
+        let i = pixel % n;
         let max_weight = if half { odd } else { samples };
         if f64::from(values[3].abs()) > max_weight {
             return Err(refuse(
@@ -267,13 +273,13 @@ pub fn decode_pixels(
                 "lies beyond the reach of the blocks the unit's mask leaves on",
             ));
         }
-        let (rgb, weight) = if half {
-            (&mut buffer.half_rgb, &mut buffer.half_weight)
+        let (rgb, weight, at) = if half {
+            (&mut buffer.half_rgb, &mut buffer.half_weight, i)
         } else {
-            (&mut buffer.rgb, &mut buffer.weight)
+            (&mut buffer.rgb, &mut buffer.weight, pixel)
         };
-        rgb[i] = [values[0], values[1], values[2]];
-        weight[i] = values[3];
+        rgb[at] = [values[0], values[1], values[2]];
+        weight[at] = values[3];
     }
     Ok(buffer)
 }
@@ -500,12 +506,15 @@ mod tests {
         let frame = FilmFrame::unbordered(s.width, s.height);
         let mut buffer = SampleBuffer::new(unit, &frame);
         assert_eq!(buffer.half_rgb.len(), 36 * 50);
+        assert_eq!(buffer.rgb.len(), 4 * 36 * 50, "a plane per block parity");
         buffer.rgb[0] = [1.0, 2.0, 3.0];
         buffer.weight[0] = 5.0;
+        buffer.rgb[3 * 36 * 50 + 48 * 36 + 32] = [4.0, 0.0, 0.0];
+        buffer.weight[3 * 36 * 50 + 48 * 36 + 32] = 1.0;
         buffer.half_rgb[0] = [0.5, 1.0, 1.5];
         buffer.half_weight[0] = 2.0;
         let bytes = encode_pixels(&buffer);
-        assert_eq!(bytes.len(), 2 * 36 * 50 * BYTES_PER_PIXEL);
+        assert_eq!(bytes.len(), 5 * 36 * 50 * BYTES_PER_PIXEL);
         assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
         assert!(decode_pixels(unit, &frame, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
         let mut heavy_half = buffer.clone();
@@ -514,12 +523,14 @@ mod tests {
             decode_pixels(unit, &frame, &encode_pixels(&heavy_half)).is_err(),
             "3 of 2 odd samples"
         );
-        let mut outside = buffer.clone();
-        outside.rgb[10 * 36 + 6] = [0.1, 0.0, 0.0];
-        assert!(
-            decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
-            "a masked-out pixel"
-        );
+        for plane in 0..4 {
+            let mut outside = buffer.clone();
+            outside.rgb[plane * 36 * 50 + 10 * 36 + 6] = [0.1, 0.0, 0.0];
+            assert!(
+                decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
+                "a masked-out pixel in plane {plane}"
+            );
+        }
 
         // With a 2-pixel border, active blocks splat into their neighbours: pixels within 2 of
         // block 0 may hold sums, those farther from every active block may not.

@@ -27,7 +27,7 @@ use crate::math::luminance;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::render::unit::{FilmFrame, PixelRect, WorkUnit};
+use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
 
 /// The film type every `Film` statement is read as.
 pub const FILM_TYPE: &str = "fleximage";
@@ -165,13 +165,16 @@ impl FilmDesc {
 
 /// A unit's result: per pixel of its region (its tile and the filter's border around it,
 /// [`FilmFrame::region`], row-major), the sum of filter-weighted sample radiance and the sum of
-/// the weights (16 bytes per pixel); for an adaptive unit (one with a block mask) the same sums
-/// over its odd-index samples too, the half the adaptive error estimate compares with the whole.
+/// the weights (16 bytes per pixel). An adaptive unit (one with a block mask) keeps these sums
+/// per source plane ([`FilmFrame::source_planes`] regions, plane-major: a sample's sums go to the
+/// plane of the block it was taken in), and the plain sums over its odd-index samples too, the
+/// half the adaptive error estimate compares with the whole.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleBuffer {
     pub unit: WorkUnit,
     /// The pixels the sums are of.
     pub region: PixelRect,
+    /// Per source plane of an adaptive unit (one plane otherwise), per pixel of the region.
     pub rgb: Vec<[f32; 3]>,
     pub weight: Vec<f32>,
     /// Sums of the odd-index samples: as long as `rgb` for a masked unit, else empty.
@@ -184,12 +187,15 @@ impl SampleBuffer {
     pub fn new(unit: WorkUnit, frame: &FilmFrame) -> Self {
         let region = frame.region(&unit);
         let n = region.pixel_count();
-        let half = if unit.mask.is_some() { n } else { 0 };
+        let (planes, half) = match unit.mask {
+            Some(_) => (frame.source_planes(), n),
+            None => (1, 0),
+        };
         Self {
             unit,
             region,
-            rgb: vec![[0.0; 3]; n],
-            weight: vec![0.0; n],
+            rgb: vec![[0.0; 3]; planes * n],
+            weight: vec![0.0; planes * n],
             half_rgb: vec![[0.0; 3]; half],
             half_weight: vec![0.0; half],
         }
@@ -229,11 +235,15 @@ fn to_fixed(v: f32) -> i64 {
 pub struct Film {
     /// The size, and the border every unit's buffer has around its tile.
     frame: FilmFrame,
-    /// Per pixel: R, G, B and weight sums in fixed point.
+    /// Per pixel: R, G, B and weight sums in fixed point; an adaptive film keeps them per
+    /// source plane (plane-major), see [`Film::pixel`].
     sums: Vec<[i64; 4]>,
     /// The same sums over the odd-index samples, kept only by an adaptive render's film (which
     /// takes only buffers that carry them); empty otherwise, so a uniform film costs nothing more.
     half: Vec<[i64; 4]>,
+    /// An adaptive film's samples per pixel of each block (row-major), as its buffers added
+    /// them; empty otherwise.
+    block_samples: Vec<u32>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -251,21 +261,30 @@ impl Film {
             frame,
             sums: vec![[0; 4]; frame.width as usize * frame.height as usize],
             half: Vec::new(),
+            block_samples: Vec::new(),
         }
     }
 
-    /// The film of an adaptive render: it also keeps the sums of the odd-index samples, and
-    /// takes only buffers of masked units.
-    pub fn with_half(frame: FilmFrame) -> Self {
+    /// The film of an adaptive render: it keeps its sums per source plane, the sums of the
+    /// odd-index samples and each block's samples, and takes only buffers of masked units.
+    pub fn adaptive(frame: FilmFrame) -> Self {
+        let pixels = frame.width as usize * frame.height as usize;
         Self {
-            half: vec![[0; 4]; frame.width as usize * frame.height as usize],
-            ..Self::new(frame)
+            frame,
+            sums: vec![[0; 4]; frame.source_planes() * pixels],
+            half: vec![[0; 4]; pixels],
+            block_samples: vec![0; block_count(&frame)],
         }
     }
 
-    /// Whether the film keeps the half sums (an adaptive render's).
+    /// Whether the film is an adaptive render's (it keeps the half sums).
     pub fn has_half(&self) -> bool {
-        !self.sums.is_empty() && self.half.len() == self.sums.len()
+        !self.half.is_empty()
+    }
+
+    /// An adaptive film's samples per pixel of each block (row-major); empty otherwise.
+    pub fn block_samples(&self) -> &[u32] {
+        &self.block_samples
     }
 
     pub fn width(&self) -> u32 {
@@ -292,14 +311,28 @@ impl Film {
         &self.half
     }
 
-    /// A film of `frame` holding these sums (and half sums: empty, or as many); None unless
-    /// there are width x height of them.
-    pub fn from_sums(frame: FilmFrame, sums: Vec<[i64; 4]>, half: Vec<[i64; 4]>) -> Option<Self> {
+    /// A film of `frame` holding these sums: a uniform film's (width x height sums, no half
+    /// sums, no block samples) or an adaptive one's (as [`Film::adaptive`] has them); None
+    /// otherwise.
+    pub fn from_sums(
+        frame: FilmFrame,
+        sums: Vec<[i64; 4]>,
+        half: Vec<[i64; 4]>,
+        block_samples: Vec<u32>,
+    ) -> Option<Self> {
         let pixels = frame.width as usize * frame.height as usize;
-        (sums.len() == pixels && (half.is_empty() || half.len() == pixels)).then_some(Self {
+        let fits = if half.is_empty() {
+            sums.len() == pixels && block_samples.is_empty()
+        } else {
+            sums.len() == frame.source_planes() * pixels
+                && half.len() == pixels
+                && block_samples.len() == block_count(&frame)
+        };
+        fits.then_some(Self {
             frame,
             sums,
             half,
+            block_samples,
         })
     }
 
@@ -318,10 +351,14 @@ impl Film {
         } else {
             usize::MAX
         };
-        let half_len = if self.has_half() { n } else { 0 };
+        let (planes, half_len) = if self.has_half() {
+            (self.frame.source_planes(), n)
+        } else {
+            (1, 0)
+        };
         let fits = n != usize::MAX
-            && buffer.rgb.len() == n
-            && buffer.weight.len() == n
+            && buffer.rgb.len() == planes * n
+            && buffer.weight.len() == planes * n
             && buffer.half_rgb.len() == half_len
             && buffer.half_weight.len() == half_len;
         if !fits {
@@ -332,8 +369,24 @@ impl Film {
             });
         }
         let width = self.frame.width;
-        add_region(&mut self.sums, width, &region, &buffer.rgb, &buffer.weight);
+        let pixels = width as usize * self.frame.height as usize;
+        let planes = self.sums.chunks_exact_mut(pixels);
+        let buffer_planes = buffer
+            .rgb
+            .chunks_exact(n)
+            .zip(buffer.weight.chunks_exact(n));
+        for (sums, (rgb, weight)) in planes.zip(buffer_planes) {
+            add_region(sums, width, &region, rgb, weight);
+        }
         if half_len > 0 {
+            let columns = self.frame.width.div_ceil(BLOCK_SIZE);
+            let samples = u.sample_end - u.sample_start;
+            for (x, y, bit) in u.tile_blocks() {
+                if u.mask.is_some_and(|mask| mask & bit != 0) {
+                    let b = (y / BLOCK_SIZE * columns + x / BLOCK_SIZE) as usize;
+                    self.block_samples[b] = self.block_samples[b].saturating_add(samples);
+                }
+            }
             add_region(
                 &mut self.half,
                 width,
@@ -351,9 +404,59 @@ impl Film {
         self.half.get(i).map_or(Vec3::ZERO, mean)
     }
 
-    /// The pixel's radiance estimate (weighted mean of its samples; black without samples).
+    /// The pixel's radiance estimate: the weighted mean of its samples (black without samples).
+    /// An adaptive film's blocks have different samples per pixel, and a wide filter reaches
+    /// across blocks: a plain weighted mean would lean toward the block with more samples, a
+    /// bias at every edge between blocks that no number of samples removes. So each source
+    /// plane's sums (the samples of one block, [`FilmFrame::source_plane`]) are divided by that
+    /// block's samples per pixel before they are added: every block then weighs as it would in
+    /// a uniform render, whatever its samples.
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
-        mean(&self.sums[(y * self.frame.width + x) as usize])
+        let i = (y * self.frame.width + x) as usize;
+        if !self.has_half() {
+            return mean(&self.sums[i]);
+        }
+        let pixels = self.frame.width as usize * self.frame.height as usize;
+        let [bx, by] = self.frame.border;
+        // The blocks the filter reaches from (x, y): at most one per source plane.
+        let span = |v: u32, border: u32, size: u32| {
+            v.saturating_sub(border) / BLOCK_SIZE..=(v + border).min(size - 1) / BLOCK_SIZE
+        };
+        let columns = self.frame.width.div_ceil(BLOCK_SIZE);
+        let mut total = [0.0f64; 4];
+        for row in span(y, by, self.frame.height) {
+            for column in span(x, bx, self.frame.width) {
+                let n = self.block_samples[(row * columns + column) as usize];
+                let plane = self
+                    .frame
+                    .source_plane(column * BLOCK_SIZE, row * BLOCK_SIZE);
+                if n > 0 {
+                    let sums = &self.sums[plane * pixels + i];
+                    for (t, &s) in total.iter_mut().zip(sums) {
+                        *t += s as f64 / f64::from(n);
+                    }
+                }
+            }
+        }
+        let [r, g, b, w] = total;
+        if w <= 0.0 {
+            return Vec3::ZERO;
+        }
+        Vec3::new((r / w) as f32, (g / w) as f32, (b / w) as f32)
+    }
+
+    /// The plain weighted mean of all the samples that reach pixel `i` (row-major), whatever
+    /// block they were taken in: what the half sums estimate too, so the two compare (the
+    /// adaptive error estimate). The same as [`Film::pixel`] for a uniform film.
+    pub fn plain_pixel(&self, i: usize) -> Vec3 {
+        let pixels = self.frame.width as usize * self.frame.height as usize;
+        let mut total = [0i64; 4];
+        for sums in self.sums.iter().skip(i).step_by(pixels) {
+            for (t, &s) in total.iter_mut().zip(sums) {
+                *t = t.saturating_add(s);
+            }
+        }
+        mean(&total)
     }
 
     /// Linear radiance of every pixel, rows top to bottom.
@@ -416,6 +519,11 @@ fn add_region(
             }
         }
     }
+}
+
+/// Blocks of an adaptive film: [`BLOCK_SIZE`] squares, the last row and column cut short.
+fn block_count(frame: &FilmFrame) -> usize {
+    frame.width.div_ceil(BLOCK_SIZE) as usize * frame.height.div_ceil(BLOCK_SIZE) as usize
 }
 
 /// The weighted mean radiance of fixed-point sums; black without weight.

@@ -15,9 +15,20 @@
 //! image's grid; the units of a round are the plan's 64-pixel tiles with a mask of their active
 //! blocks ([`WorkUnit::mask`]), tiles with none left out.
 //!
+//! **The film.** A pixel filter wider than a pixel (the seed scenes' blackmanharris reaches 4
+//! pixels, half a block) adds each sample to its neighbours too, and a plain weighted mean of
+//! what reaches a pixel leans toward the block that has more samples: by a block of 1024
+//! samples per pixel, a block of 16 is mostly its neighbour's image near their edge, a bias
+//! that more samples never remove (it made adaptive renders lose to uniform ones). So an
+//! adaptive film keeps each sample's sums in the source plane of the block it was taken in
+//! (blocks of one plane are 2 or 3 blocks apart, so a pixel gets at most one block per plane),
+//! counts each block's samples, and divides each plane's sums by its block's samples per pixel
+//! before adding them up ([`Film::pixel`]): every block weighs as in a uniform render.
+//!
 //! **Noise estimate.** A masked unit also sums its odd-index samples, so the film holds per
 //! pixel the mean `m` of all its `n` samples and the mean `h` of the odd half (the "two
-//! buffers" of Cycles and of Dammertz et al. 2010). Since `n` is even, `m - h` is half the
+//! buffers" of Cycles and of Dammertz et al. 2010; both plain means of what reaches the pixel,
+//! so they lean alike). Since `n` is even, `m - h` is half the
 //! difference of two independent half means: `E[(m - h)^2]` is exactly the variance of `m`,
 //! `sigma^2 / n`. A block's `sigma_b`, the standard deviation of one sample, is so estimated as
 //! `sqrt(n_b x mean of (m - h)^2 over its pixels and channels)` ([`Noise`]).
@@ -318,8 +329,9 @@ impl Noise {
         if film.has_half() {
             for y in 0..height {
                 for x in 0..width {
-                    let m = film.pixel(x, y).as_dvec3();
-                    let d = m - film.half_pixel((y * width + x) as usize).as_dvec3();
+                    let i = (y * width + x) as usize;
+                    let m = film.plain_pixel(i).as_dvec3();
+                    let d = m - film.half_pixel(i).as_dvec3();
                     brightness += m.abs().element_sum() / 3.0;
                     variance[(y / BLOCK_SIZE * grid.columns + x / BLOCK_SIZE) as usize] +=
                         d.length_squared() / 3.0;
@@ -454,6 +466,7 @@ mod tests {
                         continue;
                     }
                     let i = ((y - unit.y0) * w + (x - unit.x0)) as usize;
+                    let plane = film.frame().source_plane(x, y) * buffer.region.pixel_count();
                     for s in unit.sample_start..unit.sample_end {
                         let u = 2.0
                             * hash01((u64::from(y) << 40) ^ (u64::from(x) << 20) ^ u64::from(s))
@@ -463,7 +476,7 @@ mod tests {
                             rgb.iter_mut().for_each(|c| *c += v);
                             *wt += 1.0;
                         };
-                        add(&mut buffer.rgb[i], &mut buffer.weight[i]);
+                        add(&mut buffer.rgb[plane + i], &mut buffer.weight[plane + i]);
                         if s % 2 == 1 {
                             add(&mut buffer.half_rgb[i], &mut buffer.half_weight[i]);
                         }
@@ -593,7 +606,7 @@ mod tests {
             16..64 => 0.2,
             _ => 0.8,
         };
-        let mut film = Film::with_half(FilmFrame::unbordered(s.width, s.height));
+        let mut film = Film::adaptive(FilmFrame::unbordered(s.width, s.height));
         let (round, history) = render_to_the_end(&mut film, &s, &a, |_| 0.5, noise);
         let spp = samples_per_pixel(&round, &s);
         let at = |x: u32| -> Vec<u32> {
@@ -641,7 +654,7 @@ mod tests {
                 min_spp: n,
                 ..ADAPTIVE
             };
-            let mut film = Film::with_half(FilmFrame::unbordered(64, 64));
+            let mut film = Film::adaptive(FilmFrame::unbordered(64, 64));
             let round = Round::first(&s, &a);
             render(&mut film, &round.units(&s, &a), |_| 1.0, |_| amplitude);
             let noise = Noise::of(&film, &round, &s);
@@ -669,7 +682,7 @@ mod tests {
         }
         // A black image has no noise: the render stops after round 0.
         let s = settings(16, 16, 64);
-        let mut film = Film::with_half(FilmFrame::unbordered(16, 16));
+        let mut film = Film::adaptive(FilmFrame::unbordered(16, 16));
         let round = Round::first(&s, &ADAPTIVE);
         render(&mut film, &round.units(&s, &ADAPTIVE), |_| 0.0, |_| 0.0);
         assert_eq!(Noise::of(&film, &round, &s).brightness, 1.0);

@@ -230,7 +230,8 @@ impl RenderScene {
     }
 
     /// Adds a sample at `pixel + u` with `radiance` to every pixel of the buffer's region its
-    /// filter reaches, and to the half sums too when `half`.
+    /// filter reaches (in the source plane of its block when the unit is adaptive), and to the
+    /// half sums too when `half`.
     fn splat(
         &self,
         buffer: &mut SampleBuffer,
@@ -243,6 +244,11 @@ impl RenderScene {
         let columns = self.filter.taps_x(x, u.x, region.x0, region.x1);
         let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
         let width = region.width() as usize;
+        let plane = if buffer.unit.mask.is_some() {
+            self.frame.source_plane(x, y) * region.pixel_count()
+        } else {
+            0
+        };
         let first_column = (columns.first - region.x0) as usize;
         for (row, &wy) in rows.weights().iter().enumerate() {
             let start = (rows.first - region.y0) as usize * width + row * width + first_column;
@@ -254,7 +260,7 @@ impl RenderScene {
                     }
                     *weight += w;
                 };
-                add(&mut buffer.rgb[i], &mut buffer.weight[i]);
+                add(&mut buffer.rgb[plane + i], &mut buffer.weight[plane + i]);
                 if half {
                     add(&mut buffer.half_rgb[i], &mut buffer.half_weight[i]);
                 }

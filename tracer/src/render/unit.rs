@@ -145,6 +145,30 @@ impl FilmFrame {
         }
     }
 
+    /// Blocks per axis between two blocks of the same source plane of an adaptive film: 2 when
+    /// a sample reaches at most half a block beyond its pixel (a pixel then gets samples from
+    /// its own block and one neighbour per axis, of the other parity), else 3 (a border is at
+    /// most a block, `filter::MAX_BORDER`).
+    pub fn plane_period(&self) -> u32 {
+        if 2 * self.border[0].max(self.border[1]) <= BLOCK_SIZE {
+            2
+        } else {
+            3
+        }
+    }
+
+    /// Source planes of an adaptive film: a sample's sums go to the plane of the block it was
+    /// taken in, so no pixel mixes two blocks' samples in one sum (see `Film::pixel`).
+    pub fn source_planes(&self) -> usize {
+        (self.plane_period() * self.plane_period()) as usize
+    }
+
+    /// The source plane of the block holding pixel (x, y).
+    pub fn source_plane(&self, x: u32, y: u32) -> usize {
+        let k = self.plane_period();
+        (x / BLOCK_SIZE % k + k * (y / BLOCK_SIZE % k)) as usize
+    }
+
     /// The pixels `unit`'s samples reach: its tile grown by the border, clipped to the film;
     /// its sample buffer covers exactly these.
     pub fn region(&self, unit: &WorkUnit) -> PixelRect {
