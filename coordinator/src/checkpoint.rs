@@ -665,7 +665,7 @@ mod tests {
             back.film().block_samples(),
             checkpoint.film().block_samples()
         );
-        assert!(back.film().block_samples().iter().any(|&n| n == 4));
+        assert!(back.film().block_samples().contains(&4));
         assert_eq!(back.round(), Some(&round));
         assert_eq!(back.done, checkpoint.done);
         assert_eq!(back.samples(&s, Some(&a)), checkpoint.samples(&s, Some(&a)));
