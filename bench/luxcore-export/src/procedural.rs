@@ -222,9 +222,24 @@ pub fn write_procedural(
             };
             set(p, "type", quoted("brick"));
             set(p, "brickbond", quoted(bond));
-            set(p, "bricktex", tv(&t.brick));
+            // LuxCore 2.x blends bricktex into brickmodtex by a random amount per brick
+            // (plus brickmodbias), where LuxRender 1.x multiplies bricktex by brickmodtex
+            // evaluated at the brick's index: the default white brickmodtex turned half the
+            // bricks' colour to white. Bias -1 makes LuxCore return bricktex alone, so a
+            // constant modulation is folded into it.
+            set(p, "brickmodbias", "-1".to_string());
+            let brick = match (&t.brick, &t.modulation) {
+                (_, Tex::Const(m)) if *m == glam::Vec3::ONE => t.brick,
+                (Tex::Const(b), Tex::Const(m)) => Tex::Const(*b * *m),
+                _ => {
+                    notes.push(format!(
+                        "{prefix}: brickmodtex cannot be evaluated per brick in LuxCore; left out"
+                    ));
+                    t.brick
+                }
+            };
+            set(p, "bricktex", tv(&brick));
             set(p, "mortartex", tv(&t.mortar));
-            set(p, "brickmodtex", tv(&t.modulation));
             // The description holds the bond-adjusted sizes; herringbone and basket only read
             // the width.
             set(p, "brickwidth", t.size.x.to_string());
@@ -371,6 +386,19 @@ mod tests {
             .map(|x| x.parse().unwrap())
             .collect();
         assert_eq!(&m[12..15], &[-1.0, -2.0, -3.0]);
+    }
+
+    #[test]
+    fn brick_colour_is_bricktex_times_a_constant_brickmodtex() {
+        // LuxRender 1.x: bricktex x brickmodtex; LuxCore with bias -1: bricktex alone.
+        let scn = sdl(
+            "Texture \"b\" \"color\" \"brick\" \"color bricktex\" [0.5 0.2 0.1] \
+               \"color brickmodtex\" [0.5 1 2]\n\
+             Material \"matte\" \"texture Kd\" \"b\"",
+        );
+        assert_eq!(value(&scn, "scene.textures.tex0.brickmodbias"), "-1");
+        assert_eq!(value(&scn, "scene.textures.tex0.bricktex"), "0.25 0.2 0.2");
+        assert!(!scn.contains("brickmodtex"), "{scn}");
     }
 
     #[test]

@@ -24,9 +24,10 @@
 //!
 //! Spherical, cylindrical and planar mappings work in texture space: the inverse of the
 //! transform current at the `Texture` statement, applied to the shaded point's object-space
-//! position. 3D mappings apply that inverse, then (as LuxRender composes them) the inverse
-//! scale, the rotations and the negated translation: texture point =
-//! CTM^-1 x S^-1 x Rx x Ry x Rz x T(-translate) x point.
+//! position. 3D mappings start from that transform itself, not its inverse (LuxRender 1.x's
+//! `TextureMapping3D::Create` stores the CTM as its world-to-texture matrix, unlike its 2D
+//! mappings), then compose (as LuxRender does) the inverse scale, the rotations and the
+//! negated translation: texture point = CTM x S^-1 x Rx x Ry x Rz x T(-translate) x point.
 
 use std::f32::consts::{PI, TAU};
 
@@ -218,7 +219,7 @@ pub enum Coordinates {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mapping3D {
     pub coordinates: Coordinates,
-    /// CTM^-1 at the `Texture` statement, composed with the scale, rotate and translate options.
+    /// The CTM at the `Texture` statement, composed with the scale, rotate and translate options.
     pub world_to_texture: Mat4,
 }
 
@@ -250,7 +251,8 @@ impl Mapping3D {
         // A zero scale would put every point at infinity; LuxRender divides anyway, we keep
         // the axis unscaled instead.
         let inv_scale = Vec3::select(scale.cmpeq(Vec3::ZERO), Vec3::ONE, scale.recip());
-        let world_to_texture = ctx.ctm().inverse()
+        // The CTM uninverted, as LuxRender 1.x uses it (see the module notes).
+        let world_to_texture = ctx.ctm()
             * Mat4::from_scale(inv_scale)
             * Mat4::from_rotation_x(rotate.x.to_radians())
             * Mat4::from_rotation_y(rotate.y.to_radians())

@@ -272,9 +272,39 @@ fn vector_scale_rotate_translate_move_the_pattern_exactly() {
             near(turned, expected),
             "rotate at {p}: {turned} vs {expected}"
         );
-        // The transform at the Texture statement moves the pattern too.
-        let placed = value(&t, "placed", p + Vec3::new(3.0, 0.0, 0.0));
+        // The transform at the Texture statement moves the pattern too, the opposite way to
+        // `vector translate`: LuxRender 1.x's 3D mapping applies the CTM itself to the point.
+        let placed = value(&t, "placed", p - Vec3::new(3.0, 0.0, 0.0));
         assert!(near(placed, plain), "CTM at {p}: {placed} vs {plain}");
+    }
+}
+
+#[test]
+fn rotated_running_bricks_on_a_floor_follow_luxrenders_mapping() {
+    // procedural.lxs's floor: the default running bond (0.3 x 0.15 x 0.1, mortar 0.01, run
+    // 0.75, offset -0.5 in y) with "vector rotate" [90 0 0] on the plane z = -0.5. LuxRender
+    // maps world (x, y, z) through RotateX(90) to (x, -z, y) = (x, 0.5, y), adds 0.011 and
+    // divides by the brick size: (0.1, 0.2) -> (0.37, 2.9067, 2.11), course 2, in-brick
+    // fractions x 0.87, y 0.4067, z 0.11, all past the mortar (0.033, 0.067, 0.1): brick.
+    let t = textures(
+        "Texture \"f\" \"color\" \"brick\" \"color bricktex\" [0.45 0.22 0.15] \
+         \"color mortartex\" [0.6 0.6 0.58] \"vector rotate\" [90 0 0]",
+    );
+    let (brick, mortar) = (Vec3::new(0.45, 0.22, 0.15), Vec3::new(0.6, 0.6, 0.58));
+    let at = |x: f32, y: f32| eval_at(&t, "f", Vec3::new(x, y, -0.5), Vec2::ZERO);
+    assert_eq!(at(0.1, 0.2), brick);
+    // y 0.295: z fraction (0.306 - 3) 0.06 < 0.1, a bed joint.
+    assert_eq!(at(0.1, 0.295), mortar);
+    // x 0.1405 in course 2: x fraction (0.505 + 1.5 - 2) 0.005 < 0.033, a head joint.
+    assert_eq!(at(0.1405, 0.2), mortar);
+    // The depth coordinate 0.5 lies inside a brick in all four courses of the run's cycle
+    // (y fractions 0.907, 0.157, 0.407, 0.657), so every course shows bricks.
+    for course in 0..4 {
+        assert_eq!(
+            at(0.1, 0.05 + 0.1 * course as f32),
+            brick,
+            "course {course}"
+        );
     }
 }
 

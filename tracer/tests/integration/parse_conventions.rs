@@ -470,7 +470,8 @@ fn textures_map_to_descriptions() {
         TextureKind::Checkerboard3D(Checkerboard3D {
             tex1: Tex::float(1.0),
             tex2: Tex::Texture(TextureId(1)),
-            mapping: Mapping3D::global(inv)
+            // 3D mappings take the CTM uninverted, as LuxRender 1.x does.
+            mapping: Mapping3D::global(inv.inverse())
         })
     );
     assert_eq!(
