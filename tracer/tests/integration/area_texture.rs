@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use yat_tracer::assets::MemorySource;
+use yat_tracer::assets::{AssetSource, MemorySource};
 use yat_tracer::desc::{LatLongConvention, SceneDesc};
 use yat_tracer::geometry::SceneGeometry;
 use yat_tracer::lights::Lights;
@@ -35,18 +35,31 @@ fn scene(area_light: &str) -> (SceneDesc, SceneGeometry, Lights) {
     source.insert("main.lxs", Arc::from(text.as_bytes()));
     let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let (geometry, lights) = geometry_and_lights(&desc, &source, "main.lxs");
+    (desc, geometry, lights)
+}
+
+/// The geometry and lights of `desc` as the renderer builds them (its textures shared with
+/// the area lights); panics naming `what` if they do not build. Shared with
+/// `geometry_on_scenes`.
+pub fn geometry_and_lights(
+    desc: &SceneDesc,
+    source: &dyn AssetSource,
+    what: &str,
+) -> (SceneGeometry, Lights) {
     let geometry = SceneGeometry::build(&desc.shapes);
-    let textures = Arc::new(Textures::new(&desc.textures, &source).unwrap());
+    let textures =
+        Arc::new(Textures::new(&desc.textures, source).unwrap_or_else(|e| panic!("{what}: {e}")));
     let lights = Lights::build(
         &desc.shapes,
         &desc.lights,
         &geometry,
         &textures,
-        &source,
+        source,
         LatLongConvention::Seed,
     )
-    .unwrap();
-    (desc, geometry, lights)
+    .unwrap_or_else(|e| panic!("{what}: {e}"));
+    (geometry, lights)
 }
 
 /// The radiance seen looking straight up from `p` (the square's emission there).

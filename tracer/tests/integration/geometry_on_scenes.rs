@@ -6,19 +6,15 @@
 //! `cargo test --release -p yat-tracer --test integration geometry_on_scenes -- --ignored --nocapture`
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use yat_tracer::assets::FsSource;
 use yat_tracer::camera::Camera;
-use yat_tracer::desc::LatLongConvention;
-use yat_tracer::geometry::SceneGeometry;
-use yat_tracer::lights::Lights;
 use yat_tracer::math::{offset_origin, Frame, Ray};
 use yat_tracer::parse::parse_scene;
-use yat_tracer::texture::Textures;
 
+use crate::area_texture::geometry_and_lights;
 use crate::util::{seed_scenes, workspace_root};
 
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -56,20 +52,7 @@ fn bvh_and_lights_on_real_scenes() {
                 continue;
             }
         };
-        let geometry = SceneGeometry::build(&desc.shapes);
-        let textures = Arc::new(
-            Textures::new(&desc.textures, &source)
-                .unwrap_or_else(|e| panic!("{}: {e}", file.display())),
-        );
-        let lights = Lights::build(
-            &desc.shapes,
-            &desc.lights,
-            &geometry,
-            &textures,
-            &source,
-            LatLongConvention::Seed,
-        )
-        .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let (geometry, lights) = geometry_and_lights(&desc, &source, &file.display().to_string());
         if lights.is_empty() {
             println!("{name:<40} no lights (a fragment meant for Include?)");
             continue;
