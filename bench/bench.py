@@ -422,6 +422,45 @@ Export notes:
 """
 
 
+# The seed table's column that bench/adaptive.py fills; bench.py keeps its cells.
+ADAPTIVE_COLUMN = "core-s to 1000-spp error, adaptive"
+
+
+def split_sections(text):
+    """(preamble, [(heading line, whole section text)]) of a Markdown file's "## " sections."""
+    parts = ("\n" + text).split("\n## ")
+    sections = [("## " + p.split("\n", 1)[0], "## " + p.rstrip("\n")) for p in parts[1:]]
+    return parts[0].strip("\n"), sections
+
+
+def write_sections(path, new):
+    """Writes the "## " sections of `new` into the Markdown file at `path` in place of the
+    sections with the same heading, keeping every other section (hand-written findings,
+    other scripts' tables) where it is; `new`'s preamble, if any, replaces the file's."""
+    old_head, old_sections = split_sections(path.read_text() if path.exists() else "")
+    new_head, new_sections = split_sections(new)
+    replacements = dict(new_sections)
+    merged = [replacements.pop(heading, body) for heading, body in old_sections]
+    merged += [body for heading, body in new_sections if heading in replacements]
+    head = new_head or old_head or "# YAT benchmark results"
+    path.write_text("\n\n".join([head] + merged) + "\n")
+
+
+def adaptive_cells(path):
+    """Scene name to its cell in the seed table's adaptive column of the file at `path`."""
+    cells = {}
+    header = None
+    for line in path.read_text().split("\n") if path.exists() else []:
+        row = [c.strip() for c in line.strip().strip("|").split("|")]
+        if not line.startswith("|"):
+            header = None
+        elif header is None:
+            header = row if ADAPTIVE_COLUMN in row else []
+        elif header and len(row) == len(header) and not set(row[0]) <= set("-"):
+            cells[row[0]] = row[header.index(ADAPTIVE_COLUMN)]
+    return cells
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--spp", type=int, default=16, help="samples per pixel (default 16)")
@@ -452,9 +491,7 @@ def main():
         section = side_by_side_section(args)
         print(section)
         if not args.only:
-            old = results.read_text() if results.exists() else "# YAT benchmark results\n"
-            head = old.split("## Side by side")[0].rstrip("\n")
-            results.write_text(f"{head}\n\n{section}")
+            write_sections(results, section)
             log("rewrote the side-by-side section of bench/RESULTS.md")
         return
 
@@ -504,10 +541,11 @@ def main():
          "M rays/s", "peak MB", "core-us/sample"],
         rows,
     )
+    adaptive = adaptive_cells(results)
     seed_table = table(
         ["scene", "ours s @1000spp", "ours core-s", "original s (8 cores)", "original core-s",
-         "core-s ratio", "hardware", "beyond hardware"],
-        seed_rows,
+         "core-s ratio", "hardware", "beyond hardware", ADAPTIVE_COLUMN],
+        [row + [adaptive.get(row[0], "-")] for row in seed_rows],
     )
     compare_section = side_by_side_section(args) if with_compare else ""
     report = f"""# YAT benchmark results
@@ -531,13 +569,17 @@ depth 10 on an 8-core AMD FX-8150 (OpenJDK 8), converted to core-seconds (x 8).
 camera ray: its published time against the original rebuilt from its public source and run
 here (2 threads, depth 10; measured on five of the scenes). "beyond hardware" is the
 core-seconds ratio divided by it: the part of the lead that is YAT's, not the machine's.
+"{ADAPTIVE_COLUMN}": ours core-s divided by the speed-up in CPU seconds that
+adaptive sampling measured against a uniform 1000-spp render at the resolution given in the cell
+(`bench/adaptive.py --write-results`, see "Adaptive sampling, measured on the binary" below), not
+a full-resolution run; bench.py carries the cells over from the file it rewrites.
 
 {seed_table}
 
 {compare_section}"""
     print(report)
     if not (args.quick or args.only or args.no_compare):
-        results.write_text(report)
+        write_sections(results, report)
         log("wrote bench/RESULTS.md")
 
 
