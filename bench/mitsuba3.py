@@ -45,8 +45,8 @@ APPROXIMATIONS = [
     "(emits, lets rays through, blocks shadow rays, as in YAT); Mitsuba counts the crossing "
     "as a path vertex, YAT does not",
     "pixel filter: Mitsuba has no Blackman-Harris; a gaussian of the same standard deviation "
-    "(0.554 px for the scenes' half-width 2). Mitsuba splats each sample over the filter's "
-    "footprint, YAT importance-samples the filter (one pixel per sample)",
+    "(0.554 px for the scenes' half-width 2). Both splat each sample over the filter's "
+    "footprint (YAT since session 6; before, it importance-sampled the filter into one pixel)",
     "film: linear RGB float32, no tone mapping, the same as YAT's and LuxCore's EXR",
     "image textures and the environment map: decoded with the export's gamma (2.2 for "
     "textures, 1 for the maps here) and gain into linear EXR files Mitsuba reads raw (its own "
