@@ -206,11 +206,11 @@ impl Environment {
                 ))
             }
             Some(map) => {
-                // The texels looked up below sit at the sampled column nearly always: their
+                // The texels looked up below sit in the sampled cell nearly always: their
                 // load starts alongside the distribution's own cache miss.
                 let (uv, pdf_uv) = map
                     .distribution
-                    .sample(u, |row, column| map.image.prefetch(column, row))?;
+                    .sample(u, |row, column| map.prefetch_cell(row, column))?;
                 let (d_light, sin_theta) = map.direction(uv);
                 if pdf_uv <= 0.0 || sin_theta <= 0.0 {
                     return None;
@@ -266,8 +266,48 @@ impl Environment {
 struct LatLongMap {
     image: RgbImage,
     convention: LatLongConvention,
-    /// Over texels, by luminance x sin(theta).
+    /// Over cells of the map, by luminance x sin(theta).
     distribution: Distribution2D,
+    /// The distribution's cells: one per texel, or per block of texels on a large map.
+    cells_across: usize,
+    cells_down: usize,
+}
+
+/// The most cells a map's distribution holds (16 bytes each: 2 MiB). One record is read per
+/// sample at a random place, and a table of one per texel outgrows the caches: Captain Falcon's
+/// 1600x800 map made 20 MiB, and its reads were the largest item of that scene's profile. A
+/// larger map gets one cell per block of 2x2, 4x4, ... texels, sampled uniformly inside: the
+/// density follows the blocks' sums, which for a map of more than 131,072 texels changes the
+/// noise hardly at all, and it stays unbiased (any density that is positive wherever light
+/// is, is; and where it is not, the path's BSDF samples are weighted in fully).
+const MAX_DISTRIBUTION_CELLS: usize = 1 << 17;
+
+/// Cells across and down for a `w` x `h` map: texels in blocks of the least power-of-two side
+/// that keeps them within [`MAX_DISTRIBUTION_CELLS`] (a 4x4 block is one tile of the image's
+/// texel storage, which the sampler's prefetch then loads whole).
+fn distribution_cells(w: usize, h: usize) -> (usize, usize) {
+    let mut side = 1;
+    while w.div_ceil(side) * h.div_ceil(side) > MAX_DISTRIBUTION_CELLS {
+        side *= 2;
+    }
+    (w.div_ceil(side), h.div_ceil(side))
+}
+
+/// `func` (`w` x `h` texels) summed into `across` x `down` cells that split [0, 1)^2 evenly,
+/// each texel into the cell holding its centre.
+fn cell_sums(func: &[f32], w: usize, h: usize, across: usize, down: usize) -> Vec<f32> {
+    if (across, down) == (w, h) {
+        return func.to_vec();
+    }
+    let cell = |i: usize, n: usize, cells: usize| (2 * i + 1) * cells / (2 * n);
+    let mut sums = vec![0.0f32; across * down];
+    for (y, row) in func.chunks_exact(w.max(1)).enumerate() {
+        let cy = cell(y, h, down);
+        for (x, &f) in row.iter().enumerate() {
+            sums[cy * across + cell(x, w, across)] += f;
+        }
+    }
+    sums
 }
 
 impl LatLongMap {
@@ -292,11 +332,26 @@ impl LatLongMap {
                 func[y * w + x] = sum * sin_theta;
             }
         }
+        let (cells_across, cells_down) = distribution_cells(w, h);
         Self {
-            distribution: Distribution2D::new(&func, w, h),
+            distribution: Distribution2D::new(
+                &cell_sums(&func, w, h, cells_across, cells_down),
+                cells_across,
+                cells_down,
+            ),
+            cells_across,
+            cells_down,
             image,
             convention,
         }
+    }
+
+    /// Starts loading the texels of distribution cell (`column`, `row`), where a sample is
+    /// about to land.
+    fn prefetch_cell(&self, row: usize, column: usize) {
+        let (w, h) = (self.image.width as usize, self.image.height as usize);
+        self.image
+            .prefetch(column * w / self.cells_across, row * h / self.cells_down);
     }
 
     /// Map coordinates of a unit light-space direction.
@@ -346,5 +401,29 @@ impl LatLongMap {
             sum += row * solid_angle;
         }
         sum / (4.0 * PI)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn large_maps_are_sampled_by_blocks_that_keep_their_sums() {
+        assert_eq!(distribution_cells(64, 32), (64, 32));
+        assert_eq!(distribution_cells(512, 256), (512, 256));
+        // Captain Falcon's map: 4x4 blocks, 80,000 cells.
+        assert_eq!(distribution_cells(1600, 800), (400, 200));
+        // Sides that blocks do not divide: the last block is partial.
+        let (across, down) = distribution_cells(1001, 499);
+        assert_eq!((across, down), (501, 250));
+
+        let (w, h) = (1001, 499);
+        let func: Vec<f32> = (0..w * h).map(|i| (i % 7 + 1) as f32).collect();
+        let sums = cell_sums(&func, w, h, across, down);
+        let total = |v: &[f32]| v.iter().map(|&f| f64::from(f)).sum::<f64>();
+        assert!((total(&sums) / total(&func) - 1.0).abs() < 1e-6);
+        // Every cell holds a texel centre: none is left without density.
+        assert!(sums.iter().all(|&s| s > 0.0));
     }
 }

@@ -462,11 +462,18 @@ fn latlong_marker_shows_in_the_direction_each_convention_puts_it() {
 
 #[test]
 fn env_map_sampling_estimates_the_map_integral() {
-    let (w, h) = (64u32, 32u32);
+    // One distribution cell per texel, and (1024 x 512) one per 2 x 2 texels.
+    for (w, h) in [(64, 32), (1024, 512)] {
+        env_map_sampling_estimates_the_integral_of(w, h);
+    }
+}
+
+fn env_map_sampling_estimates_the_integral_of(w: u32, h: u32) {
     let texel = |x: u32, y: u32| {
         let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
         let base = 40.0 + 30.0 * (fx * 2.0 * PI).sin() * (fy * PI).cos();
-        let spot = if (20..23).contains(&x) && (8..10).contains(&y) {
+        let (sx, sy) = (x * 64 / w, y * 32 / h);
+        let spot = if (20..23).contains(&sx) && (8..10).contains(&sy) {
             200.0
         } else {
             0.0
@@ -525,7 +532,7 @@ fn env_map_sampling_estimates_the_map_integral() {
             let err = (estimate[c] / integral[c] - 1.0).abs();
             assert!(
                 err < 0.01,
-                "{convention:?}: estimate {estimate}, integral {integral}"
+                "{w}x{h} {convention:?}: estimate {estimate}, integral {integral}"
             );
         }
     }
