@@ -75,8 +75,14 @@ pub struct PixelSampler {
     /// The indices are permuted over `first..first + len`, which holds `index`.
     first: u32,
     len: u32,
-    dimension: u32,
+    /// [`permutation_mask`] of `len`.
+    mask: u32,
+    /// The next dimension times [`DIMENSION_STEP`].
+    dimension_key: u64,
 }
+
+/// Dimension d's hash is that of the pixel's with d times this (2^64 / golden ratio).
+const DIMENSION_STEP: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// The first block of [`PixelSampler::nested`]'s indices: the default first round of an
 /// adaptive render, so that rounds of that default are exactly the blocks.
@@ -107,13 +113,14 @@ impl PixelSampler {
             index,
             first,
             len,
-            dimension: 0,
+            mask: permutation_mask(len),
+            dimension_key: 0,
         }
     }
 
     /// The Sobol index this sample uses in the dimension whose hash is `p`.
     fn sobol_index(&self, p: u32) -> u32 {
-        self.first + permutation_element(self.index - self.first, self.len, p)
+        self.first + permutation_element(self.index - self.first, self.len, self.mask, p)
     }
 
     pub fn get_1d(&mut self) -> f32 {
@@ -133,10 +140,18 @@ impl PixelSampler {
         )
     }
 
+    /// Passes over `dimensions` dimensions (each [`Self::get_1d`] or [`Self::get_2d`] takes
+    /// one) without computing them, where a vertex does not use them but the next one's must
+    /// stay where they are.
+    pub fn skip(&mut self, dimensions: u32) {
+        self.dimension_key = self
+            .dimension_key
+            .wrapping_add(u64::from(dimensions).wrapping_mul(DIMENSION_STEP));
+    }
+
     fn next_dimension_hash(&mut self) -> u64 {
-        let hash =
-            mix64(self.pixel_hash ^ u64::from(self.dimension).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        self.dimension += 1;
+        let hash = mix64(self.pixel_hash ^ self.dimension_key);
+        self.dimension_key = self.dimension_key.wrapping_add(DIMENSION_STEP);
         hash
     }
 }
@@ -185,18 +200,20 @@ fn owen_scramble(v: u32, seed: u32) -> u32 {
     x.reverse_bits()
 }
 
+/// The least all-ones mask covering 0..len, which [`permutation_element`] cycles within.
+fn permutation_mask(len: u32) -> u32 {
+    u32::MAX
+        .checked_shr(len.saturating_sub(1).leading_zeros())
+        .unwrap_or(0)
+}
+
 /// Element `i` of a pseudo-random permutation of 0..len chosen by `p` (Kensler 2013,
-/// "Correlated Multi-Jittered Sampling"). A bijection on 0..len for every p.
-fn permutation_element(mut i: u32, len: u32, p: u32) -> u32 {
+/// "Correlated Multi-Jittered Sampling"); `w` is [`permutation_mask`] of `len`. A bijection on
+/// 0..len for every p.
+fn permutation_element(mut i: u32, len: u32, w: u32, p: u32) -> u32 {
     if len <= 1 {
         return 0;
     }
-    let mut w = len - 1;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
     loop {
         i ^= p;
         i = i.wrapping_mul(0xe170_893d);
@@ -233,12 +250,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn skipped_dimensions_leave_the_next_ones_where_they_were() {
+        let mut drawn = PixelSampler::new(3, 4, 5, 16, 9);
+        let mut skipped = drawn.clone();
+        drawn.get_1d();
+        drawn.get_2d();
+        skipped.skip(2);
+        assert_eq!(drawn.get_2d(), skipped.get_2d());
+        assert_eq!(drawn.get_1d(), skipped.get_1d());
+    }
+
+    #[test]
+    fn permutation_masks_cover_the_range_with_the_fewest_bits() {
+        for (len, mask) in [(0, 0), (1, 0), (2, 1), (3, 3), (7, 7), (64, 63), (65, 127)] {
+            assert_eq!(permutation_mask(len), mask, "len {len}");
+        }
+        assert_eq!(permutation_mask(u32::MAX), u32::MAX);
+    }
+
+    #[test]
     fn permutation_is_a_bijection() {
         for len in [1u32, 2, 7, 64, 100, 1000] {
             for p in [0u32, 1, 0xdead_beef] {
                 let mut seen = vec![false; len as usize];
                 for i in 0..len {
-                    let j = permutation_element(i, len, p) as usize;
+                    let j = permutation_element(i, len, permutation_mask(len), p) as usize;
                     assert!(!seen[j], "len {len} p {p}: {j} twice");
                     seen[j] = true;
                 }

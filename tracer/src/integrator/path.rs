@@ -204,9 +204,9 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             radiance +=
                 throughput * direct_light(scene, &hit, wo, &bsdf, sides, sampler, &mut rays);
         } else {
-            // Keep the dimension layout of a vertex fixed whatever the material.
-            sampler.get_1d();
-            sampler.get_2d();
+            // Keep the dimension layout of a vertex fixed whatever the material: the light
+            // sample's selection and position.
+            sampler.skip(2);
         }
 
         let Some(bs) = bsdf.sample(wo, sampler.get_1d(), sampler.get_2d()) else {
