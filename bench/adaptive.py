@@ -30,9 +30,10 @@ depth 10, every renderer on the same --threads:
   same spp, which compiles the kernels). CPU time is what to compare on a shared machine; wall
   time moves with the load. Samples are each renderer's own count.
 - Caches. References: target/bench-refs, keyed by the renderer's input (YAT's binary, the
-  export's files and the script). The rivals' renders: target/bench-refs/rivals.json, keyed by
-  renderer, version, settings, export digest and spp; a re-run with a new YAT binary re-renders
-  only YAT (and YAT's reference, unless --reference-binary keeps the old binary for it).
+  export's files and the script). Every render's figures: target/bench-refs/time-to-clean.json,
+  keyed by renderer, version, settings, reference, YAT's binary or the export's digest, and spp
+  or threshold; a re-run with a new YAT binary re-renders only YAT (and YAT's reference, unless
+  --reference-binary keeps the old binary for it), one with new settings only what they change.
 
 --write-results writes the section "Time to a clean image against LuxCore and Mitsuba" of
 bench/RESULTS.md (after the adaptive-sampling section; other sections are kept) and fills the
@@ -66,7 +67,7 @@ SCENES = bench.COMPARED_SCENES
 SECTION = "## Time to a clean image against LuxCore and Mitsuba"
 # The section goes after the adaptive-sampling section it continues.
 AFTER_SECTION = "## Adaptive sampling: samples to the error"
-RIVALS_CACHE = bench.REFS / "rivals.json"
+RENDERS_CACHE = bench.REFS / "time-to-clean.json"
 # A rival's search stops once two renders bracket the target and the nearer one's MSE is within
 # this factor of it: interpolating over at most that much keeps the interpolation's error small.
 CLOSE_ENOUGH = 1.1
@@ -90,13 +91,29 @@ def yat(binary, scene, args, out_dir, extra):
     return bench.run_measured(cmd, f"yat on {scene}", stats)
 
 
-def measure(binary, scene, args, extra):
-    """(linear image, CPU seconds, mean samples per pixel) of one YAT render."""
-    with tempfile.TemporaryDirectory() as tmp:
-        figures = yat(binary, scene, args, Path(tmp), extra)
-        image = bench.read_exr(Path(tmp) / "out.exr")
-    w, h = (int(v) for v in args.resolution.split("x"))
-    return image, figures["cpu_seconds"], figures["samples"] / (w * h)
+def cached_run(cache, key, variant, render):
+    """render() -> (MSE, CPU seconds, mean spp), or the figures cached for the configuration
+    `key` and its `variant` (the spp, the threshold: what the searches vary)."""
+    done = cache.setdefault(key, {})
+    if variant not in done:
+        done[variant] = list(render())
+        save_cache(cache)
+    return tuple(done[variant])
+
+
+def measure(yat_config, extra):
+    """(MSE, CPU seconds, mean samples per pixel) of one YAT render with `extra` arguments;
+    yat_config = (binary, scene, args, reference, cache, cache key)."""
+    binary, scene, args, reference, cache, key = yat_config
+
+    def render():
+        with tempfile.TemporaryDirectory() as tmp:
+            figures = yat(binary, scene, args, Path(tmp), extra)
+            image = bench.read_exr(Path(tmp) / "out.exr")
+        w, h = (int(v) for v in args.resolution.split("x"))
+        return clean_mse(image, reference), figures["cpu_seconds"], figures["samples"] / (w * h)
+
+    return cached_run(cache, key, " ".join(extra), render)
 
 
 def at_target(lo, hi, target):
@@ -117,17 +134,18 @@ def bracket(runs, target):
             min(above, key=lambda r: r[0]) if above else None)
 
 
-def yat_adaptive(binary, scene, args, reference, target):
+def yat_adaptive(yat_config, target):
     """Bisects log(threshold) toward the target; returns (spp, CPU s, renders) or None."""
+    args = yat_config[2]
     runs = []  # (error, seconds, spp, threshold)
     lo = hi = None
     threshold = args.start_threshold
     for _ in range(args.steps):
-        image, seconds, spp = measure(binary, scene, args, [
+        error, seconds, spp = measure(yat_config, [
             "--spp", str(args.max_spp), "--min-spp", str(args.min_spp),
             "--noise-threshold", f"{threshold:.5g}",
         ])
-        runs.append((clean_mse(image, reference), seconds, spp, threshold))
+        runs.append((error, seconds, spp, threshold))
         bench.log(f"  YAT adaptive threshold {threshold:.4g}: MSE {runs[-1][0]:.4g}, "
                   f"{seconds:.1f} CPU s, {spp:.0f} spp")
         lo, hi = bracket(runs, target)
@@ -169,7 +187,7 @@ class Rival:
     def to_target(self, target, args):
         """(spp, CPU s, renders) to the target MSE, or (None, None, renders) if not reached."""
         done = self.cache.setdefault(self.key, {})
-        runs = [tuple(r) for r in done.values()]  # (error, cpu s, spp)
+        runs = [tuple(r) for r in done.values()]  # (error, cpu s, mean spp)
         spp = max(1, args.target_spp // 4)
         for _ in range(args.rival_renders + len(runs)):
             lo, hi = bracket(runs, target)
@@ -180,26 +198,25 @@ class Rival:
                 spp = next_spp(runs, target, args.target_spp)
             if str(spp) in done:
                 break  # the prediction repeats a render: as close as the search gets
-            error, seconds, mean_spp = self.render(spp)
+            error, seconds, mean_spp = cached_run(self.cache, self.key, str(spp),
+                                                  lambda: self.render(spp))
             bench.log(f"  {self.label} {spp} spp: MSE {error:.4g}, {seconds:.1f} CPU s, "
                       f"{mean_spp:.0f} mean spp")
-            done[str(spp)] = [error, seconds, mean_spp]
             runs.append((error, seconds, mean_spp))
-            save_cache(self.cache)
         lo, hi = bracket(runs, target)
         if lo is None:
             return None, None, sorted(runs, key=lambda r: r[2])
-        spp, seconds = at_target((lo[0], lo[1], lo[2]), hi and (hi[0], hi[1], hi[2]), target)
+        spp, seconds = at_target(lo, hi, target)
         return spp, seconds, sorted(runs, key=lambda r: r[2])
 
 
 def load_cache():
-    return json.loads(RIVALS_CACHE.read_text()) if RIVALS_CACHE.exists() else {}
+    return json.loads(RENDERS_CACHE.read_text()) if RENDERS_CACHE.exists() else {}
 
 
 def save_cache(cache):
-    RIVALS_CACHE.parent.mkdir(parents=True, exist_ok=True)
-    RIVALS_CACHE.write_text(json.dumps(cache, indent=1, sort_keys=True))
+    RENDERS_CACHE.parent.mkdir(parents=True, exist_ok=True)
+    RENDERS_CACHE.write_text(json.dumps(cache, indent=1, sort_keys=True))
 
 
 def rivals(scene, export, args, cache, size, yat_reference):
@@ -367,11 +384,13 @@ def main():
         setting = f"rivals-{name}-{args.resolution}-{args.reference_spp // 2}spp-d{args.depth}"
         reference = bench.reference_pair("yat", setting, bench.file_digest(ref_binary, scene),
                                          yat_half)
-        image, uniform_s, _ = measure(binary, scene, args, ["--spp", str(args.target_spp)])
-        target = clean_mse(image, reference)
+        yat_key = (f"{name}|yat-{bench.file_digest(binary)}|{args.resolution}|d{args.depth}|"
+                   f"t{args.threads}|ref{args.reference_spp}-{bench.file_digest(ref_binary)}")
+        yat_config = (binary, scene, args, reference, cache, yat_key)
+        target, uniform_s, _ = measure(yat_config, ["--spp", str(args.target_spp)])
         bench.log(f"{name}: YAT uniform {args.target_spp} spp MSE {target:.4g} "
                   f"(reference noise {reference[1]:.3g}) in {uniform_s:.1f} CPU s")
-        adaptive = yat_adaptive(binary, scene, args, reference, target)
+        adaptive = yat_adaptive(yat_config, target)
         ada_s = adaptive[1] if adaptive else None
         if adaptive:
             measured[scene.name] = uniform_s / ada_s
