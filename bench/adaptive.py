@@ -215,8 +215,12 @@ def load_cache():
 
 
 def save_cache(cache):
+    """Writes the figures merged into the file's: runs of other scenes may share the file."""
+    merged = load_cache()
+    for key, runs in cache.items():
+        merged.setdefault(key, {}).update(runs)
     RENDERS_CACHE.parent.mkdir(parents=True, exist_ok=True)
-    RENDERS_CACHE.write_text(json.dumps(cache, indent=1, sort_keys=True))
+    RENDERS_CACHE.write_text(json.dumps(merged, indent=1, sort_keys=True))
 
 
 def rivals(scene, export, args, cache, size, yat_reference):
