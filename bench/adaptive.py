@@ -179,7 +179,8 @@ def next_spp(runs, target, target_spp):
 
 
 class Rival:
-    """One rival renderer configuration: its reference, its cached renders and its search."""
+    """One rival renderer configuration: a label, its cache key, render(spp) -> (MSE against
+    its reference, render CPU s, mean spp), and the search for the target."""
 
     def __init__(self, label, key, render, cache):
         self.label, self.key, self.render, self.cache = label, key, render, cache
@@ -239,6 +240,8 @@ def rivals(scene, export, args, cache, size, yat_reference):
     lux_version = importlib.metadata.version("pyluxcore")
     mi_version = importlib.metadata.version("mitsuba")
 
+    # Both write d/ref.exr, the name bench.reference takes a reference from; measured renders
+    # are read from there too.
     def lux_run(d, spp, seed, strength):
         cmd = [
             str(bench.VENV_PYTHON), str(bench.ROOT / "bench/luxcore.py"), str(export), "--spp",
