@@ -43,7 +43,7 @@ seed table's column "core-s to 1000-spp error, adaptive": the row's "ours core-s
     python3 bench/adaptive.py --binary /tmp/yat                # four scenes at 160x90
     python3 bench/adaptive.py --binary target/fuzz/yat --reference-binary /tmp/ref-yat \\
         --only metal-mario --write-results
-    python3 bench/adaptive.py --resolution 320x180 --reference-spp 2048 --no-rivals
+    python3 bench/adaptive.py --resolution 320x180 --reference-spp 2048 --rivals none
 
 Prints Markdown tables.
 """
@@ -190,20 +190,23 @@ class Rival:
         done = self.cache.setdefault(self.key, {})
         runs = [tuple(r) for r in done.values()]  # (error, cpu s, mean spp)
         spp = max(1, args.target_spp // 4)
-        for _ in range(args.rival_renders + len(runs)):
+        new = 0
+        while True:
             lo, hi = bracket(runs, target)
             if lo and hi and min(abs(math.log(r[0] / target)) for r in (lo, hi)) <= \
                     math.log(CLOSE_ENOUGH):
                 break
             if runs:
                 spp = next_spp(runs, target, args.target_spp)
-            if str(spp) in done:
-                break  # the prediction repeats a render: as close as the search gets
+            if str(spp) in done or new == args.rival_renders:
+                break  # as close as the search gets (the prediction repeats a render), or
+                # as many new renders as allowed
             error, seconds, mean_spp = cached_run(self.cache, self.key, str(spp),
                                                   lambda: self.render(spp))
             bench.log(f"  {self.label} {spp} spp: MSE {error:.4g}, {seconds:.1f} CPU s, "
                       f"{mean_spp:.0f} mean spp")
             runs.append((error, seconds, mean_spp))
+            new += 1
         lo, hi = bracket(runs, target)
         if lo is None:
             return None, None, sorted(runs, key=lambda r: r[2])
@@ -284,13 +287,13 @@ def rivals(scene, export, args, cache, size, yat_reference):
 
     common = f"{res}|d{args.depth}|t{args.threads}|ref{args.reference_spp}|seed{bench.SHORT_SEED}"
     out = []
-    for strength in args.luxcore_strength:
+    for strength in args.luxcore_strength if "luxcore" in args.rivals else []:
         out.append(Rival(
             f"LuxCore {lux_version} PATHCPU SOBOL, adaptive strength {strength:g}",
             f"{name}|luxcore-{lux_version}|sobol-{strength:g}|{common}|{lux_digest}",
             measured(lambda d, spp, s=strength: lux_run(d, spp, bench.SHORT_SEED, s), lux_ref),
             cache))
-    for sampler in args.mitsuba_sampler:
+    for sampler in args.mitsuba_sampler if "mitsuba" in args.rivals else []:
         out.append(Rival(
             f"Mitsuba {mi_version} llvm_ad_rgb {sampler}",
             f"{name}|mitsuba-{mi_version}|llvm_ad_rgb-{sampler}|{common}|{mi_digest}",
@@ -352,7 +355,8 @@ def main():
                     "multijitter)")
     ap.add_argument("--rival-renders", type=int, default=4,
                     help="most new renders per rival configuration (4)")
-    ap.add_argument("--no-rivals", action="store_true", help="YAT only")
+    ap.add_argument("--rivals", default="luxcore,mitsuba", help="the other renderers measured: "
+                    "luxcore, mitsuba, both (the default, luxcore,mitsuba) or none")
     ap.add_argument("--binary", default=str(bench.YAT), help="the yat binary (default: release)")
     ap.add_argument("--reference-binary", help="the yat binary YAT's references are rendered "
                     "with (default: --binary); a uniform render does not depend on the adaptive "
@@ -415,7 +419,7 @@ def main():
              f"{ada_s:.1f}" if adaptive else "-", "1.00x" if adaptive else "-"],
         ]
         agreement = []
-        if not args.no_rivals:
+        if args.rivals != "none":
             with tempfile.TemporaryDirectory() as tmp:
                 export = Path(tmp) / "export"
                 export_scene(binary, scene, export)
