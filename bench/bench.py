@@ -488,8 +488,9 @@ def main():
         print(section)
         if not args.only:
             old = results.read_text() if results.exists() else "# YAT benchmark results\n"
-            results.write_text(replace_section(old, "## Side by side", section))
-            log("rewrote the side-by-side section of bench/RESULTS.md (the others kept)")
+            head = old.split("## Side by side")[0].rstrip("\n")
+            results.write_text(f"{head}\n\n{section}")
+            log("rewrote the side-by-side section of bench/RESULTS.md")
         return
 
     scenes = [("seed", SEED / s, (t, here)) for s, t, here in SEED_TABLE] + [
