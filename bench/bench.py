@@ -11,7 +11,8 @@ render seconds).
     python3 bench/bench.py --quick         # fewer samples, no side by side, prints only
     python3 bench/bench.py --no-compare    # our scenes and the seed table only
     python3 bench/bench.py --compare-only  # only the side by side: rewrites its section of
-                                           # bench/RESULTS.md, keeps the rest
+                                           # bench/RESULTS.md (up to the next "## " heading),
+                                           # keeps every other section
 
 The side by side runs bench/setup-env.sh first (the virtualenv bench/.venv with pyluxcore,
 mitsuba, numpy and OpenEXR, and Debian's libllvm19 for Mitsuba's llvm variant) and re-runs
@@ -199,6 +200,17 @@ def reference(kind, setting, digest, make):
     return read_exr(path)
 
 
+def reference_pair(kind, setting, digest, make_half, seeds=(REFERENCE_SEED, REFERENCE_SEED + 1)):
+    """A converged reference as the mean of two independent renders (`make_half(dir, seed)`
+    renders one into dir/ref.exr; each cached by reference()), and the mean's own noise: the
+    expected squared error each pixel of the mean carries, MSE(a, b) / 4 (a and b differ by
+    twice a half's noise; the mean carries half a half's). An MSE against the mean minus that
+    noise is the MSE against the true image, whichever renderer's reference it is."""
+    a, b = (reference(kind, f"{setting}-seed{seed}", digest, lambda d, s=seed: make_half(d, s))
+            for seed in seeds)
+    return (a + b) / 2, mse(a, b) / 4
+
+
 def mse(image, ref):
     """Mean squared error per channel over all pixels."""
     import numpy as np
@@ -341,6 +353,29 @@ def side_by_side(args):
         summary,
     )
     return runs_table, summary_table, notes
+
+
+def replace_section(text, heading, section, after=None):
+    """`text` with its section `heading` ("## ..." up to the next "## " heading) replaced by
+    `section`; a missing section goes in after the section `after` (else at the end)."""
+    lines = text.rstrip("\n").split("\n")
+
+    def span(title):
+        start = next((i for i, l in enumerate(lines) if l.startswith(title)), None)
+        if start is None:
+            return None
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")),
+                   len(lines))
+        return start, end
+
+    found = span(heading)
+    if found is None:
+        at = (span(after) or (len(lines), len(lines)))[1] if after else len(lines)
+        found = (at, at)
+    start, end = found
+    new = ([""] if start > 0 and lines[start - 1] else []) + section.rstrip("\n").split("\n")
+    new += [""] if end < len(lines) else []
+    return "\n".join(lines[:start] + new + lines[end:]) + "\n"
 
 
 def fmt_row(cols, widths):

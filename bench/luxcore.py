@@ -7,7 +7,10 @@ in the benchmark's virtualenv, one process per render (as it runs yat).
         --out rgb.exr --stats stats.json
 
 Timing starts when RenderSession.Start() returns (scene and BVH ready) and stops when the
-halt condition is met, like yat's render_seconds.
+halt condition is met, like yat's render_seconds; render_cpu_seconds is the process's CPU time
+(all its threads) over the same span. SOBOL's adaptive strength is LuxCore's own default (0.95:
+pixels are picked in proportion to their estimated noise, the mean spp stays --spp) unless
+--adaptive-strength says otherwise (0 = every pixel alike).
 """
 
 import argparse
@@ -23,6 +26,8 @@ def main():
     ap.add_argument("--depth", type=int, required=True)
     ap.add_argument("--threads", type=int, required=True)
     ap.add_argument("--sampler", default="SOBOL", help="SOBOL (LuxCore's default) or RANDOM")
+    ap.add_argument("--adaptive-strength", type=float,
+                    help="sampler.sobol.adaptive.strength (LuxCore's default: 0.95)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--width", type=int, help="image width (default: the export's film)")
     ap.add_argument("--height", type=int, help="image height (default: the export's film)")
@@ -51,6 +56,8 @@ def main():
         "film.outputs.0.type": "RGB",
         "film.outputs.0.filename": out,
     }
+    if args.adaptive_strength is not None:
+        props["sampler.sobol.adaptive.strength"] = args.adaptive_strength
     if args.width and args.height:
         props["film.width"] = args.width
         props["film.height"] = args.height
@@ -73,12 +80,14 @@ def main():
     session = pyluxcore.RenderSession(config)
     session.Start()
     started = time.perf_counter()
+    started_cpu = time.process_time()
     while True:
         session.UpdateStats()
         if session.HasDone():
             break
         time.sleep(0.02)
     seconds = time.perf_counter() - started
+    cpu_seconds = time.process_time() - started_cpu
     stats = session.GetStats()
     session.Stop()
     film = session.GetFilm()
@@ -90,10 +99,13 @@ def main():
         "spp": passes,
         "load_seconds": started - loading,
         "render_seconds": seconds,
+        "render_cpu_seconds": cpu_seconds,
         "samples_per_second": width * height * passes / seconds,
         "luxcore_samples_per_second": stats.Get("stats.renderengine.total.samplesec").GetFloat(),
         "rays_per_second": stats.Get("stats.renderengine.total.raysec").GetFloat(),
         "sampler": args.sampler,
+        # The value in force (LuxCore's default when not set).
+        "adaptive_strength": config.GetProperty("sampler.sobol.adaptive.strength").GetFloat(),
         "pyluxcore": pyluxcore.Version(),
     }
     film.SaveOutputs()

@@ -464,19 +464,26 @@ def render(args):
         dr.sync_thread()
         compile_seconds = time.perf_counter() - loaded
     started = time.perf_counter()
+    started_cpu = time.process_time()
     image = mi.render(scene, spp=args.spp, seed=args.seed)
     dr.eval(image)
     dr.sync_thread()
     seconds = time.perf_counter() - started
+    # All the process's threads (Dr.Jit's pool included), as for the other renderers.
+    cpu_seconds = time.process_time() - started_cpu
+    # The stratified samplers round the count (ldsampler to a power of two, multijitter to a
+    # product of two near its square root): the samples taken are the sampler's count.
+    spp = scene.sensors()[0].sampler().sample_count()
     mi.Bitmap(image).write(args.out)
     figures = {
         "width": args.width,
         "height": args.height,
-        "spp": args.spp,
+        "spp": spp,
         "load_seconds": loaded - loading,
         "warm_up_seconds": compile_seconds,
         "render_seconds": seconds,
-        "samples_per_second": pixels * args.spp / seconds,
+        "render_cpu_seconds": cpu_seconds,
+        "samples_per_second": pixels * spp / seconds,
         "variant": args.variant,
         "sampler": args.sampler,
         "mitsuba": mi.__version__,
