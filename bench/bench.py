@@ -470,15 +470,16 @@ def split_sections(text):
 
 def write_sections(path, new):
     """Writes the "## " sections of `new` into the Markdown file at `path` in place of the
-    sections with the same heading, keeping every other section (hand-written findings,
-    other scripts' tables) where it is; `new`'s preamble, if any, replaces the file's."""
-    old_head, old_sections = split_sections(path.read_text() if path.exists() else "")
+    sections with the same heading (`replace_section`), keeping every other section
+    (hand-written findings, other scripts' tables) where it is; `new`'s preamble, if any,
+    replaces the file's."""
+    text = path.read_text() if path.exists() else ""
     new_head, new_sections = split_sections(new)
-    replacements = dict(new_sections)
-    merged = [replacements.pop(heading, body) for heading, body in old_sections]
-    merged += [body for heading, body in new_sections if heading in replacements]
+    for heading, body in new_sections:
+        text = replace_section(text, heading, body)
+    old_head, sections = split_sections(text)
     head = new_head or old_head or "# YAT benchmark results"
-    path.write_text("\n\n".join([head] + merged) + "\n")
+    path.write_text("\n\n".join([head] + [body for _, body in sections]) + "\n")
 
 
 def adaptive_cells(path):
