@@ -243,26 +243,19 @@ def rivals(scene, export, args, cache, size, yat_reference):
     lux_version = importlib.metadata.version("pyluxcore")
     mi_version = importlib.metadata.version("mitsuba")
 
-    # Both write d/ref.exr, the name bench.reference takes a reference from; measured renders
-    # are read from there too.
+    # bench's renders, moved to d/ref.exr, the name bench.reference takes a reference from;
+    # measured renders are read from there too.
     def lux_run(d, spp, seed, strength):
-        cmd = [
-            str(bench.VENV_PYTHON), str(bench.ROOT / "bench/luxcore.py"), str(export), "--spp",
-            str(spp), "--depth", str(args.depth), "--threads", str(args.threads), "--seed",
-            str(seed), "--adaptive-strength", str(strength), "--width", str(size[0]),
-            "--height", str(size[1]), "--out", str(d / "ref.exr"), "--stats", str(d / "s.json"),
-        ]
-        return bench.run_measured(cmd, f"LuxCore on {name}", d / "s.json")
+        figures = bench.render_luxcore(export, spp, args.depth, args.threads, d, seed, size,
+                                       strength)
+        (d / "lux.exr").rename(d / "ref.exr")
+        return figures
 
     def mi_run(d, spp, seed, sampler, warm_up):
-        cmd = [
-            str(bench.VENV_PYTHON), str(bench.ROOT / "bench/mitsuba3.py"), "render", str(xml),
-            "--variant", "llvm_ad_rgb", "--sampler", sampler, "--spp", str(spp), "--depth",
-            str(args.depth), "--threads", str(args.threads), "--width", str(size[0]),
-            "--height", str(size[1]), "--seed", str(seed), "--out", str(d / "ref.exr"),
-            "--stats", str(d / "s.json"),
-        ] + (["--warm-up"] if warm_up else [])
-        return bench.run_measured(cmd, f"Mitsuba {sampler} on {name}", d / "s.json")
+        figures = bench.render_mitsuba(xml, "llvm_ad_rgb", sampler, spp, args.depth,
+                                       args.threads, size, d, seed, warm_up)
+        (d / "mitsuba.exr").rename(d / "ref.exr")
+        return figures
 
     bench.log(f"  LuxCore and Mitsuba references of {name} (2 x {ref_half} spp, cached) ...")
     lux_ref = bench.reference_pair("luxcore", setting, lux_digest,

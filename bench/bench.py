@@ -154,15 +154,16 @@ def render(scene, spp, depth, threads, out_dir, seed=0, size=None):
     return run_measured(cmd, f"yat on {scene}", stats)
 
 
-def render_luxcore(export_dir, spp, depth, threads, out_dir, seed, size):
-    """One LuxCore render of an exported scene at `size`; writes out_dir/lux.exr."""
+def render_luxcore(export_dir, spp, depth, threads, out_dir, seed, size, strength=None):
+    """One LuxCore render of an exported scene at `size`, with its SOBOL sampler's adaptive
+    `strength` (default: LuxCore's); writes out_dir/lux.exr."""
     stats = out_dir / "lux.json"
     cmd = [
         str(VENV_PYTHON), str(ROOT / "bench/luxcore.py"), str(export_dir), "--spp", str(spp),
         "--depth", str(depth), "--threads", str(threads), "--seed", str(seed),
         "--width", str(size[0]), "--height", str(size[1]),
         "--out", str(out_dir / "lux.exr"), "--stats", str(stats),
-    ]
+    ] + (["--adaptive-strength", str(strength)] if strength is not None else [])
     return run_measured(cmd, f"LuxCore on {export_dir}", stats)
 
 
