@@ -219,6 +219,11 @@ impl Distribution2D {
         Some((Vec2::new(x, y), pdf_x * pdf_y))
     }
 
+    /// Cells along a row and rows.
+    pub fn cells(&self) -> (usize, usize) {
+        (self.width, self.marginal.len())
+    }
+
     pub fn pdf(&self, p: Vec2) -> f32 {
         let height = self.marginal.len();
         if self.width == 0 || height == 0 {

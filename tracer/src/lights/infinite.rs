@@ -266,11 +266,9 @@ impl Environment {
 struct LatLongMap {
     image: RgbImage,
     convention: LatLongConvention,
-    /// Over cells of the map, by luminance x sin(theta).
+    /// Over cells of the map (one per texel, or per block of texels on a large map), by
+    /// luminance x sin(theta).
     distribution: Distribution2D,
-    /// The distribution's cells: one per texel, or per block of texels on a large map.
-    cells_across: usize,
-    cells_down: usize,
 }
 
 /// The most cells a map's distribution holds (16 bytes each: 2 MiB). One record is read per
@@ -339,8 +337,6 @@ impl LatLongMap {
                 cells_across,
                 cells_down,
             ),
-            cells_across,
-            cells_down,
             image,
             convention,
         }
@@ -350,8 +346,8 @@ impl LatLongMap {
     /// about to land.
     fn prefetch_cell(&self, row: usize, column: usize) {
         let (w, h) = (self.image.width as usize, self.image.height as usize);
-        self.image
-            .prefetch(column * w / self.cells_across, row * h / self.cells_down);
+        let (across, down) = self.distribution.cells();
+        self.image.prefetch(column * w / across, row * h / down);
     }
 
     /// Map coordinates of a unit light-space direction.
