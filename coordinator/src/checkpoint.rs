@@ -70,7 +70,7 @@ impl RenderIdentity {
 
 /// Changes whenever the same adaptive settings would decide other rounds (the error estimate,
 /// the decision, the units of a round): part of an adaptive render's identity.
-const ADAPTIVE_VERSION: u32 = 3;
+const ADAPTIVE_VERSION: u32 = 4;
 
 /// The render so far: the merged film and which units of the plan it holds; for an adaptive
 /// render, the round under way (whose units `done` counts) and the half sums in the film.

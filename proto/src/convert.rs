@@ -474,19 +474,21 @@ mod tests {
             spp: 64,
             ..settings()
         };
-        // A 36x50 tile: 5 x 7 blocks.
+        // A 28x18 tile: 7 x 5 blocks (the last row 2 pixels tall); blocks (0, 0), (4, 0) and
+        // (6, 4) on.
         let unit = WorkUnit {
             index: 2,
-            x0: 64,
+            x0: 72,
             y0: 0,
             x1: 100,
-            y1: 50,
+            y1: 18,
             sample_start: 16,
             sample_end: 21,
-            mask: Some(1 | 1 << 4 | 1 << 52),
+            mask: Some(1 | 1 << 4 | 1 << (4 * 8 + 6)),
         };
         assert_eq!(unit_from_wire(&(&unit).into(), &s).unwrap(), unit);
-        for mask in [0, 1 << 5, 1 << 56, u64::MAX] {
+        // No mask, a block right of the tile, one below it, every bit.
+        for mask in [0, 1 << 7, 1 << (5 * 8), u64::MAX] {
             let bad = WorkUnit {
                 mask: Some(mask),
                 ..unit
@@ -495,66 +497,71 @@ mod tests {
         }
         let wide = WorkUnit {
             x0: 0,
-            x1: 65,
+            x1: MAX_MASKED_SIDE + 1,
             mask: Some(1),
             ..unit
         };
         assert!(unit_from_wire(&(&wide).into(), &s).is_err());
 
-        // Samples 16..21: 5 in all, 2 odd (17, 19). Pixel (64, 0) is in block 0, (70, 10) in
-        // no active block.
+        // Samples 16..21: 5 in all, 2 odd (17, 19). Pixel (72, 0) is in block (0, 0), (97, 17)
+        // in (6, 4), (78, 6) in no active block. Without a border a pixel gets only its own
+        // block's samples: one source plane.
         let frame = FilmFrame::unbordered(s.width, s.height);
+        let pixels = 28 * 18;
         let mut buffer = SampleBuffer::new(unit, &frame);
-        assert_eq!(buffer.half_rgb.len(), 36 * 50);
-        assert_eq!(buffer.rgb.len(), 4 * 36 * 50, "a plane per block parity");
+        assert_eq!(buffer.half_rgb.len(), pixels);
+        assert_eq!(buffer.rgb.len(), pixels, "one plane");
         buffer.rgb[0] = [1.0, 2.0, 3.0];
         buffer.weight[0] = 5.0;
-        buffer.rgb[3 * 36 * 50 + 48 * 36 + 32] = [4.0, 0.0, 0.0];
-        buffer.weight[3 * 36 * 50 + 48 * 36 + 32] = 1.0;
+        buffer.rgb[17 * 28 + 25] = [4.0, 0.0, 0.0];
+        buffer.weight[17 * 28 + 25] = 1.0;
         buffer.half_rgb[0] = [0.5, 1.0, 1.5];
         buffer.half_weight[0] = 2.0;
         let bytes = encode_pixels(&buffer);
-        assert_eq!(bytes.len(), 5 * 36 * 50 * BYTES_PER_PIXEL);
+        assert_eq!(bytes.len(), 2 * pixels * BYTES_PER_PIXEL);
         assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
-        assert!(decode_pixels(unit, &frame, &bytes[..36 * 50 * BYTES_PER_PIXEL]).is_err());
+        assert!(decode_pixels(unit, &frame, &bytes[..pixels * BYTES_PER_PIXEL]).is_err());
         let mut heavy_half = buffer.clone();
         heavy_half.half_weight[0] = 3.0;
         assert!(
             decode_pixels(unit, &frame, &encode_pixels(&heavy_half)).is_err(),
             "3 of 2 odd samples"
         );
-        for plane in 0..4 {
-            let mut outside = buffer.clone();
-            outside.rgb[plane * 36 * 50 + 10 * 36 + 6] = [0.1, 0.0, 0.0];
-            assert!(
-                decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
-                "a masked-out pixel in plane {plane}"
-            );
-        }
+        let mut outside = buffer.clone();
+        outside.rgb[6 * 28 + 6] = [0.1, 0.0, 0.0];
+        assert!(
+            decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
+            "a masked-out pixel"
+        );
 
-        // With a 2-pixel border, active blocks splat into their neighbours: pixels within 2 of
-        // block 0 may hold sums, those farther from every active block may not.
+        // With a 2-pixel border, active blocks splat into their neighbours (in 4 source
+        // planes): pixels within 2 of block (0, 0) may hold sums in any plane, those farther
+        // from every active block may not.
         let frame = FilmFrame {
             border: [2, 2],
             ..frame
         };
+        assert_eq!(frame.source_planes(), 4);
         let region = frame.region(&unit);
         assert_eq!(
             (region.x0, region.x1, region.y0, region.y1),
-            (62, 100, 0, 50)
+            (70, 100, 0, 20)
         );
         let at = |x: u32, y: u32| ((y - region.y0) * region.width() + x - region.x0) as usize;
-        for (x, y, reached) in [
-            (62, 3, true),
-            (73, 9, true),
-            (74, 3, false),
-            (70, 10, false),
-        ] {
-            let mut buffer = SampleBuffer::new(unit, &frame);
-            buffer.rgb[at(x, y)] = [0.1, 0.0, 0.0];
-            buffer.weight[at(x, y)] = 0.5;
-            let decoded = decode_pixels(unit, &frame, &encode_pixels(&buffer));
-            assert_eq!(decoded.is_ok(), reached, "({x}, {y})");
+        for plane in 0..4 {
+            for (x, y, reached) in [
+                (70, 3, true),
+                (77, 5, true),
+                (78, 3, false),
+                (80, 10, false),
+            ] {
+                let mut buffer = SampleBuffer::new(unit, &frame);
+                let i = plane * region.pixel_count() + at(x, y);
+                buffer.rgb[i] = [0.1, 0.0, 0.0];
+                buffer.weight[i] = 0.5;
+                let decoded = decode_pixels(unit, &frame, &encode_pixels(&buffer));
+                assert_eq!(decoded.is_ok(), reached, "({x}, {y}) in plane {plane}");
+            }
         }
     }
 

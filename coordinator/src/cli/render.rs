@@ -44,7 +44,7 @@ pub struct RenderArgs {
     /// most any pixel gets.
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Adaptive sampling: render in rounds, each doubling the samples of the 8x8-pixel blocks
+    /// Adaptive sampling: render in rounds, each doubling the samples of the 4x4-pixel blocks
     /// that still need them for the image's error to reach E (root-mean-square error over mean
     /// brightness, e.g. 0.02) at the least cost, until none does or --spp is reached. The
     /// image is the same bytes however and wherever it is rendered.

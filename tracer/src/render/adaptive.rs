@@ -12,18 +12,20 @@
 //! **Rounds.** Round 0 renders samples [0, min_spp) of every pixel; round k >= 1 renders
 //! samples [min_spp 2^(k-1), min_spp 2^k) (capped at spp) of the blocks still active, so each
 //! round doubles an active block's samples. A block is [`BLOCK_SIZE`] pixels square on the
-//! image's grid; the units of a round are the plan's 64-pixel tiles with a mask of their active
-//! blocks ([`WorkUnit::mask`]), tiles with none left out.
+//! image's grid; the units of a round are tiles of [`MAX_MASKED_SIDE`] pixels with a mask of
+//! their active blocks ([`WorkUnit::mask`]), tiles with none left out.
 //!
-//! **The film.** A pixel filter wider than a pixel (the seed scenes' blackmanharris reaches 4
-//! pixels, half a block) adds each sample to its neighbours too, and a plain weighted mean of
+//! **The film.** A pixel filter wider than a pixel (the seed scenes' blackmanharris reaches 2
+//! pixels each side, half a block) adds each sample to its neighbours too, and a plain weighted mean of
 //! what reaches a pixel leans toward the block that has more samples: by a block of 1024
 //! samples per pixel, a block of 16 is mostly its neighbour's image near their edge, a bias
 //! that more samples never remove (it made adaptive renders lose to uniform ones). So an
 //! adaptive film keeps each sample's sums in the source plane of the block it was taken in
 //! (blocks of one plane are 2 or 3 blocks apart, so a pixel gets at most one block per plane),
 //! counts each block's samples, and divides each plane's sums by its block's samples per pixel
-//! before adding them up ([`Film::pixel`]): every block weighs as in a uniform render.
+//! before adding them up ([`Film::pixel`]): every block weighs as in a uniform render. (Blocks
+//! of one plane are as many blocks apart as a filter reaches across: 2 for the seed scenes,
+//! 3 to 5 for wider filters; [`FilmFrame::plane_period`].)
 //!
 //! **Noise estimate.** A masked unit also sums its odd-index samples, so the film holds per
 //! pixel the mean `m` of all its `n` samples and the mean `h` of the odd half (the "two
@@ -50,17 +52,16 @@
 use crate::film::Film;
 use crate::sampler::NESTED_FIRST_BLOCK;
 
-use super::plan::TILE_SIZE;
 use super::settings::RenderSettings;
 use super::unit::{WorkUnit, BLOCK_SIZE, MAX_MASKED_SIDE};
 
 /// Samples of round 0 when `--min-spp` is not given: enough for the odd half (8 samples) to
-/// say something about a block of 64 pixels, and the sampler's first nested block, so that
+/// say something about a block of 16 pixels, and the sampler's first nested block, so that
 /// every round's samples are stratified on their own.
 pub const DEFAULT_MIN_SPP: u32 = NESTED_FIRST_BLOCK;
 
-// A mask covers a plan tile.
-const _: () = assert!(TILE_SIZE == MAX_MASKED_SIDE);
+/// Side of a round's tiles: the most a mask covers.
+const ROUND_TILE: u32 = MAX_MASKED_SIDE;
 
 /// A block goes on while it wants more than this many times its samples: the geometric middle
 /// of its samples now and after one more round, so it ends as near as doubling allows to what
@@ -68,7 +69,7 @@ const _: () = assert!(TILE_SIZE == MAX_MASKED_SIDE);
 pub const GO_ON: f64 = std::f64::consts::SQRT_2;
 
 /// A round's unit of a tile takes at most about this many samples (as many sample indices
-/// as fit for the tile's active pixels): a full tile gets 64 per unit, a lone block 4096, so
+/// as fit for the tile's active pixels): a full tile gets 256 per unit, a lone block 16384, so
 /// late rounds of a few blocks are cut into units as even as round 0's.
 pub const UNIT_SAMPLES: u64 = 1 << 18;
 
@@ -213,14 +214,14 @@ impl Round {
         let (start, end) = self.range(settings, adaptive);
         let grid = BlockGrid::of(settings);
         let mut tiles = Vec::new();
-        for y0 in (0..settings.height).step_by(TILE_SIZE as usize) {
-            for x0 in (0..settings.width).step_by(TILE_SIZE as usize) {
+        for y0 in (0..settings.height).step_by(ROUND_TILE as usize) {
+            for x0 in (0..settings.width).step_by(ROUND_TILE as usize) {
                 let mut unit = WorkUnit {
                     index: 0,
                     x0,
                     y0,
-                    x1: (x0 + TILE_SIZE).min(settings.width),
-                    y1: (y0 + TILE_SIZE).min(settings.height),
+                    x1: (x0 + ROUND_TILE).min(settings.width),
+                    y1: (y0 + ROUND_TILE).min(settings.height),
                     sample_start: start,
                     sample_end: end,
                     mask: None,
@@ -290,11 +291,11 @@ pub struct RoundSamples {
 }
 
 /// The most units a round can have: a tile's round is cut into chunks of at least
-/// `UNIT_SAMPLES / TILE_SIZE^2` samples (a full tile's), and no round has more than spp.
+/// `UNIT_SAMPLES / ROUND_TILE^2` samples (a full tile's), and no round has more than spp.
 pub fn max_round_units(settings: &RenderSettings) -> usize {
-    let tiles =
-        settings.width.div_ceil(TILE_SIZE) as usize * settings.height.div_ceil(TILE_SIZE) as usize;
-    let full_tile_chunk = UNIT_SAMPLES / u64::from(TILE_SIZE * TILE_SIZE);
+    let tiles = settings.width.div_ceil(ROUND_TILE) as usize
+        * settings.height.div_ceil(ROUND_TILE) as usize;
+    let full_tile_chunk = UNIT_SAMPLES / u64::from(ROUND_TILE * ROUND_TILE);
     tiles * u64::from(settings.spp).div_ceil(full_tile_chunk) as usize
 }
 
@@ -521,7 +522,7 @@ mod tests {
     fn round_units_cover_each_active_pixel_once_per_sample() {
         let s = settings(150, 70, 64);
         let grid = BlockGrid::of(&s);
-        assert_eq!((grid.columns, grid.rows), (19, 9));
+        assert_eq!((grid.columns, grid.rows), (38, 18));
         let mut round = Round {
             index: 1,
             planned: vec![16; grid.len()],
@@ -658,19 +659,30 @@ mod tests {
             let round = Round::first(&s, &a);
             render(&mut film, &round.units(&s, &a), |_| 1.0, |_| amplitude);
             let noise = Noise::of(&film, &round, &s);
-            assert_eq!(noise.sigma.len(), 64);
-            let mean = noise.sigma.iter().sum::<f64>() / 64.0;
+            let blocks = noise.sigma.len();
+            assert_eq!(blocks, 256);
+            let mean = noise.sigma.iter().sum::<f64>() / blocks as f64;
             let expected = amplitude / 3f64.sqrt();
             assert!(
                 (0.95..1.05).contains(&(mean / expected)),
                 "n {n}: {mean} vs {expected}"
             );
-            // One block's estimate (64 pixels) is within 30% of it.
+            // One block's estimate averages 16 pixels' (m - h)^2, each sigma^2 / n times a
+            // chi-square of one degree (the channels are equal here): its square is off by
+            // sqrt(2 / 16) = 35% and itself by about half that, 18%; no block by 60%.
+            let spread = (noise
+                .sigma
+                .iter()
+                .map(|&b| (b / mean - 1.0).powi(2))
+                .sum::<f64>()
+                / blocks as f64)
+                .sqrt();
+            assert!((0.12..0.24).contains(&spread), "n {n}: spread {spread}");
             assert!(
                 noise
                     .sigma
                     .iter()
-                    .all(|&b| (0.7..1.3).contains(&(b / expected))),
+                    .all(|&b| (0.4..1.6).contains(&(b / expected))),
                 "n {n}: {:?}",
                 noise.sigma
             );
@@ -691,7 +703,7 @@ mod tests {
 
     #[test]
     fn the_sample_map_is_a_log_scale_of_the_samples() {
-        let s = settings(16, 8, 64);
+        let s = settings(8, 4, 64);
         let round = Round {
             index: 2,
             planned: vec![16, 64],
@@ -699,6 +711,6 @@ mod tests {
         let (map, least, most) = sample_map(&round, &s);
         assert_eq!((least, most), (16, 64));
         assert_eq!(map.get_pixel(0, 0).0[0], 85, "1 of 3 steps");
-        assert_eq!(map.get_pixel(15, 7).0[0], 255);
+        assert_eq!(map.get_pixel(7, 3).0[0], 255);
     }
 }

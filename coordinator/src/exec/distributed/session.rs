@@ -14,6 +14,7 @@ use tokio::task::JoinSet;
 use yat_proto::convert::{result_from_wire, BYTES_PER_PIXEL};
 use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::filter::MAX_BORDER;
+use yat_tracer::render::unit::{FilmFrame, MAX_MASKED_SIDE};
 use yat_tracer::render::{WorkUnit, TILE_SIZE};
 
 use super::client::{WorkerClient, MIN_CHUNK_BYTES};
@@ -49,11 +50,18 @@ const MAX_SCENE_ID_BYTES: usize = 256;
 const REPLY_OVERHEAD_BYTES: u64 = 1024;
 
 /// The smallest message limit a worker may advertise: two of the smallest blob chunk, and the
-/// reply to the largest unit of any plan (an adaptive unit's: its sums and its half sums, over
-/// its tile and the widest filter's border).
+/// reply to the largest unit of any plan: a uniform unit's sums over its tile and the widest
+/// filter's border, or an adaptive unit's sums per source plane and its half sums over its
+/// (smaller) tile and that border.
 pub fn min_message_bytes() -> u64 {
-    let side = u64::from(TILE_SIZE + 2 * MAX_BORDER);
-    let unit_reply = 2 * side * side * BYTES_PER_PIXEL as u64;
+    let region = |tile: u32| u64::from(tile + 2 * MAX_BORDER).pow(2) * BYTES_PER_PIXEL as u64;
+    let widest = FilmFrame {
+        width: u32::MAX,
+        height: u32::MAX,
+        border: [MAX_BORDER; 2],
+    };
+    let adaptive = (widest.source_planes() as u64 + 1) * region(MAX_MASKED_SIDE);
+    let unit_reply = region(TILE_SIZE).max(adaptive);
     (2 * MIN_CHUNK_BYTES as u64).max(unit_reply + REPLY_OVERHEAD_BYTES)
 }
 
