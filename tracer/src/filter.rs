@@ -21,6 +21,7 @@
 //! (docs/architecture.md). A pixel is the filter-weighted mean of the samples around it.
 
 use crate::diag::SourcePos;
+use crate::math::floor_to_int;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -203,8 +204,8 @@ impl AxisWeights {
         let b = self.border as i64;
         // Offsets k of the pixels pixel + k reached, k in [-border, border] (clamped: f32
         // rounding of u + radius may reach one further when u is just under 1).
-        let first = ((u - self.radius - 0.5).floor() as i64 + 1).clamp(-b, b);
-        let last = ((u + self.radius - 0.5).floor() as i64).clamp(-b, b);
+        let first = (floor_to_int(u - self.radius - 0.5) + 1).clamp(-b, b);
+        let last = floor_to_int(u + self.radius - 0.5).clamp(-b, b);
         let start = (i64::from(pixel) + first).max(i64::from(lo));
         let end = (i64::from(pixel) + last + 1).min(i64::from(hi));
         let mut taps = Taps {

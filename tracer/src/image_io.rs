@@ -2,6 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::math::floor_to_int;
+
 /// Texel coordinates beyond this are clamped before conversion to integers (far outside any
 /// image, and small enough that neighbours never overflow).
 const MAX_COORD: f32 = 1.0e9;
@@ -195,8 +197,8 @@ fn tile<T: Copy>(width: u32, height: u32, texels: &[T], pad: T) -> Vec<[T; TILE_
 /// axis), after `edge`, and the weight of the second.
 fn axis_neighbours(c: f32, n: u32, edge: Edge) -> ([Option<usize>; 2], f32) {
     let x = (c * n as f32 - 0.5).clamp(-MAX_COORD, MAX_COORD);
-    let x0 = x.floor();
-    let (i, n) = (x0 as i64, i64::from(n));
+    let i = floor_to_int(x);
+    let (x0, n) = (i as f32, i64::from(n));
     let pair = match edge {
         Edge::Repeat => {
             // Lookups land inside the image nearly always: the division only when they do not.
