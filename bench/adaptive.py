@@ -311,17 +311,23 @@ def runs_text(runs, fmt):
 
 
 def write_seed_column(path, measured, resolution):
-    """Fills the seed table's adaptive column: per measured scene (file name to CPU speed-up),
-    the row's "ours core-s" over the speed-up."""
+    """Fills the seed table's adaptive column (bench.ADAPTIVE_COLUMN): per measured scene (file
+    name to CPU speed-up), the row's "ours core-s" over the speed-up."""
     lines = path.read_text().split("\n")
-    in_table = False
+    header = None
     for i, line in enumerate(lines):
-        in_table = line.startswith("|") and (in_table or "core-s to 1000-spp error" in line)
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if in_table and cells[0] in measured and re.fullmatch(r"[0-9]+", cells[2]):
-            speedup = measured[cells[0]]
-            cells[8] = f"{float(cells[2]) / speedup:.0f} ({speedup:.2f}x at {resolution})"
-            lines[i] = "| " + " | ".join(cells) + " |"
+        if not line.startswith("|"):
+            header = None
+        elif header is None:
+            header = cells if bench.ADAPTIVE_COLUMN in cells else []
+        elif header and cells[0] in measured:
+            core_s = cells[header.index("ours core-s")]
+            if re.fullmatch(r"[0-9]+", core_s):
+                speedup = measured[cells[0]]
+                cells[header.index(bench.ADAPTIVE_COLUMN)] = \
+                    f"{float(core_s) / speedup:.0f} ({speedup:.2f}x at {resolution})"
+                lines[i] = "| " + " | ".join(cells) + " |"
     path.write_text("\n".join(lines))
 
 

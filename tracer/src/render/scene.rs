@@ -251,6 +251,7 @@ impl RenderScene {
         };
         let first_column = (columns.first - region.x0) as usize;
         let taps = columns.weights().len();
+        let plane_len = region.pixel_count();
         for (row, &wy) in rows.weights().iter().enumerate() {
             let start = (rows.first - region.y0) as usize * width + row * width + first_column;
             // Each row's run of pixels is sliced once, so the loops below check no bounds (a
@@ -267,7 +268,6 @@ impl RenderScene {
                     *weight += w;
                 }
             };
-            let plane_len = region.pixel_count();
             add(
                 &mut buffer.rgb[plane..plane + plane_len],
                 &mut buffer.weight[plane..plane + plane_len],
