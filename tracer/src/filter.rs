@@ -168,14 +168,18 @@ struct AxisWeights {
     border: u32,
     /// TABLE_SIZE / radius: table steps per pixel of offset.
     steps_per_pixel: f32,
-    /// The weight at i x radius / TABLE_SIZE, i in 0..=TABLE_SIZE.
-    table: Vec<f32>,
+    /// The weight at i x radius / TABLE_SIZE, i in 0..=TABLE_SIZE (an array: the lookups
+    /// need no bounds checks).
+    table: Box<[f32; TABLE_SIZE + 1]>,
 }
 
 impl AxisWeights {
     fn new(radius: f32, f: impl Fn(f32) -> f32) -> Self {
         let step = radius / TABLE_SIZE as f32;
-        let mut table: Vec<f32> = (0..=TABLE_SIZE).map(|i| f(i as f32 * step)).collect();
+        let mut table = Box::new([0.0; TABLE_SIZE + 1]);
+        for (i, v) in table.iter_mut().enumerate() {
+            *v = f(i as f32 * step);
+        }
         let peak = table.iter().fold(0.0f32, |m, v| m.max(v.abs()));
         if peak > 0.0 && peak.is_finite() {
             table.iter_mut().for_each(|v| *v /= peak);
@@ -210,13 +214,12 @@ impl AxisWeights {
         let end = (i64::from(pixel) + last + 1).min(i64::from(hi));
         let mut taps = Taps {
             first: start.max(0) as u32,
-            len: 0,
+            len: (end - start).clamp(0, MAX_TAPS as i64) as usize,
             weights: [0.0; MAX_TAPS],
         };
-        for p in start..end {
-            let offset = (p - i64::from(pixel)) as f32 + 0.5 - u;
-            taps.weights[taps.len] = self.weight(offset);
-            taps.len += 1;
+        let offsets = start - i64::from(pixel)..;
+        for (weight, k) in taps.weights[..taps.len].iter_mut().zip(offsets) {
+            *weight = self.weight(k as f32 + 0.5 - u);
         }
         taps
     }

@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
@@ -180,7 +180,7 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
-        let mut buffer = SampleBuffer::new(*unit, &self.frame);
+        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
         let mut stats = UnitStats::default();
         let keep_half = unit.mask.is_some();
         for y in unit.y0..unit.y1 {
@@ -218,64 +218,84 @@ impl RenderScene {
                             }
                         };
                         let half = keep_half && index % 2 == 1;
-                        self.splat(&mut buffer, (x, y), u, radiance, half);
+                        self.splat(&mut sums, (x, y), u, radiance, half);
                     }
                 }
             }
         }
-        for rgb in buffer.rgb.iter_mut().chain(&mut buffer.half_rgb) {
-            *rgb = unit_sum(Vec3::from_array(*rgb));
-        }
-        Some((buffer, stats))
+        Some((sums.into_buffer(), stats))
     }
 
     /// Adds a sample at `pixel + u` with `radiance` to every pixel of the buffer's region its
     /// filter reaches (in the source plane of its block when the unit is adaptive), and to the
     /// half sums too when `half`.
-    fn splat(
-        &self,
-        buffer: &mut SampleBuffer,
-        (x, y): (u32, u32),
-        u: Vec2,
-        radiance: Vec3,
-        half: bool,
-    ) {
-        let region = buffer.region;
+    fn splat(&self, sums: &mut UnitSums, (x, y): (u32, u32), u: Vec2, radiance: Vec3, half: bool) {
+        let region = sums.buffer.region;
         let columns = self.filter.taps_x(x, u.x, region.x0, region.x1);
         let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
         let width = region.width() as usize;
-        let plane = if buffer.unit.mask.is_some() {
-            self.frame.source_plane(x, y) * region.pixel_count()
+        let plane_len = region.pixel_count();
+        let plane = if sums.buffer.unit.mask.is_some() {
+            self.frame.source_plane(x, y) * plane_len
         } else {
             0
         };
         let first_column = (columns.first - region.x0) as usize;
         let taps = columns.weights().len();
-        let plane_len = region.pixel_count();
+        let sample = radiance.extend(1.0);
         for (row, &wy) in rows.weights().iter().enumerate() {
             let start = (rows.first - region.y0) as usize * width + row * width + first_column;
             // Each row's run of pixels is sliced once, so the loops below check no bounds (a
             // check per tap was a third of the splat's instructions).
-            let add = |rgb: &mut [[f32; 3]], weight: &mut [f32]| {
-                let runs = rgb[start..start + taps]
+            let add = |pixels: &mut [Vec4]| {
+                for (sum, &wx) in pixels[start..start + taps]
                     .iter_mut()
-                    .zip(&mut weight[start..start + taps]);
-                for ((sums, weight), &wx) in runs.zip(columns.weights()) {
-                    let w = wx * wy;
-                    for (s, c) in sums.iter_mut().zip(radiance.to_array()) {
-                        *s += c * w;
-                    }
-                    *weight += w;
+                    .zip(columns.weights())
+                {
+                    *sum += sample * (wx * wy);
                 }
             };
-            add(
-                &mut buffer.rgb[plane..plane + plane_len],
-                &mut buffer.weight[plane..plane + plane_len],
-            );
+            add(&mut sums.all[plane..plane + plane_len]);
             if half {
-                add(&mut buffer.half_rgb, &mut buffer.half_weight);
+                add(&mut sums.half);
             }
         }
+    }
+}
+
+/// A unit's sums while it renders: each pixel's radiance sums and weight side by side, so that
+/// a sample adds to a pixel with one 4-lane multiply and one add. Each lane does what adding
+/// the sums one at a time did (`sum += c * w`, the weight's lane `w = 1 * w` exactly), so the
+/// buffer has the same bits.
+struct UnitSums {
+    buffer: SampleBuffer,
+    all: Vec<Vec4>,
+    half: Vec<Vec4>,
+}
+
+impl UnitSums {
+    fn new(buffer: SampleBuffer) -> Self {
+        Self {
+            all: vec![Vec4::ZERO; buffer.weight.len()],
+            half: vec![Vec4::ZERO; buffer.half_weight.len()],
+            buffer,
+        }
+    }
+
+    /// The buffer with the sums, each radiance sum clamped as reported ([`unit_sum`]).
+    fn into_buffer(self) -> SampleBuffer {
+        let mut buffer = self.buffer;
+        let planes = [
+            (&mut buffer.rgb, &mut buffer.weight, self.all),
+            (&mut buffer.half_rgb, &mut buffer.half_weight, self.half),
+        ];
+        for (rgb, weight, sums) in planes {
+            for ((rgb, weight), sum) in rgb.iter_mut().zip(weight.iter_mut()).zip(sums) {
+                *rgb = unit_sum(sum.truncate());
+                *weight = sum.w;
+            }
+        }
+        buffer
     }
 }
 
