@@ -140,13 +140,52 @@ impl PixelSampler {
         )
     }
 
-    /// Passes over `dimensions` dimensions (each [`Self::get_1d`] or [`Self::get_2d`] takes
-    /// one) without computing them, where a vertex does not use them but the next one's must
-    /// stay where they are.
-    pub fn skip(&mut self, dimensions: u32) {
+    /// The next six dimensions a scattering vertex uses, drawn together: the same values as
+    /// `get_1d`, `get_1d`, `get_2d`, `get_1d`, `get_2d` and `get_1d` in turn. The eight values'
+    /// index permutations and scrambles are computed as the lanes of one pass (AVX2 where the
+    /// CPU has it): drawn one at a time they were most of the sampler's time.
+    pub fn get_vertex(&mut self) -> VertexSamples {
+        let v = self.vertex_lanes().draw();
+        VertexSamples {
+            mix: v[0],
+            light_select: v[1],
+            light: Vec2::new(v[2], v[3]),
+            lobe: v[4],
+            bsdf: Vec2::new(v[5], v[6]),
+            roulette: v[7],
+        }
+    }
+
+    /// Steps back after [`Self::get_vertex`] to the dimension after its first, for a vertex that
+    /// used only [`VertexSamples::mix`] (a surface rays pass through).
+    pub fn unread_after_mix(&mut self) {
+        let unread = VERTEX_DIMENSIONS - 1;
         self.dimension_key = self
             .dimension_key
-            .wrapping_add(u64::from(dimensions).wrapping_mul(DIMENSION_STEP));
+            .wrapping_sub(unread.wrapping_mul(DIMENSION_STEP));
+    }
+
+    /// The lanes of [`Self::get_vertex`]'s draw; steps over its dimensions.
+    fn vertex_lanes(&mut self) -> VertexLanes {
+        let h = [(); VERTEX_DIMENSIONS as usize].map(|()| self.next_dimension_hash());
+        let scramble = |h: u64| (h >> 32) as u32;
+        VertexLanes {
+            offset: self.index - self.first,
+            first: self.first,
+            len: self.len,
+            mask: self.mask,
+            permutation: LANE_DIMENSION.map(|d| h[d] as u32),
+            seeds: [
+                scramble(h[0]),
+                scramble(h[1]),
+                scramble(h[2]),
+                mix64(h[2]) as u32,
+                scramble(h[3]),
+                scramble(h[4]),
+                mix64(h[4]) as u32,
+                scramble(h[5]),
+            ],
+        }
     }
 
     fn next_dimension_hash(&mut self) -> u64 {
@@ -174,30 +213,41 @@ fn van_der_corput(index: u32) -> u32 {
     index.reverse_bits()
 }
 
-/// Sobol dimension 1 (primitive polynomial x + 1), as a 0.32 fixed-point fraction. Its
-/// generator matrix is Pascal's triangle mod 2: fraction bit k is the parity of the index bits
-/// i with C(i, k) odd, which by Lucas' theorem are the i whose bits include k's. That sum over
-/// supersets takes five masked shifts, one per bit of a bit position, and no branches.
+/// Sobol dimension 1 (primitive polynomial x + 1), as a 0.32 fixed-point fraction.
 fn sobol_dimension_1(index: u32) -> u32 {
+    pascal_parity(index).reverse_bits()
+}
+
+/// Sobol dimension 1 with its bits reversed. Its generator matrix is Pascal's triangle mod 2:
+/// fraction bit k is the parity of the index bits i with C(i, k) odd, which by Lucas' theorem
+/// are the i whose bits include k's. That sum over supersets takes five masked shifts, one per
+/// bit of a bit position, and no branches.
+#[inline(always)]
+fn pascal_parity(index: u32) -> u32 {
     let mut x = index;
     x ^= (x >> 1) & 0x5555_5555;
     x ^= (x >> 2) & 0x3333_3333;
     x ^= (x >> 4) & 0x0f0f_0f0f;
     x ^= (x >> 8) & 0x00ff_00ff;
     x ^= (x >> 16) & 0x0000_ffff;
-    x.reverse_bits()
+    x
 }
 
 /// Hash-based nested uniform (Owen) scrambling of a 0.32 fraction (Burley 2020, "Practical
 /// Hash-based Owen Scrambling"): a Laine-Karras style permutation on the reversed bits.
 fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut x = v.reverse_bits();
+    laine_karras(v.reverse_bits(), seed).reverse_bits()
+}
+
+/// [`owen_scramble`]'s permutation, on and to reversed bits.
+#[inline(always)]
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x ^= x.wrapping_mul(0x3d20_adea);
     x = x.wrapping_add(seed);
     x = x.wrapping_mul((seed >> 16) | 1);
     x ^= x.wrapping_mul(0x0552_6c56);
     x ^= x.wrapping_mul(0x53a2_2864);
-    x.reverse_bits()
+    x
 }
 
 /// The least all-ones mask covering 0..len, which [`permutation_element`] cycles within.
@@ -210,33 +260,48 @@ fn permutation_mask(len: u32) -> u32 {
 /// Element `i` of a pseudo-random permutation of 0..len chosen by `p` (Kensler 2013,
 /// "Correlated Multi-Jittered Sampling"); `w` is [`permutation_mask`] of `len`. A bijection on
 /// 0..len for every p.
-fn permutation_element(mut i: u32, len: u32, w: u32, p: u32) -> u32 {
+fn permutation_element(i: u32, len: u32, w: u32, p: u32) -> u32 {
     if len <= 1 {
         return 0;
     }
-    loop {
-        i ^= p;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= p >> 16;
-        i ^= (i & w) >> 4;
-        i ^= p >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= p >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | (p >> 27));
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < len {
-            break;
-        }
+    permutation_offset(walk_below(permutation_round(i, w, p), len, w, p), len, p)
+}
+
+/// One round of [`permutation_element`]'s hash: a bijection on 0..=w.
+#[inline(always)]
+fn permutation_round(mut i: u32, w: u32, p: u32) -> u32 {
+    i ^= p;
+    i = i.wrapping_mul(0xe170_893d);
+    i ^= p >> 16;
+    i ^= (i & w) >> 4;
+    i ^= p >> 8;
+    i = i.wrapping_mul(0x0929_eb3f);
+    i ^= p >> 23;
+    i ^= (i & w) >> 1;
+    i = i.wrapping_mul(1 | (p >> 27));
+    i = i.wrapping_mul(0x6935_fa69);
+    i ^= (i & w) >> 11;
+    i = i.wrapping_mul(0x74dc_b303);
+    i ^= (i & w) >> 2;
+    i = i.wrapping_mul(0x9e50_1cc3);
+    i ^= (i & w) >> 2;
+    i = i.wrapping_mul(0xc860_a3df);
+    i &= w;
+    i ^ (i >> 5)
+}
+
+/// Cycle walking: more rounds from the first round's `i` until it falls in 0..len.
+#[inline(always)]
+fn walk_below(mut i: u32, len: u32, w: u32, p: u32) -> u32 {
+    while i >= len {
+        i = permutation_round(i, w, p);
     }
+    i
+}
+
+/// The walk's end rotated by `p` within 0..len.
+#[inline(always)]
+fn permutation_offset(i: u32, len: u32, p: u32) -> u32 {
     // The common power-of-two sample counts need no division.
     if len.is_power_of_two() {
         i.wrapping_add(p) & (len - 1)
@@ -245,19 +310,157 @@ fn permutation_element(mut i: u32, len: u32, w: u32, p: u32) -> u32 {
     }
 }
 
+/// The values a scattering vertex draws with [`PixelSampler::get_vertex`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexSamples {
+    /// The component of a mix material.
+    pub mix: f32,
+    /// The light's choice and its sample (next-event estimation).
+    pub light_select: f32,
+    pub light: Vec2,
+    /// The BSDF's lobe choice and its direction sample.
+    pub lobe: f32,
+    pub bsdf: Vec2,
+    /// Russian roulette.
+    pub roulette: f32,
+}
+
+/// The dimension (of the six a vertex draw takes) each lane of the draw is a value of: its
+/// first, or its second where [`LANE_SECOND`] says so.
+const LANE_DIMENSION: [usize; 8] = [0, 1, 2, 2, 3, 4, 4, 5];
+
+/// Dimensions a [`PixelSampler::get_vertex`] draw takes.
+const VERTEX_DIMENSIONS: u64 = 6;
+
+/// The lanes that draw a 2D dimension's y (Sobol dimension 1).
+const LANE_SECOND: [bool; 8] = [false, false, false, true, false, false, true, false];
+
+/// Eight sample values of one pixel sample: a lane's Sobol index is the sample's, permuted
+/// by its `permutation` hash within `first..first + len`; its value that index's point
+/// scrambled by its seed.
+struct VertexLanes {
+    /// The sample's index minus `first`.
+    offset: u32,
+    first: u32,
+    len: u32,
+    mask: u32,
+    permutation: [u32; 8],
+    seeds: [u32; 8],
+}
+
+impl VertexLanes {
+    fn draw(&self) -> [f32; 8] {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU runs AVX2.
+            return unsafe { self.draw_avx2() };
+        }
+        self.draw_lanes()
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn draw_avx2(&self) -> [f32; 8] {
+        self.draw_lanes()
+    }
+
+    /// Written lane by lane for the compiler to vectorise; each lane does exactly what
+    /// `sobol_index` and `owen_scramble` do for one value, so the values are the same bits.
+    #[inline(always)]
+    fn draw_lanes(&self) -> [f32; 8] {
+        let (len, w, p) = (self.len, self.mask, self.permutation);
+        let mut index = [self.first; 8];
+        if len > 1 {
+            let mut i = [0; 8];
+            for l in 0..8 {
+                i[l] = permutation_round(self.offset, w, p[l]);
+            }
+            // Rarely taken: a round lands in len..=w only when len is not a power of two.
+            if i.iter().any(|&i| i >= len) {
+                for l in 0..8 {
+                    i[l] = walk_below(i[l], len, w, p[l]);
+                }
+            }
+            if len.is_power_of_two() {
+                for l in 0..8 {
+                    index[l] += i[l].wrapping_add(p[l]) & (len - 1);
+                }
+            } else {
+                for l in 0..8 {
+                    index[l] += i[l].wrapping_add(p[l]) % len;
+                }
+            }
+        }
+        let mut values = [0.0; 8];
+        for l in 0..8 {
+            // Sobol dimension 0 is the index's bits reversed, and Owen scrambling works on
+            // reversed bits: its input is the index itself (or dimension 1's parity form).
+            let x = if LANE_SECOND[l] {
+                pascal_parity(index[l])
+            } else {
+                index[l]
+            };
+            values[l] = to_unit_float(laine_karras(x, self.seeds[l]).reverse_bits());
+        }
+        values
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A vertex's batched draw gives the bits of the draws one at a time, on the portable
+    /// kernel and on the one this CPU runs, for power-of-two and other sample counts (whose
+    /// permutations cycle-walk), one sample, and nested samples.
     #[test]
-    fn skipped_dimensions_leave_the_next_ones_where_they_were() {
-        let mut drawn = PixelSampler::new(3, 4, 5, 16, 9);
-        let mut skipped = drawn.clone();
-        drawn.get_1d();
-        drawn.get_2d();
-        skipped.skip(2);
-        assert_eq!(drawn.get_2d(), skipped.get_2d());
-        assert_eq!(drawn.get_1d(), skipped.get_1d());
+    fn vertex_draws_equal_the_draws_one_at_a_time() {
+        let mut samplers = Vec::new();
+        for (x, y) in [(0, 0), (7, 3), (1919, 1079)] {
+            for spp in [1, 2, 3, 16, 100, 1000] {
+                for index in [0, 1, spp / 2, spp - 1] {
+                    samplers.push(PixelSampler::new(x, y, index, spp, u64::from(x) + 5));
+                }
+            }
+            for index in [0, 15, 16, 31, 200, 4095] {
+                samplers.push(PixelSampler::nested(x, y, index, 3));
+            }
+        }
+        for mut sampler in samplers {
+            for vertex in 0..4 {
+                let mut one_at_a_time = sampler.clone();
+                let expected = VertexSamples {
+                    mix: one_at_a_time.get_1d(),
+                    light_select: one_at_a_time.get_1d(),
+                    light: one_at_a_time.get_2d(),
+                    lobe: one_at_a_time.get_1d(),
+                    bsdf: one_at_a_time.get_2d(),
+                    roulette: one_at_a_time.get_1d(),
+                };
+                let lanes = sampler.clone().vertex_lanes();
+                assert_eq!(lanes.draw_lanes(), lanes.draw());
+                assert_eq!(
+                    sampler.get_vertex(),
+                    expected,
+                    "{sampler:?} vertex {vertex}"
+                );
+                // The next dimensions are where they were.
+                assert_eq!(sampler.clone().get_2d(), one_at_a_time.get_2d());
+            }
+        }
+    }
+
+    /// After a vertex that used only its mix choice, the next draws are those that follow a
+    /// single `get_1d`.
+    #[test]
+    fn unread_vertex_dimensions_are_drawn_again() {
+        let start = PixelSampler::new(3, 4, 5, 16, 9);
+        let mut vertex = start.clone();
+        let mix = vertex.get_vertex().mix;
+        vertex.unread_after_mix();
+        let mut one = start.clone();
+        assert_eq!(mix, one.get_1d());
+        assert_eq!(vertex.get_vertex(), one.get_vertex());
     }
 
     #[test]

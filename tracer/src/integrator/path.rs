@@ -17,7 +17,7 @@ use crate::lights::Lights;
 use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
 use crate::medium::{Flight, MediumId, Phase, ShapeMedia, Volumes};
-use crate::sampler::PixelSampler;
+use crate::sampler::{PixelSampler, VertexSamples};
 
 /// What the path tracer needs from the scene. The renderer's built scene implements it, so the
 /// integrator does not depend on how the scene is built.
@@ -184,8 +184,14 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             radiance += throughput * le * weight;
         }
 
-        let bsdf = scene.bsdf_at(&hit, sampler.get_1d());
+        // Every dimension a scattering vertex uses, drawn at once. A specular vertex draws the
+        // light sample's too (and does not use them): the dimension layout of a vertex stays
+        // fixed whatever the material.
+        let u = sampler.get_vertex();
+        let bsdf = scene.bsdf_at(&hit, u.mix);
         if bsdf.is_pass_through() {
+            // Only the mix choice is used: the next vertex's dimensions follow it.
+            sampler.unread_after_mix();
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
                 break;
@@ -201,15 +207,11 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         depth += 1;
 
         if !bsdf.is_specular() {
-            radiance +=
-                throughput * direct_light(scene, &hit, wo, &bsdf, sides, sampler, &mut rays);
-        } else {
-            // Keep the dimension layout of a vertex fixed whatever the material: the light
-            // sample's selection and position.
-            sampler.skip(2);
+            let light = direct_light(scene, &hit, wo, &bsdf, sides, &u, &mut rays);
+            radiance += throughput * light;
         }
 
-        let Some(bs) = bsdf.sample(wo, sampler.get_1d(), sampler.get_2d()) else {
+        let Some(bs) = bsdf.sample(wo, u.lobe, u.bsdf) else {
             break;
         };
         if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
@@ -218,7 +220,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         let cos = bs.wi.dot(hit.ns).abs();
         throughput *= bs.f * (cos / bs.pdf);
 
-        if !survives(integrator, depth, sampler.get_1d(), &mut throughput) {
+        if !survives(integrator, depth, u.roulette, &mut throughput) {
             break;
         }
 
@@ -316,12 +318,10 @@ fn direct_light<S: PathScene>(
     wo: Vec3,
     bsdf: &Bsdf,
     sides: ShapeMedia,
-    sampler: &mut PixelSampler,
+    u: &VertexSamples,
     rays: &mut u32,
 ) -> Vec3 {
-    let u_select = sampler.get_1d();
-    let u_light = sampler.get_2d();
-    let Some(ls) = scene.lights().sample(hit.p, u_select, u_light) else {
+    let Some(ls) = scene.lights().sample(hit.p, u.light_select, u.light) else {
         return Vec3::ZERO;
     };
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
