@@ -196,9 +196,11 @@ impl AxisWeights {
     }
 
     fn weight(&self, offset: f32) -> f32 {
+        // In [0, TABLE_SIZE] (a NaN becomes TABLE_SIZE). Converted through u32, not usize:
+        // float to and from u64 takes several instructions on x86-64 without AVX-512.
         let t = (offset.abs() * self.steps_per_pixel).min(TABLE_SIZE as f32);
-        let i = (t as usize).min(TABLE_SIZE - 1);
-        let (a, b) = (self.table[i], self.table[i + 1]);
+        let i = (t as u32).min(TABLE_SIZE as u32 - 1);
+        let (a, b) = (self.table[i as usize], self.table[i as usize + 1]);
         a + (t - i as f32) * (b - a)
     }
 
