@@ -375,7 +375,7 @@ impl VertexLanes {
             for l in 0..8 {
                 i[l] = permutation_round(self.offset, w, p[l]);
             }
-            // Rarely taken: a round lands in len..=w only when len is not a power of two.
+            // A round lands in len..=w only when len is not a power of two.
             if i.iter().any(|&i| i >= len) {
                 for l in 0..8 {
                     i[l] = walk_below(i[l], len, w, p[l]);
