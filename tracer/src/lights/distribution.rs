@@ -69,7 +69,7 @@ impl Distribution1D {
     /// The probability of bin `i` as a discrete choice.
     pub fn pmf(&self, i: usize) -> f32 {
         if i < self.len() {
-            self.bins[i].func / (self.integral * self.len() as f32)
+            self.bins[i].func / (self.integral * count_f32(self.len()))
         } else {
             0.0
         }
@@ -91,7 +91,7 @@ impl Distribution1D {
     /// A point in [0, 1), its density, and its bin. None for an empty distribution.
     pub fn sample_continuous(&self, u: f32) -> Option<(f32, f32, usize)> {
         let (i, _, du) = self.sample_discrete(u)?;
-        let x = ((i as f32 + du) / self.len() as f32).min(ONE_MINUS_EPSILON);
+        let x = ((count_f32(i) + du) / count_f32(self.len())).min(ONE_MINUS_EPSILON);
         Some((x, self.bins[i].func / self.integral, i))
     }
 
@@ -101,14 +101,14 @@ impl Distribution1D {
         if n == 0 {
             return 0.0;
         }
-        let i = ((x * n as f32) as usize).min(n - 1);
+        let i = bin_at(x * count_f32(n), n);
         self.bins[i].func / self.integral
     }
 
     /// The last bin whose start is at or below `u`: bins of zero width are never chosen.
     fn find_bin(&self, u: f32) -> usize {
         let n = self.len();
-        let k = ((u * n as f32) as usize).min(n - 1);
+        let k = bin_at(u * count_f32(n), n);
         let (lo, hi) = (self.bins[k].guide as usize, self.bins[k + 1].guide as usize);
         let i = lo + self.bins[lo + 1..=hi].partition_point(|b| b.cdf <= u);
         // Rounding in u * n can pick a neighbouring bucket: check, and search it all.
@@ -118,6 +118,18 @@ impl Distribution1D {
             last_bin_at_or_below(&self.bins, u)
         }
     }
+}
+
+/// `n` as a float, through u32: float from u64 takes several instructions on x86-64 without
+/// AVX-512 (and no table has 2^32 entries, below which the value is the same).
+fn count_f32(n: usize) -> f32 {
+    n as u32 as f32
+}
+
+/// The entry of 0..n (n > 0) that `x`, in entries, lies in: `(x as usize).min(n - 1)` through
+/// u32, for the same reason (the same value for n up to 2^32).
+fn bin_at(x: f32, n: usize) -> usize {
+    (x as u32 as usize).min(n - 1)
 }
 
 fn last_bin_at_or_below(bins: &[Bin], u: f32) -> usize {
@@ -200,11 +212,11 @@ impl Distribution2D {
         }
         let (y, pdf_y, row) = self.marginal.sample_continuous(u.y)?;
         let n = self.width;
-        let scaled = u.x.clamp(0.0, ONE_MINUS_EPSILON) * n as f32;
-        let slot = (scaled as usize).min(n - 1);
+        let scaled = u.x.clamp(0.0, ONE_MINUS_EPSILON) * count_f32(n);
+        let slot = bin_at(scaled, n);
         reading(row, slot);
         let cell = self.cells[row * n + slot];
-        let within = (scaled - slot as f32).clamp(0.0, ONE_MINUS_EPSILON);
+        let within = (scaled - count_f32(slot)).clamp(0.0, ONE_MINUS_EPSILON);
         let (column, pdf_x, du) = if within < cell.keep {
             (slot, cell.pdf, within / cell.keep)
         } else {
@@ -215,7 +227,7 @@ impl Distribution2D {
             )
         };
         let du = du.clamp(0.0, ONE_MINUS_EPSILON);
-        let x = ((column as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
+        let x = ((count_f32(column) + du) / count_f32(n)).min(ONE_MINUS_EPSILON);
         Some((Vec2::new(x, y), pdf_x * pdf_y))
     }
 
@@ -229,8 +241,8 @@ impl Distribution2D {
         if self.width == 0 || height == 0 {
             return 0.0;
         }
-        let row = ((p.y * height as f32) as usize).min(height - 1);
-        let column = ((p.x * self.width as f32) as usize).min(self.width - 1);
+        let row = bin_at(p.y * count_f32(height), height);
+        let column = bin_at(p.x * count_f32(self.width), self.width);
         self.cells[row * self.width + column].pdf * self.marginal.pdf(p.y)
     }
 }
