@@ -21,7 +21,7 @@
 //! (docs/architecture.md). A pixel is the filter-weighted mean of the samples around it.
 
 use crate::diag::SourcePos;
-use crate::math::floor_to_int;
+use crate::math::{bin_at, count_f32, floor_to_int};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -196,12 +196,10 @@ impl AxisWeights {
     }
 
     fn weight(&self, offset: f32) -> f32 {
-        // In [0, TABLE_SIZE] (a NaN becomes TABLE_SIZE). Converted through u32, not usize:
-        // float to and from u64 takes several instructions on x86-64 without AVX-512.
         let t = (offset.abs() * self.steps_per_pixel).min(TABLE_SIZE as f32);
-        let i = (t as u32).min(TABLE_SIZE as u32 - 1);
-        let (a, b) = (self.table[i as usize], self.table[i as usize + 1]);
-        a + (t - i as f32) * (b - a)
+        let i = bin_at(t, TABLE_SIZE);
+        let (a, b) = (self.table[i], self.table[i + 1]);
+        a + (t - count_f32(i)) * (b - a)
     }
 
     /// The pixels of `lo..hi` a sample at `pixel + u` (u in [0, 1)) reaches: those whose centre

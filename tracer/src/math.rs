@@ -90,6 +90,18 @@ pub fn floor_to_int(x: f32) -> i64 {
     t - i64::from(t as f32 > x)
 }
 
+/// `n` as a float, through u32: float from u64 takes several instructions on x86-64 without
+/// AVX-512, and the tables and counts this is for stay below 2^32 (where the value is the same).
+pub fn count_f32(n: usize) -> f32 {
+    n as u32 as f32
+}
+
+/// The entry of 0..n (n > 0) that `x`, in entries, lies in: `(x as usize).min(n - 1)` through
+/// u32, for the same reason (the same value for n up to 2^32; NaN and negative x give 0).
+pub fn bin_at(x: f32, n: usize) -> usize {
+    (x as u32 as usize).min(n - 1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,6 +115,31 @@ mod tests {
             let v = Vec3::new(0.1, 0.7, -0.2);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
             assert!((f.to_local(n) - Vec3::Z).length() < 1e-5);
+        }
+    }
+
+    /// The u32 routes give what the usize conversions give, for the sizes they serve.
+    #[test]
+    fn bins_and_counts_through_u32_equal_the_usize_conversions() {
+        for n in [1usize, 2, 3, 256, 400, 1 << 20, u32::MAX as usize] {
+            assert_eq!(count_f32(n), n as f32);
+            for x in [
+                f32::NAN,
+                f32::NEG_INFINITY,
+                -1.5,
+                -0.0,
+                0.0,
+                0.999_999_94,
+                1.0,
+                255.5,
+                256.0,
+                399.999_97,
+                1.0e9,
+                5.0e9,
+                f32::INFINITY,
+            ] {
+                assert_eq!(bin_at(x, n), (x as usize).min(n - 1), "x {x} n {n}");
+            }
         }
     }
 

@@ -2,6 +2,8 @@
 
 use glam::Vec2;
 
+use crate::math::{bin_at, count_f32};
+
 /// The largest f32 below 1: keeps remapped sample values in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
@@ -118,18 +120,6 @@ impl Distribution1D {
             last_bin_at_or_below(&self.bins, u)
         }
     }
-}
-
-/// `n` as a float, through u32: float from u64 takes several instructions on x86-64 without
-/// AVX-512 (and no table has 2^32 entries, below which the value is the same).
-fn count_f32(n: usize) -> f32 {
-    n as u32 as f32
-}
-
-/// The entry of 0..n (n > 0) that `x`, in entries, lies in: `(x as usize).min(n - 1)` through
-/// u32, for the same reason (the same value for n up to 2^32).
-fn bin_at(x: f32, n: usize) -> usize {
-    (x as u32 as usize).min(n - 1)
 }
 
 fn last_bin_at_or_below(bins: &[Bin], u: f32) -> usize {
