@@ -381,14 +381,8 @@ impl VertexLanes {
                     i[l] = walk_below(i[l], len, w, p[l]);
                 }
             }
-            if len.is_power_of_two() {
-                for l in 0..8 {
-                    index[l] += i[l].wrapping_add(p[l]) & (len - 1);
-                }
-            } else {
-                for l in 0..8 {
-                    index[l] += i[l].wrapping_add(p[l]) % len;
-                }
+            for l in 0..8 {
+                index[l] += permutation_offset(i[l], len, p[l]);
             }
         }
         let mut values = [0.0; 8];

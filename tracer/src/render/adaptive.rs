@@ -21,11 +21,11 @@
 //! samples per pixel, a block of 16 is mostly its neighbour's image near their edge, a bias
 //! that more samples never remove (it made adaptive renders lose to uniform ones). So an
 //! adaptive film keeps each sample's sums in the source plane of the block it was taken in
-//! (blocks of one plane are 2 or 3 blocks apart, so a pixel gets at most one block per plane),
-//! counts each block's samples, and divides each plane's sums by its block's samples per pixel
-//! before adding them up ([`Film::pixel`]): every block weighs as in a uniform render. (Blocks
-//! of one plane are as many blocks apart as a filter reaches across: 2 for the seed scenes,
-//! 3 to 5 for wider filters; [`FilmFrame::plane_period`].)
+//! (blocks of one plane are as many blocks apart as a filter reaches across: 2 for the seed
+//! scenes, 3 to 5 for wider filters, [`super::unit::FilmFrame::plane_period`]; so a pixel gets
+//! at most one block per plane), counts each block's samples, and divides each plane's sums by
+//! its block's samples per pixel before adding them up ([`Film::pixel`]): every block weighs as
+//! in a uniform render.
 //!
 //! **Noise estimate.** A masked unit also sums its odd-index samples, so the film holds per
 //! pixel the mean `m` of all its `n` samples and the mean `h` of the odd half (the "two
