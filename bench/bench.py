@@ -307,20 +307,37 @@ def side_by_side(args):
             m_ref = reference("mitsuba", setting, mi_key, mi_ref)
 
             load = os.getloadavg()[0]
-            log(f"comparing {name} at {spp} spp (load {load:.1f}) ...")
-            results = []  # (renderer, sampler, figures, mse)
-            y = render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED, size)
-            results.append(("YAT", "Owen-scrambled Sobol", y,
-                            mse(read_exr(tmp / "out.exr"), y_ref)))
-            lx = render_luxcore(export, spp, args.depth, args.threads, tmp, SHORT_SEED, size)
-            results.append((f"LuxCore {lx['pyluxcore']} PATHCPU", lx["sampler"], lx,
-                            mse(read_exr(tmp / "lux.exr"), l_ref)))
+            log(f"comparing {name} at {spp} spp (load {load:.1f}, {args.compare_rounds} rounds) ...")
+            # (label from figures, sampler, render, its image, its reference)
+            jobs = [(lambda f: "YAT", "Owen-scrambled Sobol",
+                     lambda: render(scene, spp, args.depth, args.threads, tmp, SHORT_SEED, size),
+                     tmp / "out.exr", y_ref),
+                    (lambda f: f"LuxCore {f['pyluxcore']} PATHCPU", None,
+                     lambda: render_luxcore(export, spp, args.depth, args.threads, tmp,
+                                            SHORT_SEED, size),
+                     tmp / "lux.exr", l_ref)]
             for variant in MITSUBA_VARIANTS:
                 for sampler in MITSUBA_SAMPLERS:
-                    m = render_mitsuba(xml, variant, sampler, spp, args.depth, args.threads,
-                                       size, tmp, SHORT_SEED, True)
-                    results.append((f"Mitsuba {m['mitsuba']} {variant}", sampler, m,
-                                    mse(read_exr(tmp / "mitsuba.exr"), m_ref)))
+                    jobs.append((
+                        lambda f, v=variant: f"Mitsuba {f['mitsuba']} {v}", sampler,
+                        lambda v=variant, s=sampler: render_mitsuba(
+                            xml, v, s, spp, args.depth, args.threads, size, tmp, SHORT_SEED, True),
+                        tmp / "mitsuba.exr", m_ref))
+            # Rounds interleave the renderers, so a change in the machine's load between them
+            # falls on all alike; each keeps its median-time run (the images of one renderer
+            # and seed are the same every round).
+            timed = [[] for _ in jobs]
+            for _ in range(args.compare_rounds):
+                for job_runs, (_, _, run, image, ref) in zip(timed, jobs):
+                    f = run()
+                    job_runs.append((f, mse(read_exr(image), ref)))
+            results = []  # (renderer, sampler, figures, mse)
+            for job_runs, (label, sampler, _, _, _) in zip(timed, jobs):
+                job_runs.sort(key=lambda r: r[0]["render_seconds"])
+                f, e = job_runs[len(job_runs) // 2]
+                results.append((label(f), sampler or f["sampler"], f, e))
+                log(f"  {results[-1][0]} {results[-1][1]}: "
+                    f"{[round(r[0]['render_seconds'], 2) for r in job_runs]} s, MSE {e:.3g}")
             effs = [1 / (e * f["render_seconds"]) for _, _, f, e in results]
             for (who, sampler, f, e), eff in zip(results, effs):
                 rays = f.get("rays_per_second")
@@ -440,7 +457,8 @@ the row's. The summary compares the references (mean radiance, and correlation o
 block luminance: the renderers rendered the same picture) and names each Mitsuba variant's
 most efficient sampler.
 
-Render seconds: YAT's and LuxCore's from the scene and BVH being ready to the last sample;
+Render seconds, the median of {args.compare_rounds} timed renders per renderer and sampler, interleaved
+round by round: YAT's and LuxCore's from the scene and BVH being ready to the last sample;
 Mitsuba's around `mi.render` on a loaded scene, after an untimed render of the same size (the
 llvm variant JIT-compiles its kernels on the first render, several seconds; they are cached
 after that). LuxCore runs PATHCPU with its default sampler (SOBOL, adaptive strength 0.95);
@@ -513,6 +531,9 @@ def main():
                     help="spp of the side by side's timed renders (default 16)")
     ap.add_argument("--ref-spp", type=int, default=1024,
                     help="spp of the side by side's converged references (default 1024)")
+    ap.add_argument("--compare-rounds", type=int, default=3,
+                    help="timed renders per renderer in the side by side, interleaved; each "
+                         "keeps its median (default 3)")
     ap.add_argument("--no-build", action="store_true",
                     help="use the release binary as it is (do not run cargo build first)")
     args = ap.parse_args()
