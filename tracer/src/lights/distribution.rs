@@ -7,6 +7,11 @@ use crate::math::{bin_at, count_f32};
 /// The largest f32 below 1: keeps remapped sample values in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// Tables of at most this many bins are scanned, not searched: a scene's choice among a few
+/// lights, or of a lamp's few triangles, is made at every path vertex, and a compare per bin
+/// costs less there than the guide table's lookups and the search's branches.
+const SCANNED_BINS: usize = 8;
+
 /// A piecewise-constant density on [0, 1) with `len()` equal bins; also a discrete
 /// distribution over the bins.
 #[derive(Clone, Debug)]
@@ -110,6 +115,11 @@ impl Distribution1D {
     /// The last bin whose start is at or below `u`: bins of zero width are never chosen.
     fn find_bin(&self, u: f32) -> usize {
         let n = self.len();
+        if n <= SCANNED_BINS {
+            // The starts rise with the index: the bins after the first that start at or below
+            // `u` are the ones before it (NaN: none, bin 0, as the search below gives).
+            return self.bins[1..n].iter().filter(|b| b.cdf <= u).count();
+        }
         let k = bin_at(u * count_f32(n), n);
         let (lo, hi) = (self.bins[k].guide as usize, self.bins[k + 1].guide as usize);
         let i = lo + self.bins[lo + 1..=hi].partition_point(|b| b.cdf <= u);
@@ -305,7 +315,8 @@ mod tests {
     use super::*;
 
     /// Bins of very different weight, runs of empty bins (inside and at both ends) and a
-    /// single huge bin: the guided search must pick what a search of the whole table picks.
+    /// single huge bin: the guided search, and the scan of a small table, must pick what a
+    /// search of the whole table picks.
     #[test]
     fn guided_search_finds_the_bin_a_full_search_finds() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -317,7 +328,10 @@ mod tests {
         };
         let tables: Vec<Vec<f32>> = vec![
             vec![1.0],
+            vec![3.0, 1.0],
             vec![0.0, 0.0, 5.0, 0.0],
+            vec![0.0, 2.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.5],
+            vec![0.0, 2.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.5, 0.0],
             (0..1000).map(|_| next().powi(8)).collect(),
             (0..777)
                 .map(|i| if (i / 50) % 2 == 0 { 0.0 } else { next() })
