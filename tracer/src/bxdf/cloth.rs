@@ -2,7 +2,7 @@
 //! ACM TOG 2012; P. Irawan's thesis "The Appearance of Woven Cloth", 2008) over a diffuse
 //! base, as LuxRender 1.x's `cloth` material has it (which took it from Mitsuba).
 //!
-//! A weave is a tile of yarn segments ([`Weave`]); the material finds which segment a hit lies
+//! A weave is a tile of yarn segments ([`crate::material::cloth::Preset`]); the material finds which segment a hit lies
 //! on and where on it ([`crate::material::cloth`]), and this lobe evaluates the highlight of
 //! that point of that segment: the fibres of a bent, twisted yarn reflect where their normal is
 //! the half vector, a narrow band whose brightness is the segment's geometry factor times a

@@ -275,7 +275,7 @@ impl TriangleSurface {
         }
     }
 
-    /// The uv at `p`, a point of the triangle, interpolated as [`WorldMesh::hit`] does.
+    /// The uv at `p`, a point of the triangle, interpolated as a ray's hit on it is.
     pub fn uv_at(&self, p: Vec3) -> Vec2 {
         let [p0, p1, p2] = self.vertices;
         let n = (p1 - p0).cross(p2 - p0);

@@ -1,5 +1,5 @@
 //! Lights: what a `LightSource` statement describes ([`LightDesc`], one file per kind, read
-//! through the name table [`read`]), area lights on shapes ([`area`]), and the sampler the
+//! through the name table `read`), area lights on shapes (`area`), and the sampler the
 //! integrator asks ([`Lights`]): point, spot, distant, infinite (constant or LatLong map,
 //! importance-sampled by luminance), sun (a small cone), sky (Preetham or Hosek-Wilkie,
 //! tabulated and sampled like a map) and area lights, and the choice of which light to sample.
@@ -14,7 +14,7 @@
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables). A new kind is one new file, one line in
-//! [`read`] and one line in each `match` below.
+//! `read` and one line in each `match` below.
 
 mod area;
 mod distant;

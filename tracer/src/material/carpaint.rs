@@ -22,7 +22,7 @@
 //! With a `name`, the preset's values replace Kd, Ks1-3, R1-3 and M1-3 (as in LuxRender, which
 //! then ignores those parameters). LuxRender's lobes use Schlick's distribution with
 //! r = M^2, which is GGX with alpha = M. Where the three weights sum to more than 1 they are
-//! scaled down (the [`Coat`](crate::bxdf::coated::Coat) rule), so custom layers cannot create
+//! scaled down (the [`crate::bxdf::coated::Coat`] rule), so custom layers cannot create
 //! energy; the presets' weights are far below that.
 
 use glam::Vec3;

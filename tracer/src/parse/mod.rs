@@ -1,10 +1,10 @@
 //! The LuxRender 1.x scene parser: `.lxs` text -> statements with positions -> [`SceneDesc`]
 //! with LuxRender's defaults applied.
 //!
-//! Module map: [`lexer`] (bytes -> tokens), [`reader`] (tokens -> statement arguments and
-//! parameter lists), [`params`] (typed parameter access), [`builder`] (the graphics state
+//! Module map: `lexer` (bytes -> tokens), `reader` (tokens -> statement arguments and
+//! parameter lists), `params` (typed parameter access), `builder` (the graphics state
 //! machine: transforms, attribute blocks, includes, objects), and one module per kind of thing
-//! described: [`options`] (the camera, film, filter, integrator and sampler statements, read by
+//! described: `options` (the camera, film, filter, integrator and sampler statements, read by
 //! their concepts). Materials, textures, lights and shapes read themselves ([`crate::material`],
 //! [`crate::texture`], [`crate::lights`], [`crate::shape`], meshes by [`crate::mesh`]); metal
 //! presets and blackbody colours are in [`crate::spectra`].
