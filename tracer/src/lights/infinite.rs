@@ -23,7 +23,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::image_io::{self, Edge, RgbImage};
-use crate::math::luminance;
+use crate::math::{atan2, luminance};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -352,8 +352,8 @@ impl LatLongMap {
 
     /// Map coordinates of a unit light-space direction.
     fn uv(&self, d: Vec3) -> Vec2 {
-        let theta = d.truncate().length().atan2(d.z);
-        let phi = d.y.atan2(d.x);
+        let theta = atan2(d.truncate().length(), d.z);
+        let phi = atan2(d.y, d.x);
         let s = match self.convention {
             LatLongConvention::Seed => (PI + phi) / TAU,
             LatLongConvention::LuxRender => {
