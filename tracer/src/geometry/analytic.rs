@@ -6,7 +6,7 @@ use std::f32::consts::TAU;
 use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 
-use crate::math::Frame;
+use crate::math::{atan2, Frame};
 use crate::shape::Geometry;
 
 use super::hit::{SurfaceHit, SurfaceSample};
@@ -498,7 +498,7 @@ fn quadratic_roots(a: f32, b: f32, c: f32, radius: f32, closest: f32) -> Option<
 }
 
 fn phi_of(p: Vec3A) -> f32 {
-    let phi = p.y.atan2(p.x);
+    let phi = atan2(p.y, p.x);
     if phi < 0.0 {
         phi + TAU
     } else {
