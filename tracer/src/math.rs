@@ -105,8 +105,8 @@ pub fn bin_at(x: f32, n: usize) -> usize {
 /// `y.atan2(x)` within 3e-7 radians, without a libm call (which takes some 100 instructions
 /// through glibc's wrappers): Cephes' single-precision arctangent on the octant, `min / max` of
 /// the magnitudes, reduced around tan(pi/8), then unfolded by the larger magnitude and the
-/// signs. Signed zeros and NaN come out as libm's do. Environment maps look two of these up
-/// for every escaping ray and light sample.
+/// signs. Signed zeros and NaN come out as libm's do. An environment map takes two for every
+/// ray that escapes to it, an analytic shape one for every ray that reaches it.
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};

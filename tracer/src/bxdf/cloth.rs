@@ -2,11 +2,12 @@
 //! ACM TOG 2012; P. Irawan's thesis "The Appearance of Woven Cloth", 2008) over a diffuse
 //! base, as LuxRender 1.x's `cloth` material has it (which took it from Mitsuba).
 //!
-//! A weave is a tile of yarn segments ([`crate::material::cloth::Preset`]); the material finds which segment a hit lies
-//! on and where on it ([`crate::material::cloth`]), and this lobe evaluates the highlight of
-//! that point of that segment: the fibres of a bent, twisted yarn reflect where their normal is
-//! the half vector, a narrow band whose brightness is the segment's geometry factor times a
-//! phase function (uniform plus von Mises forward scattering) times Seeliger's attenuation.
+//! A weave is a tile of yarn segments ([`crate::material::cloth::Preset`]); the material finds
+//! which segment a hit lies on and where on it ([`crate::material::cloth`]), and this lobe
+//! evaluates the highlight of that point of that segment: the fibres of a bent, twisted yarn
+//! reflect where their normal is the half vector, a narrow band whose brightness is the
+//! segment's geometry factor times a phase function (uniform plus von Mises forward
+//! scattering) times Seeliger's attenuation.
 //! Filament yarns (no twist) and staple yarns (twisted fibres) have different band shapes.
 //!
 //! f = Kd / pi + Ks s N I(wo, wi) / pi, with I the highlight integrand (symmetric in its two
