@@ -21,7 +21,7 @@
 //! (docs/architecture.md). A pixel is the filter-weighted mean of the samples around it.
 
 use crate::diag::SourcePos;
-use crate::math::{bin_at, count_f32, floor_to_int};
+use crate::math::floor_to_int;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -159,6 +159,9 @@ const TABLE_SIZE: usize = 256;
 /// side.
 pub const MAX_TAPS: usize = 2 * MAX_BORDER as usize + 1;
 
+/// [`Taps`]' weight slots: [`MAX_TAPS`] rounded up to a multiple of four.
+const TAP_SLOTS: usize = MAX_TAPS.next_multiple_of(4);
+
 /// One axis of a separable filter: |offset| in [0, radius] to the weight, tabulated, the peak
 /// scaled to 1 (a pixel's weights are a ratio, so the scale cancels; the peak at 1 bounds every
 /// weight a sample gives a pixel by 1 in magnitude).
@@ -195,7 +198,10 @@ impl AxisWeights {
         }
     }
 
+    /// The weight at `offset` pixels from the sample (what `weights4` computes four at a time).
+    #[cfg(any(test, not(target_arch = "x86_64")))]
     fn weight(&self, offset: f32) -> f32 {
+        use crate::math::{bin_at, count_f32};
         let t = (offset.abs() * self.steps_per_pixel).min(TABLE_SIZE as f32);
         let i = bin_at(t, TABLE_SIZE);
         let (a, b) = (self.table[i], self.table[i + 1]);
@@ -215,13 +221,61 @@ impl AxisWeights {
         let mut taps = Taps {
             first: start.max(0) as u32,
             len: (end - start).clamp(0, MAX_TAPS as i64) as usize,
-            weights: [0.0; MAX_TAPS],
+            weights: [0.0; TAP_SLOTS],
         };
-        let offsets = start - i64::from(pixel)..;
-        for (weight, k) in taps.weights[..taps.len].iter_mut().zip(offsets) {
-            *weight = self.weight(k as f32 + 0.5 - u);
+        // Four weights at a time; the slots past `len` are computed and not read.
+        let k0 = start - i64::from(pixel);
+        for (c, chunk) in taps.weights[..taps.len.next_multiple_of(4)]
+            .chunks_exact_mut(4)
+            .enumerate()
+        {
+            let k = [0, 1, 2, 3].map(|j| (k0 + (4 * c + j) as i64) as f32);
+            chunk.copy_from_slice(&self.weights4(k, u));
         }
         taps
+    }
+
+    /// `weight(k + 0.5 - u)` for four pixel offsets k.
+    #[cfg(not(target_arch = "x86_64"))]
+    #[inline(always)]
+    fn weights4(&self, k: [f32; 4], u: f32) -> [f32; 4] {
+        k.map(|k| self.weight(k + 0.5 - u))
+    }
+
+    /// `weight(k + 0.5 - u)` for four pixel offsets k, on SSE lanes (part of x86-64): each lane
+    /// does `weight`'s operations in its order, so the weights have the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn weights4(&self, k: [f32; 4], u: f32) -> [f32; 4] {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of x86-64; the loads and stores use 4-float arrays, and the table
+        // indices are at most TABLE_SIZE - 1 (below).
+        unsafe {
+            let k = _mm_loadu_ps(k.as_ptr());
+            let offset = _mm_sub_ps(_mm_add_ps(k, _mm_set1_ps(0.5)), _mm_set1_ps(u));
+            let magnitude = _mm_andnot_ps(_mm_set1_ps(-0.0), offset);
+            // `min` returns its second operand for a NaN, as f32::min returns the number.
+            let t = _mm_min_ps(
+                _mm_mul_ps(magnitude, _mm_set1_ps(self.steps_per_pixel)),
+                _mm_set1_ps(TABLE_SIZE as f32),
+            );
+            // bin_at: truncation, at most TABLE_SIZE - 1 (t <= TABLE_SIZE, so clamping before
+            // truncating gives the same entry).
+            let i = _mm_cvttps_epi32(_mm_min_ps(t, _mm_set1_ps((TABLE_SIZE - 1) as f32)));
+            let mut entry = [0i32; 4];
+            _mm_storeu_si128(entry.as_mut_ptr().cast(), i);
+            let at = |j: usize| *self.table.get_unchecked(entry[j] as usize);
+            let next = |j: usize| *self.table.get_unchecked(entry[j] as usize + 1);
+            let a = _mm_setr_ps(at(0), at(1), at(2), at(3));
+            let b = _mm_setr_ps(next(0), next(1), next(2), next(3));
+            let w = _mm_add_ps(
+                a,
+                _mm_mul_ps(_mm_sub_ps(t, _mm_cvtepi32_ps(i)), _mm_sub_ps(b, a)),
+            );
+            let mut out = [0.0; 4];
+            _mm_storeu_ps(out.as_mut_ptr(), w);
+            out
+        }
     }
 }
 
@@ -231,7 +285,7 @@ pub struct Taps {
     /// The first pixel reached.
     pub first: u32,
     len: usize,
-    weights: [f32; MAX_TAPS],
+    weights: [f32; TAP_SLOTS],
 }
 
 impl Taps {
@@ -384,6 +438,43 @@ mod tests {
                 assert!(offset.abs() <= 2.0, "{offset}");
                 let exact = filter_1d(kind, offset, 2.0) / filter_1d(kind, 0.0, 2.0);
                 assert!((w - exact).abs() < 1e-4, "{offset}: {w} against {exact}");
+            }
+        }
+    }
+
+    /// The taps' weights, four at a time, have the bits of the weight at each offset, for
+    /// every width (up to the widest's 17 taps), at the table's ends (offset 0 and beyond the
+    /// radius) and for taps cut short by the region's edge.
+    #[test]
+    fn tap_weights_equal_the_weights_one_at_a_time() {
+        for (kind, radius) in [
+            (FilterKind::BlackmanHarris, 2.0),
+            (FilterKind::BlackmanHarris, 4.0),
+            (FilterKind::Gaussian { alpha: 2.0 }, 2.0),
+            (FilterKind::Triangle, 0.7),
+            (FilterKind::Sinc { tau: 3.0 }, MAX_WIDTH),
+        ] {
+            let axis = &filter(kind, radius).x;
+            for i in 0..=64 {
+                let u = (i as f32 / 64.0).min(1.0f32.next_down());
+                for (lo, hi) in [(0, 40), (19, 21), (20, 40), (0, 20)] {
+                    let taps = axis.taps(20, u, lo, hi);
+                    for (j, &w) in taps.weights().iter().enumerate() {
+                        let k = (taps.first + j as u32) as f32 - 20.0;
+                        let one = axis.weight(k + 0.5 - u);
+                        assert_eq!(w.to_bits(), one.to_bits(), "{kind:?} u {u} tap {k}");
+                    }
+                }
+            }
+            // Offsets 0 and far past the radius: the table's first entry and its last.
+            let k = [-0.5, 999.5, -1000.5, 2.0];
+            let four = axis.weights4(k, 0.0);
+            for j in 0..4 {
+                assert_eq!(
+                    four[j].to_bits(),
+                    axis.weight(k[j] + 0.5).to_bits(),
+                    "{k:?}"
+                );
             }
         }
     }
