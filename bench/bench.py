@@ -39,6 +39,8 @@ SEED = Path(os.environ.get("YAT_SEED_SCENES", ROOT.parent / "shared/seed-project
 # Cargo's target folder (CARGO_TARGET_DIR when set, as build() builds there).
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
 YAT = TARGET / "release/yat"
+# The profile-optimised build of deploy/build-pgo.sh (`--pgo`).
+PGO_YAT = ROOT / "target/pgo/yat"
 VENV = ROOT / "bench/.venv"
 VENV_PYTHON = VENV / "bin/python"
 SETUP = ROOT / "bench/setup-env.sh"
@@ -100,8 +102,11 @@ OWN_SCENES = [
 ]
 
 
-def build():
-    subprocess.run(["cargo", "build", "--release", "-p", "yat"], cwd=ROOT, check=True)
+def build(pgo=False):
+    if pgo:
+        subprocess.run([str(ROOT / "deploy/build-pgo.sh")], cwd=ROOT, check=True)
+    else:
+        subprocess.run(["cargo", "build", "--release", "-p", "yat"], cwd=ROOT, check=True)
     if not (ROOT / "scenes/heavy/heavy.ply").exists():
         subprocess.run(
             ["cargo", "run", "--release", "-p", "yat-tracer", "--example", "make_scene_assets"],
@@ -536,6 +541,9 @@ def main():
     ap.add_argument("--compare-rounds", type=int, default=3,
                     help="timed renders per renderer in the side by side, interleaved; each "
                          "keeps its fastest (default 3)")
+    ap.add_argument("--pgo", action="store_true",
+                    help="build with deploy/build-pgo.sh and measure its profile-optimised "
+                         "binary, target/pgo/yat (the same images, sooner)")
     ap.add_argument("--no-build", action="store_true",
                     help="use the release binary as it is (do not run cargo build first)")
     args = ap.parse_args()
@@ -544,8 +552,11 @@ def main():
     if with_compare:
         ensure_venv()
 
+    if args.pgo:
+        global YAT
+        YAT = PGO_YAT
     if not args.no_build:
-        build()
+        build(args.pgo)
     results = ROOT / "bench/RESULTS.md"
     if args.compare_only:
         section = side_by_side_section(args)
