@@ -248,8 +248,10 @@ impl AxisWeights {
     #[inline(always)]
     fn weights4(&self, k: [f32; 4], u: f32) -> [f32; 4] {
         use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of x86-64; the loads and stores use 4-float arrays, and the table
-        // indices are at most TABLE_SIZE - 1 (below).
+        // SAFETY: SSE2 is part of x86-64; the loads and stores use 4-float arrays. Each entry is
+        // in 0..TABLE_SIZE (t is at least 0, a NaN offset becomes TABLE_SIZE at the first `min`,
+        // and the second caps it below), so it and the next are inside the table's
+        // TABLE_SIZE + 1 weights.
         unsafe {
             let k = _mm_loadu_ps(k.as_ptr());
             let offset = _mm_sub_ps(_mm_add_ps(k, _mm_set1_ps(0.5)), _mm_set1_ps(u));
@@ -259,7 +261,7 @@ impl AxisWeights {
                 _mm_mul_ps(magnitude, _mm_set1_ps(self.steps_per_pixel)),
                 _mm_set1_ps(TABLE_SIZE as f32),
             );
-            // bin_at: truncation, at most TABLE_SIZE - 1 (t <= TABLE_SIZE, so clamping before
+            // bin_at: truncation, at most TABLE_SIZE - 1 (t <= TABLE_SIZE, so capping before
             // truncating gives the same entry).
             let i = _mm_cvttps_epi32(_mm_min_ps(t, _mm_set1_ps((TABLE_SIZE - 1) as f32)));
             let mut entry = [0i32; 4];
