@@ -466,10 +466,11 @@ most efficient sampler.
 
 Render seconds, the fastest of {args.compare_rounds} timed renders per renderer and sampler,
 interleaved round by round (interference from other work only adds time): YAT's and LuxCore's
-from the scene and BVH being ready to the last sample; Mitsuba's around `mi.render` on a loaded scene, after an untimed render of the same size (the
-llvm variant JIT-compiles its kernels on the first render, several seconds; they are cached
-after that). LuxCore runs PATHCPU with its default sampler (SOBOL, adaptive strength 0.95);
-its samples/s and rays/s are its own statistics.
+from the scene and BVH being ready to the last sample; Mitsuba's around `mi.render` on a loaded
+scene, after an untimed render of the same size (the llvm variant JIT-compiles its kernels on
+the first render, several seconds; they are cached after that). LuxCore runs PATHCPU with its
+default sampler (SOBOL, adaptive strength 0.95); its samples/s and rays/s are its own
+statistics.
 
 {summary_table}
 
