@@ -3,15 +3,13 @@
 # (profile-guided optimisation). The compiler lays out and inlines the code by how often each
 # branch ran in renders of the repository's scenes; the arithmetic is the same, so the images are
 # the same bytes as the plain release build's (`cargo build --release`); the seed scenes render
-# 5-9% sooner by the median of seven alternating renders, 9-19% by the best (bench/RESULTS.md,
-# session 13).
+# some 4-10% sooner (medians of alternating renders in three runs; bench/RESULTS.md, session 13).
 #
 #   deploy/build-pgo.sh                      # then: target/pgo/yat render scene.lxs ...
 #   deploy/build-pgo.sh my/scene.lxs ...     # also trained on your own scenes
 #
-# Scenes given on the command line are rendered for the profile too (at 160x90, 16 spp): a
-# render farm's binary trained on the scenes it renders gains most (trained on the four compared
-# seed scenes themselves, the seed scenes' medians were 11-18% sooner instead of 5-9%).
+# Scenes given on the command line are rendered for the profile too (at 160x90, 16 spp), so a
+# farm's binary can be trained on the scenes it renders.
 # Needs the toolchain's llvm-profdata (`rustup component add llvm-tools`, done here when missing).
 # Two release builds (an instrumented one and the final one) and a few seconds of renders.
 set -eu
