@@ -1,10 +1,10 @@
 //! The render API every node uses: settings, the unit plan, the built scene and rendering one
 //! unit into a sample buffer.
 //!
-//! Files: [`settings`] (resolved settings and command-line overrides), [`unit`](mod@unit) (a work unit
-//! and its counters: the leaf the film, the plan and the nodes share), [`plan`] (cutting an
-//! image into units), [`adaptive`] (the rounds of an adaptive render and the decision between
-//! them), [`scene`] (the built scene and rendering one unit).
+//! Files: [`settings`] (resolved settings and command-line overrides), [`unit`](mod@unit) (a
+//! work unit and its counters: the leaf the film, the plan and the nodes share), [`plan`]
+//! (cutting an image into units), [`adaptive`] (the rounds of an adaptive render and the
+//! decision between them), [`scene`] (the built scene and rendering one unit).
 
 pub mod adaptive;
 pub mod plan;
