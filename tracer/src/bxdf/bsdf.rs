@@ -82,6 +82,9 @@ impl Bsdf {
     }
 
     /// Density with which `sample` picks wi (non-specular lobes only).
+    // Inlined into the path loop, where it is hot; the mirror-image light sample calls it too,
+    // and a second call site would otherwise leave it out of line.
+    #[inline(always)]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (wo, wi) = (self.frame.to_local(wo), self.frame.to_local(wi));
         match &self.coating {
@@ -91,6 +94,8 @@ impl Bsdf {
     }
 
     /// Samples wi given wo; `u_lobe` picks a lobe, `u` the direction.
+    // As `pdf`.
+    #[inline(always)]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let wo_local = self.frame.to_local(wo);
         let LocalSample {

@@ -7,6 +7,7 @@
 //! | `rrstrategy` | string: efficiency, probability, none | efficiency |
 //! | `rrcontinueprob` | float | 0.65 |
 //! | `includeenvironment` | bool | true |
+//! | `mirrorimages` (YAT's own) | bool | true: lamps are also sampled through flat mirrors ([`crate::lights::ImageSample`]) |
 //!
 //! Without a `SurfaceIntegrator` statement the scene renders with `"path"` and these defaults.
 
@@ -21,6 +22,9 @@ pub const DEFAULT_MAX_DEPTH: i32 = 16;
 pub const DEFAULT_RR_CONTINUE_PROB: f32 = 0.65;
 /// Whether camera rays that escape see the environment.
 pub const DEFAULT_INCLUDE_ENVIRONMENT: bool = true;
+/// Whether lamps are sampled through flat mirrors too (the same image, less noise where a
+/// mirror throws light; false renders plain path tracing's estimate, for comparisons).
+pub const DEFAULT_MIRROR_IMAGES: bool = true;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RussianRoulette {
@@ -35,6 +39,8 @@ pub struct IntegratorDesc {
     pub rr_strategy: RussianRoulette,
     pub rr_continue_prob: f32,
     pub include_environment: bool,
+    /// Lamps are sampled through flat mirrors as well as directly.
+    pub mirror_images: bool,
     /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
     pub requested: String,
 }
@@ -47,6 +53,7 @@ impl IntegratorDesc {
             rr_strategy: RussianRoulette::Efficiency,
             rr_continue_prob: DEFAULT_RR_CONTINUE_PROB,
             include_environment: DEFAULT_INCLUDE_ENVIRONMENT,
+            mirror_images: DEFAULT_MIRROR_IMAGES,
             requested: requested.to_string(),
         }
     }
@@ -85,6 +92,7 @@ impl IntegratorDesc {
                     rr_continue_prob: params.float("rrcontinueprob", DEFAULT_RR_CONTINUE_PROB)?,
                     include_environment: params
                         .bool("includeenvironment", DEFAULT_INCLUDE_ENVIRONMENT)?,
+                    mirror_images: params.bool("mirrorimages", DEFAULT_MIRROR_IMAGES)?,
                     requested: ty.to_string(),
                 })
             }

@@ -9,11 +9,11 @@
 //! the volume on the near side of the surface it hits. A scene without volumes takes none of
 //! these steps and draws no extra random numbers, so it renders as it did before volumes.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::options::{IntegratorDesc, RussianRoulette};
 use crate::geometry::{SceneGeometry, SurfaceHit};
-use crate::lights::Lights;
+use crate::lights::{follows_plane, ImageWeights, Lights, IMAGE_SHARE};
 use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
 use crate::medium::{Flight, MediumId, Phase, ShapeMedia, Volumes};
@@ -65,7 +65,53 @@ struct PrevScatter {
     p: Vec3,
     pdf: f32,
     specular: bool,
+    /// The share of the light samples at `p` that went to lamp images (0 where it sees none):
+    /// the lights' own share is what is left.
+    image_share: f32,
+    /// Set when the ray just reflected in a flat mirror straight after a non-specular vertex:
+    /// a lamp it reaches is one a lamp-image sample at that vertex could have found.
+    before_mirror: Option<BeforeMirror>,
 }
+
+impl PrevScatter {
+    /// A vertex that sampled no lamp images.
+    fn plain(p: Vec3, pdf: f32, specular: bool) -> Self {
+        Self {
+            p,
+            pdf,
+            specular,
+            image_share: 0.0,
+            before_mirror: None,
+        }
+    }
+}
+
+/// The non-specular vertex before a flat mirror, and the mirror's plane.
+#[derive(Clone, Copy)]
+struct BeforeMirror {
+    p: Vec3,
+    pdf: f32,
+    image_share: f32,
+    plane: u16,
+}
+
+/// A light sample's random numbers, and the share of a vertex's light samples its kind (lights,
+/// or lamp images) gets.
+#[derive(Clone, Copy)]
+struct LightDraw {
+    share: f32,
+    u_select: f32,
+    u: Vec2,
+}
+
+impl LightDraw {
+    fn new(share: f32, u_select: f32, u: Vec2) -> Self {
+        Self { share, u_select, u }
+    }
+}
+
+/// The largest f32 below 1: a rescaled sample stays in [0, 1).
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Russian roulette after a bounce: false ends the path; else the throughput is divided by
 /// the survival probability.
@@ -87,6 +133,7 @@ fn survives(integrator: &IntegratorDesc, depth: u32, u_rr: f32, throughput: &mut
     true
 }
 
+#[inline(always)]
 pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSampler) -> PathResult {
     let integrator = scene.integrator();
     let max_depth = scene.max_depth();
@@ -100,11 +147,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
     let mut depth = 0u32;
     let mut pass_through = 0u32;
     // The camera ray counts as specular: emitters it sees are taken at full weight.
-    let mut prev = PrevScatter {
-        p: ray.origin,
-        pdf: 0.0,
-        specular: true,
-    };
+    let mut prev = PrevScatter::plain(ray.origin, 0.0, true);
 
     loop {
         rays += 1;
@@ -146,11 +189,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                     if !survives(integrator, depth, sampler.get_1d(), &mut throughput) {
                         break;
                     }
-                    prev = PrevScatter {
-                        p,
-                        pdf,
-                        specular: false,
-                    };
+                    prev = PrevScatter::plain(p, pdf, false);
                     ray = Ray::new(p, wi);
                     continue;
                 }
@@ -166,7 +205,10 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                     (lights.environment(ray.dir), 1.0)
                 } else {
                     let (le, pdf) = lights.environment_and_pdf(ray.dir);
-                    (le, power_heuristic(prev.pdf, pdf))
+                    (
+                        le,
+                        power_heuristic(prev.pdf, (1.0 - prev.image_share) * pdf),
+                    )
                 };
                 radiance += throughput * le * weight;
             }
@@ -176,10 +218,13 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
 
         let le = lights.emitted(&hit, wo);
         if le != Vec3::ZERO {
-            let weight = if prev.specular {
-                1.0
+            let weight = if !prev.specular {
+                let pdf_light = (1.0 - prev.image_share) * lights.pdf_hit(prev.p, &hit);
+                power_heuristic(prev.pdf, pdf_light)
+            } else if let Some(b) = prev.before_mirror {
+                power_heuristic(b.pdf, b.image_share * lights.image_pdf(b.p, b.plane, &hit))
             } else {
-                power_heuristic(prev.pdf, lights.pdf_hit(prev.p, &hit))
+                1.0
             };
             radiance += throughput * le * weight;
         }
@@ -200,14 +245,32 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
             continue;
         }
+        let crossed_null = pass_through > 0;
         pass_through = 0;
         if depth >= max_depth {
             break;
         }
         depth += 1;
 
+        let mut image_share = 0.0;
         if !bsdf.is_specular() {
-            let light = direct_light(scene, &hit, wo, &bsdf, sides, &u, &mut rays);
+            // A path through a mirror needs one more vertex: none past the last.
+            let (draw, image) = if lights.has_mirror_images() && depth < max_depth {
+                split_light_sample(lights, hit.p, &u)
+            } else {
+                (LightDraw::new(1.0, u.light_select, u.light), None)
+            };
+            let light = match image {
+                Some(images) => {
+                    image_share = draw.share;
+                    direct_light_via_mirror(scene, &hit, wo, &bsdf, &images, draw, &mut rays)
+                }
+                None => {
+                    // What the lights leave (nothing where no image is seen).
+                    image_share = 1.0 - draw.share;
+                    direct_light(scene, &hit, wo, &bsdf, sides, draw, &mut rays)
+                }
+            };
             radiance += throughput * light;
         }
 
@@ -224,10 +287,27 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             break;
         }
 
+        // A mirror straight after a vertex that sampled lamp images (no null surface between).
+        let before_mirror =
+            if bs.specular && !prev.specular && prev.image_share > 0.0 && !crossed_null {
+                lights
+                    .mirror_plane(&hit)
+                    .filter(|&plane| follows_plane(bs.wi, lights.reflect_in_plane(plane, ray.dir)))
+                    .map(|plane| BeforeMirror {
+                        p: prev.p,
+                        pdf: prev.pdf,
+                        image_share: prev.image_share,
+                        plane,
+                    })
+            } else {
+                None
+            };
         prev = PrevScatter {
             p: hit.p,
             pdf: bs.pdf,
             specular: bs.specular,
+            image_share,
+            before_mirror,
         };
         medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
@@ -318,12 +398,13 @@ fn direct_light<S: PathScene>(
     wo: Vec3,
     bsdf: &Bsdf,
     sides: ShapeMedia,
-    u: &VertexSamples,
+    draw: LightDraw,
     rays: &mut u32,
 ) -> Vec3 {
-    let Some(ls) = scene.lights().sample(hit.p, u.light_select, u.light) else {
+    let Some(mut ls) = scene.lights().sample(hit.p, draw.u_select, draw.u) else {
         return Vec3::ZERO;
     };
+    ls.pdf *= draw.share;
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -344,6 +425,96 @@ fn direct_light<S: PathScene>(
         power_heuristic(ls.pdf, bsdf.pdf(wo, ls.wi))
     };
     tr * f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
+}
+
+/// A vertex's light sample in a scene with lamp images: where the vertex sees one, the first
+/// [`IMAGE_SHARE`] of the choice dimension (rescaled) samples an image (returned with the
+/// images' weights), the rest the lights. Kept out of line: the path loop of a scene without
+/// mirrors stays as small as it was.
+#[inline(never)]
+fn split_light_sample(
+    lights: &Lights,
+    p: Vec3,
+    u: &VertexSamples,
+) -> (LightDraw, Option<ImageWeights>) {
+    let Some(images) = lights.image_weights(p) else {
+        return (LightDraw::new(1.0, u.light_select, u.light), None);
+    };
+    let share = IMAGE_SHARE;
+    if u.light_select < share {
+        let draw = LightDraw::new(share, u.light_select / share, u.light);
+        (draw, Some(images))
+    } else {
+        let u_select = ((u.light_select - share) / (1.0 - share)).min(ONE_BELOW);
+        (LightDraw::new(1.0 - share, u_select, u.light), None)
+    }
+}
+
+/// How far past the mirror plane the ray to a lamp image's mirror point may find the mirror
+/// (relative): the hit is checked to lie in the plane anyway.
+const MIRROR_REACH: f32 = 1.0 + 1e-3;
+
+/// One light sample through a flat mirror (a lamp image, [`crate::lights::ImageSample`]),
+/// weighted against BSDF sampling by the power heuristic: the mirror must be the first surface
+/// towards its sampled point, its reflection must follow the plane (as a BSDF sample's must for
+/// the same path to count as found by an image), and the lamp must be in view of it. Scenes
+/// with volumes have no lamp images. Out of line, as [`split_light_sample`].
+#[inline(never)]
+fn direct_light_via_mirror<S: PathScene>(
+    scene: &S,
+    hit: &SurfaceHit,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    images: &ImageWeights,
+    draw: LightDraw,
+    rays: &mut u32,
+) -> Vec3 {
+    let lights = scene.lights();
+    let Some(s) = lights.sample_image(images, draw.u_select, draw.u) else {
+        return Vec3::ZERO;
+    };
+    if s.pdf.is_nan() || s.pdf <= 0.0 || s.li == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let f = bsdf.eval(wo, s.wi);
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    *rays += 1;
+    let origin = offset_origin(hit.p, hit.ng, s.wi);
+    let ray = Ray::new(origin, s.wi);
+    let Some(mirror) = scene.geometry().intersect(&ray, s.to_mirror * MIRROR_REACH) else {
+        return Vec3::ZERO;
+    };
+    if lights.mirror_plane(&mirror) != Some(s.plane) {
+        return Vec3::ZERO;
+    }
+    // A plain mirror: nothing to choose, and its reflection draws no random number.
+    let Some(r) = scene.bsdf_at(&mirror, 0.0).sample(-s.wi, 0.0, Vec2::ZERO) else {
+        return Vec3::ZERO;
+    };
+    if !r.specular || r.pdf.is_nan() || r.pdf <= 0.0 || !follows_plane(r.wi, s.reflected) {
+        return Vec3::ZERO;
+    }
+    let reflectance = r.f * (r.wi.dot(mirror.ns).abs() / r.pdf);
+    let to_light = s.light_point - mirror.p;
+    let dist = to_light.length();
+    let dir = to_light / dist;
+    let origin = offset_origin(mirror.p, mirror.ng, dir);
+    let tr = shadow_transmittance(
+        scene,
+        origin,
+        dir,
+        shadow_tmax(mirror.p, origin, dist),
+        None,
+        rays,
+    );
+    if tr == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let pdf = draw.share * s.pdf;
+    let weight = power_heuristic(pdf, bsdf.pdf(wo, s.wi));
+    tr * f * reflectance * s.li * (s.wi.dot(hit.ns).abs() * weight / pdf)
 }
 
 /// One light sample at a scattering event inside a volume, weighted against phase-function

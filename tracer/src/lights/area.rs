@@ -287,12 +287,31 @@ impl AreaLight {
         }
     }
 
+    /// The box around the emitting surface.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match &self.emitter {
+            Emitter::Triangles { triangles, .. } => triangles
+                .iter()
+                .flat_map(|t| t.vertices)
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                }),
+            Emitter::Sphere { shape, .. } | Emitter::Quadric(shape) => {
+                let b = shape.world_bounds();
+                (b.min.into(), b.max.into())
+            }
+        }
+    }
+
     /// Radiant flux of a one-sided Lambertian emitter.
     pub fn power(&self) -> f32 {
         luminance(self.radiance) * self.area() * PI
     }
 
     /// A point on the light seen from `from`; None when it shows its back (or nothing).
+    // Inlined into `sample_chosen`, as when that was its only caller (the lamp images call it
+    // too).
+    #[inline(always)]
     pub fn sample(&self, from: Vec3, u: Vec2) -> Option<EmitterSample> {
         let (point, on) = match &self.emitter {
             Emitter::Triangles {

@@ -10,10 +10,15 @@
 //! and `pdf_environment` return for an escaping ray, so MIS sees the same numbers from both
 //! sides.
 //!
+//! Area lights are also sampled through flat mirrors, as their images (`mirrored`): scenes
+//! whose lamps light a room by way of a mirror get that light by next-event estimation
+//! instead of by BSDF samples that happen to find the lamp.
+//!
 //! Files: one per kind (`point`, `spot`, `distant`, `infinite`, `sun`, `sky/`, `area`), each
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
-//! types), `error`, `distribution` (sampling tables). A new kind is one new file, one line in
+//! types), `error`, `distribution` (sampling tables); `mirrored` (lamp images in flat
+//! mirrors). A new kind is one new file, one line in
 //! `read` and one line in each `match` below.
 
 mod area;
@@ -22,6 +27,7 @@ mod distribution;
 mod emission;
 mod error;
 mod infinite;
+mod mirrored;
 mod point;
 mod sample;
 mod sky;
@@ -49,6 +55,7 @@ pub use area::AreaLightParams;
 pub use distant::DistantLight;
 pub use error::LightError;
 pub use infinite::{EnvMapDesc, InfiniteLight, LatLongConvention};
+pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
 pub use point::PointLight;
 pub use sample::LightSample;
 pub use sky::{SkyLight, SkyModel};
@@ -213,6 +220,8 @@ pub struct Lights {
     shape_light: Vec<Option<u32>>,
     /// Indices into `lights` of the infinite lights.
     infinite: Vec<u32>,
+    /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
+    images: mirrored::MirrorImages,
 }
 
 impl Lights {
@@ -299,6 +308,7 @@ impl Lights {
             selection: Distribution1D::new(powers),
             shape_light,
             infinite,
+            images: Default::default(),
         })
     }
 

@@ -359,6 +359,9 @@ impl Materials {
     /// The BSDF of material `id` at `hit` on a shape whose world-to-object transform is
     /// `world_to_object` (the object-space position is what planar and local 3D texture
     /// mappings see). `u_mix` resolves `mix` materials stochastically.
+    // Inlined into the path loop, where it is hot; the mirror-image light sample calls it too,
+    // and a second call site would otherwise leave it out of line.
+    #[inline(always)]
     pub fn bsdf(
         &self,
         id: MaterialId,

@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
-use crate::desc::{MaterialDesc, SceneDesc};
+use crate::desc::{Geometry, MaterialDesc, SceneDesc};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
@@ -89,7 +89,8 @@ impl RenderScene {
             &textures,
             source,
             settings.latlong,
-        )?;
+        )?
+        .with_mirror_images(&flat_mirrors(desc), &geometry);
         guard.check_cancel()?;
         Ok(Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
@@ -140,6 +141,9 @@ impl RenderScene {
     }
 
     /// The BSDF at a hit; `u_mix` resolves mix materials.
+    // Inlined into the path loop, where it is hot; the mirror-image light sample calls it too,
+    // and a second call site would otherwise leave it out of line.
+    #[inline(always)]
     pub fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
         let shape = hit.shape as usize;
         self.materials.bsdf(
@@ -297,6 +301,25 @@ impl UnitSums {
         }
         buffer
     }
+}
+
+/// The shapes whose lamp images the path tracer samples: triangle meshes under a plain
+/// `mirror` (a bump map or a mix would bend the reflection), unless the scene turns that off or
+/// has volumes (the integrator samples images only between surfaces).
+fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
+    if !desc.integrator.mirror_images || !desc.volumes.media.is_empty() {
+        return Vec::new();
+    }
+    (0..desc.shapes.len() as u32)
+        .filter(|&i| {
+            let shape = &desc.shapes[i as usize];
+            matches!(shape.geometry, Geometry::Mesh(_))
+                && matches!(
+                    desc.materials.get(shape.material.0 as usize),
+                    Some(MaterialDesc::Mirror(_))
+                )
+        })
+        .collect()
 }
 
 impl PathScene for RenderScene {

@@ -11,6 +11,7 @@ mod geometry_on_scenes;
 mod hostile;
 mod hostile_scenes;
 mod luxrender_materials;
+mod mirror_images;
 mod parse_conventions;
 mod parse_errors;
 mod render;
