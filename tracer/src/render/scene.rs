@@ -141,9 +141,6 @@ impl RenderScene {
     }
 
     /// The BSDF at a hit; `u_mix` resolves mix materials.
-    // Inlined into the path loop, where it is hot; the mirror-image light sample calls it too,
-    // and a second call site would otherwise leave it out of line.
-    #[inline(always)]
     pub fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf {
         let shape = hit.shape as usize;
         self.materials.bsdf(
