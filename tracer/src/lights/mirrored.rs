@@ -453,3 +453,60 @@ impl Lights {
         self.images.planes[plane as usize].reflect_dir(v)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plane x = 1 (its front, where the normal +x points, is beyond the room), with a
+    /// mirror over y in [-1, 1], z in [0, 2].
+    fn wall() -> MirrorPlane {
+        let n = Vec3::X;
+        let mut plane = MirrorPlane {
+            n,
+            d: 1.0,
+            area: 4.0,
+            frame: Frame::from_normal(n),
+            window_lo: Vec2::INFINITY,
+            window_hi: Vec2::NEG_INFINITY,
+        };
+        for corner in [
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 2.0),
+            Vec3::new(1.0, -1.0, 2.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ] {
+            let q = plane.in_plane(corner);
+            plane.window_lo = plane.window_lo.min(q);
+            plane.window_hi = plane.window_hi.max(q);
+        }
+        plane
+    }
+
+    #[test]
+    fn reach_is_the_share_of_the_lamps_footprint_the_mirror_covers() {
+        let plane = wall();
+        // A small lamp at height 1.5 in the room, in front of the mirror's middle.
+        let (lo, hi) = (Vec3::new(0.4, -0.1, 1.5), Vec3::new(0.6, 0.1, 1.5));
+        let image = Image::new(&plane, false, lo, hi, 1e-5).expect("the lamp is in the room");
+        assert!(
+            Image::new(&plane, true, lo, hi, 1e-5).is_none(),
+            "nothing behind the wall"
+        );
+        // From the floor the lamp's image lies inside the mirror: all of it.
+        let floor = image.reach(&plane, Vec3::new(0.0, 0.0, 0.0), 1e-5);
+        assert!((floor - 1.0).abs() < 1e-6, "{floor}");
+        // From high above, the line to the image meets the plane above the mirror's top.
+        assert_eq!(image.reach(&plane, Vec3::new(0.5, 0.0, 10.0), 1e-5), 0.0);
+        // From higher up, the footprint straddles the mirror's top edge (z = 2): the line from
+        // p's reflection (2, 0, 3) to a lamp point (x, 0, 1.5) meets the plane at height
+        // 3 - 1.5 / (2 - x), 1.93 for the lamp's near edge and 2.06 for its far edge.
+        let p = Vec3::new(0.0, 0.0, 3.0);
+        assert_eq!(plane.reflect_point(p), Vec3::new(2.0, 0.0, 3.0));
+        let z = |x: f32| 3.0 - 1.5 / (2.0 - x);
+        let expected = (2.0 - z(0.6)) / (z(0.4) - z(0.6));
+        let half = image.reach(&plane, p, 1e-5);
+        assert!((half - expected).abs() < 1e-3, "{half} against {expected}");
+        assert!(half > 0.0 && half < 1.0);
+    }
+}
