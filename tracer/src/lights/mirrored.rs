@@ -33,7 +33,6 @@
 use glam::{Vec2, Vec3};
 
 use super::area::AreaLight;
-use super::{Light, Lights};
 use crate::geometry::{SceneGeometry, ShapeSurface, SurfaceHit};
 use crate::math::Frame;
 
@@ -192,7 +191,7 @@ impl Image {
 
 /// The lamp images of a scene's flat mirrors (none in most scenes).
 #[derive(Default)]
-pub(super) struct MirrorImages {
+pub struct MirrorImages {
     planes: Vec<MirrorPlane>,
     images: Vec<Image>,
     /// Shapes that are flat mirrors, sorted.
@@ -201,7 +200,7 @@ pub(super) struct MirrorImages {
 }
 
 /// How likely each lamp image is to be chosen from one shading point: what
-/// [`Lights::sample_image`] draws from.
+/// [`MirrorImages::sample`] draws from.
 pub struct ImageWeights {
     p: Vec3,
     weights: [f32; MAX_IMAGES],
@@ -224,7 +223,7 @@ pub struct ImageSample {
     /// Solid-angle density at the shading point, including the image's choice (not
     /// [`IMAGE_SHARE`]).
     pub pdf: f32,
-    /// The mirror plane (what [`Lights::mirror_plane`] says of the mirror point).
+    /// The mirror plane (what [`MirrorImages::mirror_plane`] says of the mirror point).
     pub plane: u16,
 }
 
@@ -260,10 +259,15 @@ impl MirrorImages {
     }
 }
 
-impl Lights {
-    /// Adds the lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is
-    /// a plain `mirror`; see the module doc for which take part).
-    pub fn with_mirror_images(mut self, mirror_shapes: &[u32], geometry: &SceneGeometry) -> Self {
+impl MirrorImages {
+    /// The lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is a
+    /// plain `mirror`; see the module doc for which take part) of the area lights `lamps`: each
+    /// its index among the scene's lights, the light, and its selection probability.
+    pub fn new(
+        mirror_shapes: &[u32],
+        geometry: &SceneGeometry,
+        lamps: &[(u32, &AreaLight, f32)],
+    ) -> Self {
         let scale = geometry
             .bounds()
             .map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-3));
@@ -323,24 +327,19 @@ impl Lights {
         candidates.truncate(MAX_PLANES);
 
         // The heaviest lamps only: no more can have an image among the heaviest images.
-        let mut lamps: Vec<(usize, &AreaLight)> = (self.lights.iter().enumerate())
-            .filter_map(|(i, l)| match l {
-                Light::Area(area) => Some((i, area)),
-                _ => None,
-            })
-            .collect();
-        lamps.sort_by(|a, b| self.selection.pmf(b.0).total_cmp(&self.selection.pmf(a.0)));
+        let mut lamps = lamps.to_vec();
+        lamps.sort_by(|a, b| b.2.total_cmp(&a.2));
         lamps.truncate(MAX_IMAGES);
         let mut images = Vec::new();
         for (index, plane) in candidates.iter().enumerate() {
-            for &(light, lamp) in &lamps {
+            for &(light, lamp, weight) in &lamps {
                 let (lo, hi) = lamp.bounds();
                 for front in [true, false] {
                     if let Some(image) = Image::new(plane, front, lo, hi, tolerance) {
                         images.push(Image {
                             plane: index as u16,
-                            light: light as u32,
-                            weight: self.selection.pmf(light),
+                            light,
+                            weight,
                             ..image
                         });
                     }
@@ -351,38 +350,44 @@ impl Lights {
         images.truncate(MAX_IMAGES);
         images.retain(|i| i.weight > 0.0);
         if images.is_empty() {
-            return self;
+            return Self::default();
         }
-        self.images = MirrorImages {
+        Self {
             planes: candidates,
             images,
             mirror_shapes: shapes,
             tolerance,
-        };
-        self
+        }
     }
 
-    /// Whether the scene has lamp images (most have none).
+    /// Whether there are no images (most scenes have none).
     #[inline]
-    pub fn has_mirror_images(&self) -> bool {
-        !self.images.images.is_empty()
+    pub fn is_empty(&self) -> bool {
+        self.images.is_empty()
     }
 
     /// The lamp images a shading point `p` sees, weighted; None where it sees none (its light
     /// samples then all go to the lights, else [`IMAGE_SHARE`] of them to these).
-    pub fn image_weights(&self, p: Vec3) -> Option<ImageWeights> {
-        let (weights, total) = self.images.weights(p);
+    pub fn seen_from(&self, p: Vec3) -> Option<ImageWeights> {
+        let (weights, total) = self.weights(p);
         (total > 0.0).then_some(ImageWeights { p, weights, total })
     }
 
     /// Samples a lamp image seen from the point `seen` was weighed at: `u_select` chooses the
-    /// image, `u` the point on the lamp. None when the chosen image shows nothing from there.
-    pub fn sample_image(&self, seen: &ImageWeights, u_select: f32, u: Vec2) -> Option<ImageSample> {
+    /// image, `u` the point on the lamp (`lamp` gives the area light of a light index). None
+    /// when the chosen image shows nothing from there.
+    pub fn sample<'a>(
+        &self,
+        seen: &ImageWeights,
+        u_select: f32,
+        u: Vec2,
+        lamp: impl Fn(u32) -> Option<&'a AreaLight>,
+    ) -> Option<ImageSample> {
         let ImageWeights { p, weights, total } = seen;
         let target = u_select * total;
         let mut sum = 0.0;
         let mut chosen = None;
-        for (&w, image) in weights.iter().zip(&self.images.images) {
+        for (&w, image) in weights.iter().zip(&self.images) {
             if w > 0.0 {
                 chosen = Some((w, image));
                 sum += w;
@@ -392,10 +397,8 @@ impl Lights {
             }
         }
         let (weight, image) = chosen?;
-        let plane = &self.images.planes[image.plane as usize];
-        let Light::Area(light) = &self.lights[image.light as usize] else {
-            return None;
-        };
+        let plane = &self.planes[image.plane as usize];
+        let light = lamp(image.light)?;
         let from = plane.reflect_point(*p);
         let s = light.sample(from, u)?;
         // Where the segment from p's image to the lamp point crosses the plane.
@@ -414,43 +417,44 @@ impl Lights {
         })
     }
 
-    /// Solid-angle density with which [`Self::sample_image`] from `p` would have chosen the lamp
-    /// point `hit` through mirror plane `plane` (for MIS when a BSDF-sampled ray reaches a lamp
-    /// after that mirror; not including [`IMAGE_SHARE`]).
-    pub fn image_pdf(&self, p: Vec3, plane: u16, hit: &SurfaceHit) -> f32 {
-        let Some((index, light)) = self.area_light(hit.shape) else {
-            return 0.0;
-        };
-        let (weights, total) = self.images.weights(p);
+    /// Solid-angle density with which [`Self::sample`] from `p` would have chosen the point
+    /// `hit` on lamp `light` (light index `index`) through mirror plane `plane` (for MIS when a
+    /// BSDF-sampled ray reaches a lamp after that mirror; not including [`IMAGE_SHARE`]).
+    pub fn pdf(
+        &self,
+        p: Vec3,
+        plane: u16,
+        (index, light): (u32, &AreaLight),
+        hit: &SurfaceHit,
+    ) -> f32 {
+        let (weights, total) = self.weights(p);
         let Some(weight) = weights
             .iter()
-            .zip(&self.images.images)
+            .zip(&self.images)
             .find(|(&w, i)| w > 0.0 && i.plane == plane && i.light == index)
             .map(|(&w, _)| w)
         else {
             return 0.0;
         };
-        let from = self.images.planes[plane as usize].reflect_point(p);
+        let from = self.planes[plane as usize].reflect_point(p);
         weight / total * light.pdf(from, hit.p, hit.ng)
     }
 
     /// The mirror plane a hit lies in, when it is on a flat mirror that takes part.
     pub fn mirror_plane(&self, hit: &SurfaceHit) -> Option<u16> {
-        let images = &self.images;
-        images.mirror_shapes.binary_search(&hit.shape).ok()?;
-        images
-            .planes
+        self.mirror_shapes.binary_search(&hit.shape).ok()?;
+        self.planes
             .iter()
             .position(|plane| {
                 plane.n.dot(hit.ng).abs() >= PARALLEL
-                    && (plane.n.dot(hit.p) - plane.d).abs() <= images.tolerance
+                    && (plane.n.dot(hit.p) - plane.d).abs() <= self.tolerance
             })
             .map(|i| i as u16)
     }
 
     /// The plane reflection of direction `v` in mirror plane `plane`.
-    pub fn reflect_in_plane(&self, plane: u16, v: Vec3) -> Vec3 {
-        self.images.planes[plane as usize].reflect_dir(v)
+    pub fn reflect(&self, plane: u16, v: Vec3) -> Vec3 {
+        self.planes[plane as usize].reflect_dir(v)
     }
 }
 

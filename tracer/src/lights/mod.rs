@@ -66,6 +66,7 @@ use area::AreaLight;
 use distribution::Distribution1D;
 use emission::Emission;
 use infinite::Environment;
+use mirrored::MirrorImages;
 use spot::SpotCone;
 use sun::SunDisc;
 
@@ -221,7 +222,7 @@ pub struct Lights {
     /// Indices into `lights` of the infinite lights.
     infinite: Vec<u32>,
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
-    images: mirrored::MirrorImages,
+    images: MirrorImages,
 }
 
 impl Lights {
@@ -397,6 +398,60 @@ impl Lights {
                 (radiance, self.selection.pmf(index) * pdf)
             })
             .fold((Vec3::ZERO, 0.0), |(r, p), (ri, pi)| (r + ri, p + pi))
+    }
+
+    /// Adds the lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is
+    /// a plain `mirror`; [`mirrored`] says which take part).
+    pub fn with_mirror_images(mut self, mirror_shapes: &[u32], geometry: &SceneGeometry) -> Self {
+        let lamps: Vec<(u32, &AreaLight, f32)> = (self.lights.iter().enumerate())
+            .filter_map(|(i, l)| match l {
+                Light::Area(area) => Some((i as u32, area, self.selection.pmf(i))),
+                _ => None,
+            })
+            .collect();
+        self.images = MirrorImages::new(mirror_shapes, geometry, &lamps);
+        self
+    }
+
+    /// Whether the scene has lamp images (most have none).
+    #[inline]
+    pub fn has_mirror_images(&self) -> bool {
+        !self.images.is_empty()
+    }
+
+    /// The lamp images a shading point `p` sees, weighted; None where it sees none (its light
+    /// samples then all go to the lights, else [`IMAGE_SHARE`] of them to these).
+    pub fn image_weights(&self, p: Vec3) -> Option<ImageWeights> {
+        self.images.seen_from(p)
+    }
+
+    /// Samples a lamp image seen from the point `seen` was weighed at: `u_select` chooses the
+    /// image, `u` the point on the lamp. None when the chosen image shows nothing from there.
+    pub fn sample_image(&self, seen: &ImageWeights, u_select: f32, u: Vec2) -> Option<ImageSample> {
+        self.images.sample(seen, u_select, u, |index| {
+            match self.lights.get(index as usize) {
+                Some(Light::Area(light)) => Some(light),
+                _ => None,
+            }
+        })
+    }
+
+    /// Solid-angle density with which [`Self::sample_image`] from `p` would have chosen the
+    /// emitter point `hit` through mirror plane `plane` (for MIS when a BSDF-sampled ray reaches
+    /// a lamp after that mirror; not including [`IMAGE_SHARE`]).
+    pub fn image_pdf(&self, p: Vec3, plane: u16, hit: &SurfaceHit) -> f32 {
+        self.area_light(hit.shape)
+            .map_or(0.0, |lamp| self.images.pdf(p, plane, lamp, hit))
+    }
+
+    /// The mirror plane a hit lies in, when it is on a flat mirror that takes part.
+    pub fn mirror_plane(&self, hit: &SurfaceHit) -> Option<u16> {
+        self.images.mirror_plane(hit)
+    }
+
+    /// The plane reflection of direction `v` in mirror plane `plane`.
+    pub fn reflect_in_plane(&self, plane: u16, v: Vec3) -> Vec3 {
+        self.images.reflect(plane, v)
     }
 
     fn infinite_lights(&self) -> impl Iterator<Item = (usize, &AtInfinity)> {
