@@ -37,14 +37,13 @@ RUSTFLAGS="-Cprofile-generate=$profile" \
     cargo build --release --locked -p yat --target "$host" --target-dir target/pgo/instrumented
 
 # Training renders: matte and mirror under an area light (a mirror block's lamp images too),
-# thin-lens depth of field, 8-bit and
-# HDR environment maps, the glossy, metal and glass materials, procedural textures, analytic
-# shapes, a bump map; small, so the whole profile takes seconds.
+# thin-lens depth of field, 8-bit and HDR environment maps, the glossy, metal and glass
+# materials, procedural textures, analytic shapes, a bump map; small, so the whole profile
+# takes seconds.
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for scene in cornell/cornell-box.lxs cornell/cornell-mirror.lxs cornell/cornell-fisheye-60.lxs \
-    dof/dof-0.1.lxs \
-    envmap/envmap-png.lxs envmap/envmap-hdr.lxs materials/materials.lxs \
+    dof/dof-0.1.lxs envmap/envmap-png.lxs envmap/envmap-hdr.lxs materials/materials.lxs \
     materials2/materials2.lxs textures/procedural.lxs shapes/shapes.lxs bump/bump.lxs; do
     "target/pgo/instrumented/$host/release/yat" render "scenes/$scene" --quiet \
         --resolution 320x180 --spp 16 --threads 2 -o "$out/image.png" \
