@@ -7,8 +7,9 @@ use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
-/// A closed box lit by an area light, with a glossy sphere, its materials in an Include'd file
-/// and a poster textured with a PNG image map. Returns the main file.
+/// A closed box lit by an area light, with a glossy sphere, a flat mirror (whose lamp image the
+/// path tracer samples), its materials in an Include'd file and a poster textured with a PNG
+/// image map. Returns the main file.
 pub fn write_scene(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join("textures")).unwrap();
     let checks = image::RgbImage::from_fn(8, 8, |x, y| {
@@ -30,13 +31,14 @@ MakeNamedMaterial "poster" "string type" "matte" "texture Kd" "checks"
 MakeNamedMaterial "shiny" "string type" "glossy" "color Kd" [0.2 0.3 0.6]
   "float uroughness" [0.05] "float vroughness" [0.05]
 MakeNamedMaterial "lamp" "string type" "null"
+MakeNamedMaterial "mirror" "string type" "mirror" "color Kr" [0.8 0.8 0.8]
 "#,
     )
     .unwrap();
     let scene = dir.join("box.lxs");
     std::fs::write(
         &scene,
-        r#"# A closed box with an area light, a glossy sphere and a textured poster.
+        r#"# A closed box with an area light, a glossy sphere, a mirror and a textured poster.
 Film "fleximage" "integer xresolution" [128] "integer yresolution" [96]
   "string filename" ["box"]
 PixelFilter "blackmanharris" "float xwidth" 2 "float ywidth" 2
@@ -65,6 +67,11 @@ AttributeBegin
   Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     "point P" [-0.5 0.99 0.6  0.5 0.99 0.6  0.5 0.99 1.4  -0.5 0.99 1.4]
     "float uv" [0 0  1 0  1 1  0 1]
+AttributeEnd
+AttributeBegin
+  NamedMaterial "mirror"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point P" [-0.99 -0.2 0.2  -0.99 0.6 0.2  -0.99 0.6 1.2  -0.99 -0.2 1.2]
 AttributeEnd
 AttributeBegin
   Translate 0.35 0.2 0.35
