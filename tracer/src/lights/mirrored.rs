@@ -200,7 +200,7 @@ pub struct MirrorImages {
 }
 
 /// How likely each lamp image is to be chosen from one shading point: what
-/// [`MirrorImages::sample`] draws from.
+/// [`super::Lights::sample_image`] draws from.
 pub struct ImageWeights {
     p: Vec3,
     weights: [f32; MAX_IMAGES],
@@ -223,7 +223,7 @@ pub struct ImageSample {
     /// Solid-angle density at the shading point, including the image's choice (not
     /// [`IMAGE_SHARE`]).
     pub pdf: f32,
-    /// The mirror plane (what [`MirrorImages::mirror_plane`] says of the mirror point).
+    /// The mirror plane (what [`super::Lights::mirror_plane`] says of the mirror point).
     pub plane: u16,
 }
 

@@ -401,7 +401,7 @@ impl Lights {
     }
 
     /// Adds the lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is
-    /// a plain `mirror`; [`mirrored`] says which take part).
+    /// a plain `mirror`; the `mirrored` module says which take part).
     pub fn with_mirror_images(mut self, mirror_shapes: &[u32], geometry: &SceneGeometry) -> Self {
         let lamps: Vec<(u32, &AreaLight, f32)> = (self.lights.iter().enumerate())
             .filter_map(|(i, l)| match l {
