@@ -86,12 +86,12 @@ impl PrevScatter {
     }
 }
 
-/// The non-specular vertex before a flat mirror, and the mirror's plane.
+/// The non-specular vertex before a flat mirror (one that sampled lamp images, with
+/// [`IMAGE_SHARE`] of its light samples), and the mirror's plane.
 #[derive(Clone, Copy)]
 struct BeforeMirror {
     p: Vec3,
     pdf: f32,
-    image_share: f32,
     plane: u16,
 }
 
@@ -107,6 +107,11 @@ struct LightDraw {
 impl LightDraw {
     fn new(share: f32, u_select: f32, u: Vec2) -> Self {
         Self { share, u_select, u }
+    }
+
+    /// A vertex's light sample, all of it for the lights.
+    fn lights_only(u: &VertexSamples) -> Self {
+        Self::new(1.0, u.light_select, u.light)
     }
 }
 
@@ -133,6 +138,8 @@ fn survives(integrator: &IntegratorDesc, depth: u32, u_rr: f32, throughput: &mut
     true
 }
 
+// Inlined into the unit loop: without it this loop stays a call away and the scenes without
+// mirrors run 0.5% more instructions (callgrind, depth of field 160x90 32 spp).
 #[inline(always)]
 pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSampler) -> PathResult {
     let integrator = scene.integrator();
@@ -222,7 +229,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                 let pdf_light = (1.0 - prev.image_share) * lights.pdf_hit(prev.p, &hit);
                 power_heuristic(prev.pdf, pdf_light)
             } else if let Some(b) = prev.before_mirror {
-                power_heuristic(b.pdf, b.image_share * lights.image_pdf(b.p, b.plane, &hit))
+                power_heuristic(b.pdf, IMAGE_SHARE * lights.image_pdf(b.p, b.plane, &hit))
             } else {
                 1.0
             };
@@ -258,7 +265,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             let (draw, image) = if lights.has_mirror_images() && depth < max_depth {
                 split_light_sample(lights, hit.p, &u)
             } else {
-                (LightDraw::new(1.0, u.light_select, u.light), None)
+                (LightDraw::lights_only(&u), None)
             };
             let light = match image {
                 Some(images) => {
@@ -296,7 +303,6 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                     .map(|plane| BeforeMirror {
                         p: prev.p,
                         pdf: prev.pdf,
-                        image_share: prev.image_share,
                         plane,
                     })
             } else {
@@ -438,7 +444,7 @@ fn split_light_sample(
     u: &VertexSamples,
 ) -> (LightDraw, Option<ImageWeights>) {
     let Some(images) = lights.image_weights(p) else {
-        return (LightDraw::new(1.0, u.light_select, u.light), None);
+        return (LightDraw::lights_only(u), None);
     };
     let share = IMAGE_SHARE;
     if u.light_select < share {

@@ -257,9 +257,7 @@ impl MirrorImages {
         }
         (weights, total)
     }
-}
 
-impl MirrorImages {
     /// The lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is a
     /// plain `mirror`; see the module doc for which take part) of the area lights `lamps`: each
     /// its index among the scene's lights, the light, and its selection probability.
