@@ -7,8 +7,8 @@ use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
-/// A closed box lit by an area light, with a glossy sphere, a flat mirror (whose lamp image the
-/// path tracer samples), its materials in an Include'd file and a poster textured with a PNG
+/// A closed box lit by an area light, with a glossy sphere, a rough metal ball (whose highlight
+/// paths split at), a flat mirror (whose lamp image the path tracer samples), its materials in an Include'd file and a poster textured with a PNG
 /// image map. Returns the main file.
 pub fn write_scene(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join("textures")).unwrap();
@@ -32,13 +32,15 @@ MakeNamedMaterial "shiny" "string type" "glossy" "color Kd" [0.2 0.3 0.6]
   "float uroughness" [0.05] "float vroughness" [0.05]
 MakeNamedMaterial "lamp" "string type" "null"
 MakeNamedMaterial "mirror" "string type" "mirror" "color Kr" [0.8 0.8 0.8]
+MakeNamedMaterial "steel" "string type" "metal2" "color fresnel" [0.6 0.6 0.6]
+  "float uroughness" [0.05] "float vroughness" [0.05]
 "#,
     )
     .unwrap();
     let scene = dir.join("box.lxs");
     std::fs::write(
         &scene,
-        r#"# A closed box with an area light, a glossy sphere, a mirror and a textured poster.
+        r#"# A closed box with an area light, a glossy sphere, a metal ball, a mirror and a textured poster.
 Film "fleximage" "integer xresolution" [128] "integer yresolution" [96]
   "string filename" ["box"]
 PixelFilter "blackmanharris" "float xwidth" 2 "float ywidth" 2
@@ -77,6 +79,11 @@ AttributeBegin
   Translate 0.35 0.2 0.35
   NamedMaterial "shiny"
   Shape "sphere" "float radius" 0.35
+AttributeEnd
+AttributeBegin
+  Translate -0.45 0.35 0.22
+  NamedMaterial "steel"
+  Shape "sphere" "float radius" 0.22
 AttributeEnd
 AttributeBegin
   NamedMaterial "lamp"

@@ -19,6 +19,14 @@ impl Ray {
     }
 }
 
+/// A cone of directions: its axis (unit) and its half angle (radians; pi or more is every
+/// direction).
+#[derive(Clone, Copy, Debug)]
+pub struct Cone {
+    pub axis: Vec3,
+    pub half: f32,
+}
+
 /// An orthonormal basis with `n` as its z axis; converts between world and local shading space.
 #[derive(Clone, Copy, Debug)]
 pub struct Frame {

@@ -140,6 +140,39 @@ impl PixelSampler {
         )
     }
 
+    /// The next 1D dimension drawn `N` times for a vertex that splits into `N` samples: sample
+    /// `index`'s Sobol point `s` becomes points `N s .. N s + N`. The `N` values are stratified
+    /// among themselves and all of a pixel's `N spp` values together (what `N spp` samples of
+    /// the dimension would be), where `N` separate dimensions would each be stratified alone.
+    pub fn get_split_1d<const N: usize>(&mut self) -> [f32; N] {
+        let hash = self.next_dimension_hash();
+        let first = self.split_index::<N>(hash);
+        let scramble = (hash >> 32) as u32;
+        std::array::from_fn(|i| {
+            to_unit_float(owen_scramble(van_der_corput(first + i as u32), scramble))
+        })
+    }
+
+    /// [`Self::get_split_1d`] for a 2D dimension.
+    pub fn get_split_2d<const N: usize>(&mut self) -> [Vec2; N] {
+        let hash = self.next_dimension_hash();
+        let first = self.split_index::<N>(hash);
+        let (scramble_x, scramble_y) = ((hash >> 32) as u32, mix64(hash) as u32);
+        std::array::from_fn(|i| {
+            let index = first + i as u32;
+            Vec2::new(
+                to_unit_float(owen_scramble(van_der_corput(index), scramble_x)),
+                to_unit_float(owen_scramble(sobol_dimension_1(index), scramble_y)),
+            )
+        })
+    }
+
+    /// The first of the `N` Sobol indices a split draw takes in the dimension whose hash is
+    /// `hash`. Indices wrap at 2^32 (a pixel of 2^30 samples split four ways), still valid points.
+    fn split_index<const N: usize>(&self, hash: u64) -> u32 {
+        self.sobol_index(hash as u32).wrapping_mul(N as u32)
+    }
+
     /// The next six dimensions a scattering vertex uses, drawn together: the same values as
     /// `get_1d`, `get_1d`, `get_2d`, `get_1d`, `get_2d` and `get_1d` in turn. The eight values'
     /// index permutations and scrambles are computed as the lanes of one pass (AVX2 where the
@@ -571,6 +604,29 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A split draw's values: each sample's eight are stratified among themselves, and all of
+    /// a pixel's 16 x 8 together, as 128 samples of a 2D pair (or a 1D dimension) would be.
+    #[test]
+    fn split_draws_are_stratified_alone_and_together() {
+        const N: usize = 8;
+        let spp = 16;
+        let (mut all_2d, mut all_1d) = ([0u32; 128], [0u32; 128]);
+        for i in 0..spp {
+            let mut s = PixelSampler::new(5, 9, i, spp, 3);
+            s.get_2d();
+            let (values, points) = (s.get_split_1d::<N>(), s.get_split_2d::<N>());
+            let (mut own_2d, mut own_1d) = ([0u32; N], [0u32; N]);
+            for (v, u) in values.into_iter().zip(points) {
+                own_1d[(v * 8.0) as usize] += 1;
+                own_2d[(u.y * 2.0) as usize * 4 + (u.x * 4.0) as usize] += 1;
+                all_1d[(v * 128.0) as usize] += 1;
+                all_2d[(u.y * 8.0) as usize * 16 + (u.x * 16.0) as usize] += 1;
+            }
+            assert!(own_1d.iter().chain(&own_2d).all(|&c| c == 1), "sample {i}");
+        }
+        assert!(all_1d.iter().chain(&all_2d).all(|&c| c == 1));
     }
 
     /// Integrating a smooth function with 256 stratified samples beats independent random

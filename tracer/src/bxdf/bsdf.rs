@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use super::coating::Coating;
 use super::sample::LocalSample;
 use super::Bxdf;
-use crate::math::Frame;
+use crate::math::{Cone, Frame};
 
 /// A sampled scattering direction.
 #[derive(Clone, Copy, Debug)]
@@ -58,6 +58,18 @@ impl Bsdf {
             Some(c) => c.is_specular(&self.bxdf),
             None => self.bxdf.is_specular(),
         }
+    }
+
+    /// The cone around the mirror direction of `wo` (in the shading frame) that holds most of
+    /// a bare glossy lobe ([`Bxdf::glossy_spread`]; a coat over it is not counted).
+    pub fn glossy_cone(&self, wo: Vec3) -> Option<Cone> {
+        let half = self
+            .coating
+            .is_none()
+            .then(|| self.bxdf.glossy_spread())??;
+        let n = self.frame.n;
+        let axis = (2.0 * wo.dot(n) * n - wo).normalize();
+        Some(Cone { axis, half })
     }
 
     /// Whether the geometric and shading normals agree on which side `wi` is on relative

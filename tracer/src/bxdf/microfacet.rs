@@ -10,6 +10,10 @@ use super::local::sample_disk_polar;
 /// Smallest alpha used: below it the distribution's peak overflows f32 arithmetic.
 pub const MIN_ALPHA: f32 = 1e-3;
 
+/// Slope, in alphas, within which [`TrowbridgeReitz::reflection_spread`] counts a microfacet
+/// normal: a share t^2 / (1 + t^2) of them lies within slope t alphas, 95% for sqrt(19).
+pub const LOBE_TAN_SPREAD: f32 = 4.358_899;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrowbridgeReitz {
     alpha_x: f32,
@@ -29,6 +33,18 @@ impl TrowbridgeReitz {
             alpha_x: alpha(u),
             alpha_y: alpha(v),
         })
+    }
+
+    /// The larger of the two alphas: how wide the lobe is at its widest.
+    pub fn max_alpha(&self) -> f32 {
+        self.alpha_x.max(self.alpha_y)
+    }
+
+    /// The half angle around the mirror direction that holds most of a reflection's lobe: where
+    /// microfacet normals are within [`LOBE_TAN_SPREAD`] alphas' slope of the normal (95% of
+    /// them at normal incidence), reflections within twice their angle.
+    pub fn reflection_spread(&self) -> f32 {
+        2.0 * (LOBE_TAN_SPREAD * self.max_alpha()).atan()
     }
 
     /// Microfacet normal density D(wm), normalised so that the projected area is 1.
@@ -160,6 +176,26 @@ mod tests {
             .sum::<f64>()
             / f64::from(n);
         assert!((sampled - weighted).abs() < 0.01, "{sampled} vs {weighted}");
+    }
+
+    /// At normal incidence 95% of the sampled reflections lie within the spread of the mirror
+    /// direction (a share t^2 / (1 + t^2) of visible normals within slope t alphas there).
+    #[test]
+    fn the_reflection_spread_holds_most_of_the_lobe() {
+        for alpha in [0.02f32, 0.075, 0.2] {
+            let d = TrowbridgeReitz::from_roughness(alpha, alpha).unwrap();
+            let cos_spread = d.reflection_spread().cos();
+            let n = 1 << 14;
+            let inside = (0..n)
+                .filter(|&i| {
+                    let wm = d.sample_wm(Vec3::Z, PixelSampler::new(4, 4, i, n, 9).get_2d());
+                    let wi = 2.0 * wm.z * wm - Vec3::Z;
+                    wi.z >= cos_spread
+                })
+                .count();
+            let share = inside as f32 / n as f32;
+            assert!((share - 0.95).abs() < 0.005, "alpha {alpha}: {share}");
+        }
     }
 
     #[test]

@@ -35,6 +35,11 @@ use local::flip_z;
 use scatter::Scatter;
 use velvet::Velvet;
 
+/// The widest microfacet alpha [`Bxdf::glossy_spread`] counts as glossy. A wider lobe sees a
+/// lamp as light sampling does, and more BSDF samples add little: our materials scene's copper
+/// (alpha 0.2) split lowered its error 0.5% for 6.7% more work; its gold (0.05) 10% for 4.7%.
+pub const GLOSSY_ALPHA: f32 = 0.1;
+
 #[derive(Clone, Copy, Debug)]
 pub enum Bxdf {
     /// `null`: not a surface at all.
@@ -59,6 +64,18 @@ impl Bxdf {
             | Bxdf::Velvet(_)
             | Bxdf::Scatter(_)
             | Bxdf::Cloth(_) => false,
+        }
+    }
+
+    /// For a rough metal whose lobe is narrow (alpha below [`GLOSSY_ALPHA`]), the half angle
+    /// around the mirror direction that holds most of its lobe: a lamp it reflects is a
+    /// bright, sharp-edged patch of the lobe, which one BSDF sample finds or misses.
+    pub fn glossy_spread(&self) -> Option<f32> {
+        match self {
+            Bxdf::Conductor(Conductor {
+                distrib: Some(d), ..
+            }) if d.max_alpha() < GLOSSY_ALPHA => Some(d.reflection_spread()),
+            _ => None,
         }
     }
 

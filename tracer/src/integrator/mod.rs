@@ -6,4 +6,4 @@ pub mod options;
 pub mod path;
 
 pub use options::{IntegratorDesc, RussianRoulette};
-pub use path::{trace_path, PathResult, PathScene};
+pub use path::{trace_path, PathResult, PathScene, GLOSSY_SPLIT};

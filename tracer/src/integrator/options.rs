@@ -8,6 +8,7 @@
 //! | `rrcontinueprob` | float | 0.65 |
 //! | `includeenvironment` | bool | true |
 //! | `mirrorimages` (YAT's own) | bool | true: lamps are also sampled through flat mirrors ([`crate::lights::ImageSample`]) |
+//! | `glossysplit` (YAT's own) | bool | true: a path's first glossy vertex that may see a lamp takes several BSDF samples for its direct light ([`crate::integrator::GLOSSY_SPLIT`]) |
 //!
 //! Without a `SurfaceIntegrator` statement the scene renders with `"path"` and these defaults.
 
@@ -25,6 +26,9 @@ pub const DEFAULT_INCLUDE_ENVIRONMENT: bool = true;
 /// Whether lamps are sampled through flat mirrors too (the same image, less noise where a
 /// mirror throws light; false renders plain path tracing's estimate, for comparisons).
 pub const DEFAULT_MIRROR_IMAGES: bool = true;
+/// Whether a glossy first vertex takes several BSDF samples for the light it sees directly
+/// (the same image, less noise in highlights; false renders one, for comparisons).
+pub const DEFAULT_GLOSSY_SPLIT: bool = true;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RussianRoulette {
@@ -41,6 +45,8 @@ pub struct IntegratorDesc {
     pub include_environment: bool,
     /// Lamps are sampled through flat mirrors as well as directly.
     pub mirror_images: bool,
+    /// A glossy first vertex splits (see [`crate::integrator::GLOSSY_SPLIT`]).
+    pub glossy_split: bool,
     /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
     pub requested: String,
 }
@@ -54,6 +60,7 @@ impl IntegratorDesc {
             rr_continue_prob: DEFAULT_RR_CONTINUE_PROB,
             include_environment: DEFAULT_INCLUDE_ENVIRONMENT,
             mirror_images: DEFAULT_MIRROR_IMAGES,
+            glossy_split: DEFAULT_GLOSSY_SPLIT,
             requested: requested.to_string(),
         }
     }
@@ -93,6 +100,7 @@ impl IntegratorDesc {
                     include_environment: params
                         .bool("includeenvironment", DEFAULT_INCLUDE_ENVIRONMENT)?,
                     mirror_images: params.bool("mirrorimages", DEFAULT_MIRROR_IMAGES)?,
+                    glossy_split: params.bool("glossysplit", DEFAULT_GLOSSY_SPLIT)?,
                     requested: ty.to_string(),
                 })
             }

@@ -36,11 +36,23 @@ pub trait PathScene {
     fn shape_media(&self, shape: u32) -> ShapeMedia;
     /// Whether shape `shape` is `null` (shadow rays in scenes with volumes cross it).
     fn is_pass_through(&self, shape: u32) -> bool;
+    /// Whether paths split at glossy vertices ([`GLOSSY_SPLIT`]): the integrator allows it, the
+    /// scene has lamps and metals, and no volumes or mix that can turn into `null` (a split
+    /// sample crosses a surface only where [`Self::is_pass_through`] says so).
+    fn glossy_split(&self) -> bool;
 }
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
 /// null faces).
 const MAX_PASS_THROUGH: u32 = 64;
+
+/// BSDF samples a path's first glossy vertex that may see a lamp takes for the light it sees
+/// directly (one of them goes on as the path). A lamp in a narrow lobe is a bright patch that
+/// one sample finds or misses: Mario's metal figure held some 60% of its image's error at 16
+/// spp in those highlights, and the floor's speckles are the same highlights seen from the
+/// floor. Measured on Mario (480x270, 16 spp, instructions by callgrind): 4 samples cut the
+/// error to 0.55 for 1.08 times the work, 8 to 0.46 for 1.17, 16 to 0.44 for 1.35.
+pub const GLOSSY_SPLIT: usize = 8;
 
 /// Bounces before Russian roulette may end a path.
 const RR_MIN_DEPTH: u32 = 3;
@@ -71,6 +83,9 @@ struct PrevScatter {
     /// Set when the ray just reflected in a flat mirror straight after a non-specular vertex:
     /// a lamp it reaches is one a lamp-image sample at that vertex could have found.
     before_mirror: Option<BeforeMirror>,
+    /// The BSDF samples `p` took for the light it sees directly ([`GLOSSY_SPLIT`] at a split
+    /// vertex, else 1): what this ray finds emitting is one of them, weighed by their count.
+    split: f32,
 }
 
 impl PrevScatter {
@@ -82,6 +97,7 @@ impl PrevScatter {
             specular,
             image_share: 0.0,
             before_mirror: None,
+            split: 1.0,
         }
     }
 }
@@ -95,18 +111,25 @@ struct BeforeMirror {
     plane: u16,
 }
 
-/// A light sample's random numbers, and the share of a vertex's light samples its kind (lights,
-/// or lamp images) gets.
+/// A light sample's random numbers, the share of a vertex's light samples its kind (lights,
+/// or lamp images) gets, and the BSDF samples its MIS weight counts against it.
 #[derive(Clone, Copy)]
 struct LightDraw {
     share: f32,
     u_select: f32,
     u: Vec2,
+    /// 1, or [`GLOSSY_SPLIT`] at a split vertex.
+    bsdf_count: f32,
 }
 
 impl LightDraw {
     fn new(share: f32, u_select: f32, u: Vec2) -> Self {
-        Self { share, u_select, u }
+        Self {
+            share,
+            u_select,
+            u,
+            bsdf_count: 1.0,
+        }
     }
 
     /// A vertex's light sample, all of it for the lights.
@@ -153,6 +176,8 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
     let mut rays = 0u32;
     let mut depth = 0u32;
     let mut pass_through = 0u32;
+    // A path splits once, at its first glossy vertex that may see a lamp.
+    let mut may_split = scene.glossy_split();
     // The camera ray counts as specular: emitters it sees are taken at full weight.
     let mut prev = PrevScatter::plain(ray.origin, 0.0, true);
 
@@ -212,12 +237,10 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                     (lights.environment(ray.dir), 1.0)
                 } else {
                     let (le, pdf) = lights.environment_and_pdf(ray.dir);
-                    (
-                        le,
-                        power_heuristic(prev.pdf, (1.0 - prev.image_share) * pdf),
-                    )
+                    let pdf_light = (1.0 - prev.image_share) * pdf;
+                    (le, power_heuristic(prev.split * prev.pdf, pdf_light))
                 };
-                radiance += throughput * le * weight;
+                radiance += throughput * le * (weight / prev.split);
             }
             break;
         };
@@ -227,13 +250,13 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         if le != Vec3::ZERO {
             let weight = if !prev.specular {
                 let pdf_light = (1.0 - prev.image_share) * lights.pdf_hit(prev.p, &hit);
-                power_heuristic(prev.pdf, pdf_light)
+                power_heuristic(prev.split * prev.pdf, pdf_light)
             } else if let Some(b) = prev.before_mirror {
                 power_heuristic(b.pdf, IMAGE_SHARE * lights.image_pdf(b.p, b.plane, &hit))
             } else {
                 1.0
             };
-            radiance += throughput * le * weight;
+            radiance += throughput * le * (weight / prev.split);
         }
 
         // Every dimension a scattering vertex uses, drawn at once. A specular vertex draws the
@@ -259,6 +282,13 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         }
         depth += 1;
 
+        // The first glossy vertex that may see a lamp splits (see [`GLOSSY_SPLIT`]); elsewhere
+        // more samples would find the dimmer surroundings and cost what they save. Whether it
+        // splits depends on the path so far only, not on this vertex's own samples, so either
+        // way its estimate is unbiased.
+        let split = may_split
+            && (bsdf.glossy_cone(wo)).is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone));
+        let bsdf_count = if split { GLOSSY_SPLIT as f32 } else { 1.0 };
         let mut image_share = 0.0;
         if !bsdf.is_specular() {
             // A path through a mirror needs one more vertex: none past the last.
@@ -275,13 +305,23 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                 None => {
                     // What the lights leave (nothing where no image is seen).
                     image_share = 1.0 - draw.share;
+                    let draw = LightDraw { bsdf_count, ..draw };
                     direct_light(scene, &hit, wo, &bsdf, sides, draw, &mut rays)
                 }
             };
             radiance += throughput * light;
         }
+        let (u_lobe, u_bsdf) = if split {
+            may_split = false;
+            let seen = split_bsdf_light(scene, &hit, wo, &bsdf, image_share, sampler);
+            radiance += throughput * seen.radiance;
+            rays += seen.rays;
+            seen.first
+        } else {
+            (u.lobe, u.bsdf)
+        };
 
-        let Some(bs) = bsdf.sample(wo, u.lobe, u.bsdf) else {
+        let Some(bs) = bsdf.sample(wo, u_lobe, u_bsdf) else {
             break;
         };
         if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
@@ -314,6 +354,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             specular: bs.specular,
             image_share,
             before_mirror,
+            split: bsdf_count,
         };
         medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
@@ -428,9 +469,78 @@ fn direct_light<S: PathScene>(
     let weight = if ls.delta {
         1.0
     } else {
-        power_heuristic(ls.pdf, bsdf.pdf(wo, ls.wi))
+        power_heuristic(ls.pdf, draw.bsdf_count * bsdf.pdf(wo, ls.wi))
     };
     tr * f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
+}
+
+/// What a split vertex's BSDF samples but the first see of the lights.
+struct SplitLight {
+    radiance: Vec3,
+    rays: u32,
+    /// The first sample's lobe choice and direction numbers: the path goes on with it (and
+    /// finds its light at the next vertex).
+    first: (f32, Vec2),
+}
+
+/// The light a split vertex ([`GLOSSY_SPLIT`]) sees directly along its BSDF samples but the
+/// first: each weighed against the light sample by the power heuristic with the samples'
+/// count, and divided by it. The samples come from draws of their own, stratified together
+/// (the vertex's own `lobe` and `bsdf` numbers go unused). Null surfaces are crossed as the
+/// path crosses them (a scene splits only when no mix can turn into one, see
+/// [`PathScene::glossy_split`]). Out of line: most vertices do not split.
+#[inline(never)]
+fn split_bsdf_light<S: PathScene>(
+    scene: &S,
+    hit: &SurfaceHit,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    image_share: f32,
+    sampler: &mut PixelSampler,
+) -> SplitLight {
+    let lobes = sampler.get_split_1d::<GLOSSY_SPLIT>();
+    let dirs = sampler.get_split_2d::<GLOSSY_SPLIT>();
+    let lights = scene.lights();
+    let count = GLOSSY_SPLIT as f32;
+    let mut seen = SplitLight {
+        radiance: Vec3::ZERO,
+        rays: 0,
+        first: (lobes[0], dirs[0]),
+    };
+    for (&u_lobe, &u) in lobes.iter().zip(&dirs).skip(1) {
+        let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
+            continue;
+        };
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
+            continue;
+        }
+        let weight_of = |pdf_light: f32| {
+            if bs.specular {
+                1.0
+            } else {
+                power_heuristic(count * bs.pdf, (1.0 - image_share) * pdf_light)
+            }
+        };
+        let scale = bs.f * (bs.wi.dot(hit.ns).abs() / (bs.pdf * count));
+        let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+        for _ in 0..=MAX_PASS_THROUGH {
+            seen.rays += 1;
+            let Some(next) = scene.geometry().intersect(&ray, f32::INFINITY) else {
+                let (le, pdf) = lights.environment_and_pdf(bs.wi);
+                seen.radiance += scale * le * weight_of(pdf);
+                break;
+            };
+            let le = lights.emitted(&next, -bs.wi);
+            if le != Vec3::ZERO {
+                seen.radiance += scale * le * weight_of(lights.pdf_hit(hit.p, &next));
+            }
+            if !scene.is_pass_through(next.shape) {
+                break;
+            }
+            ray = Ray::new(offset_origin(next.p, next.ng, bs.wi), bs.wi);
+        }
+    }
+    seen
 }
 
 /// A vertex's light sample in a scene with lamp images: where the vertex sees one, the first

@@ -27,6 +27,7 @@ mod distribution;
 mod emission;
 mod error;
 mod infinite;
+mod lamp_cones;
 mod mirrored;
 mod point;
 mod sample;
@@ -45,6 +46,7 @@ use glam::{Vec2, Vec3};
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::math::Cone;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -66,6 +68,7 @@ use area::AreaLight;
 use distribution::Distribution1D;
 use emission::Emission;
 use infinite::Environment;
+use lamp_cones::LampCones;
 use mirrored::MirrorImages;
 use spot::SpotCone;
 use sun::SunDisc;
@@ -223,6 +226,8 @@ pub struct Lights {
     infinite: Vec<u32>,
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
     images: MirrorImages,
+    /// The area lights' bounding spheres, for [`Self::lamp_may_be_in`].
+    lamp_cones: LampCones,
 }
 
 impl Lights {
@@ -304,7 +309,14 @@ impl Lights {
         let infinite = (0..lights.len() as u32)
             .filter(|&i| matches!(lights[i as usize], Light::Infinite(_)))
             .collect();
+        let lamp_boxes: Vec<(Vec3, Vec3)> = (lights.iter())
+            .filter_map(|l| match l {
+                Light::Area(area) => Some(area.bounds()),
+                _ => None,
+            })
+            .collect();
         Ok(Self {
+            lamp_cones: LampCones::new(&lamp_boxes),
             lights,
             selection: Distribution1D::new(powers),
             shape_light,
@@ -411,6 +423,11 @@ impl Lights {
             .collect();
         self.images = MirrorImages::new(mirror_shapes, geometry, &lamps);
         self
+    }
+
+    /// Whether an area light may lie in `cone` seen from `p` (true may be wrong, false is not).
+    pub fn lamp_may_be_in(&self, p: Vec3, cone: &Cone) -> bool {
+        self.lamp_cones.may_reach(p, cone)
     }
 
     /// Whether the scene has lamp images (most have none).

@@ -53,6 +53,8 @@ pub struct RenderScene {
     lights: Lights,
     /// Per shape, for the object-space positions 3D texture mappings use.
     world_to_object: Vec<glam::Affine3A>,
+    /// See [`PathScene::glossy_split`].
+    glossy_split: bool,
 }
 
 impl RenderScene {
@@ -109,6 +111,7 @@ impl RenderScene {
                 .iter()
                 .map(|s| glam::Affine3A::from_mat4(s.object_to_world).inverse())
                 .collect(),
+            glossy_split: glossy_split(desc),
             desc: desc.clone(),
             settings: settings.clone(),
         })
@@ -319,6 +322,34 @@ fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
         .collect()
 }
 
+/// Whether the path tracer may split glossy vertices ([`PathScene::glossy_split`]): the scene
+/// file allows it, a lamp (an area light) may shine in a metal's narrow lobe, and no volume or
+/// mix that can turn into `null` makes a split sample's way differ from the path's.
+fn glossy_split(desc: &SceneDesc) -> bool {
+    fn may_be_glossy(m: &MaterialDesc) -> bool {
+        match m {
+            MaterialDesc::Metal(_) | MaterialDesc::ShinyMetal(_) => true,
+            MaterialDesc::Bumped(inner, _) => may_be_glossy(inner),
+            _ => false,
+        }
+    }
+    let lamps = desc.shapes.iter().any(|s| s.area_light.is_some());
+    let null_in_mix = desc.materials.iter().any(|m| match m {
+        MaterialDesc::Mix(mix) => [mix.a, mix.b].iter().any(|id| {
+            matches!(
+                desc.materials.get(id.0 as usize),
+                Some(MaterialDesc::Null(_))
+            )
+        }),
+        _ => false,
+    });
+    desc.integrator.glossy_split
+        && lamps
+        && desc.materials.iter().any(may_be_glossy)
+        && desc.volumes.media.is_empty()
+        && !null_in_mix
+}
+
 impl PathScene for RenderScene {
     fn integrator(&self) -> &IntegratorDesc {
         &self.desc.integrator
@@ -349,6 +380,10 @@ impl PathScene for RenderScene {
             .shapes
             .get(shape as usize)
             .map_or_else(ShapeMedia::default, |s| s.media)
+    }
+
+    fn glossy_split(&self) -> bool {
+        self.glossy_split
     }
 
     fn is_pass_through(&self, shape: u32) -> bool {

@@ -5,8 +5,10 @@ mod adaptive;
 mod area_texture;
 mod bump_render;
 mod daylight;
+mod estimates;
 mod fuzz_regressions;
 mod geometry_on_scenes;
+mod glossy_split;
 #[path = "../../../tests/fixtures/hostile.rs"]
 mod hostile;
 mod hostile_scenes;

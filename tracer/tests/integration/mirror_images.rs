@@ -3,11 +3,10 @@
 //! plain path tracer's mean, and the noise a mirror throws onto a floor drops.
 
 use glam::{Vec2, Vec3};
-use yat_tracer::assets::MemorySource;
-use yat_tracer::film::Film;
 use yat_tracer::math::Ray;
-use yat_tracer::parse::parse_scene;
-use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
+use yat_tracer::render::{RenderScene, RenderSettings};
+
+use super::estimates::{self, compare_means, mse};
 
 const SIZE: u32 = 40;
 /// A lamp plain path tracing rarely finds through the mirror: half side 0.2 at height 1.5.
@@ -48,43 +47,12 @@ fn scene(mirror_images: bool, (lamp, z): (f32, f32)) -> String {
 }
 
 fn build(text: &str, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {
-    let mut source = MemorySource::new();
-    source.insert("main.lxs", text.as_bytes().into());
-    let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
-    let settings = RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        spp,
-        max_depth: desc.integrator.max_depth,
-        seed,
-        latlong: Default::default(),
-    };
-    let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
-    (scene, settings)
+    estimates::build(text, SIZE, spp, seed)
 }
 
 fn render(mirror_images: bool, lamp: (f32, f32), spp: u32, seed: u64) -> Vec<Vec3> {
     let (scene, settings) = build(&scene(mirror_images, lamp), spp, seed);
-    let mut film = Film::new(scene.frame());
-    for unit in plan_units(&settings) {
-        let (buffer, stats) = scene.render_unit(&unit);
-        assert_eq!(stats.dropped, 0, "NaN samples");
-        film.add(&buffer).unwrap();
-    }
-    film.radiance()
-}
-
-fn mean(image: &[Vec3]) -> f64 {
-    image.iter().map(|p| f64::from(p.x)).sum::<f64>() / image.len() as f64
-}
-
-fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(a, b)| f64::from((*a - *b).length_squared()) / 3.0)
-        .sum::<f64>()
-        / a.len() as f64
+    estimates::radiance(&scene, &settings)
 }
 
 /// The van der Corput sequence in base `base`: well-spread numbers in [0, 1).
@@ -154,14 +122,7 @@ fn an_image_sample_has_the_density_a_path_through_the_mirror_is_weighed_with() {
 fn sampling_lamps_through_the_mirror_keeps_the_mean() {
     let spp = 256;
     let renders = |images| [1, 2].map(|seed| render(images, LARGE_LAMP, spp, seed));
-    let (plain, images) = (renders(false), renders(true));
-    let mean_of = |r: &[Vec<Vec3>; 2]| (mean(&r[0]) + mean(&r[1])) / 2.0;
-    // A render's mean has about 1 / pixels of its pixels' variance, MSE(a, b) / 2; the mean of
-    // two renders half that.
-    let pixels = (SIZE * SIZE) as f64;
-    let variance = |r: &[Vec<Vec3>; 2]| mse(&r[0], &r[1]) / 2.0 / pixels / 2.0;
-    let (m_plain, m_images) = (mean_of(&plain), mean_of(&images));
-    let standard_error = (variance(&plain) + variance(&images)).sqrt();
+    let (m_plain, m_images, standard_error) = compare_means(&renders(false), &renders(true));
     assert!(
         (m_images - m_plain).abs() < 3.0 * standard_error && standard_error < 2e-3 * m_plain,
         "mean with images {m_images}, plain path tracing {m_plain} (standard error {standard_error})"

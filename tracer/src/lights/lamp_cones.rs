@@ -1,0 +1,101 @@
+//! Which lamps a narrow cone of directions may reach: the bounding spheres of the area lights,
+//! tested against a cone from a shading point. The path tracer asks it where a glossy lobe
+//! could show a lamp's highlight (the vertices worth more BSDF samples, see
+//! [`crate::integrator::GLOSSY_SPLIT`]); an answer of "maybe" costs only samples, so the test
+//! may be loose but never misses a lamp inside the cone.
+
+use glam::Vec3;
+
+use crate::math::Cone;
+
+/// Lamps tested one by one; a scene with more says "maybe" everywhere (a split vertex costs a
+/// few rays, a test per lamp at every glossy vertex would cost more).
+pub const MAX_LAMP_CONES: usize = 64;
+
+/// The lamps' bounding spheres.
+#[derive(Clone, Debug, Default)]
+pub struct LampCones {
+    spheres: Vec<(Vec3, f32)>,
+    /// More lamps than [`MAX_LAMP_CONES`]: every cone may reach one.
+    too_many: bool,
+}
+
+impl LampCones {
+    /// From the lamps' bounding boxes.
+    pub fn new(boxes: &[(Vec3, Vec3)]) -> Self {
+        if boxes.len() > MAX_LAMP_CONES {
+            return Self {
+                spheres: Vec::new(),
+                too_many: true,
+            };
+        }
+        let spheres = boxes
+            .iter()
+            .map(|&(lo, hi)| (0.5 * (lo + hi), 0.5 * (hi - lo).length()))
+            .collect();
+        Self {
+            spheres,
+            too_many: false,
+        }
+    }
+
+    /// Whether a lamp's sphere overlaps `cone` from `p`: the angle between the axis and the
+    /// sphere's centre is below the cone's half angle plus the sphere's angular radius.
+    pub fn may_reach(&self, p: Vec3, cone: &Cone) -> bool {
+        self.too_many
+            || self.spheres.iter().any(|&(centre, radius)| {
+                let to_centre = centre - p;
+                let dist = to_centre.length();
+                if dist <= radius {
+                    return true;
+                }
+                let reach = cone.half + (radius / dist).asin();
+                reach >= std::f32::consts::PI || cone.axis.dot(to_centre) >= reach.cos() * dist
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Directions sampled inside the cone that hit a lamp's sphere: any such hit means
+    /// `may_reach` says yes; cones far from every lamp say no.
+    #[test]
+    fn a_cone_reaching_a_lamp_is_never_missed() {
+        let lamp = (Vec3::new(-0.5, -0.5, 4.0), Vec3::new(0.5, 0.5, 4.0));
+        let cones = LampCones::new(&[lamp]);
+        let p = Vec3::ZERO;
+        let (centre, radius) = (Vec3::new(0.0, 0.0, 4.0), 0.5f32.sqrt());
+        let mut state = 12345u64;
+        let mut next = || {
+            state = crate::sampler::mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut reached, mut missed) = (0, 0);
+        for _ in 0..20_000 {
+            let axis = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+            let half = next() * 0.8;
+            let cone = Cone { axis, half };
+            // A direction inside the cone towards the sphere's nearest point to the axis.
+            let to_centre = (centre - p).normalize();
+            let angle = axis.dot(to_centre).clamp(-1.0, 1.0).acos();
+            let sphere_angle = (radius / 4.0).asin();
+            let touches = angle <= half + sphere_angle - 1e-3;
+            let says = cones.may_reach(p, &cone);
+            if touches {
+                assert!(says, "axis {axis} half {half}");
+                reached += 1;
+            } else if angle > half + sphere_angle + 1e-3 {
+                assert!(!says, "axis {axis} half {half}");
+                missed += 1;
+            }
+        }
+        assert!(reached > 100 && missed > 100, "{reached} {missed}");
+        let wide = Cone {
+            axis: Vec3::NEG_Z,
+            half: 3.2,
+        };
+        assert!(cones.may_reach(p, &wide));
+    }
+}
