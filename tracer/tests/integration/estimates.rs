@@ -1,5 +1,5 @@
 //! What the tests of sampling strategies share: a square render of a scene text, and the
-//! numbers they compare (mean, MSE between renders, and whether two means agree).
+//! numbers they compare (mean, MSE between renders, whether two estimators' means agree).
 
 use glam::Vec3;
 use yat_tracer::assets::MemorySource;
@@ -37,12 +37,12 @@ pub fn radiance(scene: &RenderScene, settings: &RenderSettings) -> Vec<Vec3> {
 }
 
 /// The mean of the red channel.
-pub fn mean(image: &[Vec3]) -> f64 {
+fn mean(image: &[Vec3]) -> f64 {
     image.iter().map(|p| f64::from(p.x)).sum::<f64>() / image.len() as f64
 }
 
 /// Mean squared difference per channel.
-pub fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
+fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(a, b)| f64::from((*a - *b).length_squared()) / 3.0)
@@ -50,12 +50,28 @@ pub fn mse(a: &[Vec3], b: &[Vec3]) -> f64 {
         / a.len() as f64
 }
 
-/// Two estimators' means from two renders each (different seeds): `(mean a, mean b, standard
-/// error of their difference)`. A render's mean has about 1 / pixels of its pixels' variance,
-/// which is MSE between the two renders / 2; the mean of two renders half that.
-pub fn compare_means(a: &[Vec<Vec3>; 2], b: &[Vec<Vec3>; 2]) -> (f64, f64, f64) {
-    let pixels = a[0].len() as f64;
+/// Asserts that an estimator keeps a baseline's mean: `render(new, seed)` renders with the new
+/// estimator or the baseline; two renders of each (seeds 1 and 2) must agree within three
+/// standard errors of the difference of their means, and that error must be below 0.2% of the
+/// mean (so a bias that large shows). A render's mean has about 1 / pixels of its pixels'
+/// variance, which is the MSE between the two renders / 2; the mean of two renders half that.
+pub fn assert_same_mean(render: impl Fn(bool, u64) -> Vec<Vec3>) {
+    let (baseline, new) = (
+        [1, 2].map(|seed| render(false, seed)),
+        [1, 2].map(|seed| render(true, seed)),
+    );
+    let pixels = baseline[0].len() as f64;
     let mean_of = |r: &[Vec<Vec3>; 2]| (mean(&r[0]) + mean(&r[1])) / 2.0;
     let variance = |r: &[Vec<Vec3>; 2]| mse(&r[0], &r[1]) / 2.0 / pixels / 2.0;
-    (mean_of(a), mean_of(b), (variance(a) + variance(b)).sqrt())
+    let (m_baseline, m_new) = (mean_of(&baseline), mean_of(&new));
+    let standard_error = (variance(&baseline) + variance(&new)).sqrt();
+    assert!(
+        (m_new - m_baseline).abs() < 3.0 * standard_error && standard_error < 2e-3 * m_baseline,
+        "mean {m_new}, baseline {m_baseline} (standard error {standard_error})"
+    );
+}
+
+/// How much two renders (seeds 1 and 2) differ: MSE between them, twice a render's noise.
+pub fn seed_difference(render: impl Fn(u64) -> Vec<Vec3>) -> f64 {
+    mse(&render(1), &render(2))
 }

@@ -5,7 +5,7 @@
 use glam::Vec3;
 use yat_tracer::integrator::PathScene;
 
-use super::estimates::{self, compare_means, mse};
+use super::estimates::{self, seed_difference};
 
 const SIZE: u32 = 40;
 
@@ -51,21 +51,14 @@ fn render(split: bool, spp: u32, seed: u64) -> Vec<Vec3> {
 /// either side moves the mean.
 #[test]
 fn splitting_keeps_the_mean() {
-    let spp = 512;
-    let renders = |split| [1, 2].map(|seed| render(split, spp, seed));
-    let (m_plain, m_split, standard_error) = compare_means(&renders(false), &renders(true));
-    assert!(
-        (m_split - m_plain).abs() < 3.0 * standard_error && standard_error < 2e-3 * m_plain,
-        "mean split {m_split}, one sample {m_plain} (standard error {standard_error})"
-    );
+    estimates::assert_same_mean(|split, seed| render(split, 512, seed));
 }
 
 /// The highlight is where one BSDF sample finds the lamp or misses it; eight stratified ones
 /// see it far more evenly.
 #[test]
 fn splitting_cuts_the_noise_of_highlights() {
-    let spp = 16;
-    let noise = |split| mse(&render(split, spp, 1), &render(split, spp, 2));
+    let noise = |split| seed_difference(|seed| render(split, 16, seed));
     let (noise_plain, noise_split) = (noise(false), noise(true));
     assert!(
         noise_split * 5.0 < noise_plain,

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use yat_tracer::math::Ray;
 use yat_tracer::render::{RenderScene, RenderSettings};
 
-use super::estimates::{self, compare_means, mse};
+use super::estimates::{self, seed_difference};
 
 const SIZE: u32 = 40;
 /// A lamp plain path tracing rarely finds through the mirror: half side 0.2 at height 1.5.
@@ -120,30 +120,15 @@ fn an_image_sample_has_the_density_a_path_through_the_mirror_is_weighed_with() {
 /// of the MIS weight matter to the mean.
 #[test]
 fn sampling_lamps_through_the_mirror_keeps_the_mean() {
-    let spp = 256;
-    let renders = |images| [1, 2].map(|seed| render(images, LARGE_LAMP, spp, seed));
-    let (m_plain, m_images, standard_error) = compare_means(&renders(false), &renders(true));
-    assert!(
-        (m_images - m_plain).abs() < 3.0 * standard_error && standard_error < 2e-3 * m_plain,
-        "mean with images {m_images}, plain path tracing {m_plain} (standard error {standard_error})"
-    );
+    estimates::assert_same_mean(|images, seed| render(images, LARGE_LAMP, 256, seed));
 }
 
 /// A small lamp: plain path tracing finds it through the mirror rarely, each time as a
 /// firefly.
 #[test]
 fn sampling_lamps_through_the_mirror_cuts_the_noise() {
-    let spp = 64;
-    let (plain_a, plain_b) = (
-        render(false, SMALL_LAMP, spp, 1),
-        render(false, SMALL_LAMP, spp, 2),
-    );
-    let (images_a, images_b) = (
-        render(true, SMALL_LAMP, spp, 1),
-        render(true, SMALL_LAMP, spp, 2),
-    );
-    // The two seeds of each differ by twice a render's noise.
-    let (noise_plain, noise_images) = (mse(&plain_a, &plain_b), mse(&images_a, &images_b));
+    let noise = |images| seed_difference(|seed| render(images, SMALL_LAMP, 64, seed));
+    let (noise_plain, noise_images) = (noise(false), noise(true));
     assert!(
         noise_images * 100.0 < noise_plain,
         "noise with images {noise_images}, plain path tracing {noise_plain}"
