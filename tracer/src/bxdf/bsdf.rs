@@ -60,8 +60,8 @@ impl Bsdf {
         }
     }
 
-    /// The cone around the mirror direction of `wo` (in the shading frame) that holds most of
-    /// a bare glossy lobe ([`Bxdf::glossy_spread`]; a coat over it is not counted).
+    /// The cone around `wo`'s mirror direction about the shading normal (world space) that
+    /// holds most of a bare glossy lobe ([`Bxdf::glossy_spread`]; a coated one is not counted).
     pub fn glossy_cone(&self, wo: Vec3) -> Option<Cone> {
         let half = self
             .coating

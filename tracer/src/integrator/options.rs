@@ -26,8 +26,9 @@ pub const DEFAULT_INCLUDE_ENVIRONMENT: bool = true;
 /// Whether lamps are sampled through flat mirrors too (the same image, less noise where a
 /// mirror throws light; false renders plain path tracing's estimate, for comparisons).
 pub const DEFAULT_MIRROR_IMAGES: bool = true;
-/// Whether a glossy first vertex takes several BSDF samples for the light it sees directly
-/// (the same image, less noise in highlights; false renders one, for comparisons).
+/// Whether a path's first glossy vertex that may see a lamp takes several BSDF samples for the
+/// light it sees directly (the same image, less noise in highlights; false takes one, for
+/// comparisons).
 pub const DEFAULT_GLOSSY_SPLIT: bool = true;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,7 +46,8 @@ pub struct IntegratorDesc {
     pub include_environment: bool,
     /// Lamps are sampled through flat mirrors as well as directly.
     pub mirror_images: bool,
-    /// A glossy first vertex splits (see [`crate::integrator::GLOSSY_SPLIT`]).
+    /// A path's first glossy vertex that may see a lamp splits (see
+    /// [`crate::integrator::GLOSSY_SPLIT`]).
     pub glossy_split: bool,
     /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
     pub requested: String,

@@ -488,7 +488,9 @@ struct SplitLight {
 /// count, and divided by it. The samples come from draws of their own, stratified together
 /// (the vertex's own `lobe` and `bsdf` numbers go unused). Null surfaces are crossed as the
 /// path crosses them (a scene splits only when no mix can turn into one, see
-/// [`PathScene::glossy_split`]). Out of line: most vertices do not split.
+/// [`PathScene::glossy_split`]). A lamp behind a flat mirror is the path's to find, one sample
+/// as without the split, which is what the vertex's lamp-image sample weighs against. Out of
+/// line: most vertices do not split.
 #[inline(never)]
 fn split_bsdf_light<S: PathScene>(
     scene: &S,
