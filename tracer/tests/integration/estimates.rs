@@ -7,6 +7,20 @@ use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
 
+/// A scene's opening: a camera 5 units above the origin looking down (fov 50), a `size` x
+/// `size` film with a box filter, the path integrator with `integrator` parameters, and
+/// `WorldBegin`.
+pub fn looking_down(size: u32, integrator: &str) -> String {
+    format!(
+        "LookAt 0 0 5  0 0 0  0 1 0\n\
+         Camera \"perspective\" \"float fov\" [50]\n\
+         Film \"fleximage\" \"integer xresolution\" [{size}] \"integer yresolution\" [{size}]\n\
+         PixelFilter \"box\"\n\
+         SurfaceIntegrator \"path\" {integrator}\n\
+         WorldBegin\n"
+    )
+}
+
 /// The scene `text` (which must parse without warnings) built for a `size` x `size` render.
 pub fn build(text: &str, size: u32, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {
     let mut source = MemorySource::new();

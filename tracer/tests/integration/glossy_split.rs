@@ -14,13 +14,9 @@ const SIZE: u32 = 40;
 /// its back) hangs over the left, where the metal reflects it to the camera, and the matte half
 /// sees its highlight on the metal too; a dim sky lights everything. Depth 3.
 fn scene(split: bool) -> String {
+    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
     format!(
-        "LookAt 0 0 5  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" [50]\n\
-         Film \"fleximage\" \"integer xresolution\" [{SIZE}] \"integer yresolution\" [{SIZE}]\n\
-         PixelFilter \"box\"\n\
-         SurfaceIntegrator \"path\" \"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]\n\
-         WorldBegin\n\
+        "{}\
          LightSource \"infinite\" \"color L\" [0.1 0.1 0.1]\n\
          AttributeBegin\n\
          Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \"float uroughness\" [0.05] \"float vroughness\" [0.05]\n\
@@ -38,7 +34,8 @@ fn scene(split: bool) -> String {
          Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
            \"point P\" [-1 -0.4 1.5  -1 0.4 1.5  -0.3 0.4 1.5  -0.3 -0.4 1.5]\n\
          AttributeEnd\n\
-         WorldEnd\n"
+         WorldEnd\n",
+        estimates::looking_down(SIZE, &integrator)
     )
 }
 

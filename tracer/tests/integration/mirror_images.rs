@@ -20,13 +20,10 @@ const LARGE_LAMP: (f32, f32) = (0.75, 0.4);
 /// the floor sees the lamp directly and through the mirror, and nothing else.
 fn scene(mirror_images: bool, (lamp, z): (f32, f32)) -> String {
     let (x0, x1) = (0.2 - lamp, 0.2 + lamp);
+    let integrator =
+        format!("\"integer maxdepth\" [2] \"bool mirrorimages\" [\"{mirror_images}\"]");
     format!(
-        "LookAt 0 0 5  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" [50]\n\
-         Film \"fleximage\" \"integer xresolution\" [{SIZE}] \"integer yresolution\" [{SIZE}]\n\
-         PixelFilter \"box\"\n\
-         SurfaceIntegrator \"path\" \"integer maxdepth\" [2] \"bool mirrorimages\" [\"{mirror_images}\"]\n\
-         WorldBegin\n\
+        "{}\
          AttributeBegin\n\
          Material \"matte\" \"color Kd\" [0.5 0.5 0.5]\n\
          Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
@@ -42,7 +39,8 @@ fn scene(mirror_images: bool, (lamp, z): (f32, f32)) -> String {
          Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
            \"point P\" [{x0} -{lamp} {z}  {x0} {lamp} {z}  {x1} {lamp} {z}  {x1} -{lamp} {z}]\n\
          AttributeEnd\n\
-         WorldEnd\n"
+         WorldEnd\n",
+        estimates::looking_down(SIZE, &integrator)
     )
 }
 
