@@ -7,9 +7,10 @@ use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
-/// A closed box lit by an area light, with a glossy sphere, a rough metal ball (whose highlight
-/// paths split at), a flat mirror (whose lamp image the path tracer samples), its materials in an Include'd file and a poster textured with a PNG
-/// image map. Returns the main file.
+/// A closed box lit by an area light, with a glossy sphere, a rough metal ball (paths split
+/// where it shows the lamp), a flat mirror (whose lamp image the path tracer samples), its
+/// materials in an Include'd file and a poster textured with a PNG image map. Returns the main
+/// file.
 pub fn write_scene(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join("textures")).unwrap();
     let checks = image::RgbImage::from_fn(8, 8, |x, y| {

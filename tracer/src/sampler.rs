@@ -125,19 +125,12 @@ impl PixelSampler {
 
     pub fn get_1d(&mut self) -> f32 {
         let hash = self.next_dimension_hash();
-        let index = self.sobol_index(hash as u32);
-        to_unit_float(owen_scramble(van_der_corput(index), (hash >> 32) as u32))
+        point_1d(self.sobol_index(hash as u32), hash)
     }
 
     pub fn get_2d(&mut self) -> Vec2 {
         let hash = self.next_dimension_hash();
-        let index = self.sobol_index(hash as u32);
-        let scramble_x = (hash >> 32) as u32;
-        let scramble_y = mix64(hash) as u32;
-        Vec2::new(
-            to_unit_float(owen_scramble(van_der_corput(index), scramble_x)),
-            to_unit_float(owen_scramble(sobol_dimension_1(index), scramble_y)),
-        )
+        point_2d(self.sobol_index(hash as u32), hash)
     }
 
     /// The next 1D dimension drawn `N` times for a vertex that splits into `N` samples: sample
@@ -147,28 +140,18 @@ impl PixelSampler {
     pub fn get_split_1d<const N: usize>(&mut self) -> [f32; N] {
         let hash = self.next_dimension_hash();
         let first = self.split_index::<N>(hash);
-        let scramble = (hash >> 32) as u32;
-        std::array::from_fn(|i| {
-            to_unit_float(owen_scramble(van_der_corput(first + i as u32), scramble))
-        })
+        std::array::from_fn(|i| point_1d(first + i as u32, hash))
     }
 
     /// [`Self::get_split_1d`] for a 2D dimension.
     pub fn get_split_2d<const N: usize>(&mut self) -> [Vec2; N] {
         let hash = self.next_dimension_hash();
         let first = self.split_index::<N>(hash);
-        let (scramble_x, scramble_y) = ((hash >> 32) as u32, mix64(hash) as u32);
-        std::array::from_fn(|i| {
-            let index = first + i as u32;
-            Vec2::new(
-                to_unit_float(owen_scramble(van_der_corput(index), scramble_x)),
-                to_unit_float(owen_scramble(sobol_dimension_1(index), scramble_y)),
-            )
-        })
+        std::array::from_fn(|i| point_2d(first + i as u32, hash))
     }
 
     /// The first of the `N` Sobol indices a split draw takes in the dimension whose hash is
-    /// `hash`. Indices wrap at 2^32 (a pixel of 2^30 samples split four ways), still valid points.
+    /// `hash`. Indices wrap at 2^32 (past 2^32 / N samples a pixel), still valid points.
     fn split_index<const N: usize>(&self, hash: u64) -> u32 {
         self.sobol_index(hash as u32).wrapping_mul(N as u32)
     }
@@ -226,6 +209,20 @@ impl PixelSampler {
         self.dimension_key = self.dimension_key.wrapping_add(DIMENSION_STEP);
         hash
     }
+}
+
+/// Sobol point `index` of a 1D dimension whose hash is `hash`, Owen-scrambled by the hash.
+fn point_1d(index: u32, hash: u64) -> f32 {
+    to_unit_float(owen_scramble(van_der_corput(index), (hash >> 32) as u32))
+}
+
+/// Sobol point `index` of a 2D dimension whose hash is `hash` (Sobol dimensions 0 and 1), each
+/// coordinate Owen-scrambled by its own part of the hash.
+fn point_2d(index: u32, hash: u64) -> Vec2 {
+    Vec2::new(
+        point_1d(index, hash),
+        to_unit_float(owen_scramble(sobol_dimension_1(index), mix64(hash) as u32)),
+    )
 }
 
 /// A 64-bit finaliser (splitmix64): every input bit affects every output bit.

@@ -37,8 +37,8 @@ pub trait PathScene {
     /// Whether shape `shape` is `null` (shadow rays in scenes with volumes cross it).
     fn is_pass_through(&self, shape: u32) -> bool;
     /// Whether paths split at glossy vertices ([`GLOSSY_SPLIT`]): the integrator allows it, the
-    /// scene has lamps and metals, and no volumes or mix that can turn into `null` (a split
-    /// sample crosses a surface only where [`Self::is_pass_through`] says so).
+    /// scene has lamps and metals, and no volumes or material that lets rays through at some
+    /// hits only (a split sample crosses a surface only where [`Self::is_pass_through`] says so).
     fn glossy_split(&self) -> bool;
 }
 
@@ -487,10 +487,10 @@ struct SplitLight {
 /// first: each weighed against the light sample by the power heuristic with the samples'
 /// count, and divided by it. The samples come from draws of their own, stratified together
 /// (the vertex's own `lobe` and `bsdf` numbers go unused). Null surfaces are crossed as the
-/// path crosses them (a scene splits only when no mix can turn into one, see
-/// [`PathScene::glossy_split`]). A lamp behind a flat mirror is the path's to find, one sample
-/// as without the split, which is what the vertex's lamp-image sample weighs against. Out of
-/// line: most vertices do not split.
+/// path crosses them (a scene splits only when no material lets rays through at some hits
+/// only, see [`PathScene::glossy_split`]). A lamp behind a flat mirror is the path's to find,
+/// one sample as without the split, which is what the vertex's lamp-image sample weighs
+/// against. Out of line: most vertices do not split.
 #[inline(never)]
 fn split_bsdf_light<S: PathScene>(
     scene: &S,

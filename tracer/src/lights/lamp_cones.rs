@@ -59,8 +59,9 @@ impl LampCones {
 mod tests {
     use super::*;
 
-    /// Directions sampled inside the cone that hit a lamp's sphere: any such hit means
-    /// `may_reach` says yes; cones far from every lamp say no.
+    /// Random cones from the origin: every one whose angle to the lamp's sphere is within its
+    /// half angle plus the sphere's angular radius gets a yes, every one clearly wider of it a
+    /// no, and a cone of every direction a yes.
     #[test]
     fn a_cone_reaching_a_lamp_is_never_missed() {
         let lamp = (Vec3::new(-0.5, -0.5, 4.0), Vec3::new(0.5, 0.5, 4.0));
@@ -77,7 +78,6 @@ mod tests {
             let axis = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
             let half = next() * 0.8;
             let cone = Cone { axis, half };
-            // A direction inside the cone towards the sphere's nearest point to the axis.
             let to_centre = (centre - p).normalize();
             let angle = axis.dot(to_centre).clamp(-1.0, 1.0).acos();
             let sphere_angle = (radius / 4.0).asin();

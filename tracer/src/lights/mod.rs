@@ -212,6 +212,14 @@ impl AtInfinity {
     }
 }
 
+/// The area lights among `lights`, with their indices.
+fn area_lights(lights: &[Light]) -> impl Iterator<Item = (usize, &AreaLight)> {
+    lights.iter().enumerate().filter_map(|(i, l)| match l {
+        Light::Area(area) => Some((i, area)),
+        _ => None,
+    })
+}
+
 /// An infinite light never starves: it gets at least this fraction of the other lights' power
 /// (scene-size estimates of sky power are rough, and the sky often matters more than they say).
 const INFINITE_POWER_FLOOR: f32 = 0.1;
@@ -309,12 +317,7 @@ impl Lights {
         let infinite = (0..lights.len() as u32)
             .filter(|&i| matches!(lights[i as usize], Light::Infinite(_)))
             .collect();
-        let lamp_boxes: Vec<(Vec3, Vec3)> = (lights.iter())
-            .filter_map(|l| match l {
-                Light::Area(area) => Some(area.bounds()),
-                _ => None,
-            })
-            .collect();
+        let lamp_boxes: Vec<(Vec3, Vec3)> = area_lights(&lights).map(|(_, l)| l.bounds()).collect();
         Ok(Self {
             lamp_cones: LampCones::new(&lamp_boxes),
             lights,
@@ -415,11 +418,8 @@ impl Lights {
     /// Adds the lamp images of the flat mirrors among `mirror_shapes` (shapes whose material is
     /// a plain `mirror`; the `mirrored` module says which take part).
     pub fn with_mirror_images(mut self, mirror_shapes: &[u32], geometry: &SceneGeometry) -> Self {
-        let lamps: Vec<(u32, &AreaLight, f32)> = (self.lights.iter().enumerate())
-            .filter_map(|(i, l)| match l {
-                Light::Area(area) => Some((i as u32, area, self.selection.pmf(i))),
-                _ => None,
-            })
+        let lamps: Vec<(u32, &AreaLight, f32)> = area_lights(&self.lights)
+            .map(|(i, area)| (i as u32, area, self.selection.pmf(i)))
             .collect();
         self.images = MirrorImages::new(mirror_shapes, geometry, &lamps);
         self

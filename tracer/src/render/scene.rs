@@ -323,8 +323,10 @@ fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
 }
 
 /// Whether the path tracer may split glossy vertices ([`PathScene::glossy_split`]): the scene
-/// file allows it, a lamp (an area light) may shine in a metal's narrow lobe, and no volume or
-/// mix that can turn into `null` makes a split sample's way differ from the path's.
+/// file allows it, a lamp (an area light) may shine in a metal's narrow lobe, and no volume, or
+/// material that may let a ray through at one hit and not at the next, makes a split sample's
+/// way differ from the path's (a split sample crosses only `null` itself): a mix with a `null`
+/// side, or a `layered` (whose uncaught rays pass through).
 fn glossy_split(desc: &SceneDesc) -> bool {
     fn may_be_glossy(m: &MaterialDesc) -> bool {
         match m {
@@ -333,21 +335,22 @@ fn glossy_split(desc: &SceneDesc) -> bool {
             _ => false,
         }
     }
-    let lamps = desc.shapes.iter().any(|s| s.area_light.is_some());
-    let null_in_mix = desc.materials.iter().any(|m| match m {
-        MaterialDesc::Mix(mix) => [mix.a, mix.b].iter().any(|id| {
-            matches!(
-                desc.materials.get(id.0 as usize),
-                Some(MaterialDesc::Null(_))
-            )
-        }),
+    let is_null = |id: &crate::param::MaterialId| {
+        matches!(
+            desc.materials.get(id.0 as usize),
+            Some(MaterialDesc::Null(_))
+        )
+    };
+    let sometimes_passes = |m: &MaterialDesc| match m {
+        MaterialDesc::Mix(_) => m.materials().iter().any(is_null),
+        MaterialDesc::Layered(_) => true,
         _ => false,
-    });
+    };
     desc.integrator.glossy_split
-        && lamps
+        && desc.shapes.iter().any(|s| s.area_light.is_some())
         && desc.materials.iter().any(may_be_glossy)
         && desc.volumes.media.is_empty()
-        && !null_in_mix
+        && !desc.materials.iter().any(sometimes_passes)
 }
 
 impl PathScene for RenderScene {

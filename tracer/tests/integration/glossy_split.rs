@@ -64,7 +64,7 @@ fn splitting_cuts_the_noise_of_highlights() {
 }
 
 /// A scene splits only with lamps and metals, and without what would make a split sample's way
-/// differ from the path's: volumes, or a mix that can turn into `null`.
+/// differ from the path's: volumes, a mix that can turn into `null`, a layered material.
 #[test]
 fn only_scenes_with_lamps_and_metals_split() {
     let splits = |text: &str| estimates::build(text, SIZE, 1, 0).0.glossy_split();
@@ -81,6 +81,11 @@ fn only_scenes_with_lamps_and_metals_split() {
          MakeNamedMaterial \"paint\" \"string type\" [\"matte\"]\n\
          MakeNamedMaterial \"holey\" \"string type\" [\"mix\"] \"string namedmaterial1\" [\"paint\"] \
          \"string namedmaterial2\" [\"hole\"]"
+    )));
+    assert!(!splits(&with(
+        "MakeNamedMaterial \"paint\" \"string type\" [\"matte\"]\n\
+         MakeNamedMaterial \"decal\" \"string type\" [\"layered\"] \"string namedmaterial1\" [\"paint\"] \
+         \"float opacity1\" [0.5]"
     )));
     assert!(!splits(&with(
         "MakeNamedVolume \"smoke\" \"homogeneous\" \"color sigma_s\" [1 1 1]\n\
