@@ -178,7 +178,7 @@ impl AnalyticShape {
 
     /// The first hit with t in (0, tmax) of the world-space ray.
     #[inline]
-    pub(crate) fn intersect(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<QuadricHit> {
+    pub(crate) fn intersect(&self, origin: Vec3A, dir: Vec3A, tmax: f32) -> Option<f32> {
         // The direction is not renormalised, so t is the same in both spaces.
         let o = self.world_to_object.transform_point3a(origin);
         let d = self.world_to_object.transform_vector3a(dir);
@@ -195,15 +195,21 @@ impl AnalyticShape {
                 let c = o.length_squared() - radius * radius;
                 let closest = o - (b / (2.0 * a)) * d;
                 let (t0, t1) = quadratic_roots(a, b, c, radius, closest.length())?;
-                [t0, t1].into_iter().find_map(|t| {
+                // A whole sphere clips nothing: the traversal needs no point on it.
+                let (cut_low, cut_high) = (z_min > -radius, z_max < radius);
+                let whole = !cut_low && !cut_high && !cut_in_phi(phi_max);
+                [t0, t1].into_iter().find(|&t| {
                     if !(t > 0.0 && t < tmax) {
-                        return None;
+                        return false;
                     }
-                    let hit = self.point_at(o, d, t);
-                    let clipped = (z_min > -radius && hit.p.z < z_min)
-                        || (z_max < radius && hit.p.z > z_max)
-                        || hit.phi > phi_max;
-                    (!clipped).then_some(hit)
+                    if whole {
+                        return true;
+                    }
+                    let p = self.surface_point(o, d, t);
+                    let clipped = (cut_low && p.z < z_min)
+                        || (cut_high && p.z > z_max)
+                        || (cut_in_phi(phi_max) && phi_of(p) > phi_max);
+                    !clipped
                 })
             }
             Quadric::Disk {
@@ -219,12 +225,12 @@ impl AnalyticShape {
                 if !(t > 0.0 && t < tmax) {
                     return None;
                 }
-                let hit = self.point_at(o, d, t);
-                let dist2 = hit.p.x * hit.p.x + hit.p.y * hit.p.y;
+                let p = self.surface_point(o, d, t);
+                let dist2 = p.x * p.x + p.y * p.y;
                 if dist2 > radius * radius || dist2 < inner_radius * inner_radius {
                     return None;
                 }
-                (hit.phi <= phi_max).then_some(hit)
+                (!(cut_in_phi(phi_max) && phi_of(p) > phi_max)).then_some(t)
             }
             Quadric::Cylinder {
                 radius,
@@ -241,21 +247,20 @@ impl AnalyticShape {
                 let f = b / (2.0 * a);
                 let closest = glam::Vec2::new(o.x - f * d.x, o.y - f * d.y);
                 let (t0, t1) = quadratic_roots(a, b, c, radius, closest.length())?;
-                [t0, t1].into_iter().find_map(|t| {
+                [t0, t1].into_iter().find(|&t| {
                     if !(t > 0.0 && t < tmax) {
-                        return None;
+                        return false;
                     }
-                    let hit = self.point_at(o, d, t);
-                    let inside = hit.p.z >= z_min && hit.p.z <= z_max && hit.phi <= phi_max;
-                    inside.then_some(hit)
+                    let p = self.surface_point(o, d, t);
+                    p.z >= z_min && p.z <= z_max && !(cut_in_phi(phi_max) && phi_of(p) > phi_max)
                 })
             }
         }
     }
 
-    /// The point at distance `t` along the object-space ray (`o`, `d`), on the surface: what
-    /// [`Self::intersect`] returns for a root it accepts, computed the same way.
-    fn point_at(&self, o: Vec3A, d: Vec3A, t: f32) -> QuadricHit {
+    /// The point at distance `t` along the object-space ray (`o`, `d`), moved onto the surface:
+    /// the point [`Self::intersect`] tests a root's clipping at.
+    fn surface_point(&self, o: Vec3A, d: Vec3A, t: f32) -> Vec3A {
         let mut p = o + t * d;
         match self.quadric {
             Quadric::Sphere { radius, .. } => {
@@ -272,11 +277,7 @@ impl AnalyticShape {
                 p.y *= scale;
             }
         }
-        QuadricHit {
-            t,
-            p,
-            phi: phi_of(p),
-        }
+        p
     }
 
     /// The quadric hit at `t`, a distance [`Self::intersect`] returned for this world-space
@@ -284,7 +285,12 @@ impl AnalyticShape {
     pub(crate) fn hit_at(&self, origin: Vec3A, dir: Vec3A, t: f32) -> QuadricHit {
         let o = self.world_to_object.transform_point3a(origin);
         let d = self.world_to_object.transform_vector3a(dir);
-        self.point_at(o, d, t)
+        let p = self.surface_point(o, d, t);
+        QuadricHit {
+            t,
+            p,
+            phi: phi_of(p),
+        }
     }
 
     pub(crate) fn hit(&self, hit: QuadricHit, prim: u32) -> SurfaceHit {
@@ -497,6 +503,13 @@ fn quadratic_roots(a: f32, b: f32, c: f32, radius: f32, closest: f32) -> Option<
     Some(if t0 > t1 { (t1, t0) } else { (t0, t1) })
 }
 
+/// Whether a quadric swept through `phi_max` is cut by it: a full turn clips nothing, as
+/// [`phi_of`] is at most TAU (the intersection tests skip the azimuth then).
+fn cut_in_phi(phi_max: f32) -> bool {
+    phi_max < TAU
+}
+
+/// The azimuth of `p` about z, in [0, TAU].
 fn phi_of(p: Vec3A) -> f32 {
     let phi = atan2(p.y, p.x);
     if phi < 0.0 {
@@ -509,4 +522,28 @@ fn phi_of(p: Vec3A) -> f32 {
 /// d p / d u for a surface swept around z with u = phi / phi_max.
 fn u_tangent(p: Vec3A, phi_max: f32) -> Vec3A {
     Vec3A::new(-phi_max * p.y, phi_max * p.x, 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The intersection tests skip the azimuth of a shape swept through a full turn: that
+    /// must clip nothing, so no azimuth may exceed a full turn as the scene gives it (360
+    /// degrees), even just below the +x axis where it wraps.
+    #[test]
+    fn a_full_turn_clips_no_azimuth() {
+        let full_turn = 360.0f32.to_radians();
+        assert!(!cut_in_phi(full_turn));
+        assert!(cut_in_phi(359.99f32.to_radians()));
+        for k in 0u32..255 {
+            let below_x = -f32::from_bits(1 + k * 0x0040_0000).min(1e-3);
+            for p in [
+                Vec3A::new(1.0, below_x, 0.0),
+                Vec3A::new(-1.0, below_x, 0.0),
+            ] {
+                assert!(phi_of(p) <= full_turn, "{p}: {}", phi_of(p));
+            }
+        }
+    }
 }

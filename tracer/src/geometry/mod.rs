@@ -229,9 +229,7 @@ impl SceneGeometry {
         }
         let hit = self.bvh.closest(origin, dir, t_closest, |slot, bound| {
             match self.prims[slot as usize] {
-                Prim::Analytic(a) => self.analytic[a as usize]
-                    .intersect(origin, dir, bound)
-                    .map(|h| h.t),
+                Prim::Analytic(a) => self.analytic[a as usize].intersect(origin, dir, bound),
                 Prim::Triangle { .. } => None,
             }
         });

@@ -498,9 +498,7 @@ fn brute_force(geometry: &SceneGeometry, ray: &Ray, tmax: f32) -> Option<(f32, u
         let t_best = best.map_or(tmax, |b| b.0);
         let t = match *prim {
             Prim::Triangle { edges, .. } => edges.intersect(o, d, t_best).map(|h| h.0),
-            Prim::Analytic(a) => geometry.analytic[a as usize]
-                .intersect(o, d, t_best)
-                .map(|h| h.t),
+            Prim::Analytic(a) => geometry.analytic[a as usize].intersect(o, d, t_best),
         };
         if let Some(t) = t {
             best = Some((t, slot as u32));
