@@ -328,28 +328,30 @@ def side_by_side(args):
                         lambda v=variant, s=sampler: render_mitsuba(
                             xml, v, s, spp, args.depth, args.threads, size, tmp, SHORT_SEED, True),
                         tmp / "mitsuba.exr", m_ref))
-            # Rounds interleave the renderers, so a change in the machine's load between them
-            # falls on all alike; each keeps its fastest run (the images of one renderer and
-            # seed are the same every round). Other work on a shared machine only ever adds
-            # time: the fastest run is the nearest to a renderer's own speed, and the median
-            # of three moved by a tenth or more between runs of the same binaries.
+            # Rounds interleave the renderers, so a change in the machine's speed between them
+            # falls on all alike. Each renderer and sampler is timed by its median run: on this
+            # shared virtual machine one renderer's runs spread by 20-50% with nothing else
+            # running, and the fastest of a few is a lottery that the best of three samplers
+            # (three times the draws) wins more often than YAT's one sampler does.
             timed = [[] for _ in jobs]
             for _ in range(args.compare_rounds):
                 for job_runs, (_, _, run, image, ref) in zip(timed, jobs):
                     f = run()
                     job_runs.append((f, mse(read_exr(image), ref)))
-            results = []  # (renderer, sampler, figures, mse)
+            results = []  # (renderer, sampler, figures of the median run, mse, fastest s)
             for job_runs, (label, sampler, _, _, _) in zip(timed, jobs):
                 job_runs.sort(key=lambda r: r[0]["render_seconds"])
-                f, e = job_runs[0]
-                results.append((label(f), sampler or f["sampler"], f, e))
+                f, e = job_runs[(len(job_runs) - 1) // 2]
+                fastest = job_runs[0][0]["render_seconds"]
+                results.append((label(f), sampler or f["sampler"], f, e, fastest))
                 log(f"  {results[-1][0]} {results[-1][1]}: "
                     f"{[round(r[0]['render_seconds'], 2) for r in job_runs]} s, MSE {e:.3g}")
-            effs = [1 / (e * f["render_seconds"]) for _, _, f, e in results]
-            for (who, sampler, f, e), eff in zip(results, effs):
+            effs = [1 / (e * f["render_seconds"]) for _, _, f, e, _ in results]
+            effs_fastest = [1 / (e * fastest) for _, _, _, e, fastest in results]
+            for (who, sampler, f, e, fastest), eff in zip(results, effs):
                 rays = f.get("rays_per_second")
                 runs.append([
-                    name, who, sampler, f"{f['render_seconds']:.2f}",
+                    name, who, sampler, f"{f['render_seconds']:.2f} ({fastest:.2f})",
                     f"{f['samples_per_second'] / 1e6:.3f}",
                     f"{rays / 1e6:.2f}" if rays else "-", f"{e:.3g}", f"{eff:.3g}",
                     f"{effs[0] / eff:.2f}x",
@@ -358,7 +360,10 @@ def side_by_side(args):
             def best(variant):
                 i = max((i for i, r in enumerate(results) if r[0].endswith(variant)),
                         key=lambda i: effs[i])
-                return f"{effs[0] / effs[i]:.2f}x ({results[i][1]})"
+                fastest = max(effs_fastest[i] for i, r in enumerate(results)
+                              if r[0].endswith(variant))
+                return (f"{effs[0] / effs[i]:.2f}x ({results[i][1]}; fastest runs "
+                        f"{effs_fastest[0] / fastest:.2f}x)")
 
             summary.append([
                 name, res, f"{spp} / {ref_spp}", f"{load:.1f}",
@@ -367,7 +372,7 @@ def side_by_side(args):
                 f"{effs[0] / effs[1]:.2f}x", best("scalar_rgb"), best("llvm_ad_rgb"),
             ])
     runs_table = table(
-        ["scene", "renderer", "sampler", "render s", "M samples/s", "M rays/s", "MSE",
+        ["scene", "renderer", "sampler", "render s (fastest)", "M samples/s", "M rays/s", "MSE",
          "efficiency", "YAT efficiency / this"],
         runs,
     )
@@ -442,9 +447,9 @@ def side_by_side_section(args):
 - command: `python3 bench/bench.py {" ".join(sys.argv[1:])}` (setup: `bench/setup-env.sh`,
   which `bench.py` runs itself)
 - load average (1 min) {before[0]:.1f} at the start, {after[0]:.1f} at the end; the "load"
-  column is at each scene's timed renders. The machine is shared with other builds: absolute
-  figures move with the load, ratios within one scene's renders (run back to back) are what
-  the table is for.
+  column is at each scene's timed renders, and counts the benchmark's own render threads. The
+  machine may be shared and its speed moves: absolute figures move with it, ratios within one
+  scene's renders (interleaved) are what the table is for.
 
 Each scene as YAT parsed it, written out by `yat export-luxcore` (LuxCore's own .lxs importer
 drops the spheres and the planar mapping, refuses metal2's fresnel colour and loses the named
@@ -464,8 +469,12 @@ the row's. The summary compares the references (mean radiance, and correlation o
 block luminance: the renderers rendered the same picture) and names each Mitsuba variant's
 most efficient sampler.
 
-Render seconds, the fastest of {args.compare_rounds} timed renders per renderer and sampler,
-interleaved round by round (interference from other work only adds time): YAT's and LuxCore's
+Render seconds: the median of {args.compare_rounds} timed renders per renderer and sampler,
+interleaved round by round, and the fastest in brackets; efficiencies and their ratios are of
+the medians, and the summary adds the ratio of the fastest runs (each variant's best sampler
+on them). Medians, because one renderer's runs spread by 20-50% on the shared virtual
+machine this was measured on even with nothing else running, and the best of three samplers'
+fastest runs is the luckiest of three times as many draws as YAT's. YAT's and LuxCore's
 from the scene and BVH being ready to the last sample; Mitsuba's around `mi.render` on a loaded
 scene, after an untimed render of the same size (the llvm variant JIT-compiles its kernels on
 the first render, several seconds; they are cached after that). LuxCore runs PATHCPU with its
@@ -539,9 +548,9 @@ def main():
                     help="spp of the side by side's timed renders (default 16)")
     ap.add_argument("--ref-spp", type=int, default=1024,
                     help="spp of the side by side's converged references (default 1024)")
-    ap.add_argument("--compare-rounds", type=int, default=3,
-                    help="timed renders per renderer in the side by side, interleaved; each "
-                         "keeps its fastest (default 3)")
+    ap.add_argument("--compare-rounds", type=int, default=5,
+                    help="timed renders per renderer in the side by side, interleaved; "
+                         "efficiency of each one's median (default 5)")
     ap.add_argument("--pgo", action="store_true",
                     help="build with deploy/build-pgo.sh and measure its profile-optimised "
                          "binary, target/pgo/yat (the same images, sooner)")
