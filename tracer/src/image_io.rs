@@ -62,10 +62,10 @@ impl Tiling {
     }
 }
 
-/// 8-bit files keep their bytes and decode through a table: a quarter of the memory of f32
-/// texels (a fifth counting the padding byte, which makes an 8-bit tile one 64-byte cache
-/// line), and an environment map looked up at random directions misses the cache four times
-/// less often. The table gives the same values as decoding every texel up front.
+/// 8-bit files of many colours keep their bytes and decode through a table: a quarter of the
+/// memory of f32 texels (a fifth counting the padding byte, which makes an 8-bit tile one
+/// 64-byte cache line), and an environment map looked up at random directions misses the
+/// cache four times less often. The table gives the same values as decoding every texel up front.
 ///
 /// 8-bit files of at most 256 colours (a checkerboard, a flat-shaded or posterised texture)
 /// keep one byte per texel, an index into their colours: a quarter of `Bytes`' memory, so a
