@@ -133,14 +133,7 @@ impl RgbImage {
         let (tile, i) = self.tiling.at(x, y);
         match &self.texels {
             Texels::Linear(tiles) => tiles[tile][i],
-            Texels::Bytes { tiles, linear } => {
-                let [r, g, b, _] = tiles[tile].0[i];
-                Vec3::new(
-                    linear[usize::from(r)],
-                    linear[usize::from(g)],
-                    linear[usize::from(b)],
-                )
-            }
+            Texels::Bytes { tiles, linear } => decode_code(linear, tiles[tile].0[i]),
             Texels::Indexed { tiles, palette } => palette[usize::from(tiles[tile][i])],
         }
     }
@@ -259,6 +252,16 @@ fn axis_neighbours(c: f32, n: u32, edge: Edge) -> ([Option<usize>; 2], f32) {
     (pair.map(|j| j.map(|j| j as usize)), x - x0)
 }
 
+/// An 8-bit texel's red, green and blue through the decoding table `linear`.
+#[inline(always)]
+fn decode_code(linear: &[f32; 256], [r, g, b, _]: [u8; 4]) -> Vec3 {
+    Vec3::new(
+        linear[usize::from(r)],
+        linear[usize::from(g)],
+        linear[usize::from(b)],
+    )
+}
+
 /// The distinct colours of `codes` in order of first appearance and each code's index among
 /// them, if there are at most 256; `None` as soon as a 257th appears.
 fn palette_indices(codes: &[[u8; 4]]) -> Option<(Vec<[u8; 4]>, Vec<u8>)> {
@@ -267,21 +270,18 @@ fn palette_indices(codes: &[[u8; 4]]) -> Option<(Vec<[u8; 4]>, Vec<u8>)> {
     let mut indices = Vec::with_capacity(codes.len());
     let mut previous = None;
     for &code in codes {
-        // Runs of one colour are common (flat areas): no hashing for them.
-        if let Some((last, index)) = previous {
-            if last == code {
-                indices.push(index);
-                continue;
-            }
-        }
-        let index = match index_of.get(&code) {
-            Some(&index) => index,
-            None => {
-                let index = u8::try_from(colours.len()).ok()?;
-                index_of.insert(code, index);
-                colours.push(code);
-                index
-            }
+        let index = match previous {
+            // Runs of one colour are common (flat areas): no hashing for them.
+            Some((last, index)) if last == code => index,
+            _ => match index_of.get(&code) {
+                Some(&index) => index,
+                None => {
+                    let index = u8::try_from(colours.len()).ok()?;
+                    index_of.insert(code, index);
+                    colours.push(code);
+                    index
+                }
+            },
         };
         previous = Some((code, index));
         indices.push(index);
@@ -329,12 +329,8 @@ pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeEr
             match palette_indices(&codes) {
                 Some((colours, indices)) => {
                     let mut palette = Box::new([Vec3::ZERO; 256]);
-                    for (entry, &[r, g, b, _]) in palette.iter_mut().zip(&colours) {
-                        *entry = Vec3::new(
-                            linear[usize::from(r)],
-                            linear[usize::from(g)],
-                            linear[usize::from(b)],
-                        );
+                    for (entry, &code) in palette.iter_mut().zip(&colours) {
+                        *entry = decode_code(&linear, code);
                     }
                     Texels::Indexed {
                         tiles: tile(width, height, &indices, 0),

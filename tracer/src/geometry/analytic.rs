@@ -208,7 +208,7 @@ impl AnalyticShape {
                     let p = self.surface_point(o, d, t);
                     let clipped = (cut_low && p.z < z_min)
                         || (cut_high && p.z > z_max)
-                        || (cut_in_phi(phi_max) && phi_of(p) > phi_max);
+                        || beyond_phi(p, phi_max);
                     !clipped
                 })
             }
@@ -230,7 +230,7 @@ impl AnalyticShape {
                 if dist2 > radius * radius || dist2 < inner_radius * inner_radius {
                     return None;
                 }
-                (!(cut_in_phi(phi_max) && phi_of(p) > phi_max)).then_some(t)
+                (!beyond_phi(p, phi_max)).then_some(t)
             }
             Quadric::Cylinder {
                 radius,
@@ -252,7 +252,7 @@ impl AnalyticShape {
                         return false;
                     }
                     let p = self.surface_point(o, d, t);
-                    p.z >= z_min && p.z <= z_max && !(cut_in_phi(phi_max) && phi_of(p) > phi_max)
+                    p.z >= z_min && p.z <= z_max && !beyond_phi(p, phi_max)
                 })
             }
         }
@@ -507,6 +507,12 @@ fn quadratic_roots(a: f32, b: f32, c: f32, radius: f32, closest: f32) -> Option<
 /// [`phi_of`] is at most TAU (the intersection tests skip the azimuth then).
 fn cut_in_phi(phi_max: f32) -> bool {
     phi_max < TAU
+}
+
+/// Whether `p` lies past `phi_max` in azimuth, on a quadric cut short of a full turn (without
+/// an atan2 on a whole one).
+fn beyond_phi(p: Vec3A, phi_max: f32) -> bool {
+    cut_in_phi(phi_max) && phi_of(p) > phi_max
 }
 
 /// The azimuth of `p` about z, in [0, TAU].
