@@ -204,8 +204,7 @@ impl RenderScene {
                         } else {
                             PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed)
                         };
-                        let u = sampler.get_2d();
-                        let lens = sampler.get_2d();
+                        let (u, lens) = sampler.get_camera();
                         let film = Vec2::new(x as f32 + u.x, y as f32 + u.y);
                         stats.samples += 1;
                         // A sample without a camera ray (outside a fisheye's circle) is black.
