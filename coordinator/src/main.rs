@@ -14,6 +14,10 @@ fn main() -> ExitCode {
         )
         .with_writer(std::io::stderr)
         .init();
+    if let Err(e) = yat::isa::start() {
+        eprintln!("Error: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match Cli::parse().command {
         Command::Render(args) => cli::render::run(*args),
         Command::Worker(args) => cli::worker::run(*args),

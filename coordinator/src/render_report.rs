@@ -23,6 +23,9 @@ pub struct RenderReport {
     pub peak_memory_bytes: Option<u64>,
     /// Rounds of an adaptive render (its spp is then the most a pixel got).
     pub adaptive_rounds: Option<u32>,
+    /// The build of the coordinator's process ([`crate::isa::build_name`]), which renders an
+    /// in-process render.
+    pub instruction_set: &'static str,
 }
 
 impl RenderReport {
@@ -47,6 +50,7 @@ impl RenderReport {
             rays_per_second: stats.rays as f64 / render_secs,
             peak_memory_bytes: peak_memory_bytes(),
             adaptive_rounds: outcome.round.as_ref().map(|r| r.index + 1),
+            instruction_set: crate::isa::build_name(),
         }
     }
 

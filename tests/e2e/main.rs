@@ -11,6 +11,7 @@ mod files;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;
 mod hostile_worker;
+mod isa;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;
 mod resume;
