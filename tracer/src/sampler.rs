@@ -585,21 +585,13 @@ mod tests {
         }
     }
 
-    /// The branch-free form equals the definition by direction numbers: v1 = 1/2,
-    /// v(k+1) = v(k) xor v(k)/2, the value the xor of the v(k) of the index's set bits.
+    /// The branch-free form equals the definition by direction numbers (the recurrence of
+    /// x + 1 from m_1 = 1: v1 = 1/2, v(k+1) = v(k) xor v(k)/2), the value the xor of the v(k)
+    /// of the index's set bits: the Pascal-triangle parity and `generator_columns` agree.
     #[test]
     fn sobol_dimension_1_matches_its_direction_numbers() {
-        let by_direction_numbers = |index: u32| {
-            let mut v = 1u32 << 31;
-            let mut result = 0;
-            for bit in 0..32 {
-                if index >> bit & 1 != 0 {
-                    result ^= v;
-                }
-                v ^= v >> 1;
-            }
-            result
-        };
+        let columns = generator_columns(1, 0, [1, 0, 0]);
+        let by_direction_numbers = |index: u32| generated(index, &columns);
         let mut state = 1u64;
         let indices = (0..4096u32).chain((0..4096).map(|_| {
             state = mix64(state);
