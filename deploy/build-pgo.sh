@@ -11,9 +11,10 @@
 # Scenes given on the command line are rendered for the profile too (at 160x90, 16 spp), so a
 # farm's binary can be trained on the scenes it renders.
 # Needs the toolchain's llvm-profdata (`rustup component add llvm-tools`, done here when missing).
-# On x86-64 it also builds target/pgo/yat-x86-64-v3, the same for CPUs with AVX2, FMA and BMI2,
-# which target/pgo/yat hands its process over to on such a CPU (coordinator/src/isa.rs; some
-# 12% fewer instructions, the same image bytes, checked here). Per build: two release builds
+# On an x86-64 machine whose CPU has AVX2, FMA and BMI2 it also builds
+# target/pgo/yat-x86-64-v3, the same compiled for such CPUs, which target/pgo/yat hands its
+# process over to on one (coordinator/src/isa.rs; some 12% fewer instructions, the same image
+# bytes, checked here: a difference removes it and fails). Per build: two release builds
 # (an instrumented one and the final one) and a few seconds of renders.
 set -eu
 # The training scenes given, as absolute paths (the script works from the repository's root).
@@ -75,6 +76,17 @@ build_for() {
     echo "$dest"
 }
 
+# Whether this machine's CPU has x86-64-v3's features (the v3 build is trained by running it).
+cpu_has_v3() {
+    flags=$(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null) || return 1
+    for feature in avx avx2 bmi1 bmi2 f16c fma abm movbe; do
+        case " $flags " in
+        *" $feature "*) ;;
+        *) return 1 ;;
+        esac
+    done
+}
+
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 case $host in
@@ -83,21 +95,24 @@ x86_64-*)
     # CPU has it (coordinator/src/isa.rs); a stale sibling must not outlive a rebuild.
     rm -f target/pgo/yat-x86-64-v3
     build_for x86-64 target/pgo/yat "$@"
+    if ! cpu_has_v3; then
+        echo "this CPU lacks x86-64-v3's features: built target/pgo/yat only" >&2
+        exit 0
+    fi
     build_for x86-64-v3 target/pgo/yat-x86-64-v3 "$@"
     # The two builds must render the same bytes (workers of both kinds share renders).
-    if grep -qw avx2 /proc/cpuinfo 2>/dev/null; then
-        for scene in dof/dof-0.1.lxs materials/materials.lxs envmap/envmap-hdr.lxs; do
-            for build in yat yat-x86-64-v3; do
-                YAT_ISA=baseline "target/pgo/$build" render "scenes/$scene" --quiet \
-                    --resolution 96x54 --spp 8 --threads 2 --exr -o "$out/$build.png" \
-                    --checkpoint-every 0 --preview-every 0
-            done
-            cmp "$out/yat.exr" "$out/yat-x86-64-v3.exr" || {
-                echo "the x86-64 and x86-64-v3 builds render $scene differently" >&2
-                exit 1
-            }
+    for scene in dof/dof-0.1.lxs materials/materials.lxs envmap/envmap-hdr.lxs; do
+        for build in yat yat-x86-64-v3; do
+            YAT_ISA=baseline "target/pgo/$build" render "scenes/$scene" --quiet \
+                --resolution 96x54 --spp 8 --threads 2 --exr -o "$out/$build.png" \
+                --checkpoint-every 0 --preview-every 0
         done
-    fi
+        cmp "$out/yat.exr" "$out/yat-x86-64-v3.exr" || {
+            echo "the x86-64 and x86-64-v3 builds render $scene differently" >&2
+            rm -f target/pgo/yat-x86-64-v3
+            exit 1
+        }
+    done
     ;;
 *)
     build_for generic target/pgo/yat "$@"
