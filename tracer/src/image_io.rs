@@ -236,8 +236,10 @@ fn axis_neighbours(c: f32, n: u32, edge: Edge) -> ([Option<usize>; 2], f32) {
     let (x0, n) = (i as f32, i64::from(n));
     let pair = match edge {
         Edge::Repeat => {
-            // The division only for lookups outside the first copy, and in 32 bits (`i` is
-            // within +-MAX_COORD), which divide several times faster than 64.
+            // The division only for lookups outside the first copy, and in 32 bits, which
+            // divide several times faster than 64: `i` is within +-MAX_COORD, and `n` below
+            // 2^31 (an image that wide would hold over 2^31 texels, which no decode allocates;
+            // past it the wrap would be wrong, not out of bounds: the remainder stays below n).
             let a = if (0..n).contains(&i) {
                 i
             } else {
