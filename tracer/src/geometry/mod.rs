@@ -77,6 +77,8 @@ pub struct SceneGeometry {
     /// Bounds of everything but the planes (invalid when there is nothing).
     bounds: Aabb,
     build_time: Duration,
+    /// Per shape, whether [`Self::occluded`] looks through it (empty: through none).
+    crossed: Vec<bool>,
 }
 
 impl SceneGeometry {
@@ -177,6 +179,7 @@ impl SceneGeometry {
             triangle_count,
             bounds,
             build_time: start.elapsed(),
+            crossed: Vec::new(),
         }
     }
 
@@ -255,24 +258,44 @@ impl SceneGeometry {
         }
     }
 
-    /// Whether anything blocks the ray within (0, tmax).
+    /// Makes [`Self::occluded`] look through the shapes `crossed` names (by index; `null`
+    /// surfaces, which paths cross too). Closest hits still find them.
+    pub fn cross_in_occlusion(&mut self, crossed: Vec<bool>) {
+        let prims = &self.prims;
+        let meshes = &self.meshes;
+        self.bvh
+            .cross_in_any_hit(|slot| match prims.get(slot as usize) {
+                Some(Prim::Triangle { mesh, .. }) => crossed
+                    .get(meshes[*mesh as usize].shape as usize)
+                    .copied()
+                    .unwrap_or(false),
+                _ => false,
+            });
+        self.crossed = crossed;
+    }
+
+    fn is_crossed(&self, shape: u32) -> bool {
+        self.crossed.get(shape as usize).copied().unwrap_or(false)
+    }
+
+    /// Whether anything blocks the ray within (0, tmax), but the shapes
+    /// [`Self::cross_in_occlusion`] named.
     pub fn occluded(&self, ray: &Ray, tmax: f32) -> bool {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) || tmax.is_nan() {
             return false;
         }
         let (origin, dir) = (Vec3A::from(ray.origin), canonical_dir(ray.dir));
-        if self
-            .planes
-            .iter()
-            .any(|plane| plane.intersect(origin, dir, tmax).is_some())
-        {
+        if self.planes.iter().any(|plane| {
+            !self.is_crossed(plane.shape) && plane.intersect(origin, dir, tmax).is_some()
+        }) {
             return true;
         }
         self.bvh.any(origin, dir, tmax, |slot, tmax| {
             match self.prims[slot as usize] {
-                Prim::Analytic(a) => self.analytic[a as usize]
-                    .intersect(origin, dir, tmax)
-                    .is_some(),
+                Prim::Analytic(a) => {
+                    let shape = &self.analytic[a as usize];
+                    !self.is_crossed(shape.shape) && shape.intersect(origin, dir, tmax).is_some()
+                }
                 Prim::Triangle { .. } => false,
             }
         })

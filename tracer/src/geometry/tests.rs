@@ -852,3 +852,63 @@ fn every_isa_returns_bit_identical_hits() {
         );
     }
 }
+
+/// Shapes named to [`SceneGeometry::cross_in_occlusion`] (`null` surfaces) no longer block
+/// shadow rays, whatever their kind, while closest hits still find them; the others still block.
+#[test]
+fn occlusion_looks_through_crossed_shapes_only() {
+    // Stacked under a ray going down from z = 10: a sphere at z = 6, a triangle at z = 4, a
+    // triangle sharing a packet with it at z = 3 off to the side, a plane at z = 0.
+    let big = |z: f32| {
+        mesh(
+            vec![
+                Vec3::new(-5.0, -5.0, z),
+                Vec3::new(5.0, -5.0, z),
+                Vec3::new(0.0, 5.0, z),
+            ],
+            vec![[0, 1, 2]],
+        )
+    };
+    let aside = mesh(
+        vec![
+            Vec3::new(20.0, 20.0, 3.0),
+            Vec3::new(21.0, 20.0, 3.0),
+            Vec3::new(20.0, 21.0, 3.0),
+        ],
+        vec![[0, 1, 2]],
+    );
+    let shapes = vec![
+        shape(
+            sphere(1.0),
+            Mat4::from_translation(Vec3::new(0.0, 0.0, 6.0)),
+        ),
+        shape(Geometry::Mesh(Arc::new(big(4.0))), Mat4::IDENTITY),
+        shape(Geometry::Mesh(Arc::new(aside)), Mat4::IDENTITY),
+        shape(Geometry::Plane { normal: Vec3::Z }, Mat4::IDENTITY),
+    ];
+    let ray = down(Vec3::new(0.0, 0.0, 10.0));
+    let blocked_before = |crossed: [bool; 4], tmax: f32| {
+        let mut geometry = SceneGeometry::build(&shapes);
+        geometry.cross_in_occlusion(crossed.to_vec());
+        let first = geometry.intersect(&ray, f32::INFINITY).map(|h| h.shape);
+        (geometry.occluded(&ray, tmax), first)
+    };
+    // Nothing crossed: the sphere blocks; it is also the first hit.
+    assert_eq!(blocked_before([false; 4], 100.0), (true, Some(0)));
+    // The sphere crossed: the triangle at z = 4 blocks; the sphere is still the first hit.
+    assert_eq!(
+        blocked_before([true, false, false, false], 100.0),
+        (true, Some(0))
+    );
+    // Sphere and triangle crossed: the plane blocks (at 10), not within 9.
+    assert_eq!(
+        blocked_before([true, true, false, false], 100.0),
+        (true, Some(0))
+    );
+    assert!(!blocked_before([true, true, false, false], 9.0).0);
+    // Everything in the way crossed: nothing blocks.
+    assert!(!blocked_before([true, true, false, true], 100.0).0);
+    // Only the plane crossed: the others block.
+    assert!(blocked_before([false, false, false, true], 100.0).0);
+    assert!(blocked_before([true, false, true, true], 100.0).0);
+}

@@ -39,6 +39,9 @@ pub struct WideBvh {
     packets: Vec<Packet>,
     /// Per packet: the lanes holding primitives that are not triangles (bit per lane).
     other_lanes: Vec<u8>,
+    /// Per packet: the lanes whose triangles end an any-hit query (all but those
+    /// [`Self::cross_in_any_hit`] names).
+    blocking_lanes: Vec<u8>,
     /// Stack entries a traversal can need: 7 per level below the root, plus 8.
     stack_size: usize,
     isa: Option<Isa>,
@@ -73,6 +76,7 @@ impl WideBvh {
             nodes: Vec::with_capacity(count),
             packets: Vec::new(),
             other_lanes: Vec::new(),
+            blocking_lanes: Vec::new(),
             stack_size: 0,
             isa: Some(Isa::best()),
         };
@@ -129,7 +133,20 @@ impl WideBvh {
         debug_assert!(index <= MAX_PACKETS);
         self.packets.push(packet);
         self.other_lanes.push(other);
+        self.blocking_lanes.push(u8::MAX);
         LEAF | index | if other != 0 { LEAF_HAS_OTHER } else { 0 }
+    }
+
+    /// Triangles whose primitive slot `crossed` names no longer end an any-hit query: shadow
+    /// rays cross them (`null` surfaces). Closest hits still find them.
+    pub fn cross_in_any_hit(&mut self, crossed: impl Fn(u32) -> bool) {
+        for (packet, lanes) in self.packets.iter().zip(&mut self.blocking_lanes) {
+            for (lane, &slot) in packet.slot.iter().enumerate() {
+                if *lanes & (1 << lane) != 0 && crossed(slot) {
+                    *lanes &= !(1 << lane);
+                }
+            }
+        }
     }
 
     /// The node a child reference (without the leaf bit) names.
@@ -373,7 +390,8 @@ impl WideBvh {
                 let child = n.child[i];
                 let index = (child & MAX_PACKETS) as usize;
                 let packet = self.packet(index);
-                if K::triangles(packet, &kray, bound, &mut hits) != 0 {
+                let blocking = u32::from(self.blocking_lanes[index]);
+                if K::triangles(packet, &kray, bound, &mut hits) & blocking != 0 {
                     return true;
                 }
                 if child & LEAF_HAS_OTHER != 0 {

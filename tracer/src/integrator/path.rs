@@ -34,7 +34,8 @@ pub trait PathScene {
     fn volumes(&self) -> &Volumes;
     /// The volumes on the two sides of shape `shape`.
     fn shape_media(&self, shape: u32) -> ShapeMedia;
-    /// Whether shape `shape` is `null` (shadow rays in scenes with volumes cross it).
+    /// Whether shape `shape` is `null` (shadow rays cross it, as paths do: the geometry's
+    /// occlusion test looks through it).
     fn is_pass_through(&self, shape: u32) -> bool;
     /// Whether paths split at glossy vertices ([`GLOSSY_SPLIT`]): the integrator allows it, the
     /// scene has lamps and metals, and no volumes or material that lets rays through at some
@@ -363,10 +364,12 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
 }
 
 /// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
-/// a surface blocks the way, else the volumes' transmittance. In a scene without volumes
-/// every surface blocks; with volumes, `null` surfaces let the ray through into the volume
-/// behind them (as LuxRender's shadow rays cross them), so a light inside a null-bounded
-/// volume is seen by light sampling as it is by BSDF sampling.
+/// a surface blocks the way, else the volumes' transmittance. `null` surfaces let the ray
+/// through (into the volume behind them), as LuxRender's shadow rays cross them and as paths
+/// do, so light sampling sees what BSDF sampling sees: the sky behind a `null` lamp, or a light
+/// inside a null-bounded volume. When shadow rays stopped there, the light samples of the sky
+/// behind Captain Falcon's null lamp were lost while the BSDF samples that crossed it found
+/// the sky, and MIS weighed each as if the other could: its direct light came out 0.1% dark.
 fn shadow_transmittance<S: PathScene>(
     scene: &S,
     origin: Vec3,

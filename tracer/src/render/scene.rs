@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
-use crate::desc::{Geometry, MaterialDesc, SceneDesc};
+use crate::desc::{Geometry, MaterialDesc, SceneDesc, ShapeDesc};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
@@ -80,7 +80,8 @@ impl RenderScene {
         let primitives = desc.shapes.iter().map(|s| s.geometry.primitive_count());
         BudgetMeter::default().spend(guard.budget, Limit::Primitives, primitives.sum())?;
         guard.check_cancel()?;
-        let geometry = SceneGeometry::build(&desc.shapes);
+        let mut geometry = SceneGeometry::build(&desc.shapes);
+        geometry.cross_in_occlusion(desc.shapes.iter().map(|s| is_null(desc, s)).collect());
         guard.check_cancel()?;
         let textures = Arc::new(Textures::new(&desc.textures, source)?);
         guard.check_cancel()?;
@@ -321,6 +322,14 @@ fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
         .collect()
 }
 
+/// Whether `shape`'s material is `null`: paths and shadow rays cross it.
+fn is_null(desc: &SceneDesc, shape: &ShapeDesc) -> bool {
+    matches!(
+        desc.materials.get(shape.material.0 as usize),
+        Some(MaterialDesc::Null(_))
+    )
+}
+
 /// Whether the path tracer may split glossy vertices ([`PathScene::glossy_split`]): the scene
 /// file allows it, a lamp (an area light) may shine in a metal's narrow lobe, and no volume, or
 /// material that may let a ray through at one hit and not at the next, makes a split sample's
@@ -389,10 +398,9 @@ impl PathScene for RenderScene {
     }
 
     fn is_pass_through(&self, shape: u32) -> bool {
-        let material = self.desc.shapes.get(shape as usize).map(|s| s.material);
-        matches!(
-            material.and_then(|m| self.desc.materials.get(m.0 as usize)),
-            Some(MaterialDesc::Null(_))
-        )
+        self.desc
+            .shapes
+            .get(shape as usize)
+            .is_some_and(|s| is_null(&self.desc, s))
     }
 }
