@@ -60,6 +60,21 @@ impl Bsdf {
         }
     }
 
+    /// For a BSDF that reflects only, and broadly ([`Bxdf::gathers_broadly`]), the shading
+    /// normal on `wo`'s side: all the light it scatters towards `wo` comes from that hemisphere,
+    /// weighed much as by the cosine (the light sample's environment maps are sampled for it).
+    /// None for other BSDFs.
+    pub fn gathers_from(&self, wo: Vec3) -> Option<Vec3> {
+        self.bxdf.gathers_broadly().then(|| {
+            let n = self.frame.n;
+            if wo.dot(n) < 0.0 {
+                -n
+            } else {
+                n
+            }
+        })
+    }
+
     /// The cone around `wo`'s mirror direction about the shading normal (world space) that
     /// holds most of a bare glossy lobe ([`Bxdf::glossy_spread`]; a coated one is not counted).
     pub fn glossy_cone(&self, wo: Vec3) -> Option<Cone> {

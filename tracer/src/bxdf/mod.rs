@@ -67,6 +67,22 @@ impl Bxdf {
         }
     }
 
+    /// Whether the lobe reflects only (light reaches the surface from the side it is seen
+    /// from) and spreads over the hemisphere much as the cosine does: the surfaces whose light
+    /// samples of an environment map are drawn for the side they face. A metal's lobe is
+    /// narrower: most of those samples would find it dark, each after a shadow ray, where half
+    /// of the map's own samples fall behind the surface at no cost.
+    pub fn gathers_broadly(&self) -> bool {
+        match self {
+            Bxdf::Diffuse(_) | Bxdf::Velvet(_) | Bxdf::Cloth(_) => true,
+            Bxdf::PassThrough
+            | Bxdf::Conductor(_)
+            | Bxdf::Translucent(_)
+            | Bxdf::Dielectric(_)
+            | Bxdf::Scatter(_) => false,
+        }
+    }
+
     /// For a rough metal whose lobe is narrow (alpha below [`GLOSSY_ALPHA`]), the half angle
     /// around the mirror direction that holds most of its lobe: a lamp it reflects is a
     /// bright, sharp-edged patch of the lobe, which one BSDF sample finds or misses.

@@ -87,6 +87,9 @@ struct PrevScatter {
     /// The BSDF samples `p` took for the light it sees directly ([`GLOSSY_SPLIT`] at a split
     /// vertex, else 1): what this ray finds emitting is one of them, weighed by their count.
     split: f32,
+    /// The side `p`'s light sample sampled environment maps for ([`Bsdf::gathers_from`]):
+    /// the density an escaping ray is weighed by.
+    facing: Option<Vec3>,
 }
 
 impl PrevScatter {
@@ -99,6 +102,7 @@ impl PrevScatter {
             image_share: 0.0,
             before_mirror: None,
             split: 1.0,
+            facing: None,
         }
     }
 }
@@ -237,7 +241,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                 let (le, weight) = if prev.specular {
                     (lights.environment(ray.dir), 1.0)
                 } else {
-                    let (le, pdf) = lights.environment_and_pdf(ray.dir);
+                    let (le, pdf) = lights.environment_and_pdf(ray.dir, prev.facing);
                     let pdf_light = (1.0 - prev.image_share) * pdf;
                     (le, power_heuristic(prev.split * prev.pdf, pdf_light))
                 };
@@ -356,6 +360,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             image_share,
             before_mirror,
             split: bsdf_count,
+            facing: bsdf.gathers_from(wo),
         };
         medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
@@ -369,7 +374,8 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
 /// do, so light sampling sees what BSDF sampling sees: the sky behind a `null` lamp, or a light
 /// inside a null-bounded volume. When shadow rays stopped there, the light samples of the sky
 /// behind Captain Falcon's null lamp were lost while the BSDF samples that crossed it found
-/// the sky, and MIS weighed each as if the other could: its direct light came out 0.1% dark.
+/// the sky, and MIS weighed each as if the other could: its direct light came out 0.1% dark
+/// (0.4% with the map sampled for the side a surface faces, which weighs light samples more).
 fn shadow_transmittance<S: PathScene>(
     scene: &S,
     origin: Vec3,
@@ -451,7 +457,8 @@ fn direct_light<S: PathScene>(
     draw: LightDraw,
     rays: &mut u32,
 ) -> Vec3 {
-    let Some(mut ls) = scene.lights().sample(hit.p, draw.u_select, draw.u) else {
+    let facing = bsdf.gathers_from(wo);
+    let Some(mut ls) = scene.lights().sample(hit.p, facing, draw.u_select, draw.u) else {
         return Vec3::ZERO;
     };
     ls.pdf *= draw.share;
@@ -506,6 +513,7 @@ fn split_bsdf_light<S: PathScene>(
     let lobes = sampler.get_split_1d::<GLOSSY_SPLIT>();
     let dirs = sampler.get_split_2d::<GLOSSY_SPLIT>();
     let lights = scene.lights();
+    let facing = bsdf.gathers_from(wo);
     let count = GLOSSY_SPLIT as f32;
     let mut seen = SplitLight {
         radiance: Vec3::ZERO,
@@ -531,7 +539,7 @@ fn split_bsdf_light<S: PathScene>(
         for _ in 0..=MAX_PASS_THROUGH {
             seen.rays += 1;
             let Some(next) = scene.geometry().intersect(&ray, f32::INFINITY) else {
-                let (le, pdf) = lights.environment_and_pdf(bs.wi);
+                let (le, pdf) = lights.environment_and_pdf(bs.wi, facing);
                 seen.radiance += scale * le * weight_of(pdf);
                 break;
             };
@@ -652,7 +660,7 @@ fn direct_light_in_medium<S: PathScene>(
 ) -> Vec3 {
     let u_select = sampler.get_1d();
     let u_light = sampler.get_2d();
-    let Some(ls) = scene.lights().sample(p, u_select, u_light) else {
+    let Some(ls) = scene.lights().sample(p, None, u_select, u_light) else {
         return Vec3::ZERO;
     };
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {

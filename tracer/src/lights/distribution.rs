@@ -215,18 +215,7 @@ impl Distribution2D {
         let scaled = u.x.clamp(0.0, ONE_MINUS_EPSILON) * count_f32(n);
         let slot = bin_at(scaled, n);
         reading(row, slot);
-        let cell = self.cells[row * n + slot];
-        let within = (scaled - count_f32(slot)).clamp(0.0, ONE_MINUS_EPSILON);
-        let (column, pdf_x, du) = if within < cell.keep {
-            (slot, cell.pdf, within / cell.keep)
-        } else {
-            (
-                cell.alias as usize,
-                cell.alias_pdf,
-                (within - cell.keep) / (1.0 - cell.keep),
-            )
-        };
-        let du = du.clamp(0.0, ONE_MINUS_EPSILON);
+        let (column, pdf_x, du) = self.cells[row * n + slot].pick(slot, scaled);
         let x = ((count_f32(column) + du) / count_f32(n)).min(ONE_MINUS_EPSILON);
         Some((Vec2::new(x, y), pdf_x * pdf_y))
     }
@@ -234,6 +223,16 @@ impl Distribution2D {
     /// Cells along a row and rows.
     pub fn cells(&self) -> (usize, usize) {
         (self.width, self.marginal.len())
+    }
+
+    /// The density in cell (`column`, `row`), as [`Self::pdf`] gives it for a point there.
+    pub fn cell_pdf(&self, row: usize, column: usize) -> f32 {
+        let height = self.marginal.len();
+        if column >= self.width || row >= height {
+            return 0.0;
+        }
+        let y = (count_f32(row) + 0.5) / count_f32(height);
+        self.cells[row * self.width + column].pdf * self.marginal.pdf(y)
     }
 
     pub fn pdf(&self, p: Vec2) -> f32 {
@@ -244,6 +243,59 @@ impl Distribution2D {
         let row = bin_at(p.y * count_f32(height), height);
         let column = bin_at(p.x * count_f32(self.width), self.width);
         self.cells[row * self.width + column].pdf * self.marginal.pdf(p.y)
+    }
+}
+
+impl AliasCell {
+    /// What a sample at `scaled` (in [0, n) over the table's n slots) picks from the record of
+    /// its slot `slot`: the column, its density over [0, 1), and where in the column it lands,
+    /// in [0, 1).
+    fn pick(self, slot: usize, scaled: f32) -> (usize, f32, f32) {
+        let within = (scaled - count_f32(slot)).clamp(0.0, ONE_MINUS_EPSILON);
+        let (column, pdf, du) = if within < self.keep {
+            (slot, self.pdf, within / self.keep)
+        } else {
+            (
+                self.alias as usize,
+                self.alias_pdf,
+                (within - self.keep) / (1.0 - self.keep),
+            )
+        };
+        (column, pdf, du.clamp(0.0, ONE_MINUS_EPSILON))
+    }
+}
+
+/// Discrete distributions of `len` entries each, stored one after another, each an alias
+/// table (one record read per sample).
+#[derive(Clone, Debug)]
+pub(crate) struct AliasTables {
+    len: usize,
+    cells: Vec<AliasCell>,
+}
+
+impl AliasTables {
+    /// `func` holds the tables' weights one table after another (a multiple of `len`, at least
+    /// 1, entries). Weights as [`alias_row`] takes them: an all-zero table is uniform.
+    pub fn new(func: &[f32], len: usize) -> Self {
+        let len = len.max(1);
+        Self {
+            len,
+            cells: func.chunks_exact(len).flat_map(alias_row).collect(),
+        }
+    }
+
+    /// In table `table`: the entry `u` (in [0, 1)) picks, its probability times `len` (its
+    /// density over [0, 1)), and `u` rescaled to [0, 1) within the entry.
+    pub fn sample(&self, table: usize, u: f32) -> (usize, f32, f32) {
+        let n = self.len;
+        let scaled = u.clamp(0.0, ONE_MINUS_EPSILON) * count_f32(n);
+        let slot = bin_at(scaled, n);
+        self.cells[table * n + slot].pick(slot, scaled)
+    }
+
+    /// Entry `entry`'s probability in table `table`, times `len`.
+    pub fn density(&self, table: usize, entry: usize) -> f32 {
+        self.cells[table * self.len + entry].pdf
     }
 }
 

@@ -31,6 +31,7 @@ use crate::parse::params::ParamList;
 use super::distribution::Distribution2D;
 use super::emission::{emits, Emission};
 use super::error::LightError;
+use super::facing::FacingTables;
 
 /// `mapping`: the only one modelled.
 pub const DEFAULT_MAPPING: &str = "latlong";
@@ -176,9 +177,9 @@ impl Environment {
         }
     }
 
-    /// Radiance from `dir` and the solid-angle density of [`Self::sample`] there, with one
-    /// conversion to map coordinates for both.
-    pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+    /// Radiance from `dir` and the solid-angle density of [`Self::sample`] there (for a
+    /// surface facing `facing`), with one conversion to map coordinates for both.
+    pub fn radiance_and_pdf(&self, dir: Vec3, facing: Option<Vec3>) -> (Vec3, f32) {
         match &self.map {
             None => (self.radiance, 1.0 / (4.0 * PI)),
             Some(map) => {
@@ -186,14 +187,16 @@ impl Environment {
                 let uv = map.uv(d);
                 (
                     self.radiance * map.lookup(uv),
-                    self.map_pdf(map, d, uv, dir),
+                    self.map_pdf(map, d, uv, dir, facing),
                 )
             }
         }
     }
 
-    /// A world direction, its solid-angle density and the radiance from it.
-    pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
+    /// A world direction, its solid-angle density and the radiance from it. `facing` is the
+    /// world-space normal of a reflecting surface on the side it takes light from: a map is
+    /// then sampled by its facing tables ([`super::facing`]), which give no density behind it.
+    pub fn sample(&self, u: Vec2, facing: Option<Vec3>) -> Option<(Vec3, f32, Vec3)> {
         match &self.map {
             None => {
                 let z = 1.0 - 2.0 * u.x;
@@ -206,11 +209,14 @@ impl Environment {
                 ))
             }
             Some(map) => {
-                // The texels looked up below sit in the sampled cell nearly always: their
-                // load starts alongside the distribution's own cache miss.
-                let (uv, pdf_uv) = map
-                    .distribution
-                    .sample(u, |row, column| map.prefetch_cell(row, column))?;
+                let (uv, pdf_uv) = match facing {
+                    Some(n) => map.facing.sample(self.world_to_light * n, u)?,
+                    // The texels looked up below sit in the sampled cell nearly always: their
+                    // load starts alongside the distribution's own cache miss.
+                    None => map
+                        .distribution
+                        .sample(u, |row, column| map.prefetch_cell(row, column))?,
+                };
                 let (d_light, sin_theta) = map.direction(uv);
                 if pdf_uv <= 0.0 || sin_theta <= 0.0 {
                     return None;
@@ -224,12 +230,12 @@ impl Environment {
     }
 
     /// The solid-angle density of [`Self::sample`] for world direction `dir`.
-    pub fn pdf(&self, dir: Vec3) -> f32 {
+    pub fn pdf(&self, dir: Vec3, facing: Option<Vec3>) -> f32 {
         match &self.map {
             None => 1.0 / (4.0 * PI),
             Some(map) => {
                 let d = self.to_light(dir);
-                self.map_pdf(map, d, map.uv(d), dir)
+                self.map_pdf(map, d, map.uv(d), dir, facing)
             }
         }
     }
@@ -239,13 +245,17 @@ impl Environment {
     }
 
     /// Density at light-space direction `d` (map coordinates `uv`, world direction `dir`).
-    fn map_pdf(&self, map: &LatLongMap, d: Vec3, uv: Vec2, dir: Vec3) -> f32 {
+    fn map_pdf(&self, map: &LatLongMap, d: Vec3, uv: Vec2, dir: Vec3, facing: Option<Vec3>) -> f32 {
         // Not sqrt(1 - z^2), which rounds to 0 near the poles.
         let sin_theta = d.truncate().length();
         if sin_theta <= 0.0 {
             return 0.0;
         }
-        map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta) * self.jacobian(dir)
+        let density = match facing {
+            Some(n) => map.facing.pdf(self.world_to_light * n, uv),
+            None => map.distribution.pdf(uv),
+        };
+        density / (2.0 * PI * PI * sin_theta) * self.jacobian(dir)
     }
 
     /// d omega_light / d omega_world at world direction `dir` for the map d -> A d / |A d|.
@@ -269,6 +279,8 @@ struct LatLongMap {
     /// Over cells of the map (one per texel, or per block of texels on a large map), by
     /// luminance x sin(theta).
     distribution: Distribution2D,
+    /// The same cells for surfaces facing one way or another.
+    facing: FacingTables,
 }
 
 /// The most cells a map's distribution holds (16 bytes each: 2 MiB). One record is read per
@@ -331,12 +343,13 @@ impl LatLongMap {
             }
         }
         let (cells_across, cells_down) = distribution_cells(w, h);
+        let cells = cell_sums(&func, w, h, cells_across, cells_down);
+        let facing = FacingTables::new(&cells, cells_across, cells_down, |uv| {
+            Self::direction_by(convention, uv).0
+        });
         Self {
-            distribution: Distribution2D::new(
-                &cell_sums(&func, w, h, cells_across, cells_down),
-                cells_across,
-                cells_down,
-            ),
+            distribution: Distribution2D::new(&cells, cells_across, cells_down),
+            facing,
             image,
             convention,
         }
@@ -369,8 +382,12 @@ impl LatLongMap {
 
     /// The light-space direction at map coordinates `uv`, and sin(theta) there.
     fn direction(&self, uv: Vec2) -> (Vec3, f32) {
+        Self::direction_by(self.convention, uv)
+    }
+
+    fn direction_by(convention: LatLongConvention, uv: Vec2) -> (Vec3, f32) {
         let (sin_theta, cos_theta) = (uv.y * PI).sin_cos();
-        let phi = match self.convention {
+        let phi = match convention {
             LatLongConvention::Seed => uv.x * TAU - PI,
             LatLongConvention::LuxRender => uv.x * TAU,
         };

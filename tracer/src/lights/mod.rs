@@ -17,7 +17,8 @@
 //! Files: one per kind (`point`, `spot`, `distant`, `infinite`, `sun`, `sky/`, `area`), each
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
-//! types), `error`, `distribution` (sampling tables); `mirrored` (lamp images in flat
+//! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
+//! surface faces); `mirrored` (lamp images in flat
 //! mirrors), `lamp_cones` (which lamps a cone of directions may reach). A new kind is one new
 //! file, one line in `read` and one line in each `match` below.
 
@@ -26,6 +27,7 @@ mod distant;
 mod distribution;
 mod emission;
 mod error;
+mod facing;
 mod infinite;
 mod lamp_cones;
 mod mirrored;
@@ -179,23 +181,23 @@ impl AtInfinity {
         }
     }
 
-    fn pdf(&self, dir: Vec3) -> f32 {
+    fn pdf(&self, dir: Vec3, facing: Option<Vec3>) -> f32 {
         match self {
-            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.pdf(dir),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.pdf(dir, facing),
             AtInfinity::Sun(l) => l.pdf(dir),
         }
     }
 
-    fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+    fn radiance_and_pdf(&self, dir: Vec3, facing: Option<Vec3>) -> (Vec3, f32) {
         match self {
-            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance_and_pdf(dir),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.radiance_and_pdf(dir, facing),
             AtInfinity::Sun(l) => l.radiance_and_pdf(dir),
         }
     }
 
-    fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
+    fn sample(&self, u: Vec2, facing: Option<Vec3>) -> Option<(Vec3, f32, Vec3)> {
         match self {
-            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.sample(u),
+            AtInfinity::Map(l) | AtInfinity::Sky(l) => l.sample(u, facing),
             AtInfinity::Sun(l) => l.sample(u),
         }
     }
@@ -333,28 +335,43 @@ impl Lights {
     }
 
     /// Samples a light as seen from `p` (with `u_select` choosing the light and `u` the point on
-    /// it). None when the chosen light contributes nothing from here.
-    pub fn sample(&self, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+    /// it). `facing` is the normal of a surface that only reflects, on the side it takes light
+    /// from (see [`Bsdf::gathers_from`](crate::material::Bsdf::gathers_from)): environment
+    /// maps are then sampled for that side. None when the chosen light contributes nothing
+    /// from here.
+    pub fn sample(
+        &self,
+        p: Vec3,
+        facing: Option<Vec3>,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
         let (index, pmf, _) = self.selection.sample_discrete(u_select)?;
         match &self.lights[index] {
             Light::Area(light) => light.sample_chosen(p, u, pmf),
             Light::Point(light) => light.sample(p).map(|s| s.chosen(pmf)),
             Light::Spot(light) => light.sample(p).map(|s| s.chosen(pmf)),
             Light::Distant(light) => Some(light.sample().chosen(pmf)),
-            Light::Infinite(light) => self.sample_environment(light, u, pmf),
+            Light::Infinite(light) => self.sample_environment(light, facing, u, pmf),
         }
     }
 
     /// A direction sampled from one of the infinite lights (chosen with probability `pmf`),
     /// with the radiance and density of the whole mixture.
-    fn sample_environment(&self, light: &AtInfinity, u: Vec2, pmf: f32) -> Option<LightSample> {
-        let (wi, pdf, li) = light.sample(u)?;
+    fn sample_environment(
+        &self,
+        light: &AtInfinity,
+        facing: Option<Vec3>,
+        u: Vec2,
+        pmf: f32,
+    ) -> Option<LightSample> {
+        let (wi, pdf, li) = light.sample(u, facing)?;
         // A lone infinite light is the whole mixture: its own density and radiance
         // serve, without looking the direction up again.
         let (li, pdf) = if self.infinite.len() == 1 {
             (li, pmf * pdf)
         } else {
-            self.environment_and_pdf(wi)
+            self.environment_and_pdf(wi, facing)
         };
         (pdf > 0.0).then_some(LightSample {
             wi,
@@ -396,20 +413,20 @@ impl Lights {
             .sum()
     }
 
-    /// Solid-angle density with which `sample` would have chosen direction `dir` on the
-    /// infinite lights.
-    pub fn pdf_environment(&self, dir: Vec3) -> f32 {
+    /// Solid-angle density with which `sample` (for a surface facing `facing`) would have
+    /// chosen direction `dir` on the infinite lights.
+    pub fn pdf_environment(&self, dir: Vec3, facing: Option<Vec3>) -> f32 {
         self.infinite_lights()
-            .map(|(index, light)| self.selection.pmf(index) * light.pdf(dir))
+            .map(|(index, light)| self.selection.pmf(index) * light.pdf(dir, facing))
             .sum()
     }
 
     /// [`Self::environment`] and [`Self::pdf_environment`] together, for an escaping ray that
     /// needs its MIS weight.
-    pub fn environment_and_pdf(&self, dir: Vec3) -> (Vec3, f32) {
+    pub fn environment_and_pdf(&self, dir: Vec3, facing: Option<Vec3>) -> (Vec3, f32) {
         self.infinite_lights()
             .map(|(index, light)| {
-                let (radiance, pdf) = light.radiance_and_pdf(dir);
+                let (radiance, pdf) = light.radiance_and_pdf(dir, facing);
                 (radiance, self.selection.pmf(index) * pdf)
             })
             .fold((Vec3::ZERO, 0.0), |(r, p), (ri, pi)| (r + ri, p + pi))

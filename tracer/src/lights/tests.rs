@@ -1,8 +1,8 @@
-use std::f32::consts::PI;
+use std::f32::consts::{PI, TAU};
 use std::io::Cursor;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{DVec3, Mat4, Vec2, Vec3};
 
 use super::*;
 use crate::assets::MemorySource;
@@ -83,7 +83,7 @@ fn irradiance(lights: &Lights, p: Vec3, n: Vec3, samples: u32, seed: u64) -> Vec
     let mut sum = glam::DVec3::ZERO;
     for _ in 0..samples {
         let u = Vec2::new(rng.f32(), rng.f32());
-        if let Some(s) = lights.sample(p, rng.f32(), u) {
+        if let Some(s) = lights.sample(p, None, rng.f32(), u) {
             let cos = s.wi.dot(n).max(0.0);
             sum += (s.li * cos / s.pdf).as_dvec3();
         }
@@ -202,7 +202,7 @@ fn pdf_hit_agrees_with_sample_at_the_sampled_point() {
             rng.f32() * 4.0 - 2.0,
             rng.f32() * 0.5 - 1.0,
         );
-        let Some(s) = lights.sample(p, rng.f32(), Vec2::new(rng.f32(), rng.f32())) else {
+        let Some(s) = lights.sample(p, None, rng.f32(), Vec2::new(rng.f32(), rng.f32())) else {
             continue;
         };
         if s.delta {
@@ -242,7 +242,7 @@ fn area_lights_emit_from_the_front_only() {
     let (geometry, lights) = build(vec![emitter(square_facing_down(1.0), m, Vec3::ONE)], vec![]);
     let above = Vec3::new(0.1, 0.1, 4.0);
     assert!((0..100).all(|i| lights
-        .sample(above, 0.5, Vec2::new(i as f32 / 100.0, 0.3))
+        .sample(above, None, 0.5, Vec2::new(i as f32 / 100.0, 0.3))
         .is_none()));
     let hit = geometry
         .intersect(&Ray::new(above, -Vec3::Z), f32::INFINITY)
@@ -261,10 +261,10 @@ fn area_lights_emit_from_the_front_only() {
     inward.reverse_orientation = true;
     let (_, lights) = build(vec![inward], vec![]);
     assert!((0..100).all(|i| lights
-        .sample(Vec3::X * 3.0, 0.5, Vec2::new(i as f32 / 100.0, 0.7))
+        .sample(Vec3::X * 3.0, None, 0.5, Vec2::new(i as f32 / 100.0, 0.7))
         .is_none()));
     assert!(lights
-        .sample(Vec3::X * 0.3, 0.5, Vec2::new(0.2, 0.7))
+        .sample(Vec3::X * 0.3, None, 0.5, Vec2::new(0.2, 0.7))
         .is_some());
 }
 
@@ -280,7 +280,9 @@ fn delta_lights_follow_their_definitions() {
     let (_, lights) = build(vec![], vec![spot]);
     let at_angle = |deg: f32| {
         let p = Vec3::new(deg.to_radians().sin(), 0.0, -deg.to_radians().cos()) * 2.0;
-        lights.sample(p, 0.5, Vec2::ZERO).map_or(0.0, |s| s.li.x)
+        lights
+            .sample(p, None, 0.5, Vec2::ZERO)
+            .map_or(0.0, |s| s.li.x)
     };
     assert!((at_angle(0.0) - 2.0).abs() < 1e-5, "I / d^2 on the axis");
     assert!(
@@ -314,7 +316,7 @@ fn delta_lights_follow_their_definitions() {
     let mut seen = [false; 3];
     for i in 0..1000 {
         let s = lights
-            .sample(Vec3::ZERO, (i as f32 + 0.5) / 1000.0, Vec2::ZERO)
+            .sample(Vec3::ZERO, None, (i as f32 + 0.5) / 1000.0, Vec2::ZERO)
             .unwrap();
         assert!(s.delta);
         let which = if s.dist.is_infinite() {
@@ -402,7 +404,7 @@ fn latlong_marker_shows_in_the_direction_each_convention_puts_it() {
         let mut in_marker = 0;
         for _ in 0..1000 {
             let s = lights
-                .sample(Vec3::ZERO, 0.5, Vec2::new(rng.f32(), rng.f32()))
+                .sample(Vec3::ZERO, None, 0.5, Vec2::new(rng.f32(), rng.f32()))
                 .unwrap();
             let phi = s.wi.y.atan2(s.wi.x);
             let u = match convention {
@@ -469,23 +471,9 @@ fn env_map_sampling_estimates_the_map_integral() {
 }
 
 fn env_map_sampling_estimates_the_integral_of(w: u32, h: u32) {
-    let texel = |x: u32, y: u32| {
-        let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
-        let base = 40.0 + 30.0 * (fx * 2.0 * PI).sin() * (fy * PI).cos();
-        let (sx, sy) = (x * 64 / w, y * 32 / h);
-        let spot = if (20..23).contains(&sx) && (8..10).contains(&sy) {
-            200.0
-        } else {
-            0.0
-        };
-        [
-            (base + spot) as u8,
-            (base * 0.5) as u8,
-            (spot * 0.9) as u8 + 10,
-        ]
-    };
+    let texel = spotted_map(w, h);
     let mut source = MemorySource::new();
-    source.insert("env.png", png(w, h, texel));
+    source.insert("env.png", png(w, h, &texel));
     // Sum of radiance x texel solid angle.
     let mut integral = glam::DVec3::ZERO;
     for y in 0..h {
@@ -509,9 +497,9 @@ fn env_map_sampling_estimates_the_integral_of(w: u32, h: u32) {
         for _ in 0..n {
             let u = Vec2::new(rng.f32(), rng.f32());
             let s = lights
-                .sample(Vec3::ZERO, rng.f32(), u)
+                .sample(Vec3::ZERO, None, rng.f32(), u)
                 .unwrap_or_else(|| panic!("{u}"));
-            let pdf = lights.pdf_environment(s.wi);
+            let pdf = lights.pdf_environment(s.wi, None);
             // The sample carries its own texel's density; converting its direction back to
             // map coordinates can round into the neighbouring texel on a texel edge.
             if rel_err(pdf, s.pdf) >= 1e-3 {
@@ -519,7 +507,7 @@ fn env_map_sampling_estimates_the_integral_of(w: u32, h: u32) {
             }
             let li = lights.environment(s.wi);
             assert!((li - s.li).abs().max_element() <= 1e-3 * li.max_element().max(1e-3));
-            let (li_both, pdf_both) = lights.environment_and_pdf(s.wi);
+            let (li_both, pdf_both) = lights.environment_and_pdf(s.wi, None);
             assert_eq!((li_both, pdf_both), (li, pdf));
             sum += (s.li / s.pdf).as_dvec3();
         }
@@ -550,14 +538,14 @@ fn constant_infinite_light_is_uniform_and_shares_with_other_lights() {
         lights.environment(Vec3::new(0.3, -0.2, 0.9).normalize()),
         Vec3::splat(0.5)
     );
-    assert!(rel_err(lights.pdf_environment(Vec3::Z), 1.0 / (4.0 * PI)) < 1e-6);
+    assert!(rel_err(lights.pdf_environment(Vec3::Z, None), 1.0 / (4.0 * PI)) < 1e-6);
     // Irradiance on a surface under a uniform sky: pi L.
     let e = irradiance(&lights, Vec3::ZERO, Vec3::Z, 200_000, 8);
     assert!(rel_err(e.x, PI * 0.5) < 0.01, "E = {}", e.x);
 
     // Beside a far brighter point light the sky still gets the floor's share.
     let (_, lights) = build(vec![], vec![sky, point(Vec3::Z, 1e6)]);
-    let p_sky = lights.pdf_environment(Vec3::Z) * 4.0 * PI;
+    let p_sky = lights.pdf_environment(Vec3::Z, None) * 4.0 * PI;
     assert!(
         rel_err(p_sky, 0.1 / 1.1) < 1e-4,
         "sky selection probability {p_sky}"
@@ -600,10 +588,10 @@ fn no_lights_means_no_samples() {
     let (_, lights) = build(vec![shape(sphere(1.0), Mat4::IDENTITY)], vec![]);
     assert!(lights.is_empty());
     assert!(lights
-        .sample(Vec3::X * 3.0, 0.5, Vec2::splat(0.5))
+        .sample(Vec3::X * 3.0, None, 0.5, Vec2::splat(0.5))
         .is_none());
     assert_eq!(lights.environment(Vec3::Z), Vec3::ZERO);
-    assert_eq!(lights.pdf_environment(Vec3::Z), 0.0);
+    assert_eq!(lights.pdf_environment(Vec3::Z, None), 0.0);
 }
 
 fn sun(to_sun: Vec3, relsize: f32) -> SunLight {
@@ -661,7 +649,7 @@ fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
         assert!((e60.y / (0.5 * expected.y) - 1.0).abs() < 2e-3, "{e60}");
         // An escaping ray into the disc sees the radiance, with the sampler's density.
         assert_eq!(lights.environment(to_sun), radiance);
-        let pdf = lights.pdf_environment(to_sun);
+        let pdf = lights.pdf_environment(to_sun, None);
         assert!((f64::from(pdf) * solid_angle - 1.0).abs() < 1e-3, "{pdf}");
         let off = Frame::from_normal(to_sun).to_world(Vec3::new(0.03, 0.0, 1.0).normalize());
         assert_eq!(lights.environment(off), Vec3::ZERO);
@@ -766,7 +754,7 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = 2.0 * PI * rng.f32();
             let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            pdf_sum += f64::from(lights.pdf_environment(dir));
+            pdf_sum += f64::from(lights.pdf_environment(dir, None));
         }
         let total = pdf_sum / f64::from(n) * 4.0 * std::f64::consts::PI;
         assert!((total - 1.0).abs() < 0.01, "{:?}: {total}", desc.model);
@@ -777,9 +765,9 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
         let mut mismatches = 0;
         for _ in 0..n {
             let s = lights
-                .sample(Vec3::ZERO, rng.f32(), Vec2::new(rng.f32(), rng.f32()))
+                .sample(Vec3::ZERO, None, rng.f32(), Vec2::new(rng.f32(), rng.f32()))
                 .unwrap();
-            if rel_err(lights.pdf_environment(s.wi), s.pdf) >= 1e-3 {
+            if rel_err(lights.pdf_environment(s.wi, None), s.pdf) >= 1e-3 {
                 mismatches += 1;
             }
             estimate += f64::from(luminance(s.li) / s.pdf);
@@ -808,5 +796,146 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
             "{:?}: estimate {estimate}, quadrature {quadrature}",
             desc.model
         );
+    }
+}
+
+/// A smooth map with a bright spot: 8-bit, `w` x `h`.
+fn spotted_map(w: u32, h: u32) -> impl Fn(u32, u32) -> [u8; 3] {
+    move |x, y| {
+        let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
+        let base = 40.0 + 30.0 * (fx * 2.0 * PI).sin() * (fy * PI).cos();
+        let (sx, sy) = (x * 64 / w, y * 32 / h);
+        let spot = if (20..23).contains(&sx) && (8..10).contains(&sy) {
+            200.0
+        } else {
+            0.0
+        };
+        [
+            (base + spot) as u8,
+            (base * 0.5) as u8,
+            (spot * 0.9) as u8 + 10,
+        ]
+    }
+}
+
+/// What a diffuse surface facing `n` receives from the lights, ∫ L max(cos, 0), estimated by
+/// one light sample (for the side `facing`, or none) and one cosine-weighted sample per round,
+/// weighed by the power heuristic as the path tracer weighs them. Returns the estimate, the
+/// variance of one round's luminance, and how many samples' densities `pdf_environment`
+/// does not reproduce.
+fn receives(lights: &Lights, n: Vec3, facing: Option<Vec3>, rounds: u32) -> (DVec3, f64, u32) {
+    let frame = Frame::from_normal(n);
+    let mut rng = fastrand::Rng::with_seed(3);
+    let (mut sum, mut sum_sq, mut mismatches) = (DVec3::ZERO, 0.0f64, 0);
+    let heuristic = |a: f32, b: f32| a * a / (a * a + b * b);
+    for _ in 0..rounds {
+        let mut round = Vec3::ZERO;
+        let u = Vec2::new(rng.f32(), rng.f32());
+        if let Some(s) = lights.sample(Vec3::ZERO, facing, rng.f32(), u) {
+            if rel_err(lights.pdf_environment(s.wi, facing), s.pdf) >= 1e-3 {
+                mismatches += 1;
+            }
+            let cos = s.wi.dot(n);
+            if cos > 0.0 {
+                round += s.li * cos * heuristic(s.pdf, cos / PI) / s.pdf;
+            }
+        }
+        let (r1, r2) = (rng.f32(), rng.f32());
+        let (sin_phi, cos_phi) = (TAU * r2).sin_cos();
+        let r = r1.sqrt();
+        let wi = frame.to_world(Vec3::new(r * cos_phi, r * sin_phi, (1.0 - r1).sqrt()));
+        let cos = wi.dot(n);
+        if cos > 0.0 {
+            let (li, pdf_light) = lights.environment_and_pdf(wi, facing);
+            round += li * cos * heuristic(cos / PI, pdf_light) / (cos / PI);
+        }
+        sum += round.as_dvec3();
+        sum_sq += f64::from(luminance(round)).powi(2);
+    }
+    let mean = sum / f64::from(rounds);
+    let variance = sum_sq / f64::from(rounds) - f64::from(luminance(mean.as_vec3())).powi(2);
+    (mean, variance, mismatches)
+}
+
+/// ∫ L max(cos, 0) over the texels of a map in the seed convention under `rotation`, for a
+/// surface facing `n` (radiance and cosine at texel centres).
+fn map_irradiance(
+    texel: impl Fn(u32, u32) -> [u8; 3],
+    w: u32,
+    h: u32,
+    rotation: Mat4,
+    n: Vec3,
+) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    for y in 0..h {
+        let (t0, t1) = (y as f32 / h as f32 * PI, (y + 1) as f32 / h as f32 * PI);
+        let solid_angle = TAU / w as f32 * (t0.cos() - t1.cos());
+        let theta = (y as f32 + 0.5) / h as f32 * PI;
+        for x in 0..w {
+            // Seed convention: u = (pi + phi) / 2pi.
+            let phi = (x as f32 + 0.5) / w as f32 * TAU - PI;
+            let cos = rotation.transform_vector3(spherical(theta, phi)).dot(n);
+            let l = Vec3::from_array(texel(x, y).map(|v| f32::from(v) / 255.0));
+            sum += (l * cos.max(0.0) * solid_angle).as_dvec3();
+        }
+    }
+    sum
+}
+
+#[test]
+fn facing_samples_weighed_against_cosine_samples_estimate_what_a_surface_receives() {
+    // One distribution cell per texel in one block per cell; and Captain Falcon's size: cells
+    // of 4 x 4 texels in blocks of 8 x 8 cells.
+    let cases = [
+        (
+            64,
+            32,
+            Mat4::from_rotation_y(0.4) * Mat4::from_rotation_z(1.0),
+        ),
+        (1600, 800, Mat4::IDENTITY),
+    ];
+    for (w, h, rotation) in cases {
+        let texel = spotted_map(w, h);
+        let mut source = MemorySource::new();
+        source.insert("env.png", png(w, h, &texel));
+        let lights = env_lights(
+            &source,
+            env_light("env.png", rotation),
+            LatLongConvention::Seed,
+        );
+        let mut rng = fastrand::Rng::with_seed(8);
+        let mut ratios = Vec::new();
+        for i in 0..6 {
+            let n = match i {
+                0 => Vec3::Z,
+                _ => Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5).normalize(),
+            };
+            let want = map_irradiance(&texel, w, h, rotation, n);
+            let rounds = 400_000;
+            let (got, variance, mismatches) = receives(&lights, n, Some(n), rounds);
+            let (plain, plain_variance, _) = receives(&lights, n, None, rounds);
+            assert!(
+                mismatches * 1000 < rounds,
+                "{mismatches} of {rounds} densities disagree"
+            );
+            for c in 0..3 {
+                for (what, estimate) in [("facing", got), ("plain", plain)] {
+                    let err = (estimate[c] / want[c] - 1.0).abs();
+                    assert!(
+                        err < 5e-3,
+                        "{w}x{h}, {n}: {what} {estimate}, integral {want}"
+                    );
+                }
+            }
+            // What the tables are for: the map's light samples weigh less noise in.
+            let ratio = variance / plain_variance;
+            assert!(
+                ratio < 0.85,
+                "{w}x{h}, {n}: variance {variance} against {plain_variance}"
+            );
+            ratios.push(ratio);
+        }
+        let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+        assert!(mean < 0.6, "{w}x{h}: variance ratios {ratios:?}");
     }
 }

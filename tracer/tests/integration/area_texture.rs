@@ -124,7 +124,7 @@ fn a_textured_area_light_emits_its_texture_where_seen_and_where_sampled() {
         let mut e = 0.0f64;
         for i in 0..n {
             let (u_select, u) = u3(i, n);
-            if let Some(s) = lights.sample(p, u_select, u) {
+            if let Some(s) = lights.sample(p, None, u_select, u) {
                 // Only the square is below z = 1: the sphere's samples point up past it and
                 // are shadowed by the square's back in a render; here they are left out.
                 if s.wi.z > 0.0 && s.dist < 1.5 / s.wi.z {
@@ -155,7 +155,7 @@ fn a_sampled_point_carries_the_radiance_a_ray_sees_there() {
     for from in [Vec3::new(0.3, -0.2, 0.0), Vec3::new(0.1, 0.2, 2.5)] {
         for i in 0..n {
             let (u_select, u) = u3(i, n);
-            let Some(s) = lights.sample(from, u_select, u) else {
+            let Some(s) = lights.sample(from, None, u_select, u) else {
                 continue;
             };
             let Some(hit) = geometry.intersect(&Ray::new(from, s.wi), f32::INFINITY) else {

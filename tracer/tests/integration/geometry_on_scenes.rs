@@ -113,7 +113,8 @@ fn bvh_and_lights_on_real_scenes() {
         // density the sample reported.
         let mut agreed = 0;
         for hit in hits.iter().flatten().take(2000) {
-            let Some(s) = lights.sample(hit.p, rng.f32(), Vec2::new(rng.f32(), rng.f32())) else {
+            let Some(s) = lights.sample(hit.p, None, rng.f32(), Vec2::new(rng.f32(), rng.f32()))
+            else {
                 continue;
             };
             if s.delta || !s.dist.is_finite() {
