@@ -42,8 +42,9 @@ APPROXIMATIONS = [
     "vertex's bounce), but Mitsuba's survival probability is min(max throughput x eta^2, 0.95) "
     "where YAT's is max throughput clamped to [0.05, 1]",
     "lamps: YAT's null-material area lights are Mitsuba's null BSDF with an area emitter "
-    "(emits, lets rays through, blocks shadow rays, as in YAT); Mitsuba counts the crossing "
-    "as a path vertex, YAT does not",
+    "(emits, lets rays through); Mitsuba counts the crossing as a path vertex, YAT does not, "
+    "and its shadow rays stop at the lamp where YAT's cross it (since session 18): the light "
+    "samples of what lies behind a lamp, 0.1% of Captain Falcon's direct light",
     "pixel filter: Mitsuba has no Blackman-Harris; a gaussian of the same standard deviation "
     "(0.554 px for the scenes' half-width 2). Both splat each sample over the filter's "
     "footprint (YAT since session 6; before, it importance-sampled the filter into one pixel)",
