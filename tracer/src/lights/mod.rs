@@ -18,9 +18,9 @@
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
-//! surface faces); `mirrored` (lamp images in flat
-//! mirrors), `lamp_cones` (which lamps a cone of directions may reach). A new kind is one new
-//! file, one line in `read` and one line in each `match` below.
+//! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_cones` (which lamps a cone
+//! of directions may reach). A new kind is one new file, one line in `read` and one line in
+//! each `match` below.
 
 mod area;
 mod distant;
