@@ -282,12 +282,12 @@ fn a_second_render_sends_no_scene_bytes() {
     assert_eq!(
         sent("first"),
         files,
-        "the main file, the Include and the PNG"
+        "the main file, the Include and the two PNGs"
     );
     assert_eq!(sent("second"), 0);
     let stats = worker.stats(None);
     assert_eq!(stats.blob_bytes_received, files);
-    assert_eq!(stats.blobs_cached, 3);
+    assert_eq!(stats.blobs_cached, 4);
     assert_eq!(
         stats.scenes_cached, 1,
         "the same scene and settings are built once"

@@ -7,10 +7,11 @@ use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
-/// A closed box lit by an area light, with a glossy sphere, a rough metal ball (paths split
-/// where it shows the lamp), a flat mirror (whose lamp image the path tracer samples), its
-/// materials in an Include'd file and a poster textured with a PNG image map. Returns the main
-/// file.
+/// A box lit by an area light and, through its open side behind the camera, an environment
+/// map (its light samples drawn for the side each matte surface faces), with a glossy sphere, a
+/// rough metal ball (paths split where it shows the lamp), a flat mirror (whose lamp image the
+/// path tracer samples), its materials in an Include'd file and a poster textured with a PNG
+/// image map. Returns the main file.
 pub fn write_scene(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(dir.join("textures")).unwrap();
     let checks = image::RgbImage::from_fn(8, 8, |x, y| {
@@ -21,6 +22,13 @@ pub fn write_scene(dir: &Path) -> PathBuf {
         }
     });
     checks.save(dir.join("textures/checks.png")).unwrap();
+    // A sky brighter overhead, with a small bright patch.
+    let sky = image::RgbImage::from_fn(16, 8, |x, y| {
+        let spot = if (x, y) == (3, 2) { 150 } else { 0 };
+        let v = (200 - 20 * y) as u8;
+        image::Rgb([v / 2 + spot, v / 2 + spot, v])
+    });
+    sky.save(dir.join("textures/sky.png")).unwrap();
     std::fs::write(
         dir.join("materials.lxo"),
         r#"Texture "checks" "color" "imagemap" "string filename" ["textures/checks.png"]
@@ -41,7 +49,7 @@ MakeNamedMaterial "steel" "string type" "metal2" "color fresnel" [0.6 0.6 0.6]
     let scene = dir.join("box.lxs");
     std::fs::write(
         &scene,
-        r#"# A closed box with an area light, a glossy sphere, a metal ball, a mirror and a textured poster.
+        r#"# A box open behind the camera with an area light and a sky, a glossy sphere, a metal ball, a mirror and a textured poster.
 Film "fleximage" "integer xresolution" [128] "integer yresolution" [96]
   "string filename" ["box"]
 PixelFilter "blackmanharris" "float xwidth" 2 "float ywidth" 2
@@ -55,7 +63,6 @@ AttributeBegin
   Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]
   Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 2  -1 1 2  1 1 2  1 -1 2]
   Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 1 0  1 1 0  1 1 2  -1 1 2]
-  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-1 -1 0  -1 -1 2  1 -1 2  1 -1 0]
 AttributeEnd
 AttributeBegin
   NamedMaterial "red"
@@ -92,6 +99,9 @@ AttributeBegin
   Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     "point P" [-0.3 -0.3 1.99  -0.3 0.3 1.99  0.3 0.3 1.99  0.3 -0.3 1.99]
 AttributeEnd
+AttributeBegin
+  LightSource "infinite" "string mapname" ["textures/sky.png"] "float gamma" [2.2]
+AttributeEnd
 WorldEnd
 "#,
     )
@@ -101,10 +111,15 @@ WorldEnd
 
 /// The scene's files and their total size, as a coordinator must upload them.
 pub fn scene_bytes(dir: &Path) -> u64 {
-    ["box.lxs", "materials.lxo", "textures/checks.png"]
-        .iter()
-        .map(|f| std::fs::metadata(dir.join(f)).unwrap().len())
-        .sum()
+    [
+        "box.lxs",
+        "materials.lxo",
+        "textures/checks.png",
+        "textures/sky.png",
+    ]
+    .iter()
+    .map(|f| std::fs::metadata(dir.join(f)).unwrap().len())
+    .sum()
 }
 
 /// Render settings every test uses: 4 tiles x 8 passes = 32 units.
