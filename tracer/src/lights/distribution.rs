@@ -102,13 +102,8 @@ impl Distribution1D {
         Some((x, self.bins[i].func / self.integral, i))
     }
 
-    /// The density of `sample_continuous` at `x` in [0, 1].
-    pub fn pdf(&self, x: f32) -> f32 {
-        let n = self.len();
-        if n == 0 {
-            return 0.0;
-        }
-        let i = bin_at(x * count_f32(n), n);
+    /// The density of `sample_continuous` in bin `i` (in range).
+    fn bin_pdf(&self, i: usize) -> f32 {
         self.bins[i].func / self.integral
     }
 
@@ -225,24 +220,24 @@ impl Distribution2D {
         (self.width, self.marginal.len())
     }
 
-    /// The density in cell (`column`, `row`), as [`Self::pdf`] gives it for a point there.
+    /// The density in cell (`column`, `row`); 0 outside the grid.
     pub fn cell_pdf(&self, row: usize, column: usize) -> f32 {
-        let height = self.marginal.len();
-        if column >= self.width || row >= height {
+        if column >= self.width || row >= self.marginal.len() {
             return 0.0;
         }
-        let y = (count_f32(row) + 0.5) / count_f32(height);
-        self.cells[row * self.width + column].pdf * self.marginal.pdf(y)
+        self.cells[row * self.width + column].pdf * self.marginal.bin_pdf(row)
     }
 
+    /// The density at `p`: that of the cell holding it.
     pub fn pdf(&self, p: Vec2) -> f32 {
         let height = self.marginal.len();
         if self.width == 0 || height == 0 {
             return 0.0;
         }
-        let row = bin_at(p.y * count_f32(height), height);
-        let column = bin_at(p.x * count_f32(self.width), self.width);
-        self.cells[row * self.width + column].pdf * self.marginal.pdf(p.y)
+        self.cell_pdf(
+            bin_at(p.y * count_f32(height), height),
+            bin_at(p.x * count_f32(self.width), self.width),
+        )
     }
 }
 

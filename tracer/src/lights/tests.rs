@@ -474,19 +474,7 @@ fn env_map_sampling_estimates_the_integral_of(w: u32, h: u32) {
     let texel = spotted_map(w, h);
     let mut source = MemorySource::new();
     source.insert("env.png", png(w, h, &texel));
-    // Sum of radiance x texel solid angle.
-    let mut integral = glam::DVec3::ZERO;
-    for y in 0..h {
-        let (t0, t1) = (
-            y as f64 / h as f64 * std::f64::consts::PI,
-            (y + 1) as f64 / h as f64 * std::f64::consts::PI,
-        );
-        let solid_angle = std::f64::consts::TAU / w as f64 * (t0.cos() - t1.cos());
-        for x in 0..w {
-            let t = texel(x, y).map(|v| f64::from(v) / 255.0);
-            integral += glam::DVec3::from_array(t) * solid_angle;
-        }
-    }
+    let integral = map_integral(&texel, w, h, |_| 1.0);
     let rotation = Mat4::from_rotation_y(0.4) * Mat4::from_rotation_z(1.0);
     for convention in [LatLongConvention::Seed, LatLongConvention::LuxRender] {
         let lights = env_lights(&source, env_light("env.png", rotation), convention);
@@ -857,26 +845,26 @@ fn receives(lights: &Lights, n: Vec3, facing: Option<Vec3>, rounds: u32) -> (DVe
     (mean, variance, mismatches)
 }
 
-/// ∫ L max(cos, 0) over the texels of a map in the seed convention under `rotation`, for a
-/// surface facing `n` (radiance and cosine at texel centres).
-fn map_irradiance(
+/// Σ radiance x `weight` x solid angle over the texels of a `w` x `h` map, `weight` taking the
+/// light-space direction of a texel's centre in the seed convention (u = (pi + phi) / 2pi).
+fn map_integral(
     texel: impl Fn(u32, u32) -> [u8; 3],
     w: u32,
     h: u32,
-    rotation: Mat4,
-    n: Vec3,
+    weight: impl Fn(Vec3) -> f64,
 ) -> DVec3 {
     let mut sum = DVec3::ZERO;
     for y in 0..h {
-        let (t0, t1) = (y as f32 / h as f32 * PI, (y + 1) as f32 / h as f32 * PI);
-        let solid_angle = TAU / w as f32 * (t0.cos() - t1.cos());
+        let (t0, t1) = (
+            y as f64 / h as f64 * std::f64::consts::PI,
+            (y + 1) as f64 / h as f64 * std::f64::consts::PI,
+        );
+        let solid_angle = std::f64::consts::TAU / w as f64 * (t0.cos() - t1.cos());
         let theta = (y as f32 + 0.5) / h as f32 * PI;
         for x in 0..w {
-            // Seed convention: u = (pi + phi) / 2pi.
             let phi = (x as f32 + 0.5) / w as f32 * TAU - PI;
-            let cos = rotation.transform_vector3(spherical(theta, phi)).dot(n);
-            let l = Vec3::from_array(texel(x, y).map(|v| f32::from(v) / 255.0));
-            sum += (l * cos.max(0.0) * solid_angle).as_dvec3();
+            let l = DVec3::from_array(texel(x, y).map(|v| f64::from(v) / 255.0));
+            sum += l * weight(spherical(theta, phi)) * solid_angle;
         }
     }
     sum
@@ -910,7 +898,10 @@ fn facing_samples_weighed_against_cosine_samples_estimate_what_a_surface_receive
                 0 => Vec3::Z,
                 _ => Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5).normalize(),
             };
-            let want = map_irradiance(&texel, w, h, rotation, n);
+            // ∫ L max(cos, 0), the map's directions turned into the world.
+            let want = map_integral(&texel, w, h, |d| {
+                f64::from(rotation.transform_vector3(d).dot(n).max(0.0))
+            });
             let rounds = 400_000;
             let (got, variance, mismatches) = receives(&lights, n, Some(n), rounds);
             let (plain, plain_variance, _) = receives(&lights, n, None, rounds);

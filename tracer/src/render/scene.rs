@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::assets::AssetSource;
 use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
-use crate::desc::{Geometry, MaterialDesc, SceneDesc, ShapeDesc};
+use crate::desc::{Geometry, MaterialDesc, SceneDesc};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
@@ -18,6 +18,7 @@ use crate::integrator::path::{trace_path, PathScene};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
 use crate::medium::{ShapeMedia, Volumes};
+use crate::param::MaterialId;
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
@@ -81,7 +82,12 @@ impl RenderScene {
         BudgetMeter::default().spend(guard.budget, Limit::Primitives, primitives.sum())?;
         guard.check_cancel()?;
         let mut geometry = SceneGeometry::build(&desc.shapes);
-        geometry.cross_in_occlusion(desc.shapes.iter().map(|s| is_null(desc, s)).collect());
+        geometry.cross_in_occlusion(
+            desc.shapes
+                .iter()
+                .map(|s| is_null(desc, s.material))
+                .collect(),
+        );
         guard.check_cancel()?;
         let textures = Arc::new(Textures::new(&desc.textures, source)?);
         guard.check_cancel()?;
@@ -322,10 +328,10 @@ fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
         .collect()
 }
 
-/// Whether `shape`'s material is `null`: paths and shadow rays cross it.
-fn is_null(desc: &SceneDesc, shape: &ShapeDesc) -> bool {
+/// Whether material `id` is `null`: paths and shadow rays cross the shapes it is on.
+fn is_null(desc: &SceneDesc, id: MaterialId) -> bool {
     matches!(
-        desc.materials.get(shape.material.0 as usize),
+        desc.materials.get(id.0 as usize),
         Some(MaterialDesc::Null(_))
     )
 }
@@ -343,14 +349,8 @@ fn glossy_split(desc: &SceneDesc) -> bool {
             _ => false,
         }
     }
-    let is_null = |id: &crate::param::MaterialId| {
-        matches!(
-            desc.materials.get(id.0 as usize),
-            Some(MaterialDesc::Null(_))
-        )
-    };
     let sometimes_passes = |m: &MaterialDesc| match m {
-        MaterialDesc::Mix(_) => m.materials().iter().any(is_null),
+        MaterialDesc::Mix(_) => m.materials().iter().any(|&id| is_null(desc, id)),
         MaterialDesc::Layered(_) => true,
         _ => false,
     };
@@ -401,6 +401,6 @@ impl PathScene for RenderScene {
         self.desc
             .shapes
             .get(shape as usize)
-            .is_some_and(|s| is_null(&self.desc, s))
+            .is_some_and(|s| is_null(&self.desc, s.material))
     }
 }
