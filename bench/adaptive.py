@@ -73,12 +73,6 @@ RENDERS_CACHE = bench.REFS / "time-to-clean.json"
 CLOSE_ENOUGH = 1.1
 
 
-def clean_mse(image, reference):
-    """MSE against a reference pair's mean, minus the mean's own noise."""
-    mean, noise = reference
-    return bench.mse(image, mean) - noise
-
-
 def yat(binary, scene, args, out_dir, extra):
     """One in-process YAT render into out_dir/out.exr; returns its figures."""
     stats = out_dir / "stats.json"
@@ -111,7 +105,7 @@ def measure(yat_config, extra):
             figures = yat(binary, scene, args, Path(tmp), extra)
             image = bench.read_exr(Path(tmp) / "out.exr")
         w, h = (int(v) for v in args.resolution.split("x"))
-        return clean_mse(image, reference), figures["cpu_seconds"], figures["samples"] / (w * h)
+        return bench.clean_mse(image, reference), figures["cpu_seconds"], figures["samples"] / (w * h)
 
     return cached_run(cache, key, " ".join(extra), render)
 
@@ -275,7 +269,7 @@ def rivals(scene, export, args, cache, size, yat_reference):
             with tempfile.TemporaryDirectory() as tmp:
                 f = run(Path(tmp), spp)
                 image = bench.read_exr(Path(tmp) / "ref.exr")
-            return clean_mse(image, reference), f["render_cpu_seconds"], f["spp"]
+            return bench.clean_mse(image, reference), f["render_cpu_seconds"], f["spp"]
         return render
 
     common = f"{res}|d{args.depth}|t{args.threads}|ref{args.reference_spp}|seed{bench.SHORT_SEED}"

@@ -224,6 +224,12 @@ def mse(image, ref):
     return float(np.mean((image - ref) ** 2))
 
 
+def clean_mse(image, reference):
+    """MSE against a reference pair's mean (reference_pair), minus the mean's own noise."""
+    mean, noise = reference
+    return mse(image, mean) - noise
+
+
 def block_correlation(a, b, block=16):
     """Correlation of block-mean luminance: the same picture, whatever the noise."""
     import numpy as np
@@ -289,27 +295,33 @@ def side_by_side(args):
             mi_key = file_digest(xml, *meshes, *sorted((export / "textures").glob("*")),
                                  ROOT / "bench/mitsuba3.py")
 
-            def yat_ref(d):
-                log(f"  YAT reference {name} at {ref_spp} spp ...")
-                render(scene, ref_spp, args.depth, args.threads, d, REFERENCE_SEED, size)
+            # Each reference is the mean of two renders of half its samples (other seeds than
+            # the timed renders'): the MSE against it less its own noise is the MSE against the
+            # converged image. A reference of a few hundred samples still carries an eighth or
+            # so of a 16-spp render's error, more for a noisier sampler: left in, it would count
+            # against whichever renderer it belongs to.
+            half = max(ref_spp // 2, 1)
+
+            def yat_ref(d, seed):
+                log(f"  YAT reference {name} at {half} spp, seed {seed} ...")
+                render(scene, half, args.depth, args.threads, d, seed, size)
                 (d / "out.exr").rename(d / "ref.exr")
 
-            def lux_ref(d):
-                log(f"  LuxCore reference {name} at {ref_spp} spp ...")
-                render_luxcore(export, ref_spp, args.depth, args.threads, d, REFERENCE_SEED,
-                               size)
+            def lux_ref(d, seed):
+                log(f"  LuxCore reference {name} at {half} spp, seed {seed} ...")
+                render_luxcore(export, half, args.depth, args.threads, d, seed, size)
                 (d / "lux.exr").rename(d / "ref.exr")
 
-            def mi_ref(d):
-                log(f"  Mitsuba reference {name} at {ref_spp} spp ...")
-                render_mitsuba(xml, MITSUBA_REFERENCE[0], MITSUBA_REFERENCE[1], ref_spp,
-                               args.depth, args.threads, size, d, REFERENCE_SEED, False)
+            def mi_ref(d, seed):
+                log(f"  Mitsuba reference {name} at {half} spp, seed {seed} ...")
+                render_mitsuba(xml, MITSUBA_REFERENCE[0], MITSUBA_REFERENCE[1], half,
+                               args.depth, args.threads, size, d, seed, False)
                 (d / "mitsuba.exr").rename(d / "ref.exr")
 
-            setting = f"{name}-{res}-{ref_spp}spp-d{args.depth}"
-            y_ref = reference("yat", setting, yat_key, yat_ref)
-            l_ref = reference("luxcore", setting, lux_key, lux_ref)
-            m_ref = reference("mitsuba", setting, mi_key, mi_ref)
+            setting = f"{name}-{res}-{half}spp-d{args.depth}"
+            y_ref = reference_pair("yat", setting, yat_key, yat_ref)
+            l_ref = reference_pair("luxcore", setting, lux_key, lux_ref)
+            m_ref = reference_pair("mitsuba", setting, mi_key, mi_ref)
 
             load = os.getloadavg()[0]
             log(f"comparing {name} at {spp} spp (load {load:.1f}, {args.compare_rounds} rounds) ...")
@@ -337,23 +349,24 @@ def side_by_side(args):
             for _ in range(args.compare_rounds):
                 for job_runs, (_, _, run, image, ref) in zip(timed, jobs):
                     f = run()
-                    job_runs.append((f, mse(read_exr(image), ref)))
-            results = []  # (renderer, sampler, figures of the median run, mse, fastest s)
-            for job_runs, (label, sampler, _, _, _) in zip(timed, jobs):
+                    job_runs.append((f, clean_mse(read_exr(image), ref)))
+            results = []  # (renderer, sampler, figures of the median run, mse, fastest s, ref)
+            for job_runs, (label, sampler, _, _, ref) in zip(timed, jobs):
                 job_runs.sort(key=lambda r: r[0]["render_seconds"])
                 f, e = job_runs[(len(job_runs) - 1) // 2]
                 fastest = job_runs[0][0]["render_seconds"]
-                results.append((label(f), sampler or f["sampler"], f, e, fastest))
+                results.append((label(f), sampler or f["sampler"], f, e, fastest, ref))
                 log(f"  {results[-1][0]} {results[-1][1]}: "
                     f"{[round(r[0]['render_seconds'], 2) for r in job_runs]} s, MSE {e:.3g}")
-            effs = [1 / (e * f["render_seconds"]) for _, _, f, e, _ in results]
-            effs_fastest = [1 / (e * fastest) for _, _, _, e, fastest in results]
-            for (who, sampler, f, e, fastest), eff in zip(results, effs):
+            effs = [1 / (e * f["render_seconds"]) for _, _, f, e, _, _ in results]
+            effs_fastest = [1 / (e * fastest) for _, _, _, e, fastest, _ in results]
+            for (who, sampler, f, e, fastest, ref), eff in zip(results, effs):
                 rays = f.get("rays_per_second")
                 runs.append([
                     name, who, sampler, f"{f['render_seconds']:.2f} ({fastest:.2f})",
                     f"{f['samples_per_second'] / 1e6:.3f}",
-                    f"{rays / 1e6:.2f}" if rays else "-", f"{e:.3g}", f"{eff:.3g}",
+                    f"{rays / 1e6:.2f}" if rays else "-", f"{e:.3g}", f"{ref[1]:.2g}",
+                    f"{eff:.3g}",
                     f"{effs[0] / eff:.2f}x",
                 ])
 
@@ -367,13 +380,15 @@ def side_by_side(args):
 
             summary.append([
                 name, res, f"{spp} / {ref_spp}", f"{load:.1f}",
-                f"{y_ref.mean() / l_ref.mean():.3f}", f"{block_correlation(y_ref, l_ref):.4f}",
-                f"{y_ref.mean() / m_ref.mean():.3f}", f"{block_correlation(y_ref, m_ref):.4f}",
+                f"{y_ref[0].mean() / l_ref[0].mean():.3f}",
+                f"{block_correlation(y_ref[0], l_ref[0]):.4f}",
+                f"{y_ref[0].mean() / m_ref[0].mean():.3f}",
+                f"{block_correlation(y_ref[0], m_ref[0]):.4f}",
                 f"{effs[0] / effs[1]:.2f}x", best("scalar_rgb"), best("llvm_ad_rgb"),
             ])
     runs_table = table(
         ["scene", "renderer", "sampler", "render s (fastest)", "M samples/s", "M rays/s", "MSE",
-         "efficiency", "YAT efficiency / this"],
+         "its reference's noise", "efficiency", "YAT efficiency / this"],
         runs,
     )
     summary_table = table(
@@ -461,11 +476,15 @@ reaching the lamp (LuxCore's Cornell box came out 1.3% darker than YAT's); LuxCo
 material is skipped inside its intersection routine, so no ray would see the emission. LuxCore's
 image also comes out one pixel row lower than YAT's and Mitsuba's; `bench/luxcore.py` moves
 its screen window down one row to match. All render at {size[0]}x{size[1]}, path depth {args.depth}, on the same
-threads. Each renderer renders a converged reference of its own ({args.ref_spp} spp, another
-seed; Mitsuba's with `{MITSUBA_REFERENCE[0]}` and `{MITSUBA_REFERENCE[1]}`, one reference for
-both variants) and short renders ({args.compare_spp} spp). MSE is per channel over all pixels of
-the linear images, efficiency = 1 / (MSE x render s), and "YAT efficiency / this" is YAT's over
-the row's. The summary compares the references (mean radiance, and correlation of 16x16-pixel
+threads. Each renderer renders a converged reference of its own ({args.ref_spp} spp: the mean of
+two renders of half as many with seeds of their own; Mitsuba's with `{MITSUBA_REFERENCE[0]}` and
+`{MITSUBA_REFERENCE[1]}`, one reference for both variants) and short renders
+({args.compare_spp} spp). MSE is per channel over all pixels of the linear images, less the
+reference's own noise (MSE(half a, half b) / 4, the "its reference's noise" column): what is
+left is the error against the converged image, whatever each reference's sampler (since session
+19; before, the reference's noise stayed in, which favoured the renderer with the less noisy
+reference). Efficiency = 1 / (MSE x render s), and "YAT efficiency / this" is YAT's over the
+row's. The summary compares the references (mean radiance, and correlation of 16x16-pixel
 block luminance: the renderers rendered the same picture) and names each Mitsuba variant's
 most efficient sampler.
 
