@@ -55,8 +55,26 @@ const MAX_PASS_THROUGH: u32 = 64;
 /// error to 0.55 for 1.08 times the work, 8 to 0.46 for 1.17, 16 to 0.44 for 1.35.
 pub const GLOSSY_SPLIT: usize = 8;
 
-/// Bounces before Russian roulette may end a path.
+/// Bounces before Russian roulette may end a path under the `probability` strategy (as in
+/// LuxRender).
 const RR_MIN_DEPTH: u32 = 3;
+
+/// Under the `efficiency` strategy a path survives a broad scattering vertex (diffuse, velvet,
+/// cloth, a volume's phase function) with this multiple of its throughput's largest channel as
+/// probability, capped at 1, from the first vertex on; a glossy or specular vertex never ends
+/// it. Measured against the rule it replaced (the throughput itself, from the third vertex on,
+/// at every vertex), MSE x CPU time at 16 spp, one thread: depth of field 0.81, Cornell 0.91,
+/// Mario 0.96, Captain Falcon 0.74, our volumes scene 0.87; our daylight scene 1.02-1.08 (MSE
+/// +4%: under an open sky a path's continuation is one cheap ray, little to save). A path into
+/// the black squares of a checkerboard, or off a dark wall, mostly ends there instead of
+/// bouncing on for little light; three times the throughput keeps the bright paths that the old
+/// rule ended; and the light a glossy vertex sends on is concentrated (the caustics of Mario's
+/// metal seen from the floor), which the roulette turned into fireflies.
+const RR_THROUGHPUT_SCALE: f32 = 3.0;
+
+/// The least survival probability of the `efficiency` strategy: a path it keeps is weighed by
+/// at most 20 times.
+const RR_MIN_SURVIVAL: f32 = 0.05;
 
 /// Radiance along a camera ray, and the number of rays traced for it.
 pub struct PathResult {
@@ -146,23 +164,30 @@ impl LightDraw {
 /// The largest f32 below 1: a rescaled sample stays in [0, 1).
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Russian roulette after a bounce: false ends the path; else the throughput is divided by
-/// the survival probability.
-fn survives(integrator: &IntegratorDesc, depth: u32, u_rr: f32, throughput: &mut Vec3) -> bool {
-    if depth >= RR_MIN_DEPTH {
-        let continue_prob = match integrator.rr_strategy {
-            RussianRoulette::None => 1.0,
-            RussianRoulette::Probability => integrator.rr_continue_prob,
-            // The largest channel, not luminance: a path along a saturated red wall
-            // has a small luminance but a large red throughput, and dividing that by a
-            // small survival probability is what makes coloured fireflies.
-            RussianRoulette::Efficiency => throughput.max_element().clamp(0.05, 1.0),
-        };
-        if u_rr >= continue_prob {
-            return false;
+/// Russian roulette after a bounce at the `depth`th vertex, which scattered broadly or not (see
+/// [`RR_THROUGHPUT_SCALE`]): false ends the path; else the throughput is divided by the
+/// survival probability.
+fn survives(
+    integrator: &IntegratorDesc,
+    depth: u32,
+    broad: bool,
+    u_rr: f32,
+    throughput: &mut Vec3,
+) -> bool {
+    let continue_prob = match integrator.rr_strategy {
+        RussianRoulette::Probability if depth >= RR_MIN_DEPTH => integrator.rr_continue_prob,
+        // The largest channel, not luminance: a path along a saturated red wall has a small
+        // luminance but a large red throughput, and dividing that by a small survival
+        // probability is what makes coloured fireflies.
+        RussianRoulette::Efficiency if broad => {
+            (throughput.max_element() * RR_THROUGHPUT_SCALE).clamp(RR_MIN_SURVIVAL, 1.0)
         }
-        *throughput /= continue_prob;
+        _ => return true,
+    };
+    if u_rr >= continue_prob {
+        return false;
     }
+    *throughput /= continue_prob;
     true
 }
 
@@ -223,7 +248,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
                         break;
                     }
                     throughput *= phase.eval(wo, wi) / pdf;
-                    if !survives(integrator, depth, sampler.get_1d(), &mut throughput) {
+                    if !survives(integrator, depth, true, sampler.get_1d(), &mut throughput) {
                         break;
                     }
                     prev = PrevScatter::plain(p, pdf, false);
@@ -335,7 +360,14 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
         let cos = bs.wi.dot(hit.ns).abs();
         throughput *= bs.f * (cos / bs.pdf);
 
-        if !survives(integrator, depth, u.roulette, &mut throughput) {
+        let facing = bsdf.gathers_from(wo);
+        if !survives(
+            integrator,
+            depth,
+            facing.is_some(),
+            u.roulette,
+            &mut throughput,
+        ) {
             break;
         }
 
@@ -360,7 +392,7 @@ pub fn trace_path<S: PathScene>(scene: &S, mut ray: Ray, sampler: &mut PixelSamp
             image_share,
             before_mirror,
             split: bsdf_count,
-            facing: bsdf.gathers_from(wo),
+            facing,
         };
         medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
@@ -676,4 +708,85 @@ fn direct_light_in_medium<S: PathScene>(
         power_heuristic(ls.pdf, phase.pdf(wo, ls.wi))
     };
     tr * phase.eval(wo, ls.wi) * ls.li * (weight / ls.pdf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrator::options::DEFAULT_RR_CONTINUE_PROB;
+
+    fn integrator(strategy: RussianRoulette) -> IntegratorDesc {
+        IntegratorDesc {
+            rr_strategy: strategy,
+            ..IntegratorDesc::path_defaults("path")
+        }
+    }
+
+    /// Survival as `survives` decides it, and the throughput it leaves.
+    fn roulette(
+        strategy: RussianRoulette,
+        depth: u32,
+        broad: bool,
+        u: f32,
+        t: Vec3,
+    ) -> Option<Vec3> {
+        let mut t = t;
+        survives(&integrator(strategy), depth, broad, u, &mut t).then_some(t)
+    }
+
+    #[test]
+    fn efficiency_roulette_ends_dark_paths_at_broad_vertices_from_the_first() {
+        let dark = Vec3::new(0.02, 0.01, 0.0);
+        // Survival 3 x 0.02 = 0.06, at the first vertex already.
+        assert_eq!(
+            roulette(RussianRoulette::Efficiency, 1, true, 0.06, dark),
+            None
+        );
+        let kept = roulette(RussianRoulette::Efficiency, 1, true, 0.059, dark).unwrap();
+        assert!((kept - dark / 0.06).abs().max_element() < 1e-6, "{kept}");
+        // Never below the floor: a black path survives 1 in 20, weighed by 20.
+        let black = roulette(RussianRoulette::Efficiency, 1, true, 0.049, Vec3::ZERO);
+        assert_eq!(black, Some(Vec3::ZERO));
+        assert_eq!(
+            roulette(RussianRoulette::Efficiency, 1, true, 0.05, Vec3::ZERO),
+            None
+        );
+        // A third of the throughput or more always goes on, unchanged.
+        let bright = Vec3::new(0.34, 0.1, 0.1);
+        assert_eq!(
+            roulette(RussianRoulette::Efficiency, 9, true, 0.999, bright),
+            Some(bright)
+        );
+    }
+
+    #[test]
+    fn efficiency_roulette_never_ends_paths_at_glossy_or_specular_vertices() {
+        for depth in [1, 3, 10] {
+            let t = Vec3::splat(0.001);
+            assert_eq!(
+                roulette(RussianRoulette::Efficiency, depth, false, 0.999, t),
+                Some(t)
+            );
+        }
+    }
+
+    #[test]
+    fn probability_roulette_keeps_luxrenders_rule() {
+        let t = Vec3::splat(0.5);
+        let p = DEFAULT_RR_CONTINUE_PROB;
+        for broad in [true, false] {
+            // Not before the third vertex, whatever the vertex.
+            assert_eq!(
+                roulette(RussianRoulette::Probability, 2, broad, 0.999, t),
+                Some(t)
+            );
+            assert_eq!(roulette(RussianRoulette::Probability, 3, broad, p, t), None);
+            let kept = roulette(RussianRoulette::Probability, 3, broad, p - 0.01, t).unwrap();
+            assert!((kept - t / p).abs().max_element() < 1e-6, "{kept}");
+        }
+        assert_eq!(
+            roulette(RussianRoulette::None, 9, true, 0.999, Vec3::ZERO),
+            Some(Vec3::ZERO)
+        );
+    }
 }

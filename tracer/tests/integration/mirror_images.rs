@@ -115,10 +115,12 @@ fn an_image_sample_has_the_density_a_path_through_the_mirror_is_weighed_with() {
 }
 
 /// A large lamp near the mirror: BSDF samples through the mirror find it often, so both sides
-/// of the MIS weight matter to the mean.
+/// of the MIS weight matter to the mean. 384 samples: since Russian roulette may end paths at
+/// their second vertex (it used to wait for the third), 256 left a standard error of 0.21% of
+/// the mean, above the 0.2% the comparison must resolve.
 #[test]
 fn sampling_lamps_through_the_mirror_keeps_the_mean() {
-    estimates::assert_same_mean(|images, seed| render(images, LARGE_LAMP, 256, seed));
+    estimates::assert_same_mean(|images, seed| render(images, LARGE_LAMP, 384, seed));
 }
 
 /// A small lamp: plain path tracing finds it through the mirror rarely, each time as a
