@@ -59,17 +59,18 @@ pub const GLOSSY_SPLIT: usize = 8;
 /// LuxRender).
 const RR_MIN_DEPTH: u32 = 3;
 
-/// Under the `efficiency` strategy a path survives a broad scattering vertex (diffuse, velvet,
-/// cloth, a volume's phase function) with this multiple of its throughput's largest channel as
-/// probability, capped at 1, from the first vertex on; a glossy or specular vertex never ends
-/// it. Measured against the rule it replaced (the throughput itself, from the third vertex on,
-/// at every vertex), MSE x CPU time at 16 spp, one thread: depth of field 0.81, Cornell 0.91,
-/// Mario 0.96, Captain Falcon 0.74, our volumes scene 0.87; our daylight scene 1.02-1.08 (MSE
-/// +4%: under an open sky a path's continuation is one cheap ray, little to save). A path into
-/// the black squares of a checkerboard, or off a dark wall, mostly ends there instead of
-/// bouncing on for little light; three times the throughput keeps the bright paths that the old
-/// rule ended; and the light a glossy vertex sends on is concentrated (the caustics of Mario's
-/// metal seen from the floor), which the roulette turned into fireflies.
+/// Under the `efficiency` strategy a path survives a broad scattering vertex (a diffuse, velvet
+/// or cloth lobe, under a coat or not, as [`Bsdf::gathers_from`] tells; a volume's phase
+/// function) with this multiple of its throughput's largest channel as probability, capped at
+/// 1, from the first vertex on; a glossy or specular vertex never ends it. Measured against the
+/// rule it replaced (the throughput itself, from the third vertex on, at every vertex), MSE x
+/// CPU time at 16 spp, one thread: depth of field 0.81, Cornell 0.91, Mario 0.96, Captain
+/// Falcon 0.74, our volumes scene 0.87; our daylight scene 1.02-1.08 (MSE +4%: under an open sky
+/// a path's continuation is one cheap ray, little to save). A path into the black squares of a
+/// checkerboard, or off a dark wall, mostly ends there instead of bouncing on for little light;
+/// three times the throughput keeps the bright paths that the old rule ended; and the light a
+/// glossy vertex sends on is concentrated (the caustics of Mario's metal seen from the floor),
+/// which the roulette turned into fireflies.
 const RR_THROUGHPUT_SCALE: f32 = 3.0;
 
 /// The least survival probability of the `efficiency` strategy: a path it keeps is weighed by
