@@ -107,6 +107,9 @@ pub struct RenderOutcome {
 pub struct SceneBuild {
     pub time: Duration,
     pub triangles: usize,
+    /// The continuations camera paths take at their first broad vertex (the build's pilot
+    /// chose them, its time in `time`).
+    pub first_vertex_branches: usize,
 }
 
 impl RenderJob {

@@ -12,6 +12,9 @@ pub struct RenderReport {
     pub spp: u32,
     pub max_depth: u32,
     pub triangles: Option<usize>,
+    /// The continuations camera paths took at their first broad vertex (in-process renders;
+    /// `yat_tracer::render::branching`).
+    pub first_vertex_branches: Option<usize>,
     pub parse_seconds: f64,
     pub build_seconds: Option<f64>,
     pub render_seconds: f64,
@@ -40,6 +43,7 @@ impl RenderReport {
             spp: job.settings.spp,
             max_depth: job.settings.max_depth,
             triangles: outcome.build.as_ref().map(|b| b.triangles),
+            first_vertex_branches: outcome.build.as_ref().map(|b| b.first_vertex_branches),
             parse_seconds: job.scene.parse_time.as_secs_f64(),
             build_seconds: outcome.build.as_ref().map(|b| b.time.as_secs_f64()),
             render_seconds: render_secs,
@@ -57,7 +61,7 @@ impl RenderReport {
     pub fn print(&self) {
         let pixels = u64::from(self.width) * u64::from(self.height);
         println!(
-            "{}x{} at {}, depth {}{}",
+            "{}x{} at {}, depth {}{}{}",
             self.width,
             self.height,
             match self.adaptive_rounds {
@@ -70,7 +74,12 @@ impl RenderReport {
             },
             self.max_depth,
             self.triangles
-                .map_or(String::new(), |t| format!(", {t} triangles"))
+                .map_or(String::new(), |t| format!(", {t} triangles")),
+            self.first_vertex_branches
+                .filter(|&b| b > 1)
+                .map_or(String::new(), |b| format!(
+                    ", {b} continuations from each camera path's first bounce"
+                ))
         );
         println!(
             "parse {:.3} s{}, render {:.3} s",

@@ -29,6 +29,7 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     let build = SceneBuild {
         time: build_start.elapsed(),
         triangles: scene.triangle_count(),
+        first_vertex_branches: scene.first_vertex_branches(),
     };
 
     let settings = &job.settings;

@@ -4,9 +4,11 @@
 //! Files: [`settings`] (resolved settings and command-line overrides), [`unit`](mod@unit) (a
 //! work unit and its counters: the leaf the film, the plan and the nodes share), [`plan`]
 //! (cutting an image into units), [`adaptive`] (the rounds of an adaptive render and the
-//! decision between them), [`scene`] (the built scene and rendering one unit).
+//! decision between them), [`branching`] (how many continuations camera paths take at their
+//! first broad vertex), [`scene`] (the built scene and rendering one unit).
 
 pub mod adaptive;
+pub mod branching;
 pub mod plan;
 pub mod scene;
 pub mod settings;

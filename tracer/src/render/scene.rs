@@ -14,14 +14,16 @@ use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
-use crate::integrator::path::{trace_path, PathScene};
+use crate::integrator::path::{trace_path, PathScene, MAX_BRANCHES};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
+use crate::math::Ray;
 use crate::medium::{ShapeMedia, Volumes};
 use crate::param::MaterialId;
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
+use super::branching;
 use super::settings::RenderSettings;
 use super::unit::{FilmFrame, UnitStats, WorkUnit};
 
@@ -56,6 +58,8 @@ pub struct RenderScene {
     world_to_object: Vec<glam::Affine3A>,
     /// See [`PathScene::glossy_split`].
     glossy_split: bool,
+    /// See [`PathScene::first_vertex_branches`]: chosen by [`branching::choose`].
+    first_vertex_branches: usize,
 }
 
 impl RenderScene {
@@ -101,7 +105,7 @@ impl RenderScene {
         )?
         .with_mirror_images(&flat_mirrors(desc), &geometry);
         guard.check_cancel()?;
-        Ok(Self {
+        let mut scene = Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: PixelFilter::new(&desc.filter),
             frame: FilmFrame {
@@ -119,9 +123,51 @@ impl RenderScene {
                 .map(|s| glam::Affine3A::from_mat4(s.object_to_world).inverse())
                 .collect(),
             glossy_split: glossy_split(desc),
+            first_vertex_branches: 1,
             desc: desc.clone(),
             settings: settings.clone(),
-        })
+        };
+        let branches = branching::choose(&scene.pilot());
+        scene.first_vertex_branches = branches;
+        Ok(scene)
+    }
+
+    /// What [`branching::measure`] renders this scene's pilot with.
+    pub fn pilot(
+        &self,
+    ) -> branching::Pilot<'_, Self, impl Fn(u32, u32, &mut PixelSampler) -> Option<Ray> + Sync + '_>
+    {
+        branching::Pilot {
+            scene: self,
+            settings: &self.settings,
+            camera_ray: |x, y, sampler: &mut PixelSampler| self.camera_ray(x, y, sampler),
+        }
+    }
+
+    /// The continuations camera paths take at their first broad vertex.
+    pub fn first_vertex_branches(&self) -> usize {
+        self.first_vertex_branches
+    }
+
+    /// The scene with `branches` continuations (clamped to 1 ..= [`MAX_BRANCHES`]) in place of
+    /// the pilot's choice: what the tests compare counts with.
+    pub fn with_first_vertex_branches(mut self, branches: usize) -> Self {
+        self.first_vertex_branches = branches.clamp(1, MAX_BRANCHES);
+        self
+    }
+
+    /// The camera ray of the pixel sample `sampler` draws (its first dimensions), at pixel
+    /// (`x`, `y`); None outside a fisheye's circle.
+    pub fn camera_ray(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> Option<Ray> {
+        self.camera_sample(x, y, sampler).1
+    }
+
+    /// [`Self::camera_ray`] and the sample's position within its pixel.
+    #[inline(always)]
+    fn camera_sample(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> (Vec2, Option<Ray>) {
+        let (u, lens) = sampler.get_camera();
+        let film = Vec2::new(x as f32 + u.x, y as f32 + u.y);
+        (u, self.camera.generate_ray(film, lens))
     }
 
     pub fn desc(&self) -> &SceneDesc {
@@ -211,11 +257,10 @@ impl RenderScene {
                         } else {
                             PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed)
                         };
-                        let (u, lens) = sampler.get_camera();
-                        let film = Vec2::new(x as f32 + u.x, y as f32 + u.y);
+                        let (u, ray) = self.camera_sample(x, y, &mut sampler);
                         stats.samples += 1;
                         // A sample without a camera ray (outside a fisheye's circle) is black.
-                        let radiance = match self.camera.generate_ray(film, lens) {
+                        let radiance = match ray {
                             None => Vec3::ZERO,
                             Some(ray) => {
                                 let path = trace_path(self, ray, &mut sampler);
@@ -395,6 +440,10 @@ impl PathScene for RenderScene {
 
     fn glossy_split(&self) -> bool {
         self.glossy_split
+    }
+
+    fn first_vertex_branches(&self) -> usize {
+        self.first_vertex_branches
     }
 
     fn is_pass_through(&self, shape: u32) -> bool {

@@ -21,6 +21,24 @@ pub fn looking_down(size: u32, integrator: &str) -> String {
     )
 }
 
+/// The sampling tests' grey floor (under the camera of [`looking_down`]), half-mirror and lamp.
+pub const MATTE_FLOOR: &str = "Material \"matte\" \"color Kd\" [0.5 0.5 0.5]";
+pub const FLOOR: [&str; 4] = ["-3 -3 0", "3 -3 0", "3 3 0", "-3 3 0"];
+pub const MIRROR: &str = "Material \"mirror\" \"color Kr\" [0.5 0.5 0.5]";
+pub const LAMP: &str = "AreaLightSource \"area\" \"color L\" [5 5 5] \"float power\" [0]";
+
+/// A quad (two triangles over its four `points`, "x y z" each, in order) with `material`, a
+/// `Material` or `AreaLightSource` statement, in its own attribute block.
+pub fn quad(material: &str, points: [&str; 4]) -> String {
+    format!(
+        "AttributeBegin\n\
+         {material}\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point P\" [{}]\n\
+         AttributeEnd\n",
+        points.join("  ")
+    )
+}
+
 /// The scene `text` (which must parse without warnings) built for a `size` x `size` render.
 pub fn build(text: &str, size: u32, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {
     let mut source = MemorySource::new();

@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod area_texture;
+mod branching;
 mod bump_render;
 mod daylight;
 mod estimates;

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use yat_tracer::math::Ray;
 use yat_tracer::render::{RenderScene, RenderSettings};
 
-use super::estimates::{self, seed_difference};
+use super::estimates::{self, seed_difference, LAMP, MATTE_FLOOR, MIRROR};
 
 const SIZE: u32 = 40;
 /// A lamp plain path tracing rarely finds through the mirror: half side 0.2 at height 1.5.
@@ -22,26 +22,20 @@ fn scene(mirror_images: bool, (lamp, z): (f32, f32)) -> String {
     let (x0, x1) = (0.2 - lamp, 0.2 + lamp);
     let integrator =
         format!("\"integer maxdepth\" [2] \"bool mirrorimages\" [\"{mirror_images}\"]");
-    format!(
-        "{}\
-         AttributeBegin\n\
-         Material \"matte\" \"color Kd\" [0.5 0.5 0.5]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-           \"point P\" [-3 -3 0  3 -3 0  3 3 0  -3 3 0]\n\
-         AttributeEnd\n\
-         AttributeBegin\n\
-         Material \"mirror\" \"color Kr\" [0.5 0.5 0.5]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-           \"point P\" [1 -3 0  1 3 0  1 3 3  1 -3 3]\n\
-         AttributeEnd\n\
-         AttributeBegin\n\
-         AreaLightSource \"area\" \"color L\" [5 5 5] \"float power\" [0]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-           \"point P\" [{x0} -{lamp} {z}  {x0} {lamp} {z}  {x1} {lamp} {z}  {x1} -{lamp} {z}]\n\
-         AttributeEnd\n\
-         WorldEnd\n",
-        estimates::looking_down(SIZE, &integrator)
-    )
+    let lamp = [
+        format!("{x0} -{lamp} {z}"),
+        format!("{x0} {lamp} {z}"),
+        format!("{x1} {lamp} {z}"),
+        format!("{x1} -{lamp} {z}"),
+    ];
+    [
+        estimates::looking_down(SIZE, &integrator),
+        estimates::quad(MATTE_FLOOR, estimates::FLOOR),
+        estimates::quad(MIRROR, ["1 -3 0", "1 3 0", "1 3 3", "1 -3 3"]),
+        estimates::quad(LAMP, lamp.each_ref().map(String::as_str)),
+        "WorldEnd\n".into(),
+    ]
+    .concat()
 }
 
 fn build(text: &str, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {

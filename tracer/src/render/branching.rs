@@ -1,0 +1,255 @@
+//! How many continuations a scene's camera paths send on from their first broad vertex
+//! ([`MAX_BRANCHES`]), measured on a pilot when the scene is built.
+//!
+//! A pixel's error is the error of what comes before that vertex (the pixel and lens
+//! position, the first hit, its light sample), `v_first`, plus the error of what its
+//! continuations bring, `v_next` with one continuation; a camera sample's cost is likewise
+//! `c_first` plus `c_next`. With `k` continuations the error is `v_first + v_next / k` and the
+//! cost `c_first + k c_next`, so the efficiency, 1 / (error x cost), is best at
+//! `k = sqrt((v_next / c_next) / (v_first / c_first))` (the splitting factor of Rath et al.
+//! 2022, "EARS", for the first vertex of the whole image).
+//!
+//! The pilot renders a set of pixels with one and with two continuations, each twice with
+//! independent samples: the squared difference of two renders is twice their error,
+//! stratification included (the continuations' variance measured per path, without it, came
+//! out up to ten times too large on Captain Falcon, whose first bounce the samples stratify
+//! well). The renders with one and two continuations share their samples up to the vertex, so
+//! per pixel the difference of their errors is the continuations' alone; its mean less two
+//! standard errors is the `v_next / 2` the choice believes, so that a scene whose pilot sees a
+//! few bright outliers (the caustics of Cornell's glass) keeps one continuation. Rays count for
+//! the cost. The pilot takes at most a sixteenth of the render's samples: a render too short
+//! to learn from keeps one continuation.
+//!
+//! Only the scene and the render settings decide it: every node that builds the scene takes
+//! the same number, and the image is the same bytes wherever it is rendered.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::settings::RenderSettings;
+use crate::integrator::path::{trace_branching_path, PathScene, MAX_BRANCHES};
+use crate::math::Ray;
+use crate::sampler::{mix64, PixelSampler};
+
+/// Samples per pilot pixel in each of its four renders: the render's, within these bounds
+/// (the error's make-up changes with the samples: the camera's and the first vertex's few
+/// dimensions are stratified better as they grow than a whole continuation is).
+const MIN_PILOT_SPP: u32 = 4;
+const MAX_PILOT_SPP: u32 = 16;
+
+/// The most pixels the pilot renders.
+const MAX_PILOT_PIXELS: u64 = 2304;
+
+/// Fewer pixels than this tell nothing: one continuation.
+const MIN_PILOT_PIXELS: u64 = 1024;
+
+/// The share of the render's samples the pilot may take, as a divisor.
+const PILOT_SHARE: u64 = 100;
+
+/// How much cheaper a ray before the branching vertex is than one after it, in rays per
+/// sample: the camera ray is coherent and the first light sample's shadow ray an any-hit ray,
+/// where a continuation's rays are closest hits shaded in full. Fitted to the render times of
+/// one and two continuations (16 spp, 480x270, one thread): depth of field 0.5, Mario 0.5,
+/// Captain Falcon 0.7, Cornell 1.0.
+const FIRST_RAYS_DISCOUNT: f64 = 0.6;
+
+/// Splitting must promise at least this efficiency over one continuation: a scene near the
+/// break-even point gains nothing either way.
+const MIN_GAIN: f64 = 1.05;
+
+/// Standard errors the continuations' error is taken below its estimate.
+const CONFIDENCE: f64 = 1.0;
+
+/// The pilot's samples are their own (the render's seed, keyed apart); two independent sets.
+const PILOT_KEYS: [u64; 2] = [0x7069_6c6f_745f_6b31, 0x7069_6c6f_745f_6b32];
+
+/// The pilot's estimates: errors of a pixel's mean at the pilot's samples (summed over the
+/// colour channels), costs in rays per camera sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BranchFigures {
+    pub v_first: f64,
+    pub v_next: f64,
+    pub c_first: f64,
+    pub c_next: f64,
+}
+
+impl BranchFigures {
+    /// Relative efficiency of `k` continuations (1 / (error x cost), any unit).
+    pub fn efficiency(&self, k: usize) -> f64 {
+        let k = k as f64;
+        1.0 / ((self.v_first + self.v_next / k) * (self.c_first + k * self.c_next))
+    }
+
+    /// The continuations with the best efficiency: 1 unless more beat it by [`MIN_GAIN`].
+    pub fn best(&self) -> usize {
+        let one = self.efficiency(1);
+        if !(one.is_finite() && one > 0.0) {
+            return 1;
+        }
+        let (k, eff) = (2..=MAX_BRANCHES)
+            .map(|k| (k, self.efficiency(k)))
+            .fold((1, one), |best, kv| if kv.1 > best.1 { kv } else { best });
+        if eff >= one * MIN_GAIN {
+            k
+        } else {
+            1
+        }
+    }
+}
+
+/// What the pilot renders with: the scene's paths, the render's settings and its camera rays
+/// (the camera ray of the pixel sample a sampler draws, at a pixel).
+pub struct Pilot<'a, S, C> {
+    pub scene: &'a S,
+    pub settings: &'a RenderSettings,
+    pub camera_ray: C,
+}
+
+/// Measures the scene on its pilot; None when the render is too short to spare one.
+pub fn measure<S, C>(pilot: &Pilot<S, C>) -> Option<BranchFigures>
+where
+    S: PathScene + Sync,
+    C: Fn(u32, u32, &mut PixelSampler) -> Option<Ray> + Sync,
+{
+    let settings = pilot.settings;
+    let samples = u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
+    let spp = settings.spp.clamp(MIN_PILOT_SPP, MAX_PILOT_SPP);
+    let pixels = (samples / (PILOT_SHARE * 4 * u64::from(spp))).min(MAX_PILOT_PIXELS);
+    if pixels < MIN_PILOT_PIXELS {
+        return None;
+    }
+    let keys = PILOT_KEYS.map(|key| mix64(mix64(settings.seed) ^ key));
+    // Per pixel, with one and with two continuations: the means of its two renders, and rays.
+    let pilot: Vec<[[(DVec3, u64); 2]; 2]> = (0..pixels)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = pilot_pixel(i, pixels, settings.width, settings.height);
+            [1, 2].map(|branches| keys.map(|key| pixel_mean(pilot, x, y, branches, spp, key)))
+        })
+        .collect();
+    let n = pixels as f64;
+    let error = |[a, b]: &[(DVec3, u64); 2]| (a.0 - b.0).length_squared() / 2.0;
+    let error_one = pilot.iter().map(|[one, _]| error(one)).sum::<f64>() / n;
+    let gains: Vec<f64> = pilot
+        .iter()
+        .map(|[one, two]| error(one) - error(two))
+        .collect();
+    let gain = gains.iter().sum::<f64>() / n;
+    let spread = gains.iter().map(|g| (g - gain).powi(2)).sum::<f64>() / (n - 1.0);
+    let believed_gain = (gain - CONFIDENCE * (spread / n).sqrt()).max(0.0);
+    let rays = |k: usize| {
+        let total: u64 = pilot.iter().map(|p| p[k][0].1 + p[k][1].1).sum();
+        total as f64 / (2.0 * n * f64::from(spp))
+    };
+    let c_next = (rays(1) - rays(0)).max(0.0);
+    let v_next = 2.0 * believed_gain;
+    Some(BranchFigures {
+        v_first: (error_one - v_next).max(0.0),
+        v_next,
+        c_first: (rays(0) - c_next - FIRST_RAYS_DISCOUNT).max(0.0),
+        c_next,
+    })
+}
+
+/// The continuations the scene's camera paths take.
+pub fn choose<S, C>(pilot: &Pilot<S, C>) -> usize
+where
+    S: PathScene + Sync,
+    C: Fn(u32, u32, &mut PixelSampler) -> Option<Ray> + Sync,
+{
+    let figures = measure(pilot);
+    let branches = figures.map_or(1, |f| f.best());
+    tracing::debug!(?figures, branches, "first-vertex continuations");
+    branches
+}
+
+/// Pilot pixel `i` of `count`: rows evenly down the image, columns by the golden ratio (a
+/// rank-1 lattice, spread evenly over any image shape).
+fn pilot_pixel(i: u64, count: u64, width: u32, height: u32) -> (u32, u32) {
+    const GOLDEN: f64 = 0.618_033_988_749_895;
+    let column = ((i as f64 * GOLDEN).fract() * f64::from(width)) as u32;
+    let row = ((2 * i + 1) * u64::from(height) / (2 * count)) as u32;
+    (column.min(width - 1), row.min(height - 1))
+}
+
+/// The mean of `spp` samples of pixel (`x`, `y`) with `branches` continuations and
+/// `seed`, and their rays.
+fn pixel_mean<S: PathScene, C: Fn(u32, u32, &mut PixelSampler) -> Option<Ray>>(
+    pilot: &Pilot<S, C>,
+    x: u32,
+    y: u32,
+    branches: usize,
+    spp: u32,
+    seed: u64,
+) -> (DVec3, u64) {
+    let mut sum = DVec3::ZERO;
+    let mut rays = 0;
+    for index in 0..spp {
+        let mut sampler = PixelSampler::new(x, y, index, spp, seed);
+        if let Some(ray) = (pilot.camera_ray)(x, y, &mut sampler) {
+            let path = trace_branching_path(pilot.scene, ray, &mut sampler, branches);
+            rays += u64::from(path.rays);
+            if path.radiance.is_finite() {
+                sum += path.radiance.as_dvec3();
+            }
+        }
+    }
+    (sum / f64::from(spp), rays)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn figures(v_first: f64, v_next: f64, c_first: f64, c_next: f64) -> BranchFigures {
+        BranchFigures {
+            v_first,
+            v_next,
+            c_first,
+            c_next,
+        }
+    }
+
+    #[test]
+    fn the_best_count_follows_the_splitting_factor() {
+        // sqrt((v_next / c_next) / (v_first / c_first)): here sqrt(9) = 3.
+        assert_eq!(figures(1.0, 9.0, 1.0, 1.0).best(), 3);
+        // sqrt(4 x 2) = 2.8: three (error 2.33, cost 5) beats two (3, 4) and four (2, 6).
+        assert_eq!(figures(1.0, 4.0, 2.0, 1.0).best(), 3);
+        // More than four is never taken.
+        assert_eq!(figures(1.0, 100.0, 1.0, 1.0).best(), MAX_BRANCHES);
+        // The first part's error dominates: one.
+        assert_eq!(figures(4.0, 1.0, 1.0, 1.0).best(), 1);
+    }
+
+    #[test]
+    fn a_small_gain_keeps_one_continuation() {
+        // Two continuations: error 2 for cost 3.125, against 3 for cost 2.125: 1.02x.
+        let f = figures(1.0, 2.0, 1.125, 1.0);
+        assert!(f.efficiency(2) > f.efficiency(1));
+        assert!(f.efficiency(2) < MIN_GAIN * f.efficiency(1));
+        assert_eq!(f.best(), 1);
+    }
+
+    #[test]
+    fn degenerate_figures_keep_one_continuation() {
+        assert_eq!(figures(0.0, 0.0, 1.0, 1.0).best(), 1);
+        assert_eq!(figures(f64::NAN, 1.0, 1.0, 1.0).best(), 1);
+        assert_eq!(figures(1.0, 1.0, 0.0, 0.0).best(), 1);
+    }
+
+    #[test]
+    fn pilot_pixels_lie_in_the_image_and_spread_over_it() {
+        let (width, height, count) = (7, 5, 2304);
+        let mut seen = [false; 35];
+        for i in 0..count {
+            let (x, y) = pilot_pixel(i, count, width, height);
+            assert!(x < width && y < height, "{x} {y}");
+            seen[(y * width + x) as usize] = true;
+        }
+        assert!(
+            seen.iter().all(|&s| s),
+            "every pixel of a small image is visited"
+        );
+    }
+}
