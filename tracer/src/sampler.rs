@@ -808,6 +808,50 @@ mod tests {
         assert!(all_1d.iter().chain(&all_2d).all(|&c| c == 1));
     }
 
+    /// A branching vertex's draw of `n` (of at most 4) is the split draw of `n`, whose
+    /// stratification the test above shows; the values past the first `n` are zero.
+    #[test]
+    fn branch_draws_of_n_are_split_draws_of_n() {
+        let sampler = PixelSampler::new(3, 4, 5, 16, 7);
+        let (lobes, dirs) = sampler.clone().get_split_draws::<4>(2);
+        let mut two = sampler.clone();
+        assert_eq!(lobes[..2], two.get_split_1d::<2>());
+        assert_eq!(dirs[..2], two.get_split_2d::<2>());
+        assert_eq!(lobes[2..], [0.0; 2]);
+        assert_eq!(dirs[2..], [Vec2::ZERO; 2]);
+        let (lobes, dirs) = sampler.clone().get_split_draws::<4>(3);
+        let mut three = sampler.clone();
+        assert_eq!(lobes[..3], three.get_split_1d::<3>());
+        assert_eq!(dirs[..3], three.get_split_2d::<3>());
+    }
+
+    /// A branch's stream is the same for the same branch, differs from the path's own and from
+    /// another branch's in every dimension, and is stratified over a pixel's samples.
+    #[test]
+    fn branch_streams_are_their_own() {
+        let sampler = PixelSampler::new(3, 4, 5, 16, 7);
+        let draw = |mut s: PixelSampler| [s.get_1d(), s.get_2d().x, s.get_2d().y, s.get_1d()];
+        assert_eq!(draw(sampler.branch(1)), draw(sampler.branch(1)));
+        let (own, one, two) = (
+            draw(sampler.clone()),
+            draw(sampler.branch(1)),
+            draw(sampler.branch(2)),
+        );
+        for d in 0..4 {
+            assert!(
+                own[d] != one[d] && one[d] != two[d] && own[d] != two[d],
+                "{d}"
+            );
+        }
+        let mut strata = [0; 16];
+        for i in 0..16 {
+            let mut branch = PixelSampler::new(3, 4, i, 16, 7).branch(1);
+            branch.get_1d();
+            strata[(branch.get_1d() * 16.0) as usize] += 1;
+        }
+        assert_eq!(strata, [1; 16]);
+    }
+
     /// Integrating a smooth function with 256 stratified samples beats independent random
     /// sampling's expected error by a wide margin.
     #[test]
