@@ -167,23 +167,6 @@ impl PixelSampler {
         (point_2d(index, film_hash), lens)
     }
 
-    /// The next 1D dimension drawn `N` times for a vertex that splits into `N` samples: sample
-    /// `index`'s Sobol point `s` becomes points `N s .. N s + N`. The `N` values are stratified
-    /// among themselves and all of a pixel's `N spp` values together (what `N spp` samples of
-    /// the dimension would be), where `N` separate dimensions would each be stratified alone.
-    pub fn get_split_1d<const N: usize>(&mut self) -> [f32; N] {
-        let hash = self.next_dimension_hash();
-        let first = self.split_index(hash, N);
-        std::array::from_fn(|i| point_1d(first + i as u32, hash))
-    }
-
-    /// [`Self::get_split_1d`] for a 2D dimension.
-    pub fn get_split_2d<const N: usize>(&mut self) -> [Vec2; N] {
-        let hash = self.next_dimension_hash();
-        let first = self.split_index(hash, N);
-        std::array::from_fn(|i| point_2d(first + i as u32, hash))
-    }
-
     /// The stream of branch `k` of this sample's path: the same dimensions, scrambled and
     /// permuted by hashes of their own.
     pub fn branch(&self, k: u32) -> Self {
@@ -193,9 +176,12 @@ impl PixelSampler {
         }
     }
 
-    /// A BSDF sample's lobe choice and direction numbers for a vertex that splits into `n`
-    /// samples (`n <= N`; the values past the first `n` are 0): a 1D and a 2D dimension drawn
-    /// `n` times as [`Self::get_split_1d`] and [`Self::get_split_2d`] draw them.
+    /// A BSDF sample's lobe choice (a 1D dimension) and direction numbers (a 2D one) for a
+    /// vertex that splits into `n` samples (`n <= N`; the values past the first `n` are 0):
+    /// each dimension drawn `n` times, sample `index`'s Sobol point `s` becoming points
+    /// `n s .. n s + n`. For `n` a power of two the `n` values are stratified among themselves
+    /// and all of a pixel's `n spp` values together (what `n spp` samples of the dimension would
+    /// be), where `n` separate dimensions would each be stratified alone.
     pub fn get_split_draws<const N: usize>(&mut self, n: usize) -> ([f32; N], [Vec2; N]) {
         let n = n.min(N);
         let lobe_hash = self.next_dimension_hash();
@@ -795,7 +781,7 @@ mod tests {
         for i in 0..spp {
             let mut s = PixelSampler::new(5, 9, i, spp, 3);
             s.get_2d();
-            let (values, points) = (s.get_split_1d::<N>(), s.get_split_2d::<N>());
+            let (values, points) = s.get_split_draws::<N>(N);
             let (mut own_2d, mut own_1d) = ([0u32; N], [0u32; N]);
             for (v, u) in values.into_iter().zip(points) {
                 own_1d[(v * 8.0) as usize] += 1;
@@ -808,21 +794,28 @@ mod tests {
         assert!(all_1d.iter().chain(&all_2d).all(|&c| c == 1));
     }
 
-    /// A branching vertex's draw of `n` (of at most 4) is the split draw of `n`, whose
-    /// stratification the test above shows; the values past the first `n` are zero.
+    /// A draw of 2 of at most 4 (a path branching in two): each sample's two values lie in
+    /// the two halves, a pixel's 16 x 2 together one in each 32nd (and each 8x4 cell of the
+    /// square for the directions), and the values past the two are zero.
     #[test]
-    fn branch_draws_of_n_are_split_draws_of_n() {
-        let sampler = PixelSampler::new(3, 4, 5, 16, 7);
-        let (lobes, dirs) = sampler.clone().get_split_draws::<4>(2);
-        let mut two = sampler.clone();
-        assert_eq!(lobes[..2], two.get_split_1d::<2>());
-        assert_eq!(dirs[..2], two.get_split_2d::<2>());
-        assert_eq!(lobes[2..], [0.0; 2]);
-        assert_eq!(dirs[2..], [Vec2::ZERO; 2]);
-        let (lobes, dirs) = sampler.clone().get_split_draws::<4>(3);
-        let mut three = sampler.clone();
-        assert_eq!(lobes[..3], three.get_split_1d::<3>());
-        assert_eq!(dirs[..3], three.get_split_2d::<3>());
+    fn split_draws_of_fewer_than_their_most_are_stratified() {
+        let (mut all_1d, mut all_2d) = ([0u32; 32], [0u32; 32]);
+        for i in 0..16 {
+            let (values, points) = PixelSampler::new(3, 4, i, 16, 7).get_split_draws::<4>(2);
+            assert_eq!(values[2..], [0.0; 2]);
+            assert_eq!(points[2..], [Vec2::ZERO; 2]);
+            assert_ne!(
+                (values[0] * 2.0) as u32,
+                (values[1] * 2.0) as u32,
+                "sample {i}"
+            );
+            for (v, u) in values[..2].iter().zip(&points[..2]) {
+                all_1d[(v * 32.0) as usize] += 1;
+                all_2d[(u.y * 4.0) as usize * 8 + (u.x * 8.0) as usize] += 1;
+            }
+        }
+        assert_eq!(all_1d, [1; 32]);
+        assert_eq!(all_2d, [1; 32]);
     }
 
     /// A branch's stream is the same for the same branch, differs from the path's own and from

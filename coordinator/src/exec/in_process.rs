@@ -24,8 +24,14 @@ struct InProcessState {
 
 /// Renders `job` on `threads` threads (default: the CPUs this process may use).
 pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderOutcome> {
+    let threads = crate::cpus::threads_or_usable_cpus(threads, "in-process render");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the render threads")?;
     let build_start = Instant::now();
-    let scene = job.scene.build(&job.settings)?;
+    // In the render's threads: the build's pilot (`render::branching`) runs on them too.
+    let scene = pool.install(|| job.scene.build(&job.settings))?;
     let build = SceneBuild {
         time: build_start.elapsed(),
         triangles: scene.triangle_count(),
@@ -45,12 +51,7 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     // One thread writes at a time; one finding another writing leaves it to that one.
     let writing = Mutex::new(());
     let poisoned = || anyhow::anyhow!("a render thread panicked");
-    let threads = crate::cpus::threads_or_usable_cpus(threads, "in-process render");
     status.set_threads(threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the render threads")?;
     // Round after round (a uniform render has one): the units not yet merged, then the next
     // round decided from the merged film.
     let mut completed = None;

@@ -265,8 +265,9 @@ impl PathState {
     }
 }
 
-#[inline(always)]
 /// Traces `state` on, adding its light and rays to `out`.
+// Inlined into the unit loop, as `trace_path` is.
+#[inline(always)]
 fn walk<S: PathScene>(
     scene: &S,
     state: PathState,
@@ -443,6 +444,7 @@ fn walk<S: PathScene>(
                 hit: &hit,
                 wo,
                 bsdf: &bsdf,
+                facing: broad,
                 sides,
                 image_share,
                 throughput,
@@ -468,11 +470,10 @@ fn walk<S: PathScene>(
         let cos = bs.wi.dot(hit.ns).abs();
         throughput *= bs.f * (cos / bs.pdf);
 
-        let facing = bsdf.gathers_from(wo);
         if !survives(
             integrator,
             depth,
-            facing.is_some(),
+            broad.is_some(),
             u.roulette,
             &mut throughput,
         ) {
@@ -500,7 +501,7 @@ fn walk<S: PathScene>(
             image_share,
             before_mirror,
             split: bsdf_count,
-            facing,
+            facing: broad,
         };
         medium = sides.toward(bs.wi, hit.ng);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
@@ -515,6 +516,8 @@ struct BranchVertex<'a> {
     hit: &'a SurfaceHit,
     wo: Vec3,
     bsdf: &'a Bsdf,
+    /// The side the BSDF gathers light from ([`Bsdf::gathers_from`]).
+    facing: Option<Vec3>,
     sides: ShapeMedia,
     image_share: f32,
     throughput: Vec3,
@@ -525,9 +528,15 @@ struct BranchVertex<'a> {
 }
 
 impl BranchVertex<'_> {
-    /// Traces the vertex's `count` continuations, adding their light and rays to `out`. Out of
-    /// line, as the paths of a scene that does not branch never come here: the loop they run
-    /// stays as small as it was (inlined, it made depth of field 5% slower).
+    /// Traces the vertex's `count` continuations, adding their light and rays to `out`. Their
+    /// directions are drawn as one split draw (stratified together,
+    /// [`PixelSampler::get_split_draws`]); the first goes on in the path's own stream, the
+    /// others in [`PixelSampler::branch`]es of it. Each carries 1 / `count` of the throughput and
+    /// takes its roulette on the whole (a continuation is one of `count` estimates of the same
+    /// light, not a dimmer path); the light each finds emitting is weighed against the vertex's
+    /// light sample with all `count` BSDF samples counted. Out of line, as the paths of a scene
+    /// that does not branch never come here: the loop they run stays as small as it was
+    /// (inlined, it made depth of field 5% slower).
     #[inline(never)]
     fn branch<S: PathScene>(
         &self,
@@ -536,77 +545,60 @@ impl BranchVertex<'_> {
         sampler: &mut PixelSampler,
         out: &mut PathResult,
     ) {
-        for (state, mut stream) in self
-            .continue_in(scene, count, sampler)
-            .into_iter()
-            .flatten()
-        {
-            walk(scene, state, &mut stream, out);
+        let (lobes, dirs) = sampler.get_split_draws::<MAX_BRANCHES>(count);
+        for k in 0..count {
+            let (mut stream, u_rr) = if k == 0 {
+                (sampler.clone(), self.roulette)
+            } else {
+                let mut stream = sampler.branch(k as u32);
+                let u_rr = stream.get_1d();
+                (stream, u_rr)
+            };
+            if let Some(state) = self.continuation(scene, count, lobes[k], dirs[k], u_rr) {
+                walk(scene, state, &mut stream, out);
+            }
         }
     }
 
-    /// The vertex's `count` continuations and their sample streams (None where a BSDF sample
-    /// finds nothing or the roulette ends it). Their directions are drawn as one split draw
-    /// (stratified together, [`PixelSampler::get_split_2d`]); the first goes on in the path's
-    /// own stream, the others in [`PixelSampler::branch`]es of it. Each carries 1 / `count` of
-    /// the throughput and takes its roulette on the whole (a continuation is one of `count`
-    /// estimates of the same light, not a dimmer path); the light each finds emitting is
-    /// weighed against the vertex's light sample with all `count` BSDF samples counted.
-    fn continue_in<S: PathScene>(
+    /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count`; None where the
+    /// sample finds nothing or the roulette (`u_rr`) ends it.
+    fn continuation<S: PathScene>(
         &self,
         scene: &S,
         count: usize,
-        sampler: &mut PixelSampler,
-    ) -> [Option<(PathState, PixelSampler)>; MAX_BRANCHES] {
-        let (lobes, dirs) = sampler.get_split_draws::<MAX_BRANCHES>(count);
-        let bsdf = self.bsdf;
+        u_lobe: f32,
+        u: Vec2,
+        u_rr: f32,
+    ) -> Option<PathState> {
         let hit = self.hit;
-        std::array::from_fn(|k| {
-            if k >= count {
-                return None;
-            }
-            let mut stream = if k == 0 {
-                sampler.clone()
-            } else {
-                sampler.branch(k as u32)
-            };
-            let u_rr = if k == 0 {
-                self.roulette
-            } else {
-                stream.get_1d()
-            };
-            bsdf.sample(self.wo, lobes[k], dirs[k])
-                .filter(|bs| bs.pdf > 0.0 && bs.f != Vec3::ZERO)
-                .and_then(|bs| {
-                    let mut throughput =
-                        self.throughput * bs.f * (bs.wi.dot(hit.ns).abs() / bs.pdf);
-                    let integrator = scene.integrator();
-                    if !survives(integrator, self.depth, true, u_rr, &mut throughput) {
-                        return None;
-                    }
-                    // Counted `count` times against the light sample (the split's way,
-                    // with the share already in the throughput).
-                    Some(PathState {
-                        ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
-                        throughput: throughput / count as f32,
-                        medium: self.sides.toward(bs.wi, hit.ng),
-                        depth: self.depth,
-                        pass_through: 0,
-                        may_split: self.may_split,
-                        branches: 1,
-                        // A broad BSDF's samples are not specular: no mirror follows.
-                        prev: PrevScatter {
-                            p: hit.p,
-                            pdf: count as f32 * bs.pdf,
-                            specular: bs.specular,
-                            image_share: self.image_share,
-                            before_mirror: None,
-                            split: 1.0,
-                            facing: bsdf.gathers_from(self.wo),
-                        },
-                    })
-                })
-                .map(|state| (state, stream))
+        let bs = self
+            .bsdf
+            .sample(self.wo, u_lobe, u)
+            .filter(|bs| bs.pdf > 0.0 && bs.f != Vec3::ZERO)?;
+        let mut throughput = self.throughput * bs.f * (bs.wi.dot(hit.ns).abs() / bs.pdf);
+        if !survives(scene.integrator(), self.depth, true, u_rr, &mut throughput) {
+            return None;
+        }
+        Some(PathState {
+            ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
+            throughput: throughput / count as f32,
+            medium: self.sides.toward(bs.wi, hit.ng),
+            depth: self.depth,
+            pass_through: 0,
+            may_split: self.may_split,
+            branches: 1,
+            // Counted `count` times against the light sample (the split's way, with the share
+            // already in the throughput). A broad BSDF's samples are not specular: no mirror
+            // follows.
+            prev: PrevScatter {
+                p: hit.p,
+                pdf: count as f32 * bs.pdf,
+                specular: bs.specular,
+                image_share: self.image_share,
+                before_mirror: None,
+                split: 1.0,
+                facing: self.facing,
+            },
         })
     }
 }
@@ -756,8 +748,7 @@ fn split_bsdf_light<S: PathScene>(
     image_share: f32,
     sampler: &mut PixelSampler,
 ) -> SplitLight {
-    let lobes = sampler.get_split_1d::<GLOSSY_SPLIT>();
-    let dirs = sampler.get_split_2d::<GLOSSY_SPLIT>();
+    let (lobes, dirs) = sampler.get_split_draws::<GLOSSY_SPLIT>(GLOSSY_SPLIT);
     let lights = scene.lights();
     let facing = bsdf.gathers_from(wo);
     let count = GLOSSY_SPLIT as f32;

@@ -23,7 +23,7 @@ use crate::param::MaterialId;
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 
-use super::branching;
+use super::branching::{self, PilotScene};
 use super::settings::RenderSettings;
 use super::unit::{FilmFrame, UnitStats, WorkUnit};
 
@@ -127,21 +127,9 @@ impl RenderScene {
             desc: desc.clone(),
             settings: settings.clone(),
         };
-        let branches = branching::choose(&scene.pilot());
+        let branches = branching::choose(&scene);
         scene.first_vertex_branches = branches;
         Ok(scene)
-    }
-
-    /// What [`branching::measure`] renders this scene's pilot with.
-    pub fn pilot(
-        &self,
-    ) -> branching::Pilot<'_, Self, impl Fn(u32, u32, &mut PixelSampler) -> Option<Ray> + Sync + '_>
-    {
-        branching::Pilot {
-            scene: self,
-            settings: &self.settings,
-            camera_ray: |x, y, sampler: &mut PixelSampler| self.camera_ray(x, y, sampler),
-        }
     }
 
     /// The continuations camera paths take at their first broad vertex.
@@ -156,13 +144,7 @@ impl RenderScene {
         self
     }
 
-    /// The camera ray of the pixel sample `sampler` draws (its first dimensions), at pixel
-    /// (`x`, `y`); None outside a fisheye's circle.
-    pub fn camera_ray(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> Option<Ray> {
-        self.camera_sample(x, y, sampler).1
-    }
-
-    /// [`Self::camera_ray`] and the sample's position within its pixel.
+    /// [`PilotScene::camera_ray`] and the sample's position within its pixel.
     #[inline(always)]
     fn camera_sample(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> (Vec2, Option<Ray>) {
         let (u, lens) = sampler.get_camera();
@@ -404,6 +386,17 @@ fn glossy_split(desc: &SceneDesc) -> bool {
         && desc.materials.iter().any(may_be_glossy)
         && desc.volumes.media.is_empty()
         && !desc.materials.iter().any(sometimes_passes)
+}
+
+impl PilotScene for RenderScene {
+    fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// None outside a fisheye's circle.
+    fn camera_ray(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> Option<Ray> {
+        self.camera_sample(x, y, sampler).1
+    }
 }
 
 impl PathScene for RenderScene {

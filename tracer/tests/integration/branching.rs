@@ -107,7 +107,7 @@ fn the_pilot_is_the_same_on_any_number_of_threads() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| branching::measure(&scene.pilot()))
+            .install(|| branching::measure(&scene))
     };
     let one = on(1).expect("the render is long enough for a pilot");
     assert_eq!(on(3), Some(one));
@@ -115,9 +115,11 @@ fn the_pilot_is_the_same_on_any_number_of_threads() {
     assert_eq!(scene.first_vertex_branches(), one.best());
 }
 
-/// A render too short to spare a pilot keeps one continuation.
+/// A render too short to spare a pilot (40 x 40 x 64 samples, where a pilot of 1024 pixels
+/// needs 100 times its own) takes none.
 #[test]
 fn a_short_render_takes_no_pilot() {
-    let (scene, _) = estimates::build(&scene(false), SIZE, 64, 1);
+    let (scene, _) = estimates::build(&scene(true), SIZE, 64, 1);
+    assert_eq!(branching::measure(&scene), None);
     assert_eq!(scene.first_vertex_branches(), 1);
 }
