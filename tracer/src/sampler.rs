@@ -181,7 +181,10 @@ impl PixelSampler {
     /// each dimension drawn `n` times, sample `index`'s Sobol point `s` becoming points
     /// `n s .. n s + n`. For `n` a power of two the `n` values are stratified among themselves
     /// and all of a pixel's `n spp` values together (what `n spp` samples of the dimension would
-    /// be), where `n` separate dimensions would each be stratified alone.
+    /// be), where `n` separate dimensions would each be stratified alone. Only the `n` together
+    /// are: value `j` of every sample lies in the same `1 / n` of the first coordinate, so a
+    /// caller weighs all `n` alike: paths may go on along all of them (as branches do), never
+    /// along one alone.
     pub fn get_split_draws<const N: usize>(&mut self, n: usize) -> ([f32; N], [Vec2; N]) {
         let n = n.min(N);
         let lobe_hash = self.next_dimension_hash();

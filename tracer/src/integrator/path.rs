@@ -65,11 +65,12 @@ pub const MAX_BRANCHES: usize = 4;
 const MAX_PASS_THROUGH: u32 = 64;
 
 /// BSDF samples a path's first glossy vertex that may see a lamp takes for the light it sees
-/// directly (one of them goes on as the path). A lamp in a narrow lobe is a bright patch that
-/// one sample finds or misses: Mario's metal figure held some 60% of its image's error at 16
-/// spp in those highlights, and the floor's speckles are the same highlights seen from the
-/// floor. Measured on Mario (480x270, 16 spp, instructions by callgrind): 4 samples cut the
-/// error to 0.55 for 1.08 times the work, 8 to 0.46 for 1.17, 16 to 0.44 for 1.35.
+/// directly (the path goes on with a sample of its own). A lamp in a narrow lobe is a bright
+/// patch that one sample finds or misses: Mario's metal figure held some 60% of its image's
+/// error at 16 spp in those highlights, and the floor's speckles are the same highlights seen
+/// from the floor. Measured on Mario (480x270, 16 spp, instructions by callgrind; when the path
+/// went on with one of the split's samples): 4 samples cut the error to 0.55 for 1.08 times the
+/// work, 8 to 0.46 for 1.17, 16 to 0.44 for 1.35.
 pub const GLOSSY_SPLIT: usize = 8;
 
 /// Bounces before Russian roulette may end a path under the `probability` strategy (as in
@@ -121,9 +122,9 @@ struct PrevScatter {
     /// Set when the ray just reflected in a flat mirror straight after a non-specular vertex:
     /// a lamp it reaches is one a lamp-image sample at that vertex could have found.
     before_mirror: Option<BeforeMirror>,
-    /// The BSDF samples `p` took for the light it sees directly ([`GLOSSY_SPLIT`] at a split
-    /// vertex, else 1): what this ray finds emitting is one of them, weighed by their count.
-    split: f32,
+    /// Set when `p` split ([`GLOSSY_SPLIT`]): its own BSDF samples took all the light it sees
+    /// directly, so what this ray finds emitting (through null surfaces too) is not counted.
+    direct_counted: bool,
     /// The side `p`'s light sample sampled environment maps for ([`Bsdf::gathers_from`]):
     /// the density an escaping ray is weighed by.
     facing: Option<Vec3>,
@@ -138,7 +139,7 @@ impl PrevScatter {
             specular,
             image_share: 0.0,
             before_mirror: None,
-            split: 1.0,
+            direct_counted: false,
             facing: None,
         }
     }
@@ -160,7 +161,8 @@ struct LightDraw {
     share: f32,
     u_select: f32,
     u: Vec2,
-    /// 1, or [`GLOSSY_SPLIT`] at a split vertex.
+    /// The BSDF samples the vertex weighs its light sample against: 1, [`GLOSSY_SPLIT`] at a
+    /// split vertex, the continuations' count at a branching one.
     bsdf_count: f32,
 }
 
@@ -344,31 +346,31 @@ fn walk<S: PathScene>(
         }
 
         let Some(hit) = hit else {
-            if depth > 0 || integrator.include_environment {
+            if (depth > 0 || integrator.include_environment) && !prev.direct_counted {
                 let (le, weight) = if prev.specular {
                     (lights.environment(ray.dir), 1.0)
                 } else {
                     let (le, pdf) = lights.environment_and_pdf(ray.dir, prev.facing);
                     let pdf_light = (1.0 - prev.image_share) * pdf;
-                    (le, power_heuristic(prev.split * prev.pdf, pdf_light))
+                    (le, power_heuristic(prev.pdf, pdf_light))
                 };
-                radiance += throughput * le * (weight / prev.split);
+                radiance += throughput * le * weight;
             }
             break;
         };
         let wo = -ray.dir;
 
         let le = lights.emitted(&hit, wo);
-        if le != Vec3::ZERO {
+        if le != Vec3::ZERO && !prev.direct_counted {
             let weight = if !prev.specular {
                 let pdf_light = (1.0 - prev.image_share) * lights.pdf_hit(prev.p, &hit);
-                power_heuristic(prev.split * prev.pdf, pdf_light)
+                power_heuristic(prev.pdf, pdf_light)
             } else if let Some(b) = prev.before_mirror {
                 power_heuristic(b.pdf, IMAGE_SHARE * lights.image_pdf(b.p, b.plane, &hit))
             } else {
                 1.0
             };
-            radiance += throughput * le * (weight / prev.split);
+            radiance += throughput * le * weight;
         }
 
         // Every dimension a scattering vertex uses, drawn at once. A specular vertex draws the
@@ -432,12 +434,11 @@ fn walk<S: PathScene>(
             };
             radiance += throughput * light;
         }
-        let (u_lobe, u_bsdf) = if split {
+        if split {
             may_split = false;
             let seen = split_bsdf_light(scene, &hit, wo, &bsdf, image_share, sampler);
             radiance += throughput * seen.radiance;
             rays += seen.rays;
-            seen.first
         } else if branching {
             // Each continuation is a path of its own from here; this one ends.
             let vertex = BranchVertex {
@@ -454,14 +455,12 @@ fn walk<S: PathScene>(
             };
             vertex.branch(scene, branches, sampler, out);
             break;
-        } else {
-            (u.lobe, u.bsdf)
-        };
+        }
         if !bsdf.is_specular() {
             branches = 1;
         }
 
-        let Some(bs) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+        let Some(bs) = bsdf.sample(wo, u.lobe, u.bsdf) else {
             break;
         };
         if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
@@ -500,7 +499,7 @@ fn walk<S: PathScene>(
             specular: bs.specular,
             image_share,
             before_mirror,
-            split: bsdf_count,
+            direct_counted: split,
             facing: broad,
         };
         medium = sides.toward(bs.wi, hit.ng);
@@ -596,7 +595,7 @@ impl BranchVertex<'_> {
                 specular: bs.specular,
                 image_share: self.image_share,
                 before_mirror: None,
-                split: 1.0,
+                direct_counted: false,
                 facing: self.facing,
             },
         })
@@ -722,23 +721,24 @@ fn direct_light<S: PathScene>(
     tr * f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
 }
 
-/// What a split vertex's BSDF samples but the first see of the lights.
+/// What a split vertex's BSDF samples see of the lights.
 struct SplitLight {
     radiance: Vec3,
     rays: u32,
-    /// The first sample's lobe choice and direction numbers: the path goes on with it (and
-    /// finds its light at the next vertex).
-    first: (f32, Vec2),
 }
 
-/// The light a split vertex ([`GLOSSY_SPLIT`]) sees directly along its BSDF samples but the
-/// first: each weighed against the light sample by the power heuristic with the samples'
-/// count, and divided by it. The samples come from draws of their own, stratified together
-/// (the vertex's own `lobe` and `bsdf` numbers go unused). Null surfaces are crossed as the
-/// path crosses them (a scene splits only when no material lets rays through at some hits
-/// only, see [`PathScene::glossy_split`]). A lamp behind a flat mirror is the path's to find,
-/// one sample as without the split, which is what the vertex's lamp-image sample weighs
-/// against. Out of line: most vertices do not split.
+/// The light a split vertex ([`GLOSSY_SPLIT`]) sees directly along its BSDF samples: each
+/// weighed against the light sample by the power heuristic with the samples' count, and
+/// divided by it. The samples are one split draw, stratified together; the path goes on with
+/// the vertex's own `lobe` and `bsdf` numbers and does not count the light it finds next
+/// ([`PrevScatter::direct_counted`]). It once went on with the split's first sample instead,
+/// saving a ray: but sample `j` of every camera sample's split draw lies in the same
+/// `1 / GLOSSY_SPLIT` of its first number, so a pixel's paths all went on through one strip
+/// of the lobe, and Mario's hat (which sees the lamp in its own crown) kept its noise from 16
+/// to 64 spp. Null surfaces are crossed as the path crosses them (a scene splits only when no
+/// material lets rays through at some hits only, see [`PathScene::glossy_split`]). A lamp
+/// behind a flat mirror is the path's to find, one sample as without the split, which is what
+/// the vertex's lamp-image sample weighs against. Out of line: most vertices do not split.
 #[inline(never)]
 fn split_bsdf_light<S: PathScene>(
     scene: &S,
@@ -755,9 +755,8 @@ fn split_bsdf_light<S: PathScene>(
     let mut seen = SplitLight {
         radiance: Vec3::ZERO,
         rays: 0,
-        first: (lobes[0], dirs[0]),
     };
-    for (&u_lobe, &u) in lobes.iter().zip(&dirs).skip(1) {
+    for (&u_lobe, &u) in lobes.iter().zip(&dirs) {
         let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
             continue;
         };

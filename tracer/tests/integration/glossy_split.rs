@@ -102,3 +102,53 @@ fn only_scenes_with_lamps_and_metals_split() {
     );
     assert!(!splits(&no_lamp));
 }
+
+/// The camera of [`scene`] over a rough metal floor (alpha 0.05); above the camera a matte
+/// ceiling, lit by a lamp facing up from outside the view. The floor shows the ceiling's bright
+/// patch blurred, and nothing else: every path splits at the floor (its lobe holds the lamp,
+/// whose back it sees) and goes on to the ceiling, where its light sample finds the lamp. All
+/// the light comes through the path's own BSDF sample, none through the split's. Depth 3.
+fn ceiling_scene(split: bool) -> String {
+    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
+    let metal = "Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \
+                 \"float uroughness\" [0.05] \"float vroughness\" [0.05]";
+    let lamp = format!("Material \"null\"\n{}", estimates::LAMP);
+    [
+        estimates::looking_down(SIZE, &integrator),
+        estimates::quad(metal, estimates::FLOOR),
+        estimates::quad(&lamp, ["1 -0.3 4", "1.6 -0.3 4", "1.6 0.3 4", "1 0.3 4"]),
+        estimates::quad(
+            estimates::MATTE_FLOOR,
+            ["-4 -4 6", "-4 4 6", "4 4 6", "4 -4 6"],
+        ),
+        "WorldEnd\n".to_owned(),
+    ]
+    .concat()
+}
+
+/// A split vertex's path goes on with the vertex's own numbers: the split's samples are
+/// stratified only together (each one's values over a pixel's samples lie in one strip of the
+/// lobe), so a path going on with one of them saw the same strip of the ceiling in every sample
+/// of a pixel, and its noise hardly fell with more samples.
+#[test]
+fn a_split_vertex_path_sees_the_whole_lobe() {
+    let noise = |spp| {
+        seed_difference(|seed| {
+            let (scene, settings) = estimates::build(&ceiling_scene(true), SIZE, spp, seed);
+            assert!(scene.glossy_split());
+            estimates::radiance(&scene, &settings)
+        })
+    };
+    // About 4 or more where a pixel's paths spread over the whole lobe (1.15 when they did not).
+    let ratio = noise(8) / noise(32);
+    assert!(ratio > 2.5, "noise at 8 spp / at 32 spp: {ratio}");
+}
+
+/// The light a split vertex's path finds beyond it keeps the one-sample path's mean.
+#[test]
+fn a_split_vertex_path_keeps_the_mean() {
+    estimates::assert_same_mean(|split, seed| {
+        let (scene, settings) = estimates::build(&ceiling_scene(split), SIZE, 512, seed);
+        estimates::radiance(&scene, &settings)
+    });
+}
