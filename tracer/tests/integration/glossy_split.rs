@@ -39,8 +39,8 @@ fn scene(split: bool) -> String {
     )
 }
 
-fn render(split: bool, spp: u32, seed: u64) -> Vec<Vec3> {
-    let (scene, settings) = estimates::build(&scene(split), SIZE, spp, seed);
+fn render(text: &str, spp: u32, seed: u64) -> Vec<Vec3> {
+    let (scene, settings) = estimates::build(text, SIZE, spp, seed);
     estimates::radiance(&scene, &settings)
 }
 
@@ -48,14 +48,14 @@ fn render(split: bool, spp: u32, seed: u64) -> Vec<Vec3> {
 /// either side moves the mean.
 #[test]
 fn splitting_keeps_the_mean() {
-    estimates::assert_same_mean(|split, seed| render(split, 512, seed));
+    estimates::assert_same_mean(|split, seed| render(&scene(split), 512, seed));
 }
 
 /// The highlight is where one BSDF sample finds the lamp or misses it; eight stratified ones
 /// see it far more evenly.
 #[test]
 fn splitting_cuts_the_noise_of_highlights() {
-    let noise = |split| seed_difference(|seed| render(split, 16, seed));
+    let noise = |split| seed_difference(|seed| render(&scene(split), 16, seed));
     let (noise_plain, noise_split) = (noise(false), noise(true));
     assert!(
         noise_split * 5.0 < noise_plain,
@@ -132,13 +132,10 @@ fn ceiling_scene(split: bool) -> String {
 /// of a pixel, and its noise hardly fell with more samples.
 #[test]
 fn a_split_vertex_path_sees_the_whole_lobe() {
-    let noise = |spp| {
-        seed_difference(|seed| {
-            let (scene, settings) = estimates::build(&ceiling_scene(true), SIZE, spp, seed);
-            assert!(scene.glossy_split());
-            estimates::radiance(&scene, &settings)
-        })
-    };
+    assert!(estimates::build(&ceiling_scene(true), SIZE, 1, 0)
+        .0
+        .glossy_split());
+    let noise = |spp| seed_difference(|seed| render(&ceiling_scene(true), spp, seed));
     // About 4 or more where a pixel's paths spread over the whole lobe (1.15 when they did not).
     let ratio = noise(8) / noise(32);
     assert!(ratio > 2.5, "noise at 8 spp / at 32 spp: {ratio}");
@@ -147,8 +144,5 @@ fn a_split_vertex_path_sees_the_whole_lobe() {
 /// The light a split vertex's path finds beyond it keeps the one-sample path's mean.
 #[test]
 fn a_split_vertex_path_keeps_the_mean() {
-    estimates::assert_same_mean(|split, seed| {
-        let (scene, settings) = estimates::build(&ceiling_scene(split), SIZE, 512, seed);
-        estimates::radiance(&scene, &settings)
-    });
+    estimates::assert_same_mean(|split, seed| render(&ceiling_scene(split), 512, seed));
 }
