@@ -54,10 +54,11 @@ pub trait PathScene {
 /// more before that vertex than after (the camera ray, the film, the first light sample),
 /// more continuations per camera sample are the cheaper way to less noise; how many a scene
 /// takes is measured when it is built (`render::branching`). Measured with 1 to 4 branches at
-/// 16 spp (480x270, one thread, MSE x time against 1 branch): depth of field 1.22x, 1.29x,
-/// 1.27x (the room's indirect light is most of its noise); Captain Falcon 1.15x, 1.05x;
-/// Cornell 0.97x, 0.80x (long paths in a closed box: a branch costs as much as a sample);
-/// Mario 0.87x, 0.78x (its noise is the caustics its glossy vertices already split for).
+/// 16 spp (480x270, one thread, 4 seeds, MSE x time against 1 branch): depth of field 1.25x,
+/// 1.30x, 1.26x (the room's indirect light is most of its noise); Captain Falcon 1.14x, 1.04x,
+/// 1.02x; Cornell 1.02x, 0.94x (long paths in a closed box: a branch costs nearly as much as a
+/// sample); Mario 0.98x, 0.91x (its noise is the caustics its glossy vertices already split
+/// for).
 pub const MAX_BRANCHES: usize = 4;
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
@@ -100,6 +101,25 @@ const RR_MIN_SURVIVAL: f32 = 0.05;
 pub struct PathResult {
     pub radiance: Vec3,
     pub rays: u32,
+    /// With [`BranchDraw::Independent`]: the light the first continuation brings less the
+    /// second's, each as a path with one continuation would bring it (0 where the path did
+    /// not branch). What `render::branching` measures the continuations' error with.
+    pub branch_difference: Vec3,
+    /// With [`BranchDraw::Independent`]: the rays the continuations took, of `rays`.
+    pub branch_rays: u32,
+}
+
+/// How a branching vertex draws its continuations' directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BranchDraw {
+    /// As one split draw, stratified together ([`PixelSampler::get_split_draws`]): what
+    /// renders take.
+    Split,
+    /// Each in its own stream, weighed against the vertex's light sample as its only BSDF sample
+    /// and carrying the whole throughput (its light is divided when it is in): every
+    /// continuation is stratified over a pixel's samples on its own, independent of the others,
+    /// and is what the path's one continuation would be, roulette included.
+    Independent,
 }
 
 fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
@@ -216,20 +236,31 @@ fn survives(
 // mirrors run 0.5% more instructions (callgrind, depth of field 160x90 32 spp).
 #[inline(always)]
 pub fn trace_path<S: PathScene>(scene: &S, ray: Ray, sampler: &mut PixelSampler) -> PathResult {
-    trace_branching_path(scene, ray, sampler, scene.first_vertex_branches())
+    let branches = scene.first_vertex_branches();
+    trace_with(scene, ray, sampler, branches, BranchDraw::Split)
 }
 
-/// [`trace_path`] with `branches` continuations at the first broad vertex (clamped to 1 ..=
-/// [`MAX_BRANCHES`]) whatever the scene's own number: what `render::branching` measures with.
+/// [`trace_path`] with two continuations at the first broad vertex, drawn independently
+/// ([`BranchDraw::Independent`]), whatever the scene's own number: what `render::branching`
+/// measures with.
+pub fn trace_pilot_path<S: PathScene>(
+    scene: &S,
+    ray: Ray,
+    sampler: &mut PixelSampler,
+) -> PathResult {
+    trace_with(scene, ray, sampler, 2, BranchDraw::Independent)
+}
+
 #[inline(always)]
-pub fn trace_branching_path<S: PathScene>(
+fn trace_with<S: PathScene>(
     scene: &S,
     ray: Ray,
     sampler: &mut PixelSampler,
     branches: usize,
+    draw: BranchDraw,
 ) -> PathResult {
     let mut out = PathResult::default();
-    let state = PathState::camera(scene, ray, branches.clamp(1, MAX_BRANCHES));
+    let state = PathState::camera(scene, ray, branches.clamp(1, MAX_BRANCHES), draw);
     walk(scene, state, sampler, &mut out);
     out
 }
@@ -248,11 +279,12 @@ struct PathState {
     /// The continuations its next broad vertex sends on, while every vertex so far was
     /// specular (1 after that).
     branches: usize,
+    draw: BranchDraw,
     prev: PrevScatter,
 }
 
 impl PathState {
-    fn camera<S: PathScene>(scene: &S, ray: Ray, branches: usize) -> Self {
+    fn camera<S: PathScene>(scene: &S, ray: Ray, branches: usize, draw: BranchDraw) -> Self {
         Self {
             ray,
             throughput: Vec3::ONE,
@@ -261,6 +293,7 @@ impl PathState {
             pass_through: 0,
             may_split: scene.glossy_split(),
             branches,
+            draw,
             // The camera ray counts as specular: emitters it sees are taken at full weight.
             prev: PrevScatter::plain(ray.origin, 0.0, true),
         }
@@ -289,6 +322,7 @@ fn walk<S: PathScene>(
         mut pass_through,
         mut may_split,
         mut branches,
+        draw,
         mut prev,
     } = state;
     let mut radiance = Vec3::ZERO;
@@ -406,7 +440,7 @@ fn walk<S: PathScene>(
         let branching = !split && branches > 1 && broad.is_some();
         let bsdf_count = if split {
             GLOSSY_SPLIT as f32
-        } else if branching {
+        } else if branching && draw == BranchDraw::Split {
             branches as f32
         } else {
             1.0
@@ -453,7 +487,10 @@ fn walk<S: PathScene>(
                 may_split,
                 roulette: u.roulette,
             };
-            vertex.branch(scene, branches, sampler, out);
+            match draw {
+                BranchDraw::Split => vertex.branch(scene, branches, sampler, out),
+                BranchDraw::Independent => vertex.branch_independently(scene, sampler, out),
+            }
             break;
         }
         if !bsdf.is_specular() {
@@ -546,25 +583,60 @@ impl BranchVertex<'_> {
     ) {
         let (lobes, dirs) = sampler.get_split_draws::<MAX_BRANCHES>(count);
         for k in 0..count {
-            let (mut stream, u_rr) = if k == 0 {
-                (sampler.clone(), self.roulette)
-            } else {
-                let mut stream = sampler.branch(k as u32);
-                let u_rr = stream.get_1d();
-                (stream, u_rr)
-            };
-            if let Some(state) = self.continuation(scene, count, lobes[k], dirs[k], u_rr) {
+            let (mut stream, u_rr) = self.stream(sampler, k);
+            let draw = BranchDraw::Split;
+            if let Some(state) = self.continuation(scene, count, draw, lobes[k], dirs[k], u_rr) {
                 walk(scene, state, &mut stream, out);
             }
         }
     }
 
-    /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count`; None where the
-    /// sample finds nothing or the roulette (`u_rr`) ends it.
+    /// [`Self::branch`] with two continuations drawn as [`BranchDraw::Independent`] says, each
+    /// adding half its light to `out`, which keeps their difference and their rays.
+    #[inline(never)]
+    fn branch_independently<S: PathScene>(
+        &self,
+        scene: &S,
+        sampler: &mut PixelSampler,
+        out: &mut PathResult,
+    ) {
+        let rays_before = out.rays;
+        let mut brought = [Vec3::ZERO; 2];
+        for (k, light) in brought.iter_mut().enumerate() {
+            let (mut stream, u_rr) = self.stream(sampler, k);
+            let (lobe, dir) = stream.get_split_draws::<1>(1);
+            let draw = BranchDraw::Independent;
+            let before = out.radiance;
+            if let Some(state) = self.continuation(scene, 2, draw, lobe[0], dir[0], u_rr) {
+                walk(scene, state, &mut stream, out);
+            }
+            *light = out.radiance - before;
+            out.radiance = before + *light / 2.0;
+        }
+        out.branch_difference = brought[0] - brought[1];
+        out.branch_rays = out.rays - rays_before;
+    }
+
+    /// Continuation `k`'s stream and roulette number: the path's own for the first.
+    #[inline(always)]
+    fn stream(&self, sampler: &PixelSampler, k: usize) -> (PixelSampler, f32) {
+        if k == 0 {
+            (sampler.clone(), self.roulette)
+        } else {
+            let mut stream = sampler.branch(k as u32);
+            let u_rr = stream.get_1d();
+            (stream, u_rr)
+        }
+    }
+
+    /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count` drawn as `draw`
+    /// says; None where the sample finds nothing or the roulette (`u_rr`) ends it.
+    #[inline(always)]
     fn continuation<S: PathScene>(
         &self,
         scene: &S,
         count: usize,
+        draw: BranchDraw,
         u_lobe: f32,
         u: Vec2,
         u_rr: f32,
@@ -580,18 +652,25 @@ impl BranchVertex<'_> {
         }
         Some(PathState {
             ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
-            throughput: throughput / count as f32,
+            throughput: match draw {
+                BranchDraw::Split => throughput / count as f32,
+                BranchDraw::Independent => throughput,
+            },
             medium: self.sides.toward(bs.wi, hit.ng),
             depth: self.depth,
             pass_through: 0,
             may_split: self.may_split,
             branches: 1,
+            draw: BranchDraw::Split,
             // Counted `count` times against the light sample (the split's way, with the share
-            // already in the throughput). A broad BSDF's samples are not specular: no mirror
-            // follows.
+            // already in the throughput), or once where each continuation is a path of its
+            // own. A broad BSDF's samples are not specular: no mirror follows.
             prev: PrevScatter {
                 p: hit.p,
-                pdf: count as f32 * bs.pdf,
+                pdf: match draw {
+                    BranchDraw::Split => count as f32 * bs.pdf,
+                    BranchDraw::Independent => bs.pdf,
+                },
                 specular: bs.specular,
                 image_share: self.image_share,
                 before_mirror: None,

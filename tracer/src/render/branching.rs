@@ -9,18 +9,30 @@
 //! `k = sqrt((v_next / c_next) / (v_first / c_first))` (the splitting factor of Rath et al.
 //! 2022, "EARS", for the first vertex of the whole image).
 //!
-//! The pilot renders a set of pixels with one and with two continuations, each twice with
-//! independent samples: the squared difference of two renders is twice their error,
-//! stratification included (the continuations' variance measured per path, without it, came
-//! out up to ten times too large on Captain Falcon, whose first bounce the samples stratify
-//! well). The renders with one and two continuations share their samples up to the vertex, so
-//! per pixel the difference of their errors is the continuations' alone; its mean less one
-//! standard error (`CONFIDENCE`) is the `v_next / 2` the choice believes, so that a scene
-//! whose pilot sees a few bright outliers (the caustics of Cornell's glass) keeps one
-//! continuation. Rays count for the cost. The pilot takes about a hundredth of the render's
-//! samples (`PILOT_SHARE`; at most `MAX_PILOT_PIXELS` pixels): a render too short to spare
-//! one of `MIN_PILOT_PIXELS` keeps one continuation. A pilot good enough to choose well on
-//! a 480x270 render of 16 spp would cost it some 6%.
+//! The pilot renders a set of pixels twice with independent samples, each time with two
+//! continuations drawn independently of each other, each a whole path's continuation
+//! ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)): per pixel, four renders with one continuation, (a, b) and
+//! (a', b'), where a and b share everything before the vertex. Their differences give the two
+//! parts with stratification included (the continuations' variance measured per path, without
+//! it, came out up to ten times too large on Captain Falcon, whose first bounce the samples
+//! stratify well): `v_next` is half the expected (a - b)^2, `v_first` what a and b share, the
+//! expected (a - a') (b - b') / 2, a product of independent differences (a continuation's rare
+//! bright sample, a caustic of Cornell's glass, weighs in linearly where the difference of two
+//! squared errors, the earlier pilot's, took it squared and kept Cornell's choice a coin toss).
+//! Each part is believed one standard error (`CONFIDENCE`) on the side that favours one
+//! continuation. Rays count for the cost: those of the continuations, and the rest. The model
+//! leaves out that a render's continuations are stratified together (Captain Falcon gains 1.14x
+//! with two that it does not see) and that each carries a `k`th of the throughput into the
+//! roulette (fewer rays, more noise): its choices err towards one continuation.
+//!
+//! The pilot's camera samples are a fiftieth of the render's (`PILOT_SHARE`; at most
+//! `MAX_PILOT_PIXELS` pixels), some 3% of its time: a render too short to spare a pilot of
+//! `MIN_PILOT_PIXELS` keeps one continuation; a 480x270 render of 16 spp is just long enough.
+//! Measured there (one thread, 4 seeds, MSE x time against one continuation, with the pilot's
+//! time): depth of field 1.27x (it takes 3, mostly, or 2 or 4, each 1.25-1.30x alone); Cornell
+//! 0.95x, Mario 0.97x, Captain Falcon 0.96x (one continuation, and the pilot's time). In 12
+//! seeds the pilot gave Cornell 3 continuations twice (0.94x alone) and 1 otherwise, depth of
+//! field 2 to 4, Falcon and Mario 1; on half the pixels Cornell took 2 to 4 in 6 of 24.
 //!
 //! Only the scene and the render settings decide it: every node that builds the scene takes
 //! the same number, and the image is the same bytes wherever it is rendered.
@@ -29,11 +41,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::settings::RenderSettings;
-use crate::integrator::path::{trace_branching_path, PathScene, MAX_BRANCHES};
+use crate::integrator::path::{trace_pilot_path, PathScene, MAX_BRANCHES};
 use crate::math::Ray;
 use crate::sampler::{mix64, PixelSampler};
 
-/// Samples per pilot pixel in each of its four renders: the render's, within these bounds
+/// Samples per pilot pixel in each of its two renders: the render's, within these bounds
 /// (the error's make-up changes with the samples: the camera's and the first vertex's few
 /// dimensions are stratified better as they grow than a whole continuation is).
 const MIN_PILOT_SPP: u32 = 4;
@@ -42,11 +54,12 @@ const MAX_PILOT_SPP: u32 = 16;
 /// The most pixels the pilot renders.
 const MAX_PILOT_PIXELS: u64 = 2304;
 
-/// Fewer pixels than this tell nothing: one continuation.
+/// Fewer pixels than this choose badly (Cornell's caustics): one continuation.
 const MIN_PILOT_PIXELS: u64 = 1024;
 
-/// The share of the render's samples the pilot may take, as a divisor.
-const PILOT_SHARE: u64 = 100;
+/// The share of the render's camera samples the pilot may take, as a divisor (each of its
+/// samples costs some one and a half of the render's: it traces two continuations).
+const PILOT_SHARE: u64 = 50;
 
 /// How much cheaper a ray before the branching vertex is than one after it, in rays per
 /// sample: the camera ray is coherent and the first light sample's shadow ray an any-hit ray,
@@ -62,7 +75,8 @@ const MIN_GAIN: f64 = 1.05;
 /// Standard errors the continuations' error is taken below its estimate.
 const CONFIDENCE: f64 = 1.0;
 
-/// The pilot's samples are their own (the render's seed, keyed apart); two independent sets.
+/// The pilot's samples are their own (the render's seed, keyed apart): its render with two
+/// continuations and its render with one.
 const PILOT_KEYS: [u64; 2] = [0x7069_6c6f_745f_6b31, 0x7069_6c6f_745f_6b32];
 
 /// The pilot's estimates: errors of a pixel's mean at the pilot's samples (summed over the
@@ -111,39 +125,49 @@ pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
     let settings = scene.settings();
     let samples = u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
     let spp = settings.spp.clamp(MIN_PILOT_SPP, MAX_PILOT_SPP);
-    let pixels = (samples / (PILOT_SHARE * 4 * u64::from(spp))).min(MAX_PILOT_PIXELS);
+    let pixels = (samples / (PILOT_SHARE * 2 * u64::from(spp))).min(MAX_PILOT_PIXELS);
     if pixels < MIN_PILOT_PIXELS {
         return None;
     }
     let keys = PILOT_KEYS.map(|key| mix64(mix64(settings.seed) ^ key));
-    // Per pixel, with one and with two continuations: the means of its two renders, and rays.
-    let renders: Vec<[[(DVec3, u64); 2]; 2]> = (0..pixels)
+    let renders: Vec<[PixelMean; 2]> = (0..pixels)
         .into_par_iter()
         .map(|i| {
             let (x, y) = pilot_pixel(i, pixels, settings.width, settings.height);
-            [1, 2].map(|branches| keys.map(|key| pixel_mean(scene, x, y, branches, spp, key)))
+            keys.map(|key| pixel_mean(scene, x, y, spp, key))
         })
         .collect();
     let n = pixels as f64;
-    let error = |[a, b]: &[(DVec3, u64); 2]| (a.0 - b.0).length_squared() / 2.0;
-    let error_one = renders.iter().map(|[one, _]| error(one)).sum::<f64>() / n;
-    let gains: Vec<f64> = renders
+    // Per pixel, from the continuations' renders (a, b) and (a', b'): the continuations' error,
+    // half the expected (a - b)^2, and the rest, the covariance of a and b (what they share),
+    // the expected (a - a') (b - b') / 2 (a product of independent differences, so that a
+    // continuation's rare bright sample weighs in linearly, not squared).
+    let errors: Vec<[f64; 2]> = renders
         .iter()
-        .map(|[one, two]| error(one) - error(two))
+        .map(|[one, other]| {
+            let (a, b) = one.continuations();
+            let (a2, b2) = other.continuations();
+            let next = ((a - b).length_squared() + (a2 - b2).length_squared()) / 4.0;
+            let first = ((a - a2).dot(b - b2) + (a - b2).dot(b - a2)) / 4.0;
+            [next, first]
+        })
         .collect();
-    let gain = gains.iter().sum::<f64>() / n;
-    let spread = gains.iter().map(|g| (g - gain).powi(2)).sum::<f64>() / (n - 1.0);
-    let believed_gain = (gain - CONFIDENCE * (spread / n).sqrt()).max(0.0);
-    let rays = |k: usize| {
-        let total: u64 = renders.iter().map(|p| p[k][0].1 + p[k][1].1).sum();
-        total as f64 / (2.0 * n * f64::from(spp))
+    // Each believed a standard error (`CONFIDENCE`) on the side that favours one continuation.
+    let believed = |part: usize, side: f64| {
+        let mean = errors.iter().map(|e| e[part]).sum::<f64>() / n;
+        let spread = errors.iter().map(|e| (e[part] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean + side * CONFIDENCE * (spread / n).sqrt()).max(0.0)
     };
-    let c_next = (rays(1) - rays(0)).max(0.0);
-    let v_next = 2.0 * believed_gain;
+    let (v_next, v_first) = (believed(0, -1.0), believed(1, 1.0));
+    // Rays per camera sample, before the branching vertex and in each continuation.
+    let per_sample = 2.0 * n * f64::from(spp);
+    let rays = renders.iter().flatten().map(|p| p.rays).sum::<u64>() as f64 / per_sample;
+    let c_next =
+        renders.iter().flatten().map(|p| p.branch_rays).sum::<u64>() as f64 / per_sample / 2.0;
     Some(BranchFigures {
-        v_first: (error_one - v_next).max(0.0),
+        v_first,
         v_next,
-        c_first: (rays(0) - c_next - FIRST_RAYS_DISCOUNT).max(0.0),
+        c_first: (rays - 2.0 * c_next - FIRST_RAYS_DISCOUNT).max(0.0),
         c_next,
     })
 }
@@ -165,29 +189,48 @@ fn pilot_pixel(i: u64, count: u64, width: u32, height: u32) -> (u32, u32) {
     (column.min(width - 1), row.min(height - 1))
 }
 
-/// The mean of `spp` samples of pixel (`x`, `y`) with `branches` continuations and
-/// `seed`, and their rays.
-fn pixel_mean(
-    scene: &impl PilotScene,
-    x: u32,
-    y: u32,
-    branches: usize,
-    spp: u32,
-    seed: u64,
-) -> (DVec3, u64) {
-    let mut sum = DVec3::ZERO;
-    let mut rays = 0;
+/// A pilot pixel's render with two continuations: the means of its samples' radiance and of
+/// their [`crate::integrator::PathResult::branch_difference`]s, and the rays they took, all and
+/// in the continuations.
+struct PixelMean {
+    radiance: DVec3,
+    difference: DVec3,
+    rays: u64,
+    branch_rays: u64,
+}
+
+impl PixelMean {
+    /// The pixel as each continuation alone renders it.
+    fn continuations(&self) -> (DVec3, DVec3) {
+        let half = self.difference / 2.0;
+        (self.radiance + half, self.radiance - half)
+    }
+}
+
+/// `spp` samples of pixel (`x`, `y`) with two continuations drawn independently
+/// ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)) and `seed`.
+fn pixel_mean(scene: &impl PilotScene, x: u32, y: u32, spp: u32, seed: u64) -> PixelMean {
+    let mut mean = PixelMean {
+        radiance: DVec3::ZERO,
+        difference: DVec3::ZERO,
+        rays: 0,
+        branch_rays: 0,
+    };
     for index in 0..spp {
         let mut sampler = PixelSampler::new(x, y, index, spp, seed);
         if let Some(ray) = scene.camera_ray(x, y, &mut sampler) {
-            let path = trace_branching_path(scene, ray, &mut sampler, branches);
-            rays += u64::from(path.rays);
-            if path.radiance.is_finite() {
-                sum += path.radiance.as_dvec3();
+            let path = trace_pilot_path(scene, ray, &mut sampler);
+            mean.rays += u64::from(path.rays);
+            mean.branch_rays += u64::from(path.branch_rays);
+            if path.radiance.is_finite() && path.branch_difference.is_finite() {
+                mean.radiance += path.radiance.as_dvec3();
+                mean.difference += path.branch_difference.as_dvec3();
             }
         }
     }
-    (sum / f64::from(spp), rays)
+    mean.radiance /= f64::from(spp);
+    mean.difference /= f64::from(spp);
+    mean
 }
 
 #[cfg(test)]

@@ -64,6 +64,27 @@ fn branching_cuts_the_noise_of_the_first_bounce() {
     );
 }
 
+/// The pilot's figures predict what two continuations do to the noise where the light comes
+/// off the wall: the render does as well or somewhat better (its two are stratified together,
+/// the pilot's independent).
+#[test]
+fn the_pilot_predicts_the_noise_of_two_continuations() {
+    let (scene, _) = estimates::build(&scene(true), SIZE, 4096, 1);
+    let f = branching::measure(&scene).expect("the render is long enough for a pilot");
+    let predicted = (f.v_first + f.v_next / 2.0) / (f.v_first + f.v_next);
+    let noise = |branches| -> f64 {
+        (0..4)
+            .map(|pair| seed_difference(|seed| render(true, branches, 16, 2 * pair + seed)))
+            .sum()
+    };
+    let measured = noise(2) / noise(1);
+    println!("noise with 2 continuations over 1: measured {measured}, predicted {predicted}");
+    assert!(
+        (0.75 * predicted..1.1 * predicted).contains(&measured),
+        "noise with 2 continuations over 1: measured {measured}, predicted {predicted} ({f:?})"
+    );
+}
+
 /// The pilot on a seed scene at a render long enough to run it (240x135, 512 spp).
 fn chosen(scene: &str) -> Option<usize> {
     let path = seed_scenes()?.join(scene);
