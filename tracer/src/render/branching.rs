@@ -11,28 +11,31 @@
 //!
 //! The pilot renders a set of pixels twice with independent samples, each time with two
 //! continuations drawn independently of each other, each a whole path's continuation
-//! ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)): per pixel, four renders with one continuation, (a, b) and
-//! (a', b'), where a and b share everything before the vertex. Their differences give the two
-//! parts with stratification included (the continuations' variance measured per path, without
-//! it, came out up to ten times too large on Captain Falcon, whose first bounce the samples
-//! stratify well): `v_next` is half the expected (a - b)^2, `v_first` what a and b share, the
-//! expected (a - a') (b - b') / 2, a product of independent differences (a continuation's rare
-//! bright sample, a caustic of Cornell's glass, weighs in linearly where the difference of two
-//! squared errors, the earlier pilot's, took it squared and kept Cornell's choice a coin toss).
-//! Each part is believed one standard error (`CONFIDENCE`) on the side that favours one
-//! continuation. Rays count for the cost: those of the continuations, and the rest. The model
-//! leaves out that a render's continuations are stratified together (Captain Falcon gains 1.14x
-//! with two that it does not see) and that each carries a `k`th of the throughput into the
-//! roulette (fewer rays, more noise): its choices err towards one continuation.
+//! ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)): per pixel,
+//! four renders with one continuation, (a, b) and (a', b'), where a and b share everything
+//! before the vertex. Their differences give the two parts with stratification included (the
+//! continuations' variance measured per path, without it, came out up to ten times too large on
+//! Captain Falcon, whose first bounce the samples stratify well): `v_next` is half the expected
+//! (a - b)^2, `v_first` what a and b share, the expected (a - a') (b - b') / 2, a product of
+//! independent differences (a continuation's rare bright sample, a caustic of Cornell's glass,
+//! weighs in linearly, where the difference of two squared errors, the earlier pilot's, took it
+//! squared). Each part is believed `CONFIDENCE` standard errors off its estimate, on the side
+//! that favours one continuation: what Cornell's own rare bright pixels need (the lamp seen
+//! through the glass, which a and b share; a pilot that misses them sees no `v_first`). Rays
+//! count for the cost: those of the continuations, and the rest. The model leaves out that a
+//! render's continuations are stratified together (Captain Falcon gains 1.14x with two, which
+//! it does not see) and that each carries a `k`th of the throughput into the roulette (fewer
+//! rays, more noise): its choices err towards one continuation.
 //!
 //! The pilot's camera samples are a fiftieth of the render's (`PILOT_SHARE`; at most
-//! `MAX_PILOT_PIXELS` pixels), some 3% of its time: a render too short to spare a pilot of
+//! `MAX_PILOT_PIXELS` pixels), some 3% of its time, and half that where half its pixels
+//! already rule more continuations out: a render too short to spare a pilot of
 //! `MIN_PILOT_PIXELS` keeps one continuation; a 480x270 render of 16 spp is just long enough.
-//! Measured there (one thread, 4 seeds, MSE x time against one continuation, with the pilot's
-//! time): depth of field 1.27x (it takes 3, mostly, or 2 or 4, each 1.25-1.30x alone); Cornell
-//! 0.95x, Mario 0.97x, Captain Falcon 0.96x (one continuation, and the pilot's time). In 12
-//! seeds the pilot gave Cornell 3 continuations twice (0.94x alone) and 1 otherwise, depth of
-//! field 2 to 4, Falcon and Mario 1; on half the pixels Cornell took 2 to 4 in 6 of 24.
+//! Measured there (one thread, 4 seeds, MSE x time against one continuation, the pilot's time
+//! included): depth of field 1.23x (2 or 3 continuations, 1.25x and 1.30x alone); Cornell 0.95x
+//! (1, and 2 in one seed), Mario 0.99x, Captain Falcon 0.99x (1, the pilot stopping half way).
+//! In 8 seeds the pilot gave Cornell 1 continuation 7 times and 2 once (1.02x alone); in 6,
+//! Mario and Falcon 1.
 //!
 //! Only the scene and the render settings decide it: every node that builds the scene takes
 //! the same number, and the image is the same bytes wherever it is rendered.
@@ -72,8 +75,14 @@ const FIRST_RAYS_DISCOUNT: f64 = 0.6;
 /// break-even point gains nothing either way.
 const MIN_GAIN: f64 = 1.05;
 
-/// Standard errors the continuations' error is taken below its estimate.
-const CONFIDENCE: f64 = 1.0;
+/// Standard errors each part of the error is taken off its estimate, towards one continuation,
+/// for the choice: at one, Cornell took 3 or 4 continuations in 3 of 16 seeds (0.94x, 0.85x),
+/// at two in none of 12, and depth of field still 2 to 4.
+const CONFIDENCE: f64 = 2.0;
+
+/// Standard errors each part is taken off its estimate, away from one continuation, for the
+/// early stop: the pilot ends on half its pixels where even so one continuation is best.
+const STOP_CONFIDENCE: f64 = 1.0;
 
 /// The pilot's samples are their own (the render's seed, keyed apart): its render with two
 /// continuations and its render with one.
@@ -130,19 +139,36 @@ pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
         return None;
     }
     let keys = PILOT_KEYS.map(|key| mix64(mix64(settings.seed) ^ key));
-    let renders: Vec<[PixelMean; 2]> = (0..pixels)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = pilot_pixel(i, pixels, settings.width, settings.height);
-            keys.map(|key| pixel_mean(scene, x, y, spp, key))
-        })
-        .collect();
-    let n = pixels as f64;
+    let render = |half: u64| -> Vec<[PixelMean; 2]> {
+        (0..(pixels - half).div_ceil(2))
+            .into_par_iter()
+            .map(|j| {
+                let (x, y) = pilot_pixel(2 * j + half, pixels, settings.width, settings.height);
+                keys.map(|key| pixel_mean(scene, x, y, spp, key))
+            })
+            .collect()
+    };
+    // Half the pixels first (every other one: all over the image); where even figures believed
+    // on the side that favours more continuations keep one, the rest would not change that
+    // (Mario and Captain Falcon stop there).
+    let mut renders = render(0);
+    if figures(&renders, spp, -STOP_CONFIDENCE).best() == 1 {
+        return Some(figures(&renders, spp, CONFIDENCE));
+    }
+    renders.extend(render(1));
+    Some(figures(&renders, spp, CONFIDENCE))
+}
+
+/// The figures of the pilot's `renders` of `spp` samples, each part of the error believed
+/// `errors` standard errors off its estimate: positive towards one continuation, negative
+/// away from it.
+fn figures(renders: &[[PixelMean; 2]], spp: u32, errors: f64) -> BranchFigures {
+    let n = renders.len() as f64;
     // Per pixel, from the continuations' renders (a, b) and (a', b'): the continuations' error,
     // half the expected (a - b)^2, and the rest, the covariance of a and b (what they share),
     // the expected (a - a') (b - b') / 2 (a product of independent differences, so that a
     // continuation's rare bright sample weighs in linearly, not squared).
-    let errors: Vec<[f64; 2]> = renders
+    let parts: Vec<[f64; 2]> = renders
         .iter()
         .map(|[one, other]| {
             let (a, b) = one.continuations();
@@ -152,24 +178,22 @@ pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
             [next, first]
         })
         .collect();
-    // Each believed a standard error (`CONFIDENCE`) on the side that favours one continuation.
-    let believed = |part: usize, side: f64| {
-        let mean = errors.iter().map(|e| e[part]).sum::<f64>() / n;
-        let spread = errors.iter().map(|e| (e[part] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean + side * CONFIDENCE * (spread / n).sqrt()).max(0.0)
+    let believed = |part: usize, errors: f64| {
+        let mean = parts.iter().map(|e| e[part]).sum::<f64>() / n;
+        let spread = parts.iter().map(|e| (e[part] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean + errors * (spread / n).sqrt()).max(0.0)
     };
-    let (v_next, v_first) = (believed(0, -1.0), believed(1, 1.0));
     // Rays per camera sample, before the branching vertex and in each continuation.
     let per_sample = 2.0 * n * f64::from(spp);
     let rays = renders.iter().flatten().map(|p| p.rays).sum::<u64>() as f64 / per_sample;
     let c_next =
         renders.iter().flatten().map(|p| p.branch_rays).sum::<u64>() as f64 / per_sample / 2.0;
-    Some(BranchFigures {
-        v_first,
-        v_next,
+    BranchFigures {
+        v_first: believed(1, errors),
+        v_next: believed(0, -errors),
         c_first: (rays - 2.0 * c_next - FIRST_RAYS_DISCOUNT).max(0.0),
         c_next,
-    })
+    }
 }
 
 /// The continuations the scene's camera paths take.

@@ -136,8 +136,8 @@ fn the_pilot_is_the_same_on_any_number_of_threads() {
     assert_eq!(scene.first_vertex_branches(), one.best());
 }
 
-/// A render too short to spare a pilot (40 x 40 x 64 samples, where a pilot of 1024 pixels
-/// needs 100 times its own) takes none.
+/// A render too short to spare a pilot (40 x 40 x 64 samples, where a pilot of 1024 pixels of
+/// 16 samples, two renders, needs 50 times its camera samples) takes none.
 #[test]
 fn a_short_render_takes_no_pilot() {
     let (scene, _) = estimates::build(&scene(true), SIZE, 64, 1);
