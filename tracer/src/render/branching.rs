@@ -84,8 +84,8 @@ const CONFIDENCE: f64 = 2.0;
 /// early stop: the pilot ends on half its pixels where even so one continuation is best.
 const STOP_CONFIDENCE: f64 = 1.0;
 
-/// The pilot's samples are their own (the render's seed, keyed apart): its render with two
-/// continuations and its render with one.
+/// The pilot's samples are their own (the render's seed, keyed apart): one key for each of its
+/// two renders.
 const PILOT_KEYS: [u64; 2] = [0x7069_6c6f_745f_6b31, 0x7069_6c6f_745f_6b32];
 
 /// The pilot's estimates: errors of a pixel's mean at the pilot's samples (summed over the
@@ -160,9 +160,8 @@ pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
 }
 
 /// The figures of the pilot's `renders` of `spp` samples, each part of the error believed
-/// `errors` standard errors off its estimate: positive towards one continuation, negative
-/// away from it.
-fn figures(renders: &[[PixelMean; 2]], spp: u32, errors: f64) -> BranchFigures {
+/// `standard_errors` off its estimate: positive towards one continuation, negative away from it.
+fn figures(renders: &[[PixelMean; 2]], spp: u32, standard_errors: f64) -> BranchFigures {
     let n = renders.len() as f64;
     // Per pixel, from the continuations' renders (a, b) and (a', b'): the continuations' error,
     // half the expected (a - b)^2, and the rest, the covariance of a and b (what they share),
@@ -178,10 +177,12 @@ fn figures(renders: &[[PixelMean; 2]], spp: u32, errors: f64) -> BranchFigures {
             [next, first]
         })
         .collect();
-    let believed = |part: usize, errors: f64| {
+    // `towards_one`: +1 where a larger part favours one continuation (v_first), -1 where a
+    // smaller one does (v_next).
+    let believed = |part: usize, towards_one: f64| {
         let mean = parts.iter().map(|e| e[part]).sum::<f64>() / n;
         let spread = parts.iter().map(|e| (e[part] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean + errors * (spread / n).sqrt()).max(0.0)
+        (mean + towards_one * standard_errors * (spread / n).sqrt()).max(0.0)
     };
     // Rays per camera sample, before the branching vertex and in each continuation.
     let per_sample = 2.0 * n * f64::from(spp);
@@ -189,8 +190,8 @@ fn figures(renders: &[[PixelMean; 2]], spp: u32, errors: f64) -> BranchFigures {
     let c_next =
         renders.iter().flatten().map(|p| p.branch_rays).sum::<u64>() as f64 / per_sample / 2.0;
     BranchFigures {
-        v_first: believed(1, errors),
-        v_next: believed(0, -errors),
+        v_first: believed(1, 1.0),
+        v_next: believed(0, -1.0),
         c_first: (rays - 2.0 * c_next - FIRST_RAYS_DISCOUNT).max(0.0),
         c_next,
     }
