@@ -584,8 +584,7 @@ impl BranchVertex<'_> {
         let (lobes, dirs) = sampler.get_split_draws::<MAX_BRANCHES>(count);
         for k in 0..count {
             let (mut stream, u_rr) = self.stream(sampler, k);
-            let draw = BranchDraw::Split;
-            if let Some(state) = self.continuation(scene, count, draw, lobes[k], dirs[k], u_rr) {
+            if let Some(state) = self.continuation(scene, count, lobes[k], dirs[k], u_rr) {
                 walk(scene, state, &mut stream, out);
             }
         }
@@ -605,9 +604,9 @@ impl BranchVertex<'_> {
         for (k, light) in brought.iter_mut().enumerate() {
             let (mut stream, u_rr) = self.stream(sampler, k);
             let (lobe, dir) = stream.get_split_draws::<1>(1);
-            let draw = BranchDraw::Independent;
             let before = out.radiance;
-            if let Some(state) = self.continuation(scene, 2, draw, lobe[0], dir[0], u_rr) {
+            // A continuation as the only one: the whole throughput, weighed once.
+            if let Some(state) = self.continuation(scene, 1, lobe[0], dir[0], u_rr) {
                 walk(scene, state, &mut stream, out);
             }
             *light = out.radiance - before;
@@ -629,14 +628,13 @@ impl BranchVertex<'_> {
         }
     }
 
-    /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count` drawn as `draw`
-    /// says; None where the sample finds nothing or the roulette (`u_rr`) ends it.
+    /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count`; None where the
+    /// sample finds nothing or the roulette (`u_rr`) ends it.
     #[inline(always)]
     fn continuation<S: PathScene>(
         &self,
         scene: &S,
         count: usize,
-        draw: BranchDraw,
         u_lobe: f32,
         u: Vec2,
         u_rr: f32,
@@ -652,10 +650,7 @@ impl BranchVertex<'_> {
         }
         Some(PathState {
             ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
-            throughput: match draw {
-                BranchDraw::Split => throughput / count as f32,
-                BranchDraw::Independent => throughput,
-            },
+            throughput: throughput / count as f32,
             medium: self.sides.toward(bs.wi, hit.ng),
             depth: self.depth,
             pass_through: 0,
@@ -663,14 +658,11 @@ impl BranchVertex<'_> {
             branches: 1,
             draw: BranchDraw::Split,
             // Counted `count` times against the light sample (the split's way, with the share
-            // already in the throughput), or once where each continuation is a path of its
-            // own. A broad BSDF's samples are not specular: no mirror follows.
+            // already in the throughput). A broad BSDF's samples are not specular: no mirror
+            // follows.
             prev: PrevScatter {
                 p: hit.p,
-                pdf: match draw {
-                    BranchDraw::Split => count as f32 * bs.pdf,
-                    BranchDraw::Independent => bs.pdf,
-                },
+                pdf: count as f32 * bs.pdf,
                 specular: bs.specular,
                 image_share: self.image_share,
                 before_mirror: None,

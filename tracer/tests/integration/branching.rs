@@ -66,7 +66,7 @@ fn branching_cuts_the_noise_of_the_first_bounce() {
 
 /// The pilot's figures predict what two continuations do to the noise where the light comes
 /// off the wall: the render does as well or somewhat better (its two are stratified together,
-/// the pilot's independent).
+/// the pilot's independent; 0.53 against 0.62), a tenth worse allowed for the renders' noise.
 #[test]
 fn the_pilot_predicts_the_noise_of_two_continuations() {
     let (scene, _) = estimates::build(&scene(true), SIZE, 4096, 1);
