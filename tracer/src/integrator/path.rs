@@ -101,25 +101,6 @@ const RR_MIN_SURVIVAL: f32 = 0.05;
 pub struct PathResult {
     pub radiance: Vec3,
     pub rays: u32,
-    /// With [`BranchDraw::Independent`]: the light the first continuation brings less the
-    /// second's, each as a path with one continuation would bring it (0 where the path did
-    /// not branch). What `render::branching` measures the continuations' error with.
-    pub branch_difference: Vec3,
-    /// With [`BranchDraw::Independent`]: the rays the continuations took, of `rays`.
-    pub branch_rays: u32,
-}
-
-/// How a branching vertex draws its continuations' directions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BranchDraw {
-    /// As one split draw, stratified together ([`PixelSampler::get_split_draws`]): what
-    /// renders take.
-    Split,
-    /// Each in its own stream, weighed against the vertex's light sample as its only BSDF sample
-    /// and carrying the whole throughput (its light is divided when it is in): every
-    /// continuation is stratified over a pixel's samples on its own, independent of the others,
-    /// and is what the path's one continuation would be, roulette included.
-    Independent,
 }
 
 fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
@@ -236,31 +217,21 @@ fn survives(
 // mirrors run 0.5% more instructions (callgrind, depth of field 160x90 32 spp).
 #[inline(always)]
 pub fn trace_path<S: PathScene>(scene: &S, ray: Ray, sampler: &mut PixelSampler) -> PathResult {
-    let branches = scene.first_vertex_branches();
-    trace_with(scene, ray, sampler, branches, BranchDraw::Split)
+    trace_path_with_branches(scene, ray, sampler, scene.first_vertex_branches())
 }
 
-/// [`trace_path`] with two continuations at the first broad vertex, drawn independently
-/// ([`BranchDraw::Independent`]), whatever the scene's own number: what `render::branching`
-/// measures with.
-pub fn trace_pilot_path<S: PathScene>(
-    scene: &S,
-    ray: Ray,
-    sampler: &mut PixelSampler,
-) -> PathResult {
-    trace_with(scene, ray, sampler, 2, BranchDraw::Independent)
-}
-
+/// [`trace_path`] with `branches` continuations at the first broad vertex (clamped to 1 ..=
+/// [`MAX_BRANCHES`]), whatever the scene's own number: what `render::branching` measures the
+/// counts with.
 #[inline(always)]
-fn trace_with<S: PathScene>(
+pub fn trace_path_with_branches<S: PathScene>(
     scene: &S,
     ray: Ray,
     sampler: &mut PixelSampler,
     branches: usize,
-    draw: BranchDraw,
 ) -> PathResult {
     let mut out = PathResult::default();
-    let state = PathState::camera(scene, ray, branches.clamp(1, MAX_BRANCHES), draw);
+    let state = PathState::camera(scene, ray, branches.clamp(1, MAX_BRANCHES));
     walk(scene, state, sampler, &mut out);
     out
 }
@@ -279,12 +250,11 @@ struct PathState {
     /// The continuations its next broad vertex sends on, while every vertex so far was
     /// specular (1 after that).
     branches: usize,
-    draw: BranchDraw,
     prev: PrevScatter,
 }
 
 impl PathState {
-    fn camera<S: PathScene>(scene: &S, ray: Ray, branches: usize, draw: BranchDraw) -> Self {
+    fn camera<S: PathScene>(scene: &S, ray: Ray, branches: usize) -> Self {
         Self {
             ray,
             throughput: Vec3::ONE,
@@ -293,7 +263,6 @@ impl PathState {
             pass_through: 0,
             may_split: scene.glossy_split(),
             branches,
-            draw,
             // The camera ray counts as specular: emitters it sees are taken at full weight.
             prev: PrevScatter::plain(ray.origin, 0.0, true),
         }
@@ -322,7 +291,6 @@ fn walk<S: PathScene>(
         mut pass_through,
         mut may_split,
         mut branches,
-        draw,
         mut prev,
     } = state;
     let mut radiance = Vec3::ZERO;
@@ -440,7 +408,7 @@ fn walk<S: PathScene>(
         let branching = !split && branches > 1 && broad.is_some();
         let bsdf_count = if split {
             GLOSSY_SPLIT as f32
-        } else if branching && draw == BranchDraw::Split {
+        } else if branching {
             branches as f32
         } else {
             1.0
@@ -487,10 +455,7 @@ fn walk<S: PathScene>(
                 may_split,
                 roulette: u.roulette,
             };
-            match draw {
-                BranchDraw::Split => vertex.branch(scene, branches, sampler, out),
-                BranchDraw::Independent => vertex.branch_independently(scene, sampler, out),
-            }
+            vertex.branch(scene, branches, sampler, out);
             break;
         }
         if !bsdf.is_specular() {
@@ -590,32 +555,6 @@ impl BranchVertex<'_> {
         }
     }
 
-    /// [`Self::branch`] with two continuations drawn as [`BranchDraw::Independent`] says, each
-    /// adding half its light to `out`, which keeps their difference and their rays.
-    #[inline(never)]
-    fn branch_independently<S: PathScene>(
-        &self,
-        scene: &S,
-        sampler: &mut PixelSampler,
-        out: &mut PathResult,
-    ) {
-        let rays_before = out.rays;
-        let mut brought = [Vec3::ZERO; 2];
-        for (k, light) in brought.iter_mut().enumerate() {
-            let (mut stream, u_rr) = self.stream(sampler, k);
-            let (lobe, dir) = stream.get_split_draws::<1>(1);
-            let before = out.radiance;
-            // A continuation as the only one: the whole throughput, weighed once.
-            if let Some(state) = self.continuation(scene, 1, lobe[0], dir[0], u_rr) {
-                walk(scene, state, &mut stream, out);
-            }
-            *light = out.radiance - before;
-            out.radiance = before + *light / 2.0;
-        }
-        out.branch_difference = brought[0] - brought[1];
-        out.branch_rays = out.rays - rays_before;
-    }
-
     /// Continuation `k`'s stream and roulette number: the path's own for the first.
     #[inline(always)]
     fn stream(&self, sampler: &PixelSampler, k: usize) -> (PixelSampler, f32) {
@@ -656,7 +595,6 @@ impl BranchVertex<'_> {
             pass_through: 0,
             may_split: self.may_split,
             branches: 1,
-            draw: BranchDraw::Split,
             // Counted `count` times against the light sample (the split's way, with the share
             // already in the throughput). A broad BSDF's samples are not specular: no mirror
             // follows.

@@ -2,40 +2,36 @@
 //! ([`MAX_BRANCHES`]), measured on a pilot when the scene is built.
 //!
 //! A pixel's error is the error of what comes before that vertex (the pixel and lens
-//! position, the first hit, its light sample), `v_first`, plus the error of what its
-//! continuations bring, `v_next` with one continuation; a camera sample's cost is likewise
-//! `c_first` plus `c_next`. With `k` continuations the error is `v_first + v_next / k` and the
-//! cost `c_first + k c_next`, so the efficiency, 1 / (error x cost), is best at
+//! position, the first hit, its light sample) plus the error of what its continuations bring,
+//! which more continuations divide; a camera sample's cost is likewise `c_first` plus `c_next`
+//! per continuation. With `k` continuations the error is `v_first + v_next / k` for the cost
+//! `c_first + k c_next`, and the efficiency, 1 / (error x cost), is best at
 //! `k = sqrt((v_next / c_next) / (v_first / c_first))` (the splitting factor of Rath et al.
 //! 2022, "EARS", for the first vertex of the whole image).
 //!
-//! The pilot renders a set of pixels twice with independent samples, each time with two
-//! continuations drawn independently of each other, each a whole path's continuation
-//! ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)): per pixel,
-//! four renders with one continuation, (a, b) and (a', b'), where a and b share everything
-//! before the vertex. Their differences give the two parts with stratification included (the
-//! continuations' variance measured per path, without it, came out up to ten times too large on
-//! Captain Falcon, whose first bounce the samples stratify well): `v_next` is half the expected
-//! (a - b)^2, `v_first` what a and b share, the expected (a - a') (b - b') / 2, a product of
-//! independent differences (a continuation's rare bright sample, a caustic of Cornell's glass,
-//! weighs in linearly, where the difference of two squared errors, the earlier pilot's, took it
-//! squared). Each part is believed `CONFIDENCE` standard errors off its estimate, on the side
-//! that favours one continuation: what Cornell's own rare bright pixels need (the lamp seen
-//! through the glass, which a and b share; a pilot that misses them sees no `v_first`). Rays
-//! count for the cost: those of the continuations, and the rest. The model leaves out that a
-//! render's continuations are stratified together (Captain Falcon gains 1.14x with two, which
-//! it does not see) and that each carries a `k`th of the throughput into the roulette (fewer
-//! rays, more noise): its choices err towards one continuation.
+//! The pilot renders a set of pixels as the render would, with one continuation and with two,
+//! each twice with samples of its own (two keys; a key's two renders share everything before
+//! the vertex). Half the squared difference of a pixel's two renders estimates the error of its
+//! mean, so the errors of one and of two continuations are measured, not modelled from the
+//! continuations' own: a render's two continuations are one split draw, stratified together,
+//! and do better than two independent ones (Captain Falcon: two continuations' error 0.61 of
+//! one's in the pilot, 0.62 in renders at 16 spp; modelled as independent, 0.75, for which the
+//! earlier pilot kept one continuation and Falcon's 1.15x). For three and four, the model
+//! through the two measured errors.
 //!
-//! The pilot's camera samples are a fiftieth of the render's (`PILOT_SHARE`; at most
-//! `MAX_PILOT_PIXELS` pixels), some 3% of its time, and half that where half its pixels
-//! already rule more continuations out: a render too short to spare a pilot of
-//! `MIN_PILOT_PIXELS` keeps one continuation; a 480x270 render of 16 spp is just long enough.
-//! Measured there (one thread, 4 seeds, MSE x time against one continuation, the pilot's time
-//! included): depth of field 1.23x (2 or 3 continuations, 1.25x and 1.30x alone); Cornell 0.95x
-//! (1, and 2 in one seed), Mario 0.99x, Captain Falcon 0.99x (1, the pilot stopping half way).
-//! In 8 seeds the pilot gave Cornell 1 continuation 7 times and 2 once (1.02x alone); in 6,
-//! Mario and Falcon 1.
+//! Each count is taken over one fewer only where it beats it by `MIN_GAIN` with standard
+//! errors to spare (`CONFIDENCE` for two, `MODEL_CONFIDENCE` for more): a test on the mean over
+//! pixels of the difference of the two (error x cost), paired, so that a pixel's own luck (a
+//! rare bright first hit, Cornell's lamp seen through its glass, which both counts' renders of
+//! a key share) weighs on both sides. Rays count for the cost.
+//!
+//! The pilot's camera samples are a twenty-fifth of the render's (`PILOT_SHARE`; at most
+//! `MAX_PILOT_PIXELS` pixels), half that where half its pixels already rule two continuations
+//! out: a render too short to spare a pilot of `MIN_PILOT_PIXELS` keeps one continuation; a
+//! 480x270 render of 16 spp is just long enough. Measured there (one thread, 4 seeds, MSE x
+//! time, the pilot's time included), against the earlier pilot: Captain Falcon 1.15x (two
+//! continuations in every seed), depth of field the same choices (two or three) for 1.3% more
+//! time, Cornell 1.00x (two in one seed of four), Mario 0.98x (two in one seed).
 //!
 //! Only the scene and the render settings decide it: every node that builds the scene takes
 //! the same number, and the image is the same bytes wherever it is rendered.
@@ -44,25 +40,28 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::settings::RenderSettings;
-use crate::integrator::path::{trace_pilot_path, PathScene, MAX_BRANCHES};
+use crate::integrator::path::{trace_path_with_branches, PathScene, MAX_BRANCHES};
 use crate::math::Ray;
 use crate::sampler::{mix64, PixelSampler};
 
-/// Samples per pilot pixel in each of its two renders: the render's, within these bounds
-/// (the error's make-up changes with the samples: the camera's and the first vertex's few
+/// Samples per pilot pixel in each of its renders: the render's, within these bounds (the
+/// error's make-up changes with the samples: the camera's and the first vertex's few
 /// dimensions are stratified better as they grow than a whole continuation is).
 const MIN_PILOT_SPP: u32 = 4;
 const MAX_PILOT_SPP: u32 = 16;
 
-/// The most pixels the pilot renders.
-const MAX_PILOT_PIXELS: u64 = 2304;
+/// The most pixels the pilot renders (and no more than the image has: a pixel rendered twice
+/// counts as two that agree). Some 1.3 M camera samples: a second on two cores for
+/// Captain Falcon, to choose within a few percent for a render of hours.
+const MAX_PILOT_PIXELS: u64 = 16384;
 
 /// Fewer pixels than this choose badly (Cornell's caustics): one continuation.
 const MIN_PILOT_PIXELS: u64 = 1024;
 
-/// The share of the render's camera samples the pilot may take, as a divisor (each of its
-/// samples costs some one and a half of the render's: it traces two continuations).
-const PILOT_SHARE: u64 = 50;
+/// The share of the render's camera samples the pilot's four renders may take together, as a
+/// divisor (a sample with two continuations costs some one and a half of one with one: the
+/// pilot takes some 5% of the render's time, 2.5% where it stops half way).
+const PILOT_SHARE: u64 = 25;
 
 /// How much cheaper a ray before the branching vertex is than one after it, in rays per
 /// sample: the camera ray is coherent and the first light sample's shadow ray an any-hit ray,
@@ -75,50 +74,73 @@ const FIRST_RAYS_DISCOUNT: f64 = 0.6;
 /// break-even point gains nothing either way.
 const MIN_GAIN: f64 = 1.05;
 
-/// Standard errors each part of the error is taken off its estimate, towards one continuation,
-/// for the choice: at one, Cornell took 3 or 4 continuations in 3 of 16 seeds (0.94x, 0.85x),
-/// at two in none of 12, and depth of field still 2 to 4.
-const CONFIDENCE: f64 = 2.0;
+/// Standard errors by which two continuations must beat one (by `MIN_GAIN`) to be taken: half
+/// of one, as a wrong choice costs little (two continuations measured 0.98x to 1.25x of one on
+/// the seed scenes, where the pilot's figures scatter by some 20% between seeds).
+const CONFIDENCE: f64 = 0.5;
 
-/// Standard errors each part is taken off its estimate, away from one continuation, for the
-/// early stop: the pilot ends on half its pixels where even so one continuation is best.
+/// Standard errors by which more than two continuations must beat one fewer (by `MIN_GAIN`),
+/// by the model: three or four where two barely pay cost more (Cornell 0.94x, 0.85x). At 1,
+/// depth of field takes three in 2 seeds of 4 (1.30x against two's 1.25x), and the seed of
+/// Cornell's that takes two stays there (0.85 standard errors for three).
+const MODEL_CONFIDENCE: f64 = 1.0;
+
+/// Standard errors by which two continuations may fall short of one (by `MIN_GAIN`) on half
+/// the pilot's pixels before it stops there with one.
 const STOP_CONFIDENCE: f64 = 1.0;
 
-/// The pilot's samples are their own (the render's seed, keyed apart): one key for each of its
-/// two renders.
+/// The pilot's samples are their own (the render's seed, keyed apart): one key for each of the
+/// two renders of a count.
 const PILOT_KEYS: [u64; 2] = [0x7069_6c6f_745f_6b31, 0x7069_6c6f_745f_6b32];
 
-/// The pilot's estimates: errors of a pixel's mean at the pilot's samples (summed over the
-/// colour channels), costs in rays per camera sample.
+/// The pilot's measures, with one continuation and with two: the error of a pixel's mean at
+/// the pilot's samples (summed over the colour channels), and rays per camera sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BranchFigures {
-    pub v_first: f64,
-    pub v_next: f64,
-    pub c_first: f64,
-    pub c_next: f64,
+    pub error: [f64; 2],
+    pub rays: [f64; 2],
+    /// Standard errors by which `k` continuations beat `k - 1` by `MIN_GAIN`, from `k` = 2 on
+    /// (negative where they fall short): the mean over pixels of (error x cost) with `k - 1`
+    /// less `MIN_GAIN` times that with `k`, over its standard error.
+    pub pays_by: [f64; MAX_BRANCHES - 1],
+}
+
+/// [`BranchFigures::error`] from the errors `error` of one and two continuations (a pixel's,
+/// for the confidence test, or the mean).
+fn error_of(k: usize, error: [f64; 2]) -> f64 {
+    match k {
+        1 => error[0],
+        k => {
+            let v_next = 2.0 * (error[0] - error[1]);
+            error[0] - v_next + v_next / k as f64
+        }
+    }
 }
 
 impl BranchFigures {
-    /// Relative efficiency of `k` continuations (1 / (error x cost), any unit).
-    pub fn efficiency(&self, k: usize) -> f64 {
-        let k = k as f64;
-        1.0 / ((self.v_first + self.v_next / k) * (self.c_first + k * self.c_next))
+    /// The error of `k` continuations: as measured for one and two; for more,
+    /// `v_first + v_next / k` through those two.
+    pub fn error(&self, k: usize) -> f64 {
+        error_of(k, self.error)
     }
 
-    /// The continuations with the best efficiency: 1 unless more beat it by `MIN_GAIN`.
+    /// The cost of a camera sample with `k` continuations, `c_first + k c_next`, in rays (those
+    /// before the vertex less `FIRST_RAYS_DISCOUNT`).
+    pub fn cost(&self, k: usize) -> f64 {
+        let c_next = self.rays[1] - self.rays[0];
+        (self.rays[0] - FIRST_RAYS_DISCOUNT + (k as f64 - 1.0) * c_next).max(0.0)
+    }
+
+    /// The continuations to take: one more while it beats one fewer by `MIN_GAIN`, with
+    /// `CONFIDENCE` standard errors to spare for two and `MODEL_CONFIDENCE` for more.
     pub fn best(&self) -> usize {
-        let one = self.efficiency(1);
-        if !(one.is_finite() && one > 0.0) {
-            return 1;
-        }
-        let (k, eff) = (2..=MAX_BRANCHES)
-            .map(|k| (k, self.efficiency(k)))
-            .fold((1, one), |best, kv| if kv.1 > best.1 { kv } else { best });
-        if eff >= one * MIN_GAIN {
-            k
-        } else {
-            1
-        }
+        (2..=MAX_BRANCHES)
+            .take_while(|&k| {
+                let confidence = if k == 2 { CONFIDENCE } else { MODEL_CONFIDENCE };
+                self.pays_by[k - 2] >= confidence
+            })
+            .last()
+            .unwrap_or(1)
     }
 }
 
@@ -129,72 +151,80 @@ pub trait PilotScene: PathScene + Sync {
     fn camera_ray(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> Option<Ray>;
 }
 
+/// A pilot pixel's four renders: by key, with one continuation and with two.
+type PilotPixel = [[PixelMean; 2]; 2];
+
 /// Measures the scene on its pilot; None when the render is too short to spare one.
 pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
     let settings = scene.settings();
-    let samples = u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
+    let image = u64::from(settings.width) * u64::from(settings.height);
+    let samples = image * u64::from(settings.spp);
     let spp = settings.spp.clamp(MIN_PILOT_SPP, MAX_PILOT_SPP);
-    let pixels = (samples / (PILOT_SHARE * 2 * u64::from(spp))).min(MAX_PILOT_PIXELS);
+    let pixels = (samples / (PILOT_SHARE * 4 * u64::from(spp)))
+        .min(MAX_PILOT_PIXELS)
+        .min(image);
     if pixels < MIN_PILOT_PIXELS {
         return None;
     }
     let keys = PILOT_KEYS.map(|key| mix64(mix64(settings.seed) ^ key));
-    let render = |half: u64| -> Vec<[PixelMean; 2]> {
+    let render = |half: u64| -> Vec<PilotPixel> {
         (0..(pixels - half).div_ceil(2))
             .into_par_iter()
             .map(|j| {
                 let (x, y) = pilot_pixel(2 * j + half, pixels, settings.width, settings.height);
-                keys.map(|key| pixel_mean(scene, x, y, spp, key))
+                keys.map(|key| [1, 2].map(|branches| pixel_mean(scene, x, y, spp, key, branches)))
             })
             .collect()
     };
-    // Half the pixels first (every other one: all over the image); where even figures believed
-    // on the side that favours more continuations keep one, the rest would not change that
-    // (Mario and Captain Falcon stop there).
+    // Half the pixels first (every other one: all over the image); where two continuations
+    // fall short of one even so, the rest would not change that (Mario and Captain Falcon at
+    // the old pilot stopped there).
     let mut renders = render(0);
-    if figures(&renders, spp, -STOP_CONFIDENCE).best() == 1 {
-        return Some(figures(&renders, spp, CONFIDENCE));
+    let half = figures(&renders, spp);
+    if half.pays_by[0] < -STOP_CONFIDENCE {
+        return Some(half);
     }
     renders.extend(render(1));
-    Some(figures(&renders, spp, CONFIDENCE))
+    Some(figures(&renders, spp))
 }
 
-/// The figures of the pilot's `renders` of `spp` samples, each part of the error believed
-/// `standard_errors` off its estimate: positive towards one continuation, negative away from it.
-fn figures(renders: &[[PixelMean; 2]], spp: u32, standard_errors: f64) -> BranchFigures {
+/// The figures of the pilot's `renders` of `spp` samples.
+fn figures(renders: &[PilotPixel], spp: u32) -> BranchFigures {
     let n = renders.len() as f64;
-    // Per pixel, from the continuations' renders (a, b) and (a', b'): the continuations' error,
-    // half the expected (a - b)^2, and the rest, the covariance of a and b (what they share),
-    // the expected (a - a') (b - b') / 2 (a product of independent differences, so that a
-    // continuation's rare bright sample weighs in linearly, not squared).
-    let parts: Vec<[f64; 2]> = renders
+    let rays = [0, 1].map(|count| {
+        renders
+            .iter()
+            .map(|[one, other]| one[count].rays + other[count].rays)
+            .sum::<u64>() as f64
+            / (2.0 * n * f64::from(spp))
+    });
+    // Per pixel, the error of its mean with one continuation and with two: half the squared
+    // difference of its two keys' renders.
+    let errors: Vec<[f64; 2]> = renders
         .iter()
         .map(|[one, other]| {
-            let (a, b) = one.continuations();
-            let (a2, b2) = other.continuations();
-            let next = ((a - b).length_squared() + (a2 - b2).length_squared()) / 4.0;
-            let first = ((a - a2).dot(b - b2) + (a - b2).dot(b - a2)) / 4.0;
-            [next, first]
+            [0, 1].map(|count| (one[count].radiance - other[count].radiance).length_squared() / 2.0)
         })
         .collect();
-    // `towards_one`: +1 where a larger part favours one continuation (v_first), -1 where a
-    // smaller one does (v_next).
-    let believed = |part: usize, towards_one: f64| {
-        let mean = parts.iter().map(|e| e[part]).sum::<f64>() / n;
-        let spread = parts.iter().map(|e| (e[part] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean + towards_one * standard_errors * (spread / n).sqrt()).max(0.0)
+    let mean = |count: usize| errors.iter().map(|e| e[count]).sum::<f64>() / n;
+    let mut figures = BranchFigures {
+        error: [mean(0), mean(1)],
+        rays,
+        pays_by: [0.0; MAX_BRANCHES - 1],
     };
-    // Rays per camera sample, before the branching vertex and in each continuation.
-    let per_sample = 2.0 * n * f64::from(spp);
-    let rays = renders.iter().flatten().map(|p| p.rays).sum::<u64>() as f64 / per_sample;
-    let c_next =
-        renders.iter().flatten().map(|p| p.branch_rays).sum::<u64>() as f64 / per_sample / 2.0;
-    BranchFigures {
-        v_first: believed(1, 1.0),
-        v_next: believed(0, -1.0),
-        c_first: (rays - 2.0 * c_next - FIRST_RAYS_DISCOUNT).max(0.0),
-        c_next,
+    // Per pixel, (error x cost) with k - 1 less MIN_GAIN times that with k: paired, so that a
+    // pixel's own luck weighs on both sides.
+    for k in 2..=MAX_BRANCHES {
+        let (fewer, more) = (figures.cost(k - 1), MIN_GAIN * figures.cost(k));
+        let pays: Vec<f64> = errors
+            .iter()
+            .map(|&e| error_of(k - 1, e) * fewer - error_of(k, e) * more)
+            .collect();
+        let pay = pays.iter().sum::<f64>() / n;
+        let spread = pays.iter().map(|p| (p - pay).powi(2)).sum::<f64>() / (n - 1.0);
+        figures.pays_by[k - 2] = pay / (spread / n).sqrt();
     }
+    figures
 }
 
 /// The continuations the scene's camera paths take.
@@ -214,47 +244,36 @@ fn pilot_pixel(i: u64, count: u64, width: u32, height: u32) -> (u32, u32) {
     (column.min(width - 1), row.min(height - 1))
 }
 
-/// A pilot pixel's render with two continuations: the means of its samples' radiance and of
-/// their [`crate::integrator::PathResult::branch_difference`]s, and the rays they took, all and
-/// in the continuations.
+/// A pilot pixel's render: the mean of its samples' radiance and the rays they took.
 struct PixelMean {
     radiance: DVec3,
-    difference: DVec3,
     rays: u64,
-    branch_rays: u64,
 }
 
-impl PixelMean {
-    /// The pixel as each continuation alone renders it.
-    fn continuations(&self) -> (DVec3, DVec3) {
-        let half = self.difference / 2.0;
-        (self.radiance + half, self.radiance - half)
-    }
-}
-
-/// `spp` samples of pixel (`x`, `y`) with two continuations drawn independently
-/// ([`BranchDraw::Independent`](crate::integrator::path::BranchDraw::Independent)) and `seed`.
-fn pixel_mean(scene: &impl PilotScene, x: u32, y: u32, spp: u32, seed: u64) -> PixelMean {
+/// `spp` samples of pixel (`x`, `y`) with `branches` continuations and `seed`.
+fn pixel_mean(
+    scene: &impl PilotScene,
+    x: u32,
+    y: u32,
+    spp: u32,
+    seed: u64,
+    branches: usize,
+) -> PixelMean {
     let mut mean = PixelMean {
         radiance: DVec3::ZERO,
-        difference: DVec3::ZERO,
         rays: 0,
-        branch_rays: 0,
     };
     for index in 0..spp {
         let mut sampler = PixelSampler::new(x, y, index, spp, seed);
         if let Some(ray) = scene.camera_ray(x, y, &mut sampler) {
-            let path = trace_pilot_path(scene, ray, &mut sampler);
+            let path = trace_path_with_branches(scene, ray, &mut sampler, branches);
             mean.rays += u64::from(path.rays);
-            mean.branch_rays += u64::from(path.branch_rays);
-            if path.radiance.is_finite() && path.branch_difference.is_finite() {
+            if path.radiance.is_finite() {
                 mean.radiance += path.radiance.as_dvec3();
-                mean.difference += path.branch_difference.as_dvec3();
             }
         }
     }
     mean.radiance /= f64::from(spp);
-    mean.difference /= f64::from(spp);
     mean
 }
 
@@ -262,41 +281,61 @@ fn pixel_mean(scene: &impl PilotScene, x: u32, y: u32, spp: u32, seed: u64) -> P
 mod tests {
     use super::*;
 
-    fn figures(v_first: f64, v_next: f64, c_first: f64, c_next: f64) -> BranchFigures {
-        BranchFigures {
-            v_first,
-            v_next,
-            c_first,
-            c_next,
+    #[test]
+    fn the_error_model_goes_through_one_and_two() {
+        // v_first 1, v_next 8.
+        let error = [9.0, 5.0];
+        for k in 1..=MAX_BRANCHES {
+            let model = 1.0 + 8.0 / k as f64;
+            assert!((error_of(k, error) - model).abs() < 1e-12, "{k}");
         }
     }
 
     #[test]
-    fn the_best_count_follows_the_splitting_factor() {
-        // sqrt((v_next / c_next) / (v_first / c_first)): here sqrt(9) = 3.
-        assert_eq!(figures(1.0, 9.0, 1.0, 1.0).best(), 3);
-        // sqrt(4 x 2) = 2.8: three (error 2.33, cost 5) beats two (3, 4) and four (2, 6).
-        assert_eq!(figures(1.0, 4.0, 2.0, 1.0).best(), 3);
-        // More than four is never taken.
-        assert_eq!(figures(1.0, 100.0, 1.0, 1.0).best(), MAX_BRANCHES);
-        // The first part's error dominates: one.
-        assert_eq!(figures(4.0, 1.0, 1.0, 1.0).best(), 1);
+    fn each_more_continuation_must_pay_with_confidence() {
+        let f = |pays_by| BranchFigures {
+            error: [9.0, 5.0],
+            rays: [3.0, 4.0],
+            pays_by,
+        };
+        assert_eq!(f([CONFIDENCE, MODEL_CONFIDENCE, 0.0]).best(), 3);
+        assert_eq!(f([CONFIDENCE, 0.99 * MODEL_CONFIDENCE, 10.0]).best(), 2);
+        assert_eq!(f([0.99 * CONFIDENCE, 10.0, 10.0]).best(), 1);
+        assert_eq!(f([f64::NAN, 10.0, 10.0]).best(), 1);
+        assert_eq!(f([10.0; 3]).best(), MAX_BRANCHES);
+    }
+
+    /// Pilot renders of `n` pixels whose two keys differ by `d1` with one continuation and `d2`
+    /// with two, from pixel to pixel a little more or less, and take `rays` per sample.
+    fn renders(n: usize, d1: f64, d2: f64, rays: [u64; 2]) -> Vec<PilotPixel> {
+        (0..n)
+            .map(|i| {
+                let scale = 1.0 + 0.1 * ((i % 5) as f64 - 2.0);
+                let mean = |d: f64, count: usize| PixelMean {
+                    radiance: DVec3::splat(d * scale),
+                    rays: rays[count],
+                };
+                [[mean(0.0, 0), mean(0.0, 1)], [mean(d1, 0), mean(d2, 1)]]
+            })
+            .collect()
     }
 
     #[test]
-    fn a_small_gain_keeps_one_continuation() {
-        // Two continuations: error 2 for cost 3.125, against 3 for cost 2.125: 1.02x.
-        let f = figures(1.0, 2.0, 1.125, 1.0);
-        assert!(f.efficiency(2) > f.efficiency(1));
-        assert!(f.efficiency(2) < MIN_GAIN * f.efficiency(1));
-        assert_eq!(f.best(), 1);
-    }
-
-    #[test]
-    fn degenerate_figures_keep_one_continuation() {
-        assert_eq!(figures(0.0, 0.0, 1.0, 1.0).best(), 1);
-        assert_eq!(figures(f64::NAN, 1.0, 1.0, 1.0).best(), 1);
-        assert_eq!(figures(1.0, 1.0, 0.0, 0.0).best(), 1);
+    fn the_figures_say_where_two_continuations_pay() {
+        // 2 samples a pixel: 4.5 rays a sample with one continuation, 6.5 with two (costs 3.9
+        // and 5.9).
+        let rays = [9, 13];
+        // Two halve the error for 1.5 times the cost.
+        let pays = figures(&renders(100, 2.0, 2f64.sqrt(), rays), 2);
+        assert!(
+            (pays.error[1] / pays.error[0] - 0.5).abs() < 1e-9,
+            "{pays:?}"
+        );
+        assert!(pays.pays_by[0] > 10.0, "{pays:?}");
+        // Two bring the same error at more cost.
+        let not = figures(&renders(100, 2.0, 2.0, rays), 2);
+        assert!(not.pays_by[0] < -10.0, "{not:?}");
+        assert_eq!((pays.best() > 1, not.best()), (true, 1));
     }
 
     #[test]

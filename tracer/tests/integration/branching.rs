@@ -64,24 +64,29 @@ fn branching_cuts_the_noise_of_the_first_bounce() {
     );
 }
 
-/// The pilot's figures predict what two continuations do to the noise where the light comes
-/// off the wall: the render does as well or somewhat better (its two are stratified together,
-/// the pilot's independent; 0.53 against 0.62), a tenth worse allowed for the renders' noise.
+/// The pilot's errors of one and two continuations say what two do to a render's noise where
+/// the light comes off the wall, a tenth either way allowed for the noise of both (the pilot's
+/// ratio over four seeds, 0.58; the renders' over eight pairs, 0.61).
 #[test]
-fn the_pilot_predicts_the_noise_of_two_continuations() {
-    let (scene, _) = estimates::build(&scene(true), SIZE, 4096, 1);
-    let f = branching::measure(&scene).expect("the render is long enough for a pilot");
-    let predicted = (f.v_first + f.v_next / 2.0) / (f.v_first + f.v_next);
+fn the_pilot_measures_the_noise_of_two_continuations() {
+    let predicted = (1..=4)
+        .map(|seed| {
+            let (scene, _) = estimates::build(&scene(true), SIZE, 4096, seed);
+            let f = branching::measure(&scene).expect("the render is long enough for a pilot");
+            f.error[1] / f.error[0]
+        })
+        .sum::<f64>()
+        / 4.0;
     let noise = |branches| -> f64 {
-        (0..4)
+        (0..8)
             .map(|pair| seed_difference(|seed| render(true, branches, 16, 2 * pair + seed)))
             .sum()
     };
     let measured = noise(2) / noise(1);
     println!("noise with 2 continuations over 1: measured {measured}, predicted {predicted}");
     assert!(
-        (0.75 * predicted..1.1 * predicted).contains(&measured),
-        "noise with 2 continuations over 1: measured {measured}, predicted {predicted} ({f:?})"
+        (0.9 * predicted..1.1 * predicted).contains(&measured),
+        "noise with 2 continuations over 1: measured {measured}, predicted {predicted}"
     );
 }
 
@@ -104,15 +109,17 @@ fn chosen(scene: &str) -> Option<usize> {
     Some(scene.first_vertex_branches())
 }
 
-/// Measured (16 spp, MSE x time against one continuation): depth of field 1.22x with two,
-/// 1.29x with three; Mario 0.87x with two (its noise is caustics its glossy vertices split
-/// for). The pilot must find both.
+/// Measured (480x270, 16 spp, MSE x time against one continuation): depth of field 1.25x with
+/// two, 1.30x with three; Captain Falcon 1.17x with two; Mario 0.98x with two (its noise is
+/// caustics its glossy vertices split for). The pilot must find all three.
 #[test]
-fn the_pilot_branches_depth_of_field_and_not_mario() {
+fn the_pilot_branches_depth_of_field_and_falcon_not_mario() {
     let Some(dof) = chosen("DepthOfField/depth-of-field-high.lxs") else {
         return;
     };
     assert!(dof >= 2, "depth of field: {dof} continuations");
+    let falcon = chosen("CaptainFalcon/captainfalcon.lxs").expect("the seed scenes are there");
+    assert_eq!(falcon, 2, "Captain Falcon");
     let mario = chosen("MetalMario/metal-mario-bg1.lxs").expect("the seed scenes are there");
     assert_eq!(mario, 1, "Mario");
 }
@@ -132,12 +139,12 @@ fn the_pilot_is_the_same_on_any_number_of_threads() {
     };
     let one = on(1).expect("the render is long enough for a pilot");
     assert_eq!(on(3), Some(one));
-    assert!(one.v_next > 0.0 && one.c_next > 0.0, "{one:?}");
+    assert!(one.error[0] > 0.0 && one.rays[1] > one.rays[0], "{one:?}");
     assert_eq!(scene.first_vertex_branches(), one.best());
 }
 
 /// A render too short to spare a pilot (40 x 40 x 64 samples, where a pilot of 1024 pixels of
-/// 16 samples, two renders, needs 50 times its camera samples) takes none.
+/// 16 samples, four renders, needs 25 times their camera samples) takes none.
 #[test]
 fn a_short_render_takes_no_pilot() {
     let (scene, _) = estimates::build(&scene(true), SIZE, 64, 1);
