@@ -105,8 +105,9 @@ pub struct BranchFigures {
     pub pays_by: [f64; MAX_BRANCHES - 1],
 }
 
-/// [`BranchFigures::error`] from the errors `error` of one and two continuations (a pixel's,
-/// for the confidence test, or the mean).
+/// The error of `k` continuations from `error`, that of one and of two (a pixel's, or the mean
+/// over pixels): as measured for one and two; for more, `v_first + v_next / k` through those
+/// two.
 fn error_of(k: usize, error: [f64; 2]) -> f64 {
     match k {
         1 => error[0],
@@ -118,12 +119,6 @@ fn error_of(k: usize, error: [f64; 2]) -> f64 {
 }
 
 impl BranchFigures {
-    /// The error of `k` continuations: as measured for one and two; for more,
-    /// `v_first + v_next / k` through those two.
-    pub fn error(&self, k: usize) -> f64 {
-        error_of(k, self.error)
-    }
-
     /// The cost of a camera sample with `k` continuations, `c_first + k c_next`, in rays (those
     /// before the vertex less `FIRST_RAYS_DISCOUNT`).
     pub fn cost(&self, k: usize) -> f64 {
@@ -177,8 +172,7 @@ pub fn measure(scene: &impl PilotScene) -> Option<BranchFigures> {
             .collect()
     };
     // Half the pixels first (every other one: all over the image); where two continuations
-    // fall short of one even so, the rest would not change that (Mario and Captain Falcon at
-    // the old pilot stopped there).
+    // fall short of one even so, the rest would not change that.
     let mut renders = render(0);
     let half = figures(&renders, spp);
     if half.pays_by[0] < -STOP_CONFIDENCE {
