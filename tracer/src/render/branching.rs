@@ -66,9 +66,11 @@ const PILOT_SHARE: u64 = 25;
 /// How much cheaper a ray before the branching vertex is than one after it, in rays per
 /// sample: the camera ray is coherent and the first light sample's shadow ray an any-hit ray,
 /// where a continuation's rays are closest hits shaded in full. Fitted to the render times of
-/// one and two continuations (16 spp, 480x270, one thread): depth of field 0.5, Mario 0.5,
-/// Captain Falcon 0.7, Cornell 1.0.
-const FIRST_RAYS_DISCOUNT: f64 = 0.6;
+/// one and two continuations against their rays per sample (480x270 16 spp, one thread):
+/// depth of field 0.27, Cornell 0.34, Mario 0.41, Captain Falcon 0.48; at 0.4 the model's cost
+/// of two over one is within 2% of the time for all four (at session 20's 0.6, depth of field's
+/// was 4% high).
+const FIRST_RAYS_DISCOUNT: f64 = 0.4;
 
 /// Splitting must promise at least this efficiency over one continuation: a scene near the
 /// break-even point gains nothing either way.
