@@ -217,14 +217,13 @@ fn survives(
 // mirrors run 0.5% more instructions (callgrind, depth of field 160x90 32 spp).
 #[inline(always)]
 pub fn trace_path<S: PathScene>(scene: &S, ray: Ray, sampler: &mut PixelSampler) -> PathResult {
-    trace_path_with_branches(scene, ray, sampler, scene.first_vertex_branches())
+    trace_branching_path(scene, ray, sampler, scene.first_vertex_branches())
 }
 
 /// [`trace_path`] with `branches` continuations at the first broad vertex (clamped to 1 ..=
-/// [`MAX_BRANCHES`]), whatever the scene's own number: what `render::branching` measures the
-/// counts with.
+/// [`MAX_BRANCHES`]) whatever the scene's own number: what `render::branching` measures with.
 #[inline(always)]
-pub fn trace_path_with_branches<S: PathScene>(
+pub fn trace_branching_path<S: PathScene>(
     scene: &S,
     ray: Ray,
     sampler: &mut PixelSampler,
@@ -548,28 +547,21 @@ impl BranchVertex<'_> {
     ) {
         let (lobes, dirs) = sampler.get_split_draws::<MAX_BRANCHES>(count);
         for k in 0..count {
-            let (mut stream, u_rr) = self.stream(sampler, k);
+            let (mut stream, u_rr) = if k == 0 {
+                (sampler.clone(), self.roulette)
+            } else {
+                let mut stream = sampler.branch(k as u32);
+                let u_rr = stream.get_1d();
+                (stream, u_rr)
+            };
             if let Some(state) = self.continuation(scene, count, lobes[k], dirs[k], u_rr) {
                 walk(scene, state, &mut stream, out);
             }
         }
     }
 
-    /// Continuation `k`'s stream and roulette number: the path's own for the first.
-    #[inline(always)]
-    fn stream(&self, sampler: &PixelSampler, k: usize) -> (PixelSampler, f32) {
-        if k == 0 {
-            (sampler.clone(), self.roulette)
-        } else {
-            let mut stream = sampler.branch(k as u32);
-            let u_rr = stream.get_1d();
-            (stream, u_rr)
-        }
-    }
-
     /// The continuation along the BSDF sample (`u_lobe`, `u`), one of `count`; None where the
     /// sample finds nothing or the roulette (`u_rr`) ends it.
-    #[inline(always)]
     fn continuation<S: PathScene>(
         &self,
         scene: &S,

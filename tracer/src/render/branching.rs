@@ -40,7 +40,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::settings::RenderSettings;
-use crate::integrator::path::{trace_path_with_branches, PathScene, MAX_BRANCHES};
+use crate::integrator::path::{trace_branching_path, PathScene, MAX_BRANCHES};
 use crate::math::Ray;
 use crate::sampler::{mix64, PixelSampler};
 
@@ -262,7 +262,7 @@ fn pixel_mean(
     for index in 0..spp {
         let mut sampler = PixelSampler::new(x, y, index, spp, seed);
         if let Some(ray) = scene.camera_ray(x, y, &mut sampler) {
-            let path = trace_path_with_branches(scene, ray, &mut sampler, branches);
+            let path = trace_branching_path(scene, ray, &mut sampler, branches);
             mean.rays += u64::from(path.rays);
             if path.radiance.is_finite() {
                 mean.radiance += path.radiance.as_dvec3();
