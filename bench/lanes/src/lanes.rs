@@ -84,6 +84,15 @@ fn unit_of(x: i32) -> f32 {
     ((x as u32 >> 8) as i32) as f32 * (1.0 / 16_777_216.0)
 }
 
+#[inline(always)]
+fn either<T>(m: bool, a: T, b: T) -> T {
+    if m {
+        a
+    } else {
+        b
+    }
+}
+
 impl Mask for bool {
     #[inline(always)]
     fn any(self) -> bool {
@@ -117,11 +126,7 @@ impl Lanes for f32 {
     }
     #[inline(always)]
     fn select(m: bool, a: Self, b: Self) -> Self {
-        if m {
-            a
-        } else {
-            b
-        }
+        either(m, a, b)
     }
     #[inline(always)]
     fn mask(b: bool) -> bool {
@@ -157,11 +162,7 @@ impl Lanes for f32 {
     }
     #[inline(always)]
     fn iselect(m: bool, a: i32, b: i32) -> i32 {
-        if m {
-            a
-        } else {
-            b
-        }
+        either(m, a, b)
     }
     #[inline(always)]
     fn hash(x: i32) -> i32 {
@@ -277,13 +278,7 @@ impl<const N: usize> Lanes for Arr<N> {
     }
     #[inline(always)]
     fn select(m: ArrMask<N>, a: Self, b: Self) -> Self {
-        Arr(std::array::from_fn(|i| {
-            if m.0[i] != 0 {
-                a.0[i]
-            } else {
-                b.0[i]
-            }
-        }))
+        Arr(std::array::from_fn(|i| either(m.0[i] != 0, a.0[i], b.0[i])))
     }
     #[inline(always)]
     fn mask(b: bool) -> ArrMask<N> {
@@ -321,13 +316,7 @@ impl<const N: usize> Lanes for Arr<N> {
     }
     #[inline(always)]
     fn iselect(m: ArrMask<N>, a: ArrInt<N>, b: ArrInt<N>) -> ArrInt<N> {
-        ArrInt(std::array::from_fn(|i| {
-            if m.0[i] != 0 {
-                a.0[i]
-            } else {
-                b.0[i]
-            }
-        }))
+        ArrInt(std::array::from_fn(|i| either(m.0[i] != 0, a.0[i], b.0[i])))
     }
     #[inline(always)]
     fn hash(x: ArrInt<N>) -> ArrInt<N> {
