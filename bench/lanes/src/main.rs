@@ -10,14 +10,14 @@
 //! rays/s, the lanes' occupancy and the speed-up over one path at a time, and fails unless
 //! every variant's image has the scalar image's bits.
 //!
-//! `cargo run --release -p yat-lanes -- --rounds 5`
+//! `cargo run --release -p yat-lanes -- --rounds 5 [--output lanes.png]`
 
 mod lanes;
 mod tracer;
 
 use std::time::Instant;
 
-use anyhow::{ensure, Result};
+use anyhow::{ensure, Context, Result};
 use clap::Parser;
 
 use lanes::Arr;
@@ -35,6 +35,9 @@ struct Args {
     /// Rounds; each variant's best is reported (the variants alternate within a round).
     #[arg(long, default_value_t = 3)]
     rounds: usize,
+    /// Also write the scalar image here (PNG, gamma 2.2, x / (1 + x) tone curve).
+    #[arg(long)]
+    output: Option<std::path::PathBuf>,
 }
 
 type Image = Vec<[f32; 3]>;
@@ -176,6 +179,16 @@ fn main() -> Result<()> {
         );
     }
     ensure!(unlike == 0, "{unlike} pixels differ from the scalar image");
+    if let Some(path) = &args.output {
+        let bytes = reference
+            .iter()
+            .flat_map(|p| p.map(|c| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0) as u8))
+            .collect();
+        let png = image::RgbImage::from_raw(args.width as u32, args.height as u32, bytes)
+            .context("image size")?;
+        png.save(path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     Ok(())
 }
 
