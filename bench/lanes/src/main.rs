@@ -103,13 +103,14 @@ mod x86 {
 }
 
 fn variants() -> Vec<Variant> {
-    let mut out = vec![Variant {
+    let baseline = Variant {
         name: "arrays of 8, baseline",
         render: arrays_baseline,
-    }];
+    };
     #[cfg(target_arch = "x86_64")]
-    out.extend(x86::variants());
-    out
+    return std::iter::once(baseline).chain(x86::variants()).collect();
+    #[cfg(not(target_arch = "x86_64"))]
+    vec![baseline]
 }
 
 /// Pixels whose bits differ.
