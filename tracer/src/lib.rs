@@ -31,6 +31,7 @@ pub mod filter;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
+pub mod lanes;
 pub mod lights;
 pub mod material;
 pub mod math;

@@ -33,6 +33,7 @@
 
 use glam::Vec2;
 
+use crate::lanes::{Lanes, Mask, U32Lanes, MAX_LANES};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
@@ -154,17 +155,8 @@ impl PixelSampler {
         let film_hash = self.next_dimension_hash();
         let lens_hash = self.next_dimension_hash();
         let index = self.sobol_index(film_hash as u32);
-        let lens = Vec2::new(
-            to_unit_float(owen_scramble(
-                generated(index, &SOBOL_DIMENSION_2),
-                (lens_hash >> 32) as u32,
-            )),
-            to_unit_float(owen_scramble(
-                generated(index, &SOBOL_DIMENSION_3),
-                mix64(lens_hash) as u32,
-            )),
-        );
-        (point_2d(index, film_hash), lens)
+        let (film, lens) = camera_point(index, film_hash, lens_hash);
+        (Vec2::from(film), Vec2::from(lens))
     }
 
     /// The stream of branch `k` of this sample's path: the same dimensions, scrambled and
@@ -270,18 +262,125 @@ impl PixelSampler {
     }
 }
 
+/// The streams of `L::N` consecutive samples of one pixel, drawn together: lane `i` is sample
+/// `index + i` of [`PixelSampler::new`], and draws its values bit for bit. The dimensions'
+/// hashes are the pixel's, so each is computed once for all lanes. For a renderer that runs
+/// paths in lanes (`bench/lanes` measures one).
+pub struct PacketSampler<L: Lanes> {
+    /// The first lane's stream: the pixel's hash, permutation range and next dimension.
+    pixel: PixelSampler,
+    /// Each lane's index less the permutation range's first.
+    offset: L::U,
+}
+
+/// The values a scattering vertex draws, as [`VertexSamples`], for a packet's lanes.
+#[derive(Clone, Copy)]
+pub struct VertexPacket<L> {
+    pub mix: L,
+    pub light_select: L,
+    pub light: [L; 2],
+    pub lobe: L,
+    pub bsdf: [L; 2],
+    pub roulette: L,
+}
+
+impl<L: Lanes> PacketSampler<L> {
+    /// Samples `index .. index + L::N` of a pixel that takes all of `spp` samples
+    /// (`index + L::N <= spp`).
+    pub fn new(x: u32, y: u32, index: u32, spp: u32, seed: u64) -> Self {
+        let pixel = PixelSampler::new(x, y, index, spp, seed);
+        let mut offsets = [0; MAX_LANES];
+        for (lane, offset) in offsets.iter_mut().enumerate() {
+            *offset = (index - pixel.first).wrapping_add(lane as u32);
+        }
+        Self {
+            pixel,
+            offset: L::U::load(&offsets),
+        }
+    }
+
+    #[inline(always)]
+    fn sobol_index(&self, p: u32) -> L::U {
+        let (first, len, mask) = (self.pixel.first, self.pixel.len, self.pixel.mask);
+        L::U::splat(first).wrapping_add(permutation_element(self.offset, len, mask, L::U::splat(p)))
+    }
+
+    /// [`PixelSampler::get_1d`] in every lane.
+    #[inline(always)]
+    pub fn get_1d(&mut self) -> L {
+        let hash = self.pixel.next_dimension_hash();
+        point_1d(self.sobol_index(hash as u32), hash)
+    }
+
+    /// [`PixelSampler::get_2d`] in every lane.
+    #[inline(always)]
+    pub fn get_2d(&mut self) -> [L; 2] {
+        let hash = self.pixel.next_dimension_hash();
+        point_2d_lanes(self.sobol_index(hash as u32), hash)
+    }
+
+    /// [`PixelSampler::get_camera`] in every lane.
+    #[inline(always)]
+    pub fn get_camera(&mut self) -> ([L; 2], [L; 2]) {
+        let film_hash = self.pixel.next_dimension_hash();
+        let lens_hash = self.pixel.next_dimension_hash();
+        camera_point(self.sobol_index(film_hash as u32), film_hash, lens_hash)
+    }
+
+    /// [`PixelSampler::get_vertex`] in every lane.
+    #[inline(always)]
+    pub fn get_vertex(&mut self) -> VertexPacket<L> {
+        VertexPacket {
+            mix: self.get_1d(),
+            light_select: self.get_1d(),
+            light: self.get_2d(),
+            lobe: self.get_1d(),
+            bsdf: self.get_2d(),
+            roulette: self.get_1d(),
+        }
+    }
+}
+
 /// Sobol point `index` of a 1D dimension whose hash is `hash`, Owen-scrambled by the hash.
-fn point_1d(index: u32, hash: u64) -> f32 {
-    to_unit_float(owen_scramble(van_der_corput(index), (hash >> 32) as u32))
+#[inline(always)]
+fn point_1d<U: U32Lanes>(index: U, hash: u64) -> U::F {
+    to_unit_float(owen_scramble(
+        van_der_corput(index),
+        U::splat((hash >> 32) as u32),
+    ))
 }
 
 /// Sobol point `index` of a 2D dimension whose hash is `hash` (Sobol dimensions 0 and 1), each
 /// coordinate Owen-scrambled by its own part of the hash.
-fn point_2d(index: u32, hash: u64) -> Vec2 {
-    Vec2::new(
+#[inline(always)]
+fn point_2d_lanes<U: U32Lanes>(index: U, hash: u64) -> [U::F; 2] {
+    [
         point_1d(index, hash),
-        to_unit_float(owen_scramble(sobol_dimension_1(index), mix64(hash) as u32)),
-    )
+        to_unit_float(owen_scramble(
+            sobol_dimension_1(index),
+            U::splat(mix64(hash) as u32),
+        )),
+    ]
+}
+
+fn point_2d(index: u32, hash: u64) -> Vec2 {
+    Vec2::from(point_2d_lanes(index, hash))
+}
+
+/// [`PixelSampler::get_camera`]'s film and lens positions of Sobol index `index`.
+#[inline(always)]
+fn camera_point<U: U32Lanes>(index: U, film_hash: u64, lens_hash: u64) -> ([U::F; 2], [U::F; 2]) {
+    let lens = [
+        to_unit_float(owen_scramble(
+            generated(index, &SOBOL_DIMENSION_2),
+            U::splat((lens_hash >> 32) as u32),
+        )),
+        to_unit_float(owen_scramble(
+            generated(index, &SOBOL_DIMENSION_3),
+            U::splat(mix64(lens_hash) as u32),
+        )),
+    ];
+    (point_2d_lanes(index, film_hash), lens)
 }
 
 /// A 64-bit finaliser (splitmix64): every input bit affects every output bit.
@@ -293,17 +392,20 @@ pub fn mix64(mut v: u64) -> u64 {
     v ^ (v >> 31)
 }
 
-fn to_unit_float(bits: u32) -> f32 {
-    ((bits >> 8) as f32 * (1.0 / 16_777_216.0)).min(ONE_MINUS_EPSILON)
+#[inline(always)]
+fn to_unit_float<U: U32Lanes>(bits: U) -> U::F {
+    ((bits >> 8).to_f32() * U::F::splat(1.0 / 16_777_216.0)).min(U::F::splat(ONE_MINUS_EPSILON))
 }
 
 /// Sobol dimension 0: the base-2 radical inverse, as a 0.32 fixed-point fraction.
-fn van_der_corput(index: u32) -> u32 {
+#[inline(always)]
+fn van_der_corput<U: U32Lanes>(index: U) -> U {
     index.reverse_bits()
 }
 
 /// Sobol dimension 1 (primitive polynomial x + 1), as a 0.32 fixed-point fraction.
-fn sobol_dimension_1(index: u32) -> u32 {
+#[inline(always)]
+fn sobol_dimension_1<U: U32Lanes>(index: U) -> U {
     pascal_parity(index).reverse_bits()
 }
 
@@ -344,12 +446,16 @@ const fn generator_columns(degree: usize, inner: u32, m: [u32; 3]) -> [u32; 32] 
 }
 
 /// Point `index` of the Sobol dimension whose generator matrix has `columns`: the columns of
-/// the index's set bits, added in GF(2).
-fn generated(index: u32, columns: &[u32; 32]) -> u32 {
-    let mut x = 0;
-    let mut bits = index;
+/// the index's set bits, added in GF(2) (each lane's, over the bits set in any lane).
+#[inline(always)]
+fn generated<U: U32Lanes>(index: U, columns: &[u32; 32]) -> U {
+    let one = U::splat(1);
+    let mut x = U::splat(0);
+    let mut bits = index.any_lane_bits();
     while bits != 0 {
-        x ^= columns[bits.trailing_zeros() as usize];
+        let k = bits.trailing_zeros();
+        // The column times the lane's bit k (0 or 1).
+        x = x ^ ((index >> k) & one).wrapping_mul(U::splat(columns[k as usize]));
         bits &= bits - 1;
     }
     x
@@ -360,31 +466,35 @@ fn generated(index: u32, columns: &[u32; 32]) -> u32 {
 /// are the i whose bits include k's. That sum over supersets takes five masked shifts, one per
 /// bit of a bit position, and no branches.
 #[inline(always)]
-fn pascal_parity(index: u32) -> u32 {
+fn pascal_parity<U: U32Lanes>(index: U) -> U {
     let mut x = index;
-    x ^= (x >> 1) & 0x5555_5555;
-    x ^= (x >> 2) & 0x3333_3333;
-    x ^= (x >> 4) & 0x0f0f_0f0f;
-    x ^= (x >> 8) & 0x00ff_00ff;
-    x ^= (x >> 16) & 0x0000_ffff;
+    for (shift, mask) in [
+        (1, 0x5555_5555),
+        (2, 0x3333_3333),
+        (4, 0x0f0f_0f0f),
+        (8, 0x00ff_00ff),
+        (16, 0x0000_ffff),
+    ] {
+        x = x ^ ((x >> shift) & U::splat(mask));
+    }
     x
 }
 
 /// Hash-based nested uniform (Owen) scrambling of a 0.32 fraction (Burley 2020, "Practical
 /// Hash-based Owen Scrambling"): a Laine-Karras style permutation on the reversed bits.
-fn owen_scramble(v: u32, seed: u32) -> u32 {
+#[inline(always)]
+fn owen_scramble<U: U32Lanes>(v: U, seed: U) -> U {
     laine_karras(v.reverse_bits(), seed).reverse_bits()
 }
 
 /// [`owen_scramble`]'s permutation, on and to reversed bits.
 #[inline(always)]
-fn laine_karras(mut x: u32, seed: u32) -> u32 {
-    x ^= x.wrapping_mul(0x3d20_adea);
+fn laine_karras<U: U32Lanes>(mut x: U, seed: U) -> U {
+    x = x ^ x.wrapping_mul(U::splat(0x3d20_adea));
     x = x.wrapping_add(seed);
-    x = x.wrapping_mul((seed >> 16) | 1);
-    x ^= x.wrapping_mul(0x0552_6c56);
-    x ^= x.wrapping_mul(0x53a2_2864);
-    x
+    x = x.wrapping_mul((seed >> 16) | U::splat(1));
+    x = x ^ x.wrapping_mul(U::splat(0x0552_6c56));
+    x ^ x.wrapping_mul(U::splat(0x53a2_2864))
 }
 
 /// The least all-ones mask covering 0..len, which [`permutation_element`] cycles within.
@@ -397,53 +507,59 @@ fn permutation_mask(len: u32) -> u32 {
 /// Element `i` of a pseudo-random permutation of 0..len chosen by `p` (Kensler 2013,
 /// "Correlated Multi-Jittered Sampling"); `w` is [`permutation_mask`] of `len`. A bijection on
 /// 0..len for every p.
-fn permutation_element(i: u32, len: u32, w: u32, p: u32) -> u32 {
+#[inline(always)]
+fn permutation_element<U: U32Lanes>(i: U, len: u32, w: u32, p: U) -> U {
     if len <= 1 {
-        return 0;
+        return U::splat(0);
     }
+    let w = U::splat(w);
     permutation_offset(walk_below(permutation_round(i, w, p), len, w, p), len, p)
 }
 
 /// One round of [`permutation_element`]'s hash: a bijection on 0..=w.
 #[inline(always)]
-fn permutation_round(mut i: u32, w: u32, p: u32) -> u32 {
-    i ^= p;
-    i = i.wrapping_mul(0xe170_893d);
-    i ^= p >> 16;
-    i ^= (i & w) >> 4;
-    i ^= p >> 8;
-    i = i.wrapping_mul(0x0929_eb3f);
-    i ^= p >> 23;
-    i ^= (i & w) >> 1;
-    i = i.wrapping_mul(1 | (p >> 27));
-    i = i.wrapping_mul(0x6935_fa69);
-    i ^= (i & w) >> 11;
-    i = i.wrapping_mul(0x74dc_b303);
-    i ^= (i & w) >> 2;
-    i = i.wrapping_mul(0x9e50_1cc3);
-    i ^= (i & w) >> 2;
-    i = i.wrapping_mul(0xc860_a3df);
-    i &= w;
+fn permutation_round<U: U32Lanes>(mut i: U, w: U, p: U) -> U {
+    let k = U::splat;
+    i = i ^ p;
+    i = i.wrapping_mul(k(0xe170_893d));
+    i = i ^ (p >> 16);
+    i = i ^ ((i & w) >> 4);
+    i = i ^ (p >> 8);
+    i = i.wrapping_mul(k(0x0929_eb3f));
+    i = i ^ (p >> 23);
+    i = i ^ ((i & w) >> 1);
+    i = i.wrapping_mul(k(1) | (p >> 27));
+    i = i.wrapping_mul(k(0x6935_fa69));
+    i = i ^ ((i & w) >> 11);
+    i = i.wrapping_mul(k(0x74dc_b303));
+    i = i ^ ((i & w) >> 2);
+    i = i.wrapping_mul(k(0x9e50_1cc3));
+    i = i ^ ((i & w) >> 2);
+    i = i.wrapping_mul(k(0xc860_a3df));
+    i = i & w;
     i ^ (i >> 5)
 }
 
 /// Cycle walking: more rounds from the first round's `i` until it falls in 0..len.
 #[inline(always)]
-fn walk_below(mut i: u32, len: u32, w: u32, p: u32) -> u32 {
-    while i >= len {
-        i = permutation_round(i, w, p);
+fn walk_below<U: U32Lanes>(mut i: U, len: u32, w: U, p: U) -> U {
+    loop {
+        let over = i.at_least(U::splat(len));
+        if !over.any() {
+            return i;
+        }
+        i = U::select(over, permutation_round(i, w, p), i);
     }
-    i
 }
 
 /// The walk's end rotated by `p` within 0..len.
 #[inline(always)]
-fn permutation_offset(i: u32, len: u32, p: u32) -> u32 {
+fn permutation_offset<U: U32Lanes>(i: U, len: u32, p: U) -> U {
     // The common power-of-two sample counts need no division.
     if len.is_power_of_two() {
-        i.wrapping_add(p) & (len - 1)
+        i.wrapping_add(p) & U::splat(len - 1)
     } else {
-        i.wrapping_add(p) % len
+        i.wrapping_add(p).remainder(len)
     }
 }
 
@@ -579,6 +695,60 @@ mod tests {
                 assert_eq!(sampler.clone().get_2d(), one_at_a_time.get_2d());
             }
         }
+    }
+
+    /// Lane `i` of a packet draws what sample `index + i` draws alone, for power-of-two and
+    /// other sample counts (whose permutations cycle-walk), on every lane type.
+    fn packet_draws_equal_the_pixel_draws<L: Lanes>() {
+        let lane = |v: L, i: usize| {
+            let mut out = [0.0; MAX_LANES];
+            v.store(&mut out);
+            out[i]
+        };
+        for (x, y, spp, seed) in [(0, 0, 16, 0), (7, 3, 48, 5), (1919, 1079, 256, 9)] {
+            for index in (0..spp).step_by(L::N) {
+                let mut packet = PacketSampler::<L>::new(x, y, index, spp, seed);
+                let (film, lens) = packet.get_camera();
+                let vertices = [packet.get_vertex(), packet.get_vertex()];
+                let after = packet.get_2d();
+                for i in 0..L::N {
+                    let mut alone = PixelSampler::new(x, y, index + i as u32, spp, seed);
+                    let both = |v: [L; 2]| Vec2::new(lane(v[0], i), lane(v[1], i));
+                    let at = format!("pixel ({x}, {y}) sample {} of {spp}", index + i as u32);
+                    assert_eq!((both(film), both(lens)), alone.get_camera(), "{at}");
+                    for v in vertices {
+                        let drawn = VertexSamples {
+                            mix: lane(v.mix, i),
+                            light_select: lane(v.light_select, i),
+                            light: both(v.light),
+                            lobe: lane(v.lobe, i),
+                            bsdf: both(v.bsdf),
+                            roulette: lane(v.roulette, i),
+                        };
+                        assert_eq!(drawn, alone.get_vertex(), "{at}");
+                    }
+                    assert_eq!(both(after), alone.get_2d(), "{at}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn packets_draw_each_samples_own_values() {
+        packet_draws_equal_the_pixel_draws::<f32>();
+        packet_draws_equal_the_pixel_draws::<crate::lanes::Arr<8>>();
+        packet_draws_equal_the_pixel_draws::<crate::lanes::Arr<16>>();
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            unsafe { packets_on_avx2() }
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn packets_on_avx2() {
+        packet_draws_equal_the_pixel_draws::<crate::lanes::Avx2>();
     }
 
     /// After a vertex that used only its mix choice, the next draws are those that follow a

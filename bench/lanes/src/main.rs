@@ -12,7 +12,6 @@
 //!
 //! `cargo run --release -p yat-lanes -- --rounds 5 [--output lanes.png]`
 
-mod lanes;
 mod tracer;
 
 use std::time::Instant;
@@ -20,8 +19,8 @@ use std::time::Instant;
 use anyhow::{ensure, Context, Result};
 use clap::Parser;
 
-use lanes::Arr;
 use tracer::{render, Counts, Scene, Traversal};
+use yat_tracer::lanes::Arr;
 
 #[derive(Parser)]
 struct Args {
@@ -59,7 +58,7 @@ fn arrays_baseline(scene: &Scene, spp: usize, traversal: Traversal) -> (Image, C
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::*;
-    use crate::lanes::Avx2;
+    use yat_tracer::lanes::Avx2;
 
     #[target_feature(enable = "avx2")]
     fn intrinsics_avx2(scene: &Scene, spp: usize, traversal: Traversal) -> (Image, Counts) {

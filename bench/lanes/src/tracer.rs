@@ -4,10 +4,12 @@
 //! The scene imitates depth-of-field-high (our numbers, not its file): three matte spheres, a
 //! floor and two walls with a bilinearly filtered checkerboard, a quad lamp, a thin-lens camera.
 //! Next-event estimation with the power heuristic, cosine-weighted continuations, roulette from
-//! the third vertex, depth 10. Random numbers are hashes of (pixel, sample, dimension), so a
-//! sample draws the same numbers in every variant.
+//! the third vertex, depth 10. Random numbers are YAT's own (Owen-scrambled Sobol) drawn for a
+//! packet at once by `yat_tracer::sampler::PacketSampler`, so a sample draws the same numbers in
+//! every variant, and the numbers cost what they cost in YAT.
 
-use crate::lanes::{hash32, Lanes, Mask, MAX_LANES};
+use yat_tracer::lanes::{Lanes, Mask, U32Lanes, MAX_LANES};
+use yat_tracer::sampler::PacketSampler;
 
 pub const MAX_DEPTH: usize = 10;
 const RADIUS: f32 = 0.5;
@@ -24,11 +26,11 @@ const LAMP_EDGE_2: [f32; 3] = [-0.5304, 0.9186, 1.0607];
 const LAMP_NORMAL: [f32; 3] = [-0.353_553_4, 0.612_372_46, -std::f32::consts::FRAC_1_SQRT_2];
 const LAMP_AREA: f32 = 2.25;
 const LAMP_RADIANCE: f32 = 8.0;
-const ID_FLOOR: i32 = 3;
-const ID_BACK: i32 = 4;
-const ID_LEFT: i32 = 5;
-const ID_LAMP: i32 = 6;
-const ID_MISS: i32 = 7;
+const ID_FLOOR: u32 = 3;
+const ID_BACK: u32 = 4;
+const ID_LEFT: u32 = 5;
+const ID_LAMP: u32 = 6;
+const ID_MISS: u32 = 7;
 const PI: f32 = std::f32::consts::PI;
 const TEXELS: usize = 16;
 /// Surfaces are offset by this along their normal, and hits nearer than it ignored.
@@ -201,16 +203,16 @@ fn within<L: Lanes>(a: L, lo: f32, hi: f32) -> L::M {
 
 struct Hit<L: Lanes> {
     t: L,
-    id: L::I,
+    id: L::U,
 }
 
 impl<L: Lanes> Hit<L> {
     /// Takes primitive `id` at distance `t` in the lanes of `m` where it is nearer.
     #[inline(always)]
-    fn keep(&mut self, m: L::M, t: L, id: i32) {
+    fn keep(&mut self, m: L::M, t: L, id: u32) {
         let m = m & L::splat(EPSILON).lt(t) & t.lt(self.t);
         self.t = L::select(m, t, self.t);
-        self.id = L::iselect(m, L::isplat(id), self.id);
+        self.id = L::U::select(m, L::U::splat(id), self.id);
     }
 }
 
@@ -220,7 +222,7 @@ fn closest<L: Lanes>(o: V3<L>, d: V3<L>) -> Hit<L> {
     let zero = L::splat(0.0);
     let mut hit = Hit {
         t: L::splat(f32::INFINITY),
-        id: L::isplat(ID_MISS),
+        id: L::U::splat(ID_MISS),
     };
     for (i, (centre, _)) in SPHERES.iter().enumerate() {
         let oc = o.sub(V3::splat(*centre));
@@ -229,7 +231,7 @@ fn closest<L: Lanes>(o: V3<L>, d: V3<L>) -> Hit<L> {
         let root = disc.max(zero).sqrt();
         let (near, far) = (zero - b - root, zero - b + root);
         let tp = L::select(eps.lt(near), near, far);
-        hit.keep(zero.le(disc), tp, i as i32);
+        hit.keep(zero.le(disc), tp, i as u32);
     }
     let floor = (zero - o.z) / d.z;
     let p = o.add(d.scale(floor));
@@ -285,12 +287,12 @@ fn closest_by_lane<L: Lanes>(o: V3<L>, d: V3<L>, live: L::M) -> Hit<L> {
     }
     Hit {
         t: L::load(&t),
-        id: L::iload(&id),
+        id: L::U::load(&id),
     }
 }
 
 #[inline(never)]
-fn closest_scalar(o: [f32; 3], d: [f32; 3]) -> (f32, i32) {
+fn closest_scalar(o: [f32; 3], d: [f32; 3]) -> (f32, u32) {
     let hit = closest::<f32>(V3::splat(o), V3::splat(d));
     (hit.t, hit.id)
 }
@@ -306,18 +308,21 @@ fn hit<L: Lanes>(traversal: Traversal, o: V3<L>, d: V3<L>, live: L::M) -> Hit<L>
 /// The two texels bracketing coordinate `c` along an axis (the texture repeats every 4 units)
 /// and the second's weight.
 #[inline(always)]
-fn texel_axis<L: Lanes>(c: L) -> (L::I, L::I, L) {
+fn texel_axis<L: Lanes>(c: L) -> (L::U, L::U, L) {
     let c = c * L::splat(0.25);
     let x = (c - c.floor()) * L::splat(TEXELS as f32) - L::splat(0.5);
     let x0 = x.floor();
-    let wrap = TEXELS as i32 - 1;
-    let i0 = L::iand((x0 + L::splat(TEXELS as f32)).to_int(), wrap);
-    (i0, L::iand(L::iadd(i0, 1), wrap), x - x0)
+    let wrap = L::U::splat(TEXELS as u32 - 1);
+    let i0 = (x0 + L::splat(TEXELS as f32)).to_u32() & wrap;
+    (i0, i0.wrapping_add(L::U::splat(1)) & wrap, x - x0)
 }
 
 #[inline(always)]
-fn texel<L: Lanes>(channel: &[f32], x: L::I, y: L::I) -> L {
-    L::gather(channel, L::imad(y, TEXELS as i32, x))
+fn texel<L: Lanes>(channel: &[f32], x: L::U, y: L::U) -> L {
+    L::gather(
+        channel,
+        y.wrapping_mul(L::U::splat(TEXELS as u32)).wrapping_add(x),
+    )
 }
 
 #[inline(always)]
@@ -335,19 +340,13 @@ fn checkerboard<L: Lanes>(scene: &Scene, u: L, v: L) -> V3<L> {
 #[inline(always)]
 fn bilinear<L: Lanes>(
     channel: &[f32],
-    (x0, x1, fx): (L::I, L::I, L),
-    (y0, y1, fy): (L::I, L::I, L),
+    (x0, x1, fx): (L::U, L::U, L),
+    (y0, y1, fy): (L::U, L::U, L),
 ) -> L {
     let one = L::splat(1.0);
     let row0 = texel::<L>(channel, x0, y0) * (one - fx) + texel::<L>(channel, x1, y0) * fx;
     let row1 = texel::<L>(channel, x0, y1) * (one - fx) + texel::<L>(channel, x1, y1) * fx;
     row0 * (one - fy) + row1 * fy
-}
-
-#[inline(always)]
-fn random<L: Lanes>(seed: L::I, dimension: u32) -> L {
-    let key = hash32(dimension.wrapping_mul(0x9e37_79b9).wrapping_add(1)) as i32;
-    L::unit(L::hash(L::ixor(seed, key)))
 }
 
 /// Live lanes of `m`.
@@ -382,15 +381,11 @@ fn trace<L: Lanes>(
     scene: &Scene,
     traversal: Traversal,
     (px, py): (usize, usize),
-    first: usize,
+    (first, spp): (usize, usize),
     counts: &mut Counts,
     sum: &mut [f32; 3],
 ) {
-    let mut index = [0i32; MAX_LANES];
-    for (i, x) in index.iter_mut().enumerate() {
-        *x = ((py * scene.width + px) * 256 + first + i) as i32;
-    }
-    let seed = L::hash(L::iload(&index));
+    let mut sampler = PacketSampler::<L>::new(px as u32, py as u32, first as u32, spp as u32, 0);
     let zero = L::splat(0.0);
     let one = L::splat(1.0);
     let inv_pi = L::splat(1.0 / PI);
@@ -398,10 +393,9 @@ fn trace<L: Lanes>(
     // Thin lens: aperture radius 0.1, focused at 5, 49.1 degrees across the shorter side.
     let tan_half_fov = L::splat(0.457_08);
     let aspect = scene.height as f32 / scene.width as f32;
-    let sx =
-        (L::splat(px as f32) + random::<L>(seed, 0)) * L::splat(2.0 / scene.width as f32) - one;
-    let sy = (one
-        - (L::splat(py as f32) + random::<L>(seed, 1)) * L::splat(2.0 / scene.height as f32))
+    let ([film_x, film_y], [lens_u, lens_v]) = sampler.get_camera();
+    let sx = (L::splat(px as f32) + film_x) * L::splat(2.0 / scene.width as f32) - one;
+    let sy = (one - (L::splat(py as f32) + film_y) * L::splat(2.0 / scene.height as f32))
         * L::splat(aspect);
     let focus = L::splat(5.0);
     let on_focus = V3 {
@@ -409,8 +403,8 @@ fn trace<L: Lanes>(
         y: sy * tan_half_fov * focus,
         z: focus,
     };
-    let r = random::<L>(seed, 2).sqrt() * L::splat(0.1);
-    let (sin, cos) = sin_cos(random::<L>(seed, 3) * L::splat(2.0 * PI));
+    let r = lens_u.sqrt() * L::splat(0.1);
+    let (sin, cos) = sin_cos(lens_v * L::splat(2.0 * PI));
     let lens = V3 {
         x: r * cos,
         y: r * sin,
@@ -431,8 +425,8 @@ fn trace<L: Lanes>(
         counts.rays += count::<L>(live);
         counts.lane_steps += L::N as u64;
         let h = hit(traversal, o, d, live);
-        live = live & !L::ieq(h.id, ID_MISS);
-        let on_lamp = L::ieq(h.id, ID_LAMP) & live;
+        live = live & !h.id.equals(L::U::splat(ID_MISS));
+        let on_lamp = h.id.equals(L::U::splat(ID_LAMP)) & live;
         if on_lamp.any() {
             let cos_lamp = zero - d.dot(lamp_normal);
             let front = zero.lt(cos_lamp) & on_lamp;
@@ -454,15 +448,15 @@ fn trace<L: Lanes>(
         let mut n = V3::<L>::splat([0.0, 0.0, 1.0]);
         let mut albedo = V3::<L>::splat([0.0; 3]);
         for (i, (centre, colour)) in SPHERES.iter().enumerate() {
-            let m = L::ieq(h.id, i as i32);
+            let m = h.id.equals(L::U::splat(i as u32));
             let sphere_normal = p.sub(V3::splat(*centre)).scale(L::splat(1.0 / RADIUS));
             n = V3::select(m, sphere_normal, n);
             albedo = V3::select(m, V3::splat(*colour), albedo);
         }
         let (is_floor, is_back, is_left) = (
-            L::ieq(h.id, ID_FLOOR),
-            L::ieq(h.id, ID_BACK),
-            L::ieq(h.id, ID_LEFT),
+            h.id.equals(L::U::splat(ID_FLOOR)),
+            h.id.equals(L::U::splat(ID_BACK)),
+            h.id.equals(L::U::splat(ID_LEFT)),
         );
         n = V3::select(is_back, V3::splat([0.0, -1.0, 0.0]), n);
         n = V3::select(is_left, V3::splat([1.0, 0.0, 0.0]), n);
@@ -473,12 +467,12 @@ fn trace<L: Lanes>(
             albedo = V3::select(textured, checkerboard(scene, u, v), albedo);
         }
         n = V3::select(zero.lt(n.dot(d)), n.neg(), n);
-        let dimension = 4 + 5 * depth as u32;
+        let u = sampler.get_vertex();
         let origin = p.add(n.scale(L::splat(EPSILON)));
 
         // A point on the lamp, weighed against the BSDF's density.
-        let a = random::<L>(seed, dimension) - L::splat(0.5);
-        let b = random::<L>(seed, dimension + 1) - L::splat(0.5);
+        let a = u.light[0] - L::splat(0.5);
+        let b = u.light[1] - L::splat(0.5);
         let on_lamp = V3::splat(LAMP_CENTRE)
             .add(V3::splat(LAMP_EDGE_1).scale(a))
             .add(V3::splat(LAMP_EDGE_2).scale(b));
@@ -506,10 +500,9 @@ fn trace<L: Lanes>(
         }
 
         // A cosine-weighted continuation in the frame of Duff et al.
-        let u = random::<L>(seed, dimension + 2);
-        let (sin, cos) = sin_cos(random::<L>(seed, dimension + 3) * L::splat(2.0 * PI));
-        let r = u.sqrt();
-        let z = (one - u).max(zero).sqrt();
+        let (sin, cos) = sin_cos(u.bsdf[1] * L::splat(2.0 * PI));
+        let r = u.bsdf[0].sqrt();
+        let z = (one - u.bsdf[0]).max(zero).sqrt();
         let sign = L::select(n.z.lt(zero), L::splat(-1.0), one);
         let a = L::splat(-1.0) / (sign + n.z);
         let b = n.x * n.y * a;
@@ -530,7 +523,7 @@ fn trace<L: Lanes>(
         if depth >= 2 {
             let q = throughput.x.max(throughput.y).max(throughput.z);
             let q = q.max(L::splat(0.05)).min(one);
-            live = live & random::<L>(seed, dimension + 4).lt(q);
+            live = live & u.roulette.lt(q);
             throughput = throughput.scale(one / q);
         }
         o = origin;
@@ -565,7 +558,14 @@ pub fn render<L: Lanes>(
         for px in 0..scene.width {
             let mut sum = [0f32; 3];
             for first in (0..spp).step_by(L::N) {
-                trace::<L>(scene, traversal, (px, py), first, &mut counts, &mut sum);
+                trace::<L>(
+                    scene,
+                    traversal,
+                    (px, py),
+                    (first, spp),
+                    &mut counts,
+                    &mut sum,
+                );
             }
             image[py * scene.width + px] = sum.map(|s| s / spp as f32);
         }
