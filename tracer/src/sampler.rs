@@ -129,7 +129,15 @@ impl PixelSampler {
 
     /// The Sobol index this sample uses in the dimension whose hash is `p`.
     fn sobol_index(&self, p: u32) -> u32 {
-        self.first + permutation_element(self.index - self.first, self.len, self.mask, p)
+        self.sobol_index_of(self.index - self.first, p)
+    }
+
+    /// The Sobol indices, in the dimension whose hash is `p`, of the samples `offset` past the
+    /// first of this sample's permutation range (several lanes of them at once).
+    #[inline(always)]
+    fn sobol_index_of<U: U32Lanes>(&self, offset: U, p: u32) -> U {
+        let element = permutation_element(offset, self.len, self.mask, U::splat(p));
+        U::splat(self.first).wrapping_add(element)
     }
 
     pub fn get_1d(&mut self) -> f32 {
@@ -301,8 +309,7 @@ impl<L: Lanes> PacketSampler<L> {
 
     #[inline(always)]
     fn sobol_index(&self, p: u32) -> L::U {
-        let (first, len, mask) = (self.pixel.first, self.pixel.len, self.pixel.mask);
-        L::U::splat(first).wrapping_add(permutation_element(self.offset, len, mask, L::U::splat(p)))
+        self.pixel.sobol_index_of(self.offset, p)
     }
 
     /// [`PixelSampler::get_1d`] in every lane.
