@@ -596,7 +596,7 @@ mod avx2 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// An operation's name, its lanes and its scalar form.
@@ -679,21 +679,37 @@ mod tests {
         }
     }
 
-    #[test]
-    fn every_lane_type_computes_the_scalar_bits() {
-        agrees_with_scalar::<f32>();
-        agrees_with_scalar::<Arr<8>>();
-        agrees_with_scalar::<Arr<16>>();
+    /// A check to run on a lane type.
+    pub(crate) trait OnLanes {
+        fn run<L: Lanes>(&self);
+    }
+
+    /// Runs `check` on one lane, arrays of 8 and 16, and AVX2 where the CPU has it.
+    pub(crate) fn on_every_lane_type(check: &impl OnLanes) {
+        check.run::<f32>();
+        check.run::<Arr<8>>();
+        check.run::<Arr<16>>();
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2.
-            unsafe { avx2_agrees() }
+            unsafe { on_avx2(check) }
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn avx2_agrees() {
-        agrees_with_scalar::<Avx2>();
+    fn on_avx2(check: &impl OnLanes) {
+        check.run::<Avx2>();
+    }
+
+    #[test]
+    fn every_lane_type_computes_the_scalar_bits() {
+        struct Agrees;
+        impl OnLanes for Agrees {
+            fn run<L: Lanes>(&self) {
+                agrees_with_scalar::<L>();
+            }
+        }
+        on_every_lane_type(&Agrees);
     }
 }

@@ -296,6 +296,10 @@ impl<L: Lanes> PacketSampler<L> {
     /// Samples `index .. index + L::N` of a pixel that takes all of `spp` samples
     /// (`index + L::N <= spp`).
     pub fn new(x: u32, y: u32, index: u32, spp: u32, seed: u64) -> Self {
+        debug_assert!(
+            index as usize + L::N <= spp.max(1) as usize,
+            "lanes past spp"
+        );
         let pixel = PixelSampler::new(x, y, index, spp, seed);
         let mut offsets = [0; MAX_LANES];
         for (lane, offset) in offsets.iter_mut().enumerate() {
@@ -742,20 +746,13 @@ mod tests {
 
     #[test]
     fn packets_draw_each_samples_own_values() {
-        packet_draws_equal_the_pixel_draws::<f32>();
-        packet_draws_equal_the_pixel_draws::<crate::lanes::Arr<8>>();
-        packet_draws_equal_the_pixel_draws::<crate::lanes::Arr<16>>();
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            unsafe { packets_on_avx2() }
+        struct PacketDraws;
+        impl crate::lanes::tests::OnLanes for PacketDraws {
+            fn run<L: Lanes>(&self) {
+                packet_draws_equal_the_pixel_draws::<L>();
+            }
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn packets_on_avx2() {
-        packet_draws_equal_the_pixel_draws::<crate::lanes::Avx2>();
+        crate::lanes::tests::on_every_lane_type(&PacketDraws);
     }
 
     /// After a vertex that used only its mix choice, the next draws are those that follow a

@@ -8,6 +8,7 @@
 //! packet at once by `yat_tracer::sampler::PacketSampler`, so a sample draws the same numbers in
 //! every variant, and the numbers cost what they cost in YAT.
 
+use glam::Vec3;
 use yat_tracer::lanes::{Lanes, Mask, U32Lanes, MAX_LANES};
 use yat_tracer::sampler::PacketSampler;
 
@@ -57,19 +58,6 @@ pub struct Scene {
     pub height: usize,
 }
 
-fn normalize(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|c| c / l)
-}
-
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 impl Scene {
     pub fn new(width: usize, height: usize) -> Self {
         let texture = [0.8, 0.78, 0.75].map(|white| {
@@ -81,17 +69,19 @@ impl Scene {
             }
             t
         });
-        let eye = [1.33, -5.0, 1.5];
-        let target = [1.075_113, -4.048_749, 1.326_352];
-        let forward = normalize([target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]]);
-        let right = normalize(cross(forward, [-0.044_943, 0.167_731, 0.984_808]));
-        let up = cross(right, forward);
+        let eye = Vec3::new(1.33, -5.0, 1.5);
+        let target = Vec3::new(1.075_113, -4.048_749, 1.326_352);
+        let forward = (target - eye).normalize();
+        let right = forward
+            .cross(Vec3::new(-0.044_943, 0.167_731, 0.984_808))
+            .normalize();
+        let up = right.cross(forward);
         Scene {
             texture,
-            eye,
-            right,
-            up,
-            forward,
+            eye: eye.to_array(),
+            right: right.to_array(),
+            up: up.to_array(),
+            forward: forward.to_array(),
             width,
             height,
         }
