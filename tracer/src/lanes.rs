@@ -57,6 +57,7 @@ pub trait Lanes:
     const N: usize;
     fn splat(x: f32) -> Self;
     fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
     /// Floor of values within +-2^31.
     fn floor(self) -> Self;
     fn lt(self, o: Self) -> Self::M;
@@ -97,6 +98,23 @@ fn floor_in_range(x: f32) -> f32 {
     either(t > x, t - 1.0, t)
 }
 
+/// The sine and cosine of `x` for |x| <= pi/4, as polynomials (Cephes' `sinf` and `cosf`
+/// kernels' coefficients: within 2 ulp there) that every lane type evaluates with the same
+/// operations, where the C library's `sincosf` might differ from a vector one in the last bit.
+/// The range needs no reduction: callers fold their angles into it (the concentric disk
+/// mapping swaps sine and cosine for its other half).
+#[inline(always)]
+pub fn sin_cos_quarter<L: Lanes>(x: L) -> (L, L) {
+    let z = x * x;
+    let sin_poly =
+        (L::splat(-1.951_529_6e-4) * z + L::splat(8.332_161e-3)) * z - L::splat(1.666_665_5e-1);
+    let sin = sin_poly * z * x + x;
+    let cos_poly =
+        (L::splat(2.443_315_7e-5) * z - L::splat(1.388_731_6e-3)) * z + L::splat(4.166_664_6e-2);
+    let cos = cos_poly * z * z - L::splat(0.5) * z + L::splat(1.0);
+    (sin, cos)
+}
+
 impl Mask for bool {
     #[inline(always)]
     fn any(self) -> bool {
@@ -115,6 +133,10 @@ impl Lanes for f32 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
     }
     #[inline(always)]
     fn floor(self) -> Self {
@@ -271,6 +293,10 @@ impl<const N: usize> Lanes for Arr<N> {
     #[inline(always)]
     fn sqrt(self) -> Self {
         Arr(std::array::from_fn(|i| self.0[i].sqrt()))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Arr(std::array::from_fn(|i| self.0[i].abs()))
     }
     #[inline(always)]
     fn floor(self) -> Self {
@@ -460,6 +486,10 @@ mod avx2 {
         #[inline(always)]
         fn sqrt(self) -> Self {
             unsafe { Avx2(_mm256_sqrt_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { Avx2(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
         }
         #[inline(always)]
         fn floor(self) -> Self {
@@ -667,6 +697,24 @@ pub(crate) mod tests {
             for (i, &x) in floats[..chunk.len()].iter().enumerate() {
                 assert_eq!(out[i], x.floor(), "floor of {x} on {} lanes", L::N);
             }
+            let angles = L::load(&floats.map(|x| x * 0.045));
+            let (sin, cos) = sin_cos_quarter(angles);
+            let mut sines = [0f32; MAX_LANES];
+            sin.store(&mut sines);
+            cos.store(&mut out);
+            for (i, &x) in floats[..chunk.len()].iter().enumerate() {
+                let scalar = sin_cos_quarter(x * 0.045);
+                assert_eq!(
+                    (sines[i], out[i]),
+                    scalar,
+                    "sin, cos of {x} on {} lanes",
+                    L::N
+                );
+            }
+            angles.abs().store(&mut out);
+            for (i, &x) in floats[..chunk.len()].iter().enumerate() {
+                assert_eq!(out[i], (x * 0.045).abs(), "|{x}| on {} lanes", L::N);
+            }
             (a >> 1).to_f32().store(&mut out);
             for (i, &x) in chunk.iter().enumerate() {
                 assert_eq!(
@@ -700,6 +748,24 @@ pub(crate) mod tests {
     #[target_feature(enable = "avx2")]
     fn on_avx2(check: &impl OnLanes) {
         check.run::<Avx2>();
+    }
+
+    #[test]
+    fn sine_and_cosine_are_within_two_ulp_over_their_range() {
+        let ulp = |x: f32| f32::from_bits(x.abs().to_bits() + 1) - x.abs();
+        let steps = 100_000;
+        for i in -steps..=steps {
+            let x = std::f32::consts::FRAC_PI_4 * i as f32 / steps as f32;
+            let (sin, cos) = sin_cos_quarter(x);
+            let (exact_sin, exact_cos) = f64::from(x).sin_cos();
+            for (got, exact) in [(sin, exact_sin), (cos, exact_cos)] {
+                let error = (f64::from(got) - exact).abs();
+                assert!(
+                    error <= 2.0 * f64::from(ulp(exact as f32)),
+                    "at {x}: {got} against {exact}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -1,9 +1,11 @@
 //! Directions in the local shading frame, where z is the shading normal: the trigonometry,
 //! reflection, refraction and hemisphere sampling every BxDF shares.
 
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
+
+use crate::lanes::{sin_cos_quarter, Lanes};
 
 pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
     a.z * b.z > 0.0
@@ -43,16 +45,27 @@ pub fn refract(w: Vec3, n: Vec3, eta: f32) -> Option<(Vec3, f32)> {
 /// Shirley-Chiu concentric mapping of the unit square onto the unit disk (keeps strata
 /// compact, which the Sobol sampler's 2D stratification benefits from).
 pub fn sample_disk_concentric(u: Vec2) -> Vec2 {
-    let o = u * 2.0 - Vec2::ONE;
-    if o == Vec2::ZERO {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    Vec2::new(theta.cos(), theta.sin()) * r
+    Vec2::from(concentric_disk(u.to_array()))
+}
+
+/// [`sample_disk_concentric`] in lanes, and what it runs on one: the same bits on every lane
+/// type. The angle is pi/4 times a ratio within [-1, 1], whose sine and cosine are the disk
+/// point, or its cosine and sine on the half where the angle was pi/2 less it.
+#[inline(always)]
+pub fn concentric_disk<L: Lanes>(u: [L; 2]) -> [L; 2] {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    let (x, y) = (u[0] * two - one, u[1] * two - one);
+    let (ax, ay) = (x.abs(), y.abs());
+    let centre = !(L::splat(0.0).lt(ax) | L::splat(0.0).lt(ay));
+    let across = ay.lt(ax);
+    let r = L::select(across, x, y);
+    let ratio = L::select(across, y, x) / r;
+    let (sin, cos) = sin_cos_quarter(L::splat(FRAC_PI_4) * ratio);
+    let zero = L::splat(0.0);
+    [
+        L::select(centre, zero, L::select(across, cos, sin) * r),
+        L::select(centre, zero, L::select(across, sin, cos) * r),
+    ]
 }
 
 /// The polar mapping of the unit square onto the unit disk (what visible-normal sampling's
@@ -65,9 +78,15 @@ pub fn sample_disk_polar(u: Vec2) -> Vec2 {
 
 /// Cosine-weighted direction in the upper hemisphere (Malley's method).
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_disk_concentric(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    Vec3::from(cosine_hemisphere(u.to_array()))
+}
+
+/// [`sample_cosine_hemisphere`] in lanes, and what it runs on one.
+#[inline(always)]
+pub fn cosine_hemisphere<L: Lanes>(u: [L; 2]) -> [L; 3] {
+    let [x, y] = concentric_disk(u);
+    let z = (L::splat(1.0) - (x * x + y * y)).max(L::splat(0.0)).sqrt();
+    [x, y, z]
 }
 
 pub fn cosine_hemisphere_pdf(abs_cos: f32) -> f32 {
