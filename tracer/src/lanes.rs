@@ -71,6 +71,13 @@ pub trait Lanes:
     /// Truncated to integers (values in 0..2^31).
     fn to_u32(self) -> Self::U;
 
+    /// The lanes' values (past `N`: zeros).
+    #[inline(always)]
+    fn values(self) -> [f32; MAX_LANES] {
+        let mut out = [0.0; MAX_LANES];
+        self.store(&mut out);
+        out
+    }
     #[inline(always)]
     fn min(self, o: Self) -> Self {
         Self::select(self.lt(o), self, o)

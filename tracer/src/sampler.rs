@@ -274,6 +274,7 @@ impl PixelSampler {
 /// `index + i` of [`PixelSampler::new`], and draws its values bit for bit. The dimensions'
 /// hashes are the pixel's, so each is computed once for all lanes. For a renderer that runs
 /// paths in lanes (`bench/lanes` measures one).
+#[derive(Clone)]
 pub struct PacketSampler<L: Lanes> {
     /// The first lane's stream: the pixel's hash, permutation range and next dimension.
     pixel: PixelSampler,
@@ -300,7 +301,23 @@ impl<L: Lanes> PacketSampler<L> {
             index as usize + L::N <= spp.max(1) as usize,
             "lanes past spp"
         );
-        let pixel = PixelSampler::new(x, y, index, spp, seed);
+        Self::of(PixelSampler::new(x, y, index, spp, seed))
+    }
+
+    /// Samples `index .. index + L::N` of [`PixelSampler::nested`] (`index` a multiple of
+    /// `L::N`, which divides [`NESTED_FIRST_BLOCK`]: the lanes share a permutation range).
+    pub fn nested(x: u32, y: u32, index: u32, seed: u64) -> Self {
+        debug_assert!(
+            (index as usize).is_multiple_of(L::N)
+                && (NESTED_FIRST_BLOCK as usize).is_multiple_of(L::N),
+            "lanes across nested blocks"
+        );
+        Self::of(PixelSampler::nested(x, y, index, seed))
+    }
+
+    /// The packet whose first lane is `pixel`.
+    fn of(pixel: PixelSampler) -> Self {
+        let index = pixel.index;
         let mut offsets = [0; MAX_LANES];
         for (lane, offset) in offsets.iter_mut().enumerate() {
             *offset = (index - pixel.first).wrapping_add(lane as u32);
@@ -314,6 +331,43 @@ impl<L: Lanes> PacketSampler<L> {
     #[inline(always)]
     fn sobol_index(&self, p: u32) -> L::U {
         self.pixel.sobol_index_of(self.offset, p)
+    }
+
+    /// Lane `lane`'s own stream, at the packet's next dimension: where a path that leaves the
+    /// packet goes on.
+    pub fn lane(&self, lane: usize) -> PixelSampler {
+        PixelSampler {
+            index: self.pixel.index + lane as u32,
+            ..self.pixel.clone()
+        }
+    }
+
+    /// [`PixelSampler::branch`] of every lane.
+    pub fn branch(&self, k: u32) -> Self {
+        Self {
+            pixel: self.pixel.branch(k),
+            offset: self.offset,
+        }
+    }
+
+    /// [`PixelSampler::get_split_draws`] in every lane.
+    #[inline(always)]
+    pub fn get_split_draws<const N: usize>(&mut self, n: usize) -> ([L; N], [[L; 2]; N]) {
+        let n = n.min(N);
+        let lobe_hash = self.pixel.next_dimension_hash();
+        let dir_hash = self.pixel.next_dimension_hash();
+        let count = L::U::splat(n as u32);
+        let lobe_first = self.sobol_index(lobe_hash as u32).wrapping_mul(count);
+        let dir_first = self.sobol_index(dir_hash as u32).wrapping_mul(count);
+        // Loops, not `from_fn`: a closure would not inherit an AVX2 caller's target features.
+        let zero = L::splat(0.0);
+        let (mut lobes, mut dirs) = ([zero; N], [[zero; 2]; N]);
+        for i in 0..n {
+            let step = L::U::splat(i as u32);
+            lobes[i] = point_1d(lobe_first.wrapping_add(step), lobe_hash);
+            dirs[i] = point_2d_lanes(dir_first.wrapping_add(step), dir_hash);
+        }
+        (lobes, dirs)
     }
 
     /// [`PixelSampler::get_1d`] in every lane.
@@ -716,14 +770,32 @@ mod tests {
             v.store(&mut out);
             out[i]
         };
-        for (x, y, spp, seed) in [(0, 0, 16, 0), (7, 3, 48, 5), (1919, 1079, 256, 9)] {
-            for index in (0..spp).step_by(L::N) {
-                let mut packet = PacketSampler::<L>::new(x, y, index, spp, seed);
+        // (x, y, spp, seed), spp 0 for nested samples.
+        let runs = [
+            (0, 0, 16, 0),
+            (7, 3, 48, 5),
+            (1919, 1079, 256, 9),
+            (5, 6, 0, 2),
+        ];
+        for (x, y, spp, seed) in runs {
+            let samples = if spp == 0 { 64 } else { spp };
+            for index in (0..samples).step_by(L::N) {
+                let new_alone = |i| match spp {
+                    0 => PixelSampler::nested(x, y, i, seed),
+                    _ => PixelSampler::new(x, y, i, spp, seed),
+                };
+                let mut packet = match spp {
+                    0 => PacketSampler::<L>::nested(x, y, index, seed),
+                    _ => PacketSampler::<L>::new(x, y, index, spp, seed),
+                };
                 let (film, lens) = packet.get_camera();
                 let vertices = [packet.get_vertex(), packet.get_vertex()];
+                let mut branch = packet.branch(2);
+                let (branch_lobes, branch_dirs) = branch.get_split_draws::<4>(3);
+                let streams: Vec<_> = (0..L::N).map(|i| packet.lane(i)).collect();
                 let after = packet.get_2d();
-                for i in 0..L::N {
-                    let mut alone = PixelSampler::new(x, y, index + i as u32, spp, seed);
+                for (i, stream) in streams.into_iter().enumerate() {
+                    let mut alone = new_alone(index + i as u32);
                     let both = |v: [L; 2]| Vec2::new(lane(v[0], i), lane(v[1], i));
                     let at = format!("pixel ({x}, {y}) sample {} of {spp}", index + i as u32);
                     assert_eq!((both(film), both(lens)), alone.get_camera(), "{at}");
@@ -738,6 +810,12 @@ mod tests {
                         };
                         assert_eq!(drawn, alone.get_vertex(), "{at}");
                     }
+                    let (lobes, dirs) = alone.branch(2).get_split_draws::<4>(3);
+                    for k in 0..4 {
+                        assert_eq!(lane(branch_lobes[k], i), lobes[k], "{at}: split lobe {k}");
+                        assert_eq!(both(branch_dirs[k]), dirs[k], "{at}: split direction {k}");
+                    }
+                    assert_eq!(stream.clone().get_2d(), alone.clone().get_2d(), "{at}");
                     assert_eq!(both(after), alone.get_2d(), "{at}");
                 }
             }

@@ -52,6 +52,17 @@ impl Bsdf {
         matches!(self.bxdf, Bxdf::PassThrough)
     }
 
+    /// A bare Lambert BSDF's shading frame, geometric normal and value (the same for every
+    /// pair of directions it reflects): what a path traced in lanes shades with. None for
+    /// every other BSDF, and for a value that is zero or not finite.
+    pub fn as_lambert(&self) -> Option<(Frame, Vec3, Vec3)> {
+        let (Bxdf::Diffuse(d), None) = (&self.bxdf, &self.coating) else {
+            return None;
+        };
+        let f = d.lambert_value()?;
+        (f != Vec3::ZERO && f.is_finite()).then_some((self.frame, self.ng, f))
+    }
+
     /// True when every lobe is specular (light sampling is useless here).
     pub fn is_specular(&self) -> bool {
         match &self.coating {

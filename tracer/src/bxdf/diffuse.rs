@@ -69,6 +69,12 @@ impl DiffuseReflection {
         cosine_pdf(wo, wi)
     }
 
+    /// The lobe's value for every pair of directions it reflects, where that is one value
+    /// (Lambert: no Oren-Nayar slope term).
+    pub fn lambert_value(&self) -> Option<Vec3> {
+        (self.roughness.b == 0.0).then(|| self.r * (FRAC_1_PI * self.roughness.a))
+    }
+
     pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
         LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
     }

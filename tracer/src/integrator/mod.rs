@@ -3,6 +3,7 @@
 //! them); the path tracer sees the scene through the [`PathScene`] interface it defines.
 
 pub mod options;
+pub mod packet;
 pub mod path;
 
 pub use options::{IntegratorDesc, RussianRoulette};

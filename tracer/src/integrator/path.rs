@@ -76,7 +76,7 @@ pub const GLOSSY_SPLIT: usize = 8;
 
 /// Bounces before Russian roulette may end a path under the `probability` strategy (as in
 /// LuxRender).
-const RR_MIN_DEPTH: u32 = 3;
+pub(super) const RR_MIN_DEPTH: u32 = 3;
 
 /// Under the `efficiency` strategy a path survives a broad scattering vertex (a diffuse, velvet
 /// or cloth lobe, under a coat or not, as [`Bsdf::gathers_from`] tells; a volume's phase
@@ -90,11 +90,11 @@ const RR_MIN_DEPTH: u32 = 3;
 /// three times the throughput keeps the bright paths that the old rule ended; and the light a
 /// glossy vertex sends on is concentrated (the caustics of Mario's metal seen from the floor),
 /// which the roulette turned into fireflies.
-const RR_THROUGHPUT_SCALE: f32 = 3.0;
+pub(super) const RR_THROUGHPUT_SCALE: f32 = 3.0;
 
 /// The least survival probability of the `efficiency` strategy: a path it keeps is weighed by
 /// at most 20 times.
-const RR_MIN_SURVIVAL: f32 = 0.05;
+pub(super) const RR_MIN_SURVIVAL: f32 = 0.05;
 
 /// Radiance along a camera ray, and the number of rays traced for it.
 #[derive(Clone, Copy, Debug, Default)]
@@ -113,27 +113,27 @@ fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
 }
 
 /// Where the ray that reached the current vertex was sampled, for MIS on emitters it hits.
-struct PrevScatter {
-    p: Vec3,
-    pdf: f32,
-    specular: bool,
+pub(super) struct PrevScatter {
+    pub(super) p: Vec3,
+    pub(super) pdf: f32,
+    pub(super) specular: bool,
     /// The share of the light samples at `p` that went to lamp images (0 where it sees none):
     /// the lights' own share is what is left.
-    image_share: f32,
+    pub(super) image_share: f32,
     /// Set when the ray just reflected in a flat mirror straight after a non-specular vertex:
     /// a lamp it reaches is one a lamp-image sample at that vertex could have found.
-    before_mirror: Option<BeforeMirror>,
+    pub(super) before_mirror: Option<BeforeMirror>,
     /// Set when `p` split ([`GLOSSY_SPLIT`]): its own BSDF samples took all the light it sees
     /// directly, so what this ray finds emitting (through null surfaces too) is not counted.
-    direct_counted: bool,
+    pub(super) direct_counted: bool,
     /// The side `p`'s light sample sampled environment maps for ([`Bsdf::gathers_from`]):
     /// the density an escaping ray is weighed by.
-    facing: Option<Vec3>,
+    pub(super) facing: Option<Vec3>,
 }
 
 impl PrevScatter {
     /// A vertex that sampled no lamp images.
-    fn plain(p: Vec3, pdf: f32, specular: bool) -> Self {
+    pub(super) fn plain(p: Vec3, pdf: f32, specular: bool) -> Self {
         Self {
             p,
             pdf,
@@ -149,7 +149,7 @@ impl PrevScatter {
 /// The non-specular vertex before a flat mirror (one that sampled lamp images, with
 /// [`IMAGE_SHARE`] of its light samples), and the mirror's plane.
 #[derive(Clone, Copy)]
-struct BeforeMirror {
+pub(super) struct BeforeMirror {
     p: Vec3,
     pdf: f32,
     plane: u16,
@@ -189,7 +189,7 @@ const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 /// Russian roulette after a bounce at the `depth`th vertex, which scattered broadly or not (see
 /// [`RR_THROUGHPUT_SCALE`]): false ends the path; else the throughput is divided by the
 /// survival probability.
-fn survives(
+pub(super) fn survives(
     integrator: &IntegratorDesc,
     depth: u32,
     broad: bool,
@@ -236,20 +236,23 @@ pub fn trace_branching_path<S: PathScene>(
 }
 
 /// A path between two vertices: the ray to the next one and what the path carries.
-struct PathState {
-    ray: Ray,
-    throughput: Vec3,
-    medium: Option<MediumId>,
-    depth: u32,
+pub(super) struct PathState {
+    pub(super) ray: Ray,
+    pub(super) throughput: Vec3,
+    /// The light the path has gathered so far (a path traced in lanes up to here goes on one
+    /// at a time with its sum, which it adds to in the same order).
+    pub(super) radiance: Vec3,
+    pub(super) medium: Option<MediumId>,
+    pub(super) depth: u32,
     /// Null surfaces crossed since the last vertex.
-    pass_through: u32,
+    pub(super) pass_through: u32,
     /// Whether the path may still split at a glossy vertex (once, at its first that may see a
     /// lamp).
-    may_split: bool,
+    pub(super) may_split: bool,
     /// The continuations its next broad vertex sends on, while every vertex so far was
     /// specular (1 after that).
-    branches: usize,
-    prev: PrevScatter,
+    pub(super) branches: usize,
+    pub(super) prev: PrevScatter,
 }
 
 impl PathState {
@@ -257,6 +260,7 @@ impl PathState {
         Self {
             ray,
             throughput: Vec3::ONE,
+            radiance: Vec3::ZERO,
             medium: scene.volumes().camera,
             depth: 0,
             pass_through: 0,
@@ -271,7 +275,7 @@ impl PathState {
 /// Traces `state` on, adding its light and rays to `out`.
 // Inlined into the unit loop, as `trace_path` is.
 #[inline(always)]
-fn walk<S: PathScene>(
+pub(super) fn walk<S: PathScene>(
     scene: &S,
     state: PathState,
     sampler: &mut PixelSampler,
@@ -285,6 +289,7 @@ fn walk<S: PathScene>(
     let PathState {
         mut ray,
         mut throughput,
+        mut radiance,
         mut medium,
         mut depth,
         mut pass_through,
@@ -292,7 +297,6 @@ fn walk<S: PathScene>(
         mut branches,
         mut prev,
     } = state;
-    let mut radiance = Vec3::ZERO;
     let mut rays = 0u32;
 
     loop {
@@ -582,6 +586,7 @@ impl BranchVertex<'_> {
         Some(PathState {
             ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
             throughput: throughput / count as f32,
+            radiance: Vec3::ZERO,
             medium: self.sides.toward(bs.wi, hit.ng),
             depth: self.depth,
             pass_through: 0,

@@ -14,13 +14,15 @@ use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
-use crate::integrator::path::{trace_path, PathScene, MAX_BRANCHES};
+use crate::integrator::packet;
+use crate::integrator::path::{trace_path, PathResult, PathScene, MAX_BRANCHES};
+use crate::lanes::{Lanes, MAX_LANES};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
 use crate::math::Ray;
 use crate::medium::{ShapeMedia, Volumes};
 use crate::param::MaterialId;
-use crate::sampler::PixelSampler;
+use crate::sampler::{PacketSampler, PixelSampler};
 use crate::texture::Textures;
 
 use super::branching::{self, PilotScene};
@@ -60,6 +62,9 @@ pub struct RenderScene {
     glossy_split: bool,
     /// See [`PathScene::first_vertex_branches`]: chosen by [`branching::choose`].
     first_vertex_branches: usize,
+    /// Whether camera paths are traced in packets where the CPU has the lanes
+    /// ([`packet::covers`]).
+    packets: bool,
 }
 
 impl RenderScene {
@@ -124,11 +129,13 @@ impl RenderScene {
                 .collect(),
             glossy_split: glossy_split(desc),
             first_vertex_branches: 1,
+            packets: false,
             desc: desc.clone(),
             settings: settings.clone(),
         };
         let branches = branching::choose(&scene);
         scene.first_vertex_branches = branches;
+        scene.packets = packet::covers(&scene);
         Ok(scene)
     }
 
@@ -219,9 +226,38 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
+        #[cfg(target_arch = "x86_64")]
+        if self.packets && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { self.render_unit_avx2(unit, cancel) };
+        }
+        self.render_unit_in::<f32>(unit, cancel)
+    }
+
+    /// [`Self::render_unit_in`] with 8 lanes of AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn render_unit_avx2(
+        &self,
+        unit: &WorkUnit,
+        cancel: &AtomicBool,
+    ) -> Option<(SampleBuffer, UnitStats)> {
+        self.render_unit_in::<crate::lanes::Avx2>(unit, cancel)
+    }
+
+    /// [`Self::render_unit_cancellable`] with the camera paths of `L::N` consecutive samples
+    /// of a pixel traced as a packet ([`packet::trace_packet`]) where they fit (one at a time
+    /// for `f32`, and for the samples left over): the same bits either way.
+    #[inline(always)]
+    pub(crate) fn render_unit_in<L: Lanes>(
+        &self,
+        unit: &WorkUnit,
+        cancel: &AtomicBool,
+    ) -> Option<(SampleBuffer, UnitStats)> {
         let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
         let mut stats = UnitStats::default();
-        let keep_half = unit.mask.is_some();
+        let adaptive = unit.mask.is_some();
+        let seed = self.settings.seed;
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
                 if !unit.renders(x, y) {
@@ -231,36 +267,82 @@ impl RenderScene {
                     if cancel.load(Ordering::Relaxed) {
                         return None;
                     }
-                    let chunk_end = chunk.saturating_add(CANCEL_CHECK_SAMPLES as u32);
-                    for index in chunk..chunk_end.min(unit.sample_end) {
-                        // An adaptive pixel may stop after any round: its samples are nested.
-                        let mut sampler = if unit.mask.is_some() {
-                            PixelSampler::nested(x, y, index, self.settings.seed)
+                    let chunk_end = chunk
+                        .saturating_add(CANCEL_CHECK_SAMPLES as u32)
+                        .min(unit.sample_end);
+                    let mut index = chunk;
+                    while index < chunk_end {
+                        // A packet's lanes share their sampler's permutation range: an adaptive
+                        // pixel's nested blocks hold whole packets.
+                        let fits = L::N > 1
+                            && self.packets
+                            && index as usize + L::N <= chunk_end as usize
+                            && (!adaptive || (index as usize).is_multiple_of(L::N));
+                        if !fits {
+                            // An adaptive pixel may stop after any round: its samples are nested.
+                            let mut sampler = if adaptive {
+                                PixelSampler::nested(x, y, index, seed)
+                            } else {
+                                PixelSampler::new(x, y, index, self.settings.spp, seed)
+                            };
+                            let (u, ray) = self.camera_sample(x, y, &mut sampler);
+                            // A sample without a camera ray (outside a fisheye's circle) is black.
+                            let path = match ray {
+                                None => PathResult::default(),
+                                Some(ray) => trace_path(self, ray, &mut sampler),
+                            };
+                            self.add_sample(&mut sums, &mut stats, (x, y, index), u, path);
+                            index += 1;
+                            continue;
+                        }
+                        let mut sampler = if adaptive {
+                            PacketSampler::<L>::nested(x, y, index, seed)
                         } else {
-                            PixelSampler::new(x, y, index, self.settings.spp, self.settings.seed)
+                            PacketSampler::<L>::new(x, y, index, self.settings.spp, seed)
                         };
-                        let (u, ray) = self.camera_sample(x, y, &mut sampler);
-                        stats.samples += 1;
-                        // A sample without a camera ray (outside a fisheye's circle) is black.
-                        let radiance = match ray {
-                            None => Vec3::ZERO,
-                            Some(ray) => {
-                                let path = trace_path(self, ray, &mut sampler);
-                                stats.rays += u64::from(path.rays);
-                                if !path.radiance.is_finite() {
-                                    stats.dropped += 1;
-                                    continue;
-                                }
-                                path.radiance
-                            }
-                        };
-                        let half = keep_half && index % 2 == 1;
-                        self.splat(&mut sums, (x, y), u, radiance, half);
+                        let (film, lens) = sampler.get_camera();
+                        let film = [0, 1].map(|axis| film[axis].values());
+                        let lens = [0, 1].map(|axis| lens[axis].values());
+                        let mut rays = [None; MAX_LANES];
+                        let mut us = [Vec2::ZERO; MAX_LANES];
+                        for i in 0..L::N {
+                            us[i] = Vec2::new(film[0][i], film[1][i]);
+                            let at = Vec2::new(x as f32 + us[i].x, y as f32 + us[i].y);
+                            let lens = Vec2::new(lens[0][i], lens[1][i]);
+                            rays[i] = self.camera.generate_ray(at, lens);
+                        }
+                        let paths = packet::trace_packet(self, &rays, &mut sampler);
+                        for i in 0..L::N {
+                            let sample = (x, y, index + i as u32);
+                            self.add_sample(&mut sums, &mut stats, sample, us[i], paths[i]);
+                        }
+                        index += L::N as u32;
                     }
                 }
             }
         }
         Some((sums.into_buffer(), stats))
+    }
+
+    /// Counts sample `index` of pixel (x, y), at `u` in the pixel, and splats its light (a
+    /// sample whose light is not finite is dropped).
+    #[inline(always)]
+    fn add_sample(
+        &self,
+        sums: &mut UnitSums,
+        stats: &mut UnitStats,
+        (x, y, index): (u32, u32, u32),
+        u: Vec2,
+        path: PathResult,
+    ) {
+        stats.samples += 1;
+        stats.rays += u64::from(path.rays);
+        if !path.radiance.is_finite() {
+            stats.dropped += 1;
+            return;
+        }
+        let half = sums.buffer.unit.mask.is_some() && index % 2 == 1;
+        self.splat(sums, (x, y), u, path.radiance, half);
     }
 
     /// Adds a sample at `pixel + u` with `radiance` to every pixel of the buffer's region its

@@ -1,0 +1,732 @@
+//! Camera paths traced in lanes ([`crate::lanes`]): `L::N` consecutive samples of one pixel
+//! step together from vertex to vertex, their random numbers drawn at once
+//! ([`PacketSampler`]), their Lambert vertices sampled, weighed and rouletted in lanes. Rays are
+//! traced, materials and lights looked up one lane at a time, as [`walk`] does.
+//!
+//! Every lane computes what [`walk`] computes for its sample, operation for operation, so a
+//! pixel's samples are the same bits whether traced here or one at a time: the choice between
+//! the two (the CPU's lane types, a scene's coverage) never shows in an image. A lane whose
+//! path meets anything but a bare Lambert surface (a miss, an emitter, a null surface, another
+//! material) leaves the packet and goes on one at a time from the same state and the same
+//! place in its sample stream, by [`walk`] itself.
+
+use glam::{Vec2, Vec3};
+
+use super::options::RussianRoulette;
+use super::path::{
+    walk, PathResult, PathScene, PathState, PrevScatter, MAX_BRANCHES, RR_MIN_DEPTH,
+    RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
+};
+use crate::bxdf::local::cosine_hemisphere;
+use crate::lanes::{Lanes, MAX_LANES};
+use crate::math::{Frame, Ray};
+use crate::sampler::PacketSampler;
+
+/// Whether `scene`'s camera paths may be traced in packets: no volumes (a packet's lanes all
+/// travel in none), no glossy splits and no lamp images (a packet's vertices are Lambert ones,
+/// which neither concerns). Any material, light or camera: lanes that meet what a packet does
+/// not shade leave it.
+pub fn covers<S: PathScene>(scene: &S) -> bool {
+    scene.volumes().media.is_empty()
+        && scene.volumes().camera.is_none()
+        && !scene.glossy_split()
+        && !scene.lights().has_mirror_images()
+}
+
+/// Three coordinates in lanes.
+type V3<L> = [L; 3];
+
+#[inline(always)]
+fn dot<L: Lanes>(a: V3<L>, b: V3<L>) -> L {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn scale<L: Lanes>(a: V3<L>, k: L) -> V3<L> {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+
+#[inline(always)]
+fn times<L: Lanes>(a: V3<L>, b: V3<L>) -> V3<L> {
+    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
+}
+
+#[inline(always)]
+fn plus<L: Lanes>(a: V3<L>, b: V3<L>) -> V3<L> {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// `-a`, exactly (the sign of a zero too).
+#[inline(always)]
+fn negate<L: Lanes>(a: V3<L>) -> V3<L> {
+    scale(a, L::splat(-1.0))
+}
+
+#[inline(always)]
+fn select3<L: Lanes>(m: L::M, a: V3<L>, b: V3<L>) -> V3<L> {
+    [
+        L::select(m, a[0], b[0]),
+        L::select(m, a[1], b[1]),
+        L::select(m, a[2], b[2]),
+    ]
+}
+
+/// Per-lane vectors, as lanes (lanes past `L::N` are not read).
+#[inline(always)]
+fn load3<L: Lanes>(v: &[Vec3; MAX_LANES]) -> V3<L> {
+    let mut c = [[0.0; MAX_LANES]; 3];
+    for (i, v) in v.iter().enumerate() {
+        (c[0][i], c[1][i], c[2][i]) = (v.x, v.y, v.z);
+    }
+    [L::load(&c[0]), L::load(&c[1]), L::load(&c[2])]
+}
+
+#[inline(always)]
+fn store3<L: Lanes>(v: V3<L>) -> [Vec3; MAX_LANES] {
+    let mut c = [[0.0; MAX_LANES]; 3];
+    for (lanes, out) in v.iter().zip(&mut c) {
+        lanes.store(out);
+    }
+    let mut out = [Vec3::ZERO; MAX_LANES];
+    for (i, v) in out.iter_mut().enumerate() {
+        *v = Vec3::new(c[0][i], c[1][i], c[2][i]);
+    }
+    out
+}
+
+/// `x == 0` (either zero).
+#[inline(always)]
+fn is_zero<L: Lanes>(x: L) -> L::M {
+    let zero = L::splat(0.0);
+    x.le(zero) & zero.le(x)
+}
+
+/// Which lanes a mask sets.
+#[inline(always)]
+fn lanes_set<L: Lanes>(m: L::M) -> [bool; MAX_LANES] {
+    let ones = L::select(m, L::splat(1.0), L::splat(0.0)).values();
+    let mut set = [false; MAX_LANES];
+    for (set, one) in set.iter_mut().zip(ones) {
+        *set = one > 0.0;
+    }
+    set
+}
+
+/// [`crate::math::offset_origin`] in lanes.
+#[inline(always)]
+fn offset_origin<L: Lanes>(p: V3<L>, ng: V3<L>, dir: V3<L>) -> V3<L> {
+    let a = [p[0].abs(), p[1].abs(), p[2].abs()];
+    let largest = a[0].max(a[1].max(a[2]));
+    let eps = L::splat(1e-4) * (L::splat(1.0) + largest);
+    let step = scale(ng, eps);
+    let ahead = L::splat(0.0).le(dot(dir, ng));
+    select3(
+        ahead,
+        plus(p, step),
+        [p[0] - step[0], p[1] - step[1], p[2] - step[2]],
+    )
+}
+
+/// The Lambert vertices of a packet's live lanes: what [`Bsdf`] holds of a bare Lambert one.
+struct LambertVertex<L: Lanes> {
+    p: V3<L>,
+    ng: V3<L>,
+    ns: V3<L>,
+    frame: [V3<L>; 3],
+    f: V3<L>,
+    /// `-ray.dir`, the direction the path arrived from.
+    wo: V3<L>,
+    /// `wo` in the shading frame.
+    wo_local: V3<L>,
+}
+
+/// A BSDF sample of a packet's Lambert vertices.
+struct LambertSample<L: Lanes> {
+    wi: V3<L>,
+    pdf: L,
+    /// Where the sample is a direction the path may take (else the scalar code finds none).
+    valid: L::M,
+}
+
+impl<L: Lanes> LambertVertex<L> {
+    /// The shading normal on `wo`'s side ([`Bsdf::gathers_from`]).
+    #[inline(always)]
+    fn facing(&self) -> V3<L> {
+        let n = self.frame[2];
+        select3(self.wo_local[2].lt(L::splat(0.0)), negate(n), n)
+    }
+
+    /// [`Bsdf::sample`] of a Lambert lobe, with [`DiffuseReflection::sample`]'s checks.
+    ///
+    /// [`DiffuseReflection::sample`]: crate::bxdf::diffuse::DiffuseReflection::sample
+    #[inline(always)]
+    fn sample(&self, u: [L; 2]) -> LambertSample<L> {
+        let zero = L::splat(0.0);
+        let wo_z = self.wo_local[2];
+        let mirrored = wo_z.lt(zero);
+        // The lobe mirrors a query from below to the upper hemisphere and back.
+        let [x, y, z] = cosine_hemisphere(u);
+        let wo_up = L::select(mirrored, L::splat(-1.0) * wo_z, wo_z);
+        let same_hemisphere = zero.lt(wo_up * z);
+        let pdf = L::select(
+            same_hemisphere,
+            z.abs() * L::splat(std::f32::consts::FRAC_1_PI),
+            zero,
+        );
+        let z = L::select(mirrored, L::splat(-1.0) * z, z);
+        let [s, t, n] = self.frame;
+        let world = [
+            s[0] * x + t[0] * y + n[0] * z,
+            s[1] * x + t[1] * y + n[1] * z,
+            s[2] * x + t[2] * y + n[2] * z,
+        ];
+        let wi = scale(world, L::splat(1.0) / dot(world, world).sqrt());
+        // The geometric and shading normals agree on the sides of wo and wi.
+        let geometric = dot(self.wo, self.ng) * dot(wi, self.ng);
+        let shading = wo_z * z;
+        let agree =
+            (zero.lt(geometric) & zero.lt(shading)) | (geometric.lt(zero) & shading.lt(zero));
+        LambertSample {
+            wi,
+            pdf,
+            valid: agree & same_hemisphere & zero.lt(pdf),
+        }
+    }
+}
+
+impl<L: Lanes> LambertVertex<L> {
+    /// [`direct_light`] at the live lanes' vertices: the light's choice and point and the
+    /// shadow ray one lane at a time, the rest in lanes.
+    #[inline(always)]
+    fn direct_light<S: PathScene>(
+        &self,
+        scene: &S,
+        packet: &mut Packet<L>,
+        u_select: L,
+        u: [L; 2],
+        bsdf_count: f32,
+    ) -> V3<L> {
+        let zero = L::splat(0.0);
+        let (p, facing) = (store3(self.p), store3(self.facing()));
+        let (select, ux, uy) = (u_select.values(), u[0].values(), u[1].values());
+        let mut wi = [Vec3::Z; MAX_LANES];
+        let mut li = [Vec3::ZERO; MAX_LANES];
+        let (mut pdf, mut dist, mut delta) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
+        for i in 0..L::N {
+            if !packet.live[i] {
+                continue;
+            }
+            let u = Vec2::new(ux[i], uy[i]);
+            // No sample: a density of 0, which ends the lane's light sample as `direct_light`.
+            if let Some(ls) = scene.lights().sample(p[i], Some(facing[i]), select[i], u) {
+                (wi[i], li[i], pdf[i], dist[i]) = (ls.wi, ls.li, ls.pdf, ls.dist);
+                delta[i] = if ls.delta { 1.0 } else { 0.0 };
+            }
+        }
+        let (wi, li, pdf, dist) = (load3(&wi), load3(&li), L::load(&pdf), L::load(&dist));
+        let dark: L::M = is_zero(li[0]) & is_zero(li[1]) & is_zero(li[2]);
+        let lit = !pdf.le(zero) & !dark;
+        // The BSDF's value: Lambert's where the normals agree and wo and wi share a side.
+        let wi_z = dot(wi, self.frame[2]);
+        let geometric = dot(self.wo, self.ng) * dot(wi, self.ng);
+        let shading = self.wo_local[2] * wi_z;
+        let agree =
+            (zero.lt(geometric) & zero.lt(shading)) | (geometric.lt(zero) & shading.lt(zero));
+        let reflects = agree & zero.lt(shading);
+        let origin = offset_origin(self.p, self.ng, wi);
+        let to_origin = [
+            origin[0] - self.p[0],
+            origin[1] - self.p[1],
+            origin[2] - self.p[2],
+        ];
+        // `shadow_tmax`: its multiply-add by -1 is this subtraction, exactly.
+        let short = (dist - dot(to_origin, to_origin).sqrt()) * L::splat(1.0 - 1e-3);
+        let finite = dist.abs().lt(L::splat(f32::INFINITY));
+        let tmax = L::select(finite, short, L::splat(f32::INFINITY)).values();
+        let tested = lanes_set::<L>(lit & reflects);
+        let (origin, dir) = (store3(origin), store3(wi));
+        let mut visible = [0.0; MAX_LANES];
+        for i in 0..L::N {
+            if packet.live[i] && tested[i] {
+                packet.rays[i] += 1;
+                let blocked = scene
+                    .geometry()
+                    .occluded(&Ray::new(origin[i], dir[i]), tmax[i]);
+                visible[i] = if blocked { 0.0 } else { 1.0 };
+            }
+        }
+        let bsdf_pdf = L::select(
+            zero.lt(shading),
+            wi_z.abs() * L::splat(std::f32::consts::FRAC_1_PI),
+            zero,
+        );
+        let (a, b) = (pdf * pdf, L::splat(bsdf_count) * bsdf_pdf);
+        let (a, b) = (a, b * b);
+        let heuristic = L::select(zero.lt(a + b), a / (a + b), zero);
+        let weight = L::select(zero.lt(L::load(&delta)), L::splat(1.0), heuristic);
+        let k = dot(wi, self.ns).abs() * weight / pdf;
+        let light = scale(times(self.f, li), k);
+        let shown = zero.lt(L::load(&visible));
+        [
+            L::select(shown, light[0], zero),
+            L::select(shown, light[1], zero),
+            L::select(shown, light[2], zero),
+        ]
+    }
+}
+
+/// [`super::path::survives`] in lanes, for a broad vertex: the lanes the roulette keeps, and
+/// the throughput divided by their survival probability.
+#[inline(always)]
+fn survives<S: PathScene, L: Lanes>(
+    scene: &S,
+    depth: u32,
+    u_rr: L,
+    throughput: &mut V3<L>,
+) -> L::M {
+    let integrator = scene.integrator();
+    let continue_prob = match integrator.rr_strategy {
+        RussianRoulette::Probability if depth >= RR_MIN_DEPTH => {
+            L::splat(integrator.rr_continue_prob)
+        }
+        RussianRoulette::Efficiency => {
+            let t = *throughput;
+            let largest = t[0].max(t[1].max(t[2])) * L::splat(RR_THROUGHPUT_SCALE);
+            // f32::clamp's order of tests.
+            let low = L::select(
+                largest.lt(L::splat(RR_MIN_SURVIVAL)),
+                L::splat(RR_MIN_SURVIVAL),
+                largest,
+            );
+            L::select(L::splat(1.0).lt(low), L::splat(1.0), low)
+        }
+        _ => return L::mask(true),
+    };
+    // What `u_rr >= continue_prob` ends (NaN included).
+    let kept = !continue_prob.le(u_rr);
+    *throughput = [
+        throughput[0] / continue_prob,
+        throughput[1] / continue_prob,
+        throughput[2] / continue_prob,
+    ];
+    kept
+}
+
+/// Camera paths in lanes between two vertices. Every lane still in the packet has met only
+/// Lambert vertices, so all are at the same depth, with the same branching count, and came
+/// from the same kind of vertex.
+struct Packet<L: Lanes> {
+    live: [bool; MAX_LANES],
+    origin: V3<L>,
+    dir: V3<L>,
+    throughput: V3<L>,
+    radiance: V3<L>,
+    depth: u32,
+    branches: usize,
+    prev_p: V3<L>,
+    prev_pdf: L,
+    /// True for camera rays (no vertex before), false after a Lambert vertex.
+    prev_specular: bool,
+    /// After a Lambert vertex, the side it gathered light from.
+    prev_facing: V3<L>,
+    /// The rays each lane traced in this packet.
+    rays: [u32; MAX_LANES],
+}
+
+impl<L: Lanes> Packet<L> {
+    /// Lane `i`'s path as [`walk`] carries it.
+    #[inline(always)]
+    fn lane_state(&self, i: usize, parts: &PacketParts) -> PathState {
+        PathState {
+            ray: Ray::new(parts.origin[i], parts.dir[i]),
+            throughput: parts.throughput[i],
+            radiance: parts.radiance[i],
+            medium: None,
+            depth: self.depth,
+            pass_through: 0,
+            may_split: false,
+            branches: self.branches,
+            prev: PrevScatter {
+                facing: (!self.prev_specular).then_some(parts.prev_facing[i]),
+                ..PrevScatter::plain(parts.prev_p[i], parts.prev_pdf[i], self.prev_specular)
+            },
+        }
+    }
+
+    /// Ends lane `i`: its light and rays go to `out`.
+    #[inline(always)]
+    fn finish(&mut self, i: usize, radiance: Vec3, out: &mut PathResult) {
+        self.live[i] = false;
+        out.radiance += radiance;
+        out.rays += self.rays[i];
+    }
+
+    /// Ends every live lane where `m` is not set.
+    #[inline(always)]
+    fn keep(&mut self, m: L::M, out: &mut [PathResult; MAX_LANES]) {
+        let kept = lanes_set::<L>(m);
+        if (0..L::N).all(|i| kept[i] || !self.live[i]) {
+            return;
+        }
+        let radiance = store3(self.radiance);
+        for i in 0..L::N {
+            if self.live[i] && !kept[i] {
+                self.finish(i, radiance[i], &mut out[i]);
+            }
+        }
+    }
+
+    /// Ends every live lane.
+    #[inline(always)]
+    fn finish_all(&mut self, out: &mut [PathResult; MAX_LANES]) {
+        self.keep(L::mask(false), out);
+    }
+}
+
+/// A packet's state, lane by lane: what a lane leaving it takes along.
+struct PacketParts {
+    origin: [Vec3; MAX_LANES],
+    dir: [Vec3; MAX_LANES],
+    throughput: [Vec3; MAX_LANES],
+    radiance: [Vec3; MAX_LANES],
+    prev_p: [Vec3; MAX_LANES],
+    prev_pdf: [f32; MAX_LANES],
+    prev_facing: [Vec3; MAX_LANES],
+}
+
+impl PacketParts {
+    #[inline(always)]
+    fn of<L: Lanes>(packet: &Packet<L>) -> Self {
+        Self {
+            origin: store3(packet.origin),
+            dir: store3(packet.dir),
+            throughput: store3(packet.throughput),
+            radiance: store3(packet.radiance),
+            prev_p: store3(packet.prev_p),
+            prev_pdf: packet.prev_pdf.values(),
+            prev_facing: store3(packet.prev_facing),
+        }
+    }
+}
+
+/// Where a packet's paths branch ([`MAX_BRANCHES`]): the vertex its continuations start from.
+struct BranchPoint<L: Lanes> {
+    vertex: LambertVertex<L>,
+    throughput: V3<L>,
+    roulette: L,
+    /// The packet's stream after the vertex's own dimensions.
+    sampler: PacketSampler<L>,
+}
+
+/// Traces the packet's camera rays (`None`: no ray, black) to the end, one [`PathResult`] per
+/// lane; the same bits as [`super::path::trace_path`] on each lane's ray and stream.
+#[inline(always)]
+pub fn trace_packet<S: PathScene, L: Lanes>(
+    scene: &S,
+    rays: &[Option<Ray>; MAX_LANES],
+    sampler: &mut PacketSampler<L>,
+) -> [PathResult; MAX_LANES] {
+    let mut out = [PathResult::default(); MAX_LANES];
+    let mut origin = [Vec3::ZERO; MAX_LANES];
+    let mut dir = [Vec3::Z; MAX_LANES];
+    let mut live = [false; MAX_LANES];
+    for i in 0..L::N {
+        if let Some(ray) = rays[i] {
+            (origin[i], dir[i], live[i]) = (ray.origin, ray.dir, true);
+        }
+    }
+    let origin = load3(&origin);
+    let zero = L::splat(0.0);
+    let mut packet = Packet {
+        live,
+        origin,
+        dir: load3(&dir),
+        throughput: [L::splat(1.0); 3],
+        radiance: [zero; 3],
+        depth: 0,
+        branches: scene.first_vertex_branches().clamp(1, MAX_BRANCHES),
+        prev_p: origin,
+        prev_pdf: zero,
+        prev_specular: true,
+        prev_facing: [zero; 3],
+        rays: [0; MAX_LANES],
+    };
+    if let Some(branch) = walk_packet(scene, &mut packet, sampler, &mut out) {
+        branch_packet(scene, &packet, branch, &mut out);
+        packet.finish_all(&mut out);
+    }
+    out
+}
+
+/// The continuations of a packet's paths at their branching vertex, one packet each, traced
+/// in order (as [`super::path`]'s `BranchVertex::branch` traces a path's).
+#[inline(always)]
+fn branch_packet<S: PathScene, L: Lanes>(
+    scene: &S,
+    parent: &Packet<L>,
+    mut branch: BranchPoint<L>,
+    out: &mut [PathResult; MAX_LANES],
+) {
+    let count = parent.branches;
+    let (_, dirs) = branch.sampler.get_split_draws::<MAX_BRANCHES>(count);
+    let v = &branch.vertex;
+    let facing = v.facing();
+    let count_f = L::splat(count as f32);
+    for (k, &dir) in dirs.iter().enumerate().take(count) {
+        let (mut stream, u_rr) = if k == 0 {
+            (branch.sampler.clone(), branch.roulette)
+        } else {
+            let mut stream = branch.sampler.branch(k as u32);
+            let u_rr = stream.get_1d();
+            (stream, u_rr)
+        };
+        let bs = v.sample(dir);
+        let cos = dot(bs.wi, v.ns).abs();
+        let mut throughput = scale(times(branch.throughput, v.f), cos / bs.pdf);
+        let kept = bs.valid & survives(scene, parent.depth, u_rr, &mut throughput);
+        let kept = lanes_set::<L>(kept);
+        let mut live = [false; MAX_LANES];
+        for i in 0..L::N {
+            live[i] = parent.live[i] && kept[i];
+        }
+        let zero = L::splat(0.0);
+        let mut continuation = Packet {
+            live,
+            origin: offset_origin(v.p, v.ng, bs.wi),
+            dir: bs.wi,
+            throughput: [
+                throughput[0] / count_f,
+                throughput[1] / count_f,
+                throughput[2] / count_f,
+            ],
+            radiance: [zero; 3],
+            depth: parent.depth,
+            branches: 1,
+            prev_p: v.p,
+            prev_pdf: count_f * bs.pdf,
+            prev_specular: false,
+            prev_facing: facing,
+            rays: [0; MAX_LANES],
+        };
+        let branched = walk_packet(scene, &mut continuation, &mut stream, out);
+        debug_assert!(branched.is_none(), "a continuation branches once only");
+    }
+}
+
+/// Traces the packet on from its rays, adding each lane's light and rays to its `out`, until
+/// every lane has ended or left, or the packet reaches the vertex where its paths branch
+/// (returned, its lanes still live: the caller traces the continuations, then ends them).
+#[inline(always)]
+fn walk_packet<S: PathScene, L: Lanes>(
+    scene: &S,
+    packet: &mut Packet<L>,
+    sampler: &mut PacketSampler<L>,
+    out: &mut [PathResult; MAX_LANES],
+) -> Option<BranchPoint<L>> {
+    let geometry = scene.geometry();
+    let lights = scene.lights();
+    let max_depth = scene.max_depth();
+    loop {
+        if !packet.live[..L::N].contains(&true) {
+            return None;
+        }
+        let before = sampler.clone();
+        let u = sampler.get_vertex();
+        let mix = u.mix.values();
+        let parts = PacketParts::of(packet);
+        let mut p = [Vec3::ZERO; MAX_LANES];
+        let mut ng = [Vec3::ZERO; MAX_LANES];
+        let mut ns = [Vec3::ZERO; MAX_LANES];
+        let mut frame = [[Vec3::ZERO; MAX_LANES]; 3];
+        let mut f = [Vec3::ZERO; MAX_LANES];
+        for i in 0..L::N {
+            if !packet.live[i] {
+                continue;
+            }
+            let ray = Ray::new(parts.origin[i], parts.dir[i]);
+            let lambert = geometry
+                .intersect(&ray, f32::INFINITY)
+                .filter(|hit| lights.emitted(hit, -ray.dir) == Vec3::ZERO)
+                .and_then(|hit| Some((hit, scene.bsdf_at(&hit, mix[i]).as_lambert()?)));
+            let Some((hit, (shading, normal, value))) = lambert else {
+                // The path goes on alone from this ray, in its own stream.
+                packet.live[i] = false;
+                out[i].rays += packet.rays[i];
+                let state = packet.lane_state(i, &parts);
+                walk(scene, state, &mut before.lane(i), &mut out[i]);
+                continue;
+            };
+            packet.rays[i] += 1;
+            (p[i], ng[i], ns[i], f[i]) = (hit.p, normal, hit.ns, value);
+            let Frame { s, t, n } = shading;
+            (frame[0][i], frame[1][i], frame[2][i]) = (s, t, n);
+        }
+        if !packet.live[..L::N].contains(&true) {
+            return None;
+        }
+        if packet.depth >= max_depth {
+            packet.finish_all(out);
+            return None;
+        }
+        packet.depth += 1;
+
+        let wo = negate(packet.dir);
+        let frame = [load3(&frame[0]), load3(&frame[1]), load3(&frame[2])];
+        let vertex = LambertVertex {
+            p: load3(&p),
+            ng: load3(&ng),
+            ns: load3(&ns),
+            f: load3(&f),
+            wo,
+            wo_local: [dot(wo, frame[0]), dot(wo, frame[1]), dot(wo, frame[2])],
+            frame,
+        };
+        let branching = packet.branches > 1;
+        let bsdf_count = if branching {
+            packet.branches as f32
+        } else {
+            1.0
+        };
+        let light = vertex.direct_light(scene, packet, u.light_select, u.light, bsdf_count);
+        packet.radiance = plus(packet.radiance, times(packet.throughput, light));
+        if branching {
+            return Some(BranchPoint {
+                vertex,
+                throughput: packet.throughput,
+                roulette: u.roulette,
+                sampler: sampler.clone(),
+            });
+        }
+
+        let bs = vertex.sample(u.bsdf);
+        let cos = dot(bs.wi, vertex.ns).abs();
+        packet.throughput = times(packet.throughput, scale(vertex.f, cos / bs.pdf));
+        let kept = bs.valid & survives(scene, packet.depth, u.roulette, &mut packet.throughput);
+        packet.keep(kept, out);
+        packet.prev_p = vertex.p;
+        packet.prev_pdf = bs.pdf;
+        packet.prev_specular = false;
+        packet.prev_facing = vertex.facing();
+        packet.origin = offset_origin(vertex.p, vertex.ng, bs.wi);
+        packet.dir = bs.wi;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicBool;
+
+    use crate::assets::MemorySource;
+    use crate::film::SampleBuffer;
+    use crate::lanes::tests::{on_every_lane_type, OnLanes};
+    use crate::lanes::Lanes;
+    use crate::parse::parse_scene;
+    use crate::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
+
+    /// A depth-of-field scene of our own: a thin lens, a checkered Lambert floor, a red
+    /// Lambert sphere, and what packets do not shade, which their lanes leave them for: a glass
+    /// sphere, a rough (Oren-Nayar) wall, a null lamp seen directly, the open sky.
+    const SCENE: &str = r#"LookAt 0 -4 1.2  0 0 0.6  0 0 1
+Camera "perspective" "float fov" [50] "float lensradius" [0.1] "float focaldistance" [3.5]
+Film "fleximage" "integer xresolution" [24] "integer yresolution" [16]
+PixelFilter "gaussian"
+SurfaceIntegrator "path" "integer maxdepth" [6]
+WorldBegin
+Texture "checks" "color" "checkerboard" "float uscale" [6] "float vscale" [6] "color tex1" [0.8 0.8 0.8] "color tex2" [0.1 0.1 0.1]
+AttributeBegin
+Material "matte" "texture Kd" ["checks"]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-3 -3 0 3 -3 0 3 3 0 -3 3 0] "float uv" [0 0 1 0 1 1 0 1]
+AttributeEnd
+AttributeBegin
+Material "matte" "color Kd" [0.5 0.5 0.5] "float sigma" [30]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-3 2 0 3 2 0 3 2 3 -3 2 3]
+AttributeEnd
+AttributeBegin
+Material "matte" "color Kd" [0.7 0.2 0.2]
+Translate -0.6 0 0.5
+Shape "sphere" "float radius" [0.5]
+AttributeEnd
+AttributeBegin
+Material "glass"
+Translate 0.7 -0.4 0.4
+Shape "sphere" "float radius" [0.4]
+AttributeEnd
+AttributeBegin
+Material "null"
+AreaLightSource "area" "color L" [6 6 6] "float power" [0]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-0.5 -0.5 2 -0.5 0.5 2 0.5 0.5 2 0.5 -0.5 2]
+AttributeEnd
+WorldEnd
+"#;
+
+    fn scene(spp: u32, branches: usize) -> (RenderScene, RenderSettings) {
+        let mut source = MemorySource::new();
+        source.insert("main.lxs", SCENE.as_bytes().into());
+        let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        let settings = RenderSettings {
+            width: 24,
+            height: 16,
+            spp,
+            max_depth: desc.integrator.max_depth,
+            seed: 3,
+            latlong: Default::default(),
+        };
+        let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
+        assert!(super::covers(&scene), "packets cover the scene");
+        (scene.with_first_vertex_branches(branches), settings)
+    }
+
+    /// Every unit of uniform renders (20 samples a pixel: packets and samples left over) and
+    /// of an adaptive round (nested samples 16 to 48, half the blocks) renders to the same
+    /// buffer bytes and counts in packets of every lane type as one sample at a time, with one
+    /// continuation per camera path and with three.
+    fn packets_render_the_scalar_bytes<L: Lanes>() {
+        let never = AtomicBool::new(false);
+        for branches in [1, 3] {
+            let (scene, settings) = scene(20, branches);
+            let adaptive = WorkUnit {
+                index: 0,
+                x0: 0,
+                y0: 0,
+                x1: 16,
+                y1: 16,
+                sample_start: 16,
+                sample_end: 48,
+                mask: Some(0b1001_0110),
+            };
+            let mut rays = 0;
+            for unit in plan_units(&settings).iter().chain([&adaptive]) {
+                let (one, one_stats) = scene.render_unit_in::<f32>(unit, &never).unwrap();
+                let (lanes, lane_stats) = scene.render_unit_in::<L>(unit, &never).unwrap();
+                let at = format!("unit {unit:?}, {branches} continuations, {} lanes", L::N);
+                assert_eq!(lane_stats, one_stats, "{at}");
+                assert_eq!(
+                    bits(lanes.rgb.as_flattened()),
+                    bits(one.rgb.as_flattened()),
+                    "{at}"
+                );
+                assert_eq!(bits(&lanes.weight), bits(&one.weight), "{at}");
+                let half = |b: &SampleBuffer| bits(b.half_rgb.as_flattened());
+                assert_eq!(half(&lanes), half(&one), "{at}");
+                rays += one_stats.rays;
+            }
+            assert!(rays > 0);
+        }
+    }
+
+    fn bits(values: &[f32]) -> Vec<u32> {
+        values.iter().map(|v| v.to_bits()).collect()
+    }
+
+    #[test]
+    fn packets_render_what_one_path_at_a_time_renders() {
+        struct Renders;
+        impl OnLanes for Renders {
+            fn run<L: Lanes>(&self) {
+                packets_render_the_scalar_bytes::<L>();
+            }
+        }
+        on_every_lane_type(&Renders);
+    }
+}
