@@ -21,6 +21,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
+use crate::bxdf::local::sample_disk_concentric;
 use crate::diag::SourcePos;
 use crate::film::FilmDesc;
 use crate::math::Ray;
@@ -232,28 +233,11 @@ impl Camera {
         if self.lens_radius <= 0.0 {
             return (origin, dir);
         }
-        let on_lens = concentric_disk(lens) * self.lens_radius;
+        let on_lens = sample_disk_concentric(lens) * self.lens_radius;
         let focus = origin + dir * (self.focal_distance / dir.z);
         let lens_point = origin + Vec3::new(on_lens.x, on_lens.y, 0.0);
         (lens_point, focus - lens_point)
     }
-}
-
-/// Shirley-Chiu concentric mapping of the unit square onto the unit disk (keeps strata).
-pub fn concentric_disk(u: Vec2) -> Vec2 {
-    let o = u * 2.0 - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, std::f32::consts::FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (
-            o.y,
-            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (o.x / o.y),
-        )
-    };
-    Vec2::new(theta.cos(), theta.sin()) * r
 }
 
 #[cfg(test)]
@@ -340,14 +324,5 @@ mod tests {
         // The top edge is straight up (psi = fov = 90 degrees).
         let top = cam.generate_ray(Vec2::new(50.0, 0.0), Vec2::ZERO).unwrap();
         assert!((top.dir - Vec3::Z).length() < 1e-5);
-    }
-
-    #[test]
-    fn concentric_disk_stays_inside() {
-        for i in 0..100 {
-            let u = Vec2::new((i % 10) as f32 / 10.0, (i / 10) as f32 / 10.0);
-            assert!(concentric_disk(u).length() <= 1.0 + 1e-6);
-        }
-        assert!((concentric_disk(Vec2::new(1.0, 0.5)) - Vec2::X).length() < 1e-6);
     }
 }
