@@ -677,14 +677,15 @@ WorldEnd
         (scene.with_first_vertex_branches(branches), settings)
     }
 
-    /// Every unit of uniform renders (20 samples a pixel: packets and samples left over) and
-    /// of an adaptive round (nested samples 16 to 48, half the blocks) renders to the same
-    /// buffer bytes and counts in packets of every lane type as one sample at a time, with one
-    /// continuation per camera path and with three.
+    /// Every unit of a uniform render (72 samples a pixel, 9 a unit: a packet and a sample
+    /// left over) and of an adaptive round (nested samples 16 to 48 in blocks of the floor,
+    /// the spheres and the wall) renders to the same buffer bytes and counts in packets of
+    /// every lane type as one sample at a time, with one continuation per camera path and with
+    /// three.
     fn packets_render_the_scalar_bytes<L: Lanes>() {
         let never = AtomicBool::new(false);
         for branches in [1, 3] {
-            let (scene, settings) = scene(20, branches);
+            let (scene, settings) = scene(72, branches);
             let adaptive = WorkUnit {
                 index: 0,
                 x0: 0,
@@ -693,7 +694,8 @@ WorldEnd
                 y1: 16,
                 sample_start: 16,
                 sample_end: 48,
-                mask: Some(0b1001_0110),
+                // Blocks (1, 0), and (1, 2), (2, 2), (1, 3), (2, 3) on the floor and spheres.
+                mask: Some(0x0606_0002),
             };
             let mut rays = 0;
             for unit in plan_units(&settings).iter().chain([&adaptive]) {
