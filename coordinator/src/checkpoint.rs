@@ -547,7 +547,7 @@ mod tests {
         RenderSettings {
             width: 70,
             height: 40,
-            spp: 8,
+            spp: 64,
             max_depth: 3,
             seed: 0,
             latlong: LatLongConvention::Seed,

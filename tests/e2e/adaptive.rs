@@ -146,20 +146,24 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
     // the uniform render's image, up to the f32 rounding of the other unit cut.
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
+    let settings = ["--spp", "16", "--resolution", "128x96"];
     let uniform = dir.path().join("uniform.png");
-    assert_success(&render(&scene, &uniform, &["--threads", "2", "--quiet"]));
+    let output = render_command_with(&scene, &uniform, &settings, &["--threads", "2", "--quiet"])
+        .output()
+        .unwrap();
+    assert_success(&output);
     let adaptive = dir.path().join("adaptive.png");
     let output = render_command_with(
         &scene,
         &adaptive,
-        &["--spp", "16", "--resolution", "128x96"],
+        &settings,
         &["--noise-threshold", "0.5", "--min-spp", "16", "--quiet"],
     )
     .output()
     .unwrap();
     assert_success(&output);
     // min-spp = spp: one round, every pixel 16 samples, the same samples as the uniform
-    // render; only the unit cut differs (one unit per tile instead of 8 passes), which changes
+    // render; only the unit cut differs (one unit per tile instead of 2 passes), which changes
     // the f32 sums' rounding at most.
     let a = image::open(uniform.with_extension("exr"))
         .unwrap()

@@ -123,7 +123,7 @@ pub fn scene_bytes(dir: &Path) -> u64 {
 }
 
 /// Render settings every test uses: 4 tiles x 8 passes = 32 units.
-pub const SETTINGS: [&str; 4] = ["--spp", "16", "--resolution", "128x96"];
+pub const SETTINGS: [&str; 4] = ["--spp", "64", "--resolution", "128x96"];
 
 /// A `yat worker` process on a loopback port; killed when dropped.
 pub struct Worker {

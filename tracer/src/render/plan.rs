@@ -10,6 +10,11 @@ pub const TILE_SIZE: u32 = 64;
 /// unit's work dwarfs its network round trip.
 pub const PASSES: u32 = 8;
 
+/// A unit's samples per pixel are a multiple of this (but the last pass's): whole packets of
+/// the samples a pixel's camera paths are traced in together (8 lanes of AVX2,
+/// `integrator::packet`). A render of fewer than 8 x `PASSES` samples a pixel has fewer passes.
+pub const UNIT_SAMPLE_STEP: u32 = 8;
+
 /// The last pass is cut into tiles of this side when its full-size units are long (see
 /// `FINE_FINAL_PASS_SAMPLES`).
 pub const FINAL_PASS_TILE_SIZE: u32 = TILE_SIZE / 2;
@@ -23,8 +28,9 @@ pub const FINE_FINAL_PASS_SAMPLES: u64 = 1 << 18;
 /// Changes whenever the same settings would give another plan. A unit's buffer is summed in
 /// f32 before it reaches the exact film, so another plan gives slightly different image bits:
 /// a checkpoint of another plan must not be resumed (it is part of the render's identity).
-/// Version 3: samples are splatted through the pixel filter into their neighbours.
-pub const PLAN_VERSION: u32 = 3;
+/// Version 3: samples are splatted through the pixel filter into their neighbours. Version 4:
+/// a unit's sample range is a multiple of [`UNIT_SAMPLE_STEP`].
+pub const PLAN_VERSION: u32 = 4;
 
 /// The unit plan: tiles of `TILE_SIZE` in scanline order, and `PASSES` sample ranges, ordered
 /// by sample range first so that any prefix of the plan covers the whole image; the last range
@@ -32,7 +38,11 @@ pub const PLAN_VERSION: u32 = 3;
 /// pixel's sum is added up unit by unit, so the same plan everywhere is what makes in-process
 /// and distributed images bit-identical.
 pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
-    let samples_per_unit = settings.spp.div_ceil(PASSES).max(1);
+    let samples_per_unit = settings
+        .spp
+        .div_ceil(PASSES)
+        .max(1)
+        .next_multiple_of(UNIT_SAMPLE_STEP);
     let fine_final_pass =
         u64::from(TILE_SIZE * TILE_SIZE) * u64::from(samples_per_unit) >= FINE_FINAL_PASS_SAMPLES;
     let mut units = Vec::new();
@@ -120,6 +130,25 @@ mod tests {
         }
     }
 
+    /// Units hold whole packets of a pixel's samples: 16 samples are two passes of 8, 1000 are
+    /// seven of 128 and one of 104, 3 one pass.
+    #[test]
+    fn units_hold_whole_packets_of_samples() {
+        for (spp, passes) in [(16, 2), (64, 8), (1000, 8), (3, 1)] {
+            let units = plan_units(&settings(64, 64, spp));
+            let mut starts: Vec<_> = units.iter().map(|u| u.sample_start).collect();
+            starts.dedup();
+            assert_eq!(starts.len(), passes, "{spp} spp");
+            for u in units.iter().filter(|u| u.sample_end < spp) {
+                assert_eq!(
+                    (u.sample_end - u.sample_start) % UNIT_SAMPLE_STEP,
+                    0,
+                    "{u:?}"
+                );
+            }
+        }
+    }
+
     /// An spp `check` refuses still plans without overflowing: the last pass ends at u32::MAX.
     #[test]
     fn an_unchecked_spp_does_not_overflow() {
@@ -133,11 +162,11 @@ mod tests {
         // 64x64 x 16 samples per pass = 65536 samples: short units, one tile size.
         let short = plan_units(&settings(128, 96, 128));
         assert_eq!(short.len(), 4 * PASSES as usize);
-        // 64x64 x 125 samples per pass: the last pass in 32-pixel tiles (4 x 3 of them).
+        // 64x64 x 128 samples per pass: the last pass in 32-pixel tiles (4 x 3 of them).
         let long = plan_units(&settings(128, 96, 1000));
         assert_eq!(long.len(), 4 * (PASSES as usize - 1) + 12);
         let last = long.last().unwrap();
-        assert_eq!((last.sample_start, last.sample_end), (875, 1000));
+        assert_eq!((last.sample_start, last.sample_end), (896, 1000));
         assert_eq!(last.x1 - last.x0, FINAL_PASS_TILE_SIZE);
         assert!(long[..28].iter().all(|u| u.x1 - u.x0 == TILE_SIZE));
     }

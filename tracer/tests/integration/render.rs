@@ -522,7 +522,7 @@ fn a_constant_sky_renders_exactly_constant_through_every_filter() {
         },
     ] {
         let desc = sky_only(70, filter);
-        let settings = settings(&desc, 2);
+        let settings = settings(&desc, 16);
         let scene = RenderScene::build(&desc, &MemorySource::new(), &settings).unwrap();
         let units = plan_units(&settings);
         assert!(units.len() >= 8, "tiles meet inside the film");
