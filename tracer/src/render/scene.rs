@@ -301,8 +301,9 @@ impl RenderScene {
                             PacketSampler::<L>::new(x, y, index, self.settings.spp, seed)
                         };
                         let (film, lens) = sampler.get_camera();
-                        let film = [0, 1].map(|axis| film[axis].values());
-                        let lens = [0, 1].map(|axis| lens[axis].values());
+                        // Not `map`: a closure would not inherit the AVX2 caller's features.
+                        let film = [film[0].values(), film[1].values()];
+                        let lens = [lens[0].values(), lens[1].values()];
                         let mut rays = [None; MAX_LANES];
                         let mut us = [Vec2::ZERO; MAX_LANES];
                         for i in 0..L::N {
