@@ -14,8 +14,8 @@ use glam::{Vec2, Vec3};
 
 use super::options::RussianRoulette;
 use super::path::{
-    walk, PathResult, PathScene, PathState, PrevScatter, MAX_BRANCHES, RR_MIN_DEPTH,
-    RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
+    power_heuristic, walk, PathResult, PathScene, PathState, PrevScatter, MAX_BRANCHES,
+    RR_MIN_DEPTH, RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
 };
 use crate::bxdf::local::cosine_hemisphere;
 use crate::lanes::{Lanes, MAX_LANES};
@@ -260,9 +260,7 @@ impl<L: Lanes> LambertVertex<L> {
             wi_z.abs() * L::splat(std::f32::consts::FRAC_1_PI),
             zero,
         );
-        let (a, b) = (pdf * pdf, L::splat(bsdf_count) * bsdf_pdf);
-        let (a, b) = (a, b * b);
-        let heuristic = L::select(zero.lt(a + b), a / (a + b), zero);
+        let heuristic = power_heuristic(pdf, L::splat(bsdf_count) * bsdf_pdf);
         let weight = L::select(zero.lt(L::load(&delta)), L::splat(1.0), heuristic);
         let k = dot(wi, self.ns).abs() * weight / pdf;
         let light = scale(times(self.f, li), k);

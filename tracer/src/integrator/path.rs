@@ -13,6 +13,7 @@ use glam::{Vec2, Vec3};
 
 use super::options::{IntegratorDesc, RussianRoulette};
 use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::lanes::Lanes;
 use crate::lights::{follows_plane, ImageWeights, Lights, IMAGE_SHARE};
 use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
@@ -103,13 +104,13 @@ pub struct PathResult {
     pub rays: u32,
 }
 
-fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+/// The power heuristic's weight of a sample drawn with density `pdf_a` against one of
+/// `pdf_b`, in lanes (one lane for a path alone; the packets' weights are the same bits).
+#[inline(always)]
+pub(super) fn power_heuristic<L: Lanes>(pdf_a: L, pdf_b: L) -> L {
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if a + b > 0.0 {
-        a / (a + b)
-    } else {
-        0.0
-    }
+    let zero = L::splat(0.0);
+    L::select(zero.lt(a + b), a / (a + b), zero)
 }
 
 /// Where the ray that reached the current vertex was sampled, for MIS on emitters it hits.
