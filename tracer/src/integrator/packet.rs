@@ -18,6 +18,7 @@ use super::path::{
     RR_MIN_DEPTH, RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
 };
 use crate::bxdf::local::cosine_hemisphere;
+use crate::geometry::SurfaceHit;
 use crate::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray};
 use crate::sampler::PacketSampler;
@@ -334,9 +335,10 @@ struct Packet<L: Lanes> {
 impl<L: Lanes> Packet<L> {
     /// Lane `i`'s path as [`walk`] carries it.
     #[inline(always)]
-    fn lane_state(&self, i: usize, parts: &PacketParts) -> PathState {
+    fn lane_state(&self, i: usize, parts: &PacketParts, traced: Option<SurfaceHit>) -> PathState {
         PathState {
             ray: Ray::new(parts.origin[i], parts.dir[i]),
+            traced: Some(traced),
             throughput: parts.throughput[i],
             radiance: parts.radiance[i],
             medium: None,
@@ -542,15 +544,15 @@ fn walk_packet<S: PathScene, L: Lanes>(
                 continue;
             }
             let ray = Ray::new(parts.origin[i], parts.dir[i]);
-            let lambert = geometry
-                .intersect(&ray, f32::INFINITY)
+            let traced = geometry.intersect(&ray, f32::INFINITY);
+            let lambert = traced
                 .filter(|hit| lights.emitted(hit, -ray.dir) == Vec3::ZERO)
                 .and_then(|hit| Some((hit, scene.bsdf_at(&hit, mix[i]).as_lambert()?)));
             let Some((hit, (shading, normal, value))) = lambert else {
-                // The path goes on alone from this ray, in its own stream.
+                // The path goes on alone from this ray and its hit, in its own stream.
                 packet.live[i] = false;
                 out[i].rays += packet.rays[i];
-                let state = packet.lane_state(i, &parts);
+                let state = packet.lane_state(i, &parts, traced);
                 walk(scene, state, &mut before.lane(i), &mut out[i]);
                 continue;
             };

@@ -239,6 +239,9 @@ pub fn trace_branching_path<S: PathScene>(
 /// A path between two vertices: the ray to the next one and what the path carries.
 pub(super) struct PathState {
     pub(super) ray: Ray,
+    /// What `ray` hits (`Some(None)`: nothing), when the caller has traced it already: a path
+    /// leaving a packet at a vertex the packet does not shade is not traced twice.
+    pub(super) traced: Option<Option<SurfaceHit>>,
     pub(super) throughput: Vec3,
     /// The light the path has gathered so far (a path traced in lanes up to here goes on one
     /// at a time with its sum, which it adds to in the same order).
@@ -260,6 +263,7 @@ impl PathState {
     fn camera<S: PathScene>(scene: &S, ray: Ray, branches: usize) -> Self {
         Self {
             ray,
+            traced: None,
             throughput: Vec3::ONE,
             radiance: Vec3::ZERO,
             medium: scene.volumes().camera,
@@ -289,6 +293,7 @@ pub(super) fn walk<S: PathScene>(
     let has_media = !volumes.media.is_empty();
     let PathState {
         mut ray,
+        mut traced,
         mut throughput,
         mut radiance,
         mut medium,
@@ -302,7 +307,10 @@ pub(super) fn walk<S: PathScene>(
 
     loop {
         rays += 1;
-        let hit = scene.geometry().intersect(&ray, f32::INFINITY);
+        let hit = match traced.take() {
+            Some(hit) => hit,
+            None => scene.geometry().intersect(&ray, f32::INFINITY),
+        };
         // The sides of the surface hit as this ray meets them (no volumes: nothing to do).
         let sides = match &hit {
             Some(hit) if has_media => {
@@ -586,6 +594,7 @@ impl BranchVertex<'_> {
         }
         Some(PathState {
             ray: Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi),
+            traced: None,
             throughput: throughput / count as f32,
             radiance: Vec3::ZERO,
             medium: self.sides.toward(bs.wi, hit.ng),
