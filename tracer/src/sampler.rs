@@ -293,6 +293,36 @@ pub struct VertexPacket<L> {
     pub roulette: L,
 }
 
+impl<L: Lanes> VertexPacket<L> {
+    /// Each lane's values (lanes past `L::N` are zero).
+    #[inline(always)]
+    pub fn by_lane(&self) -> [VertexSamples; MAX_LANES] {
+        let (mix, light_select) = (self.mix.values(), self.light_select.values());
+        let light = [self.light[0].values(), self.light[1].values()];
+        let (lobe, roulette) = (self.lobe.values(), self.roulette.values());
+        let bsdf = [self.bsdf[0].values(), self.bsdf[1].values()];
+        let mut out = [VertexSamples {
+            mix: 0.0,
+            light_select: 0.0,
+            light: Vec2::ZERO,
+            lobe: 0.0,
+            bsdf: Vec2::ZERO,
+            roulette: 0.0,
+        }; MAX_LANES];
+        for (i, v) in out.iter_mut().enumerate() {
+            *v = VertexSamples {
+                mix: mix[i],
+                light_select: light_select[i],
+                light: Vec2::new(light[0][i], light[1][i]),
+                lobe: lobe[i],
+                bsdf: Vec2::new(bsdf[0][i], bsdf[1][i]),
+                roulette: roulette[i],
+            };
+        }
+        out
+    }
+}
+
 impl<L: Lanes> PacketSampler<L> {
     /// Samples `index .. index + L::N` of a pixel that takes all of `spp` samples
     /// (`index + L::N <= spp`).

@@ -1,37 +1,39 @@
 //! Camera paths traced in lanes ([`crate::lanes`]): `L::N` consecutive samples of one pixel
 //! step together from vertex to vertex, their random numbers drawn at once
 //! ([`PacketSampler`]), their Lambert vertices sampled, weighed and rouletted in lanes. Rays are
-//! traced, materials and lights looked up one lane at a time, as [`walk`] does.
+//! traced, materials and lights looked up one lane at a time, as [`walk`] does; a light sample
+//! that goes to a lamp image, and a vertex of any other material (mirror, glass, metal, a rough
+//! or coated surface), are shaded one lane at a time by [`walk`]'s own [`Vertex`], and the lane
+//! stays in the packet.
 //!
 //! Every lane computes what [`walk`] computes for its sample, operation for operation, so a
 //! pixel's samples are the same bits whether traced here or one at a time: the choice between
 //! the two (the CPU's lane types, a scene's coverage) never shows in an image. A lane whose
-//! path meets anything but a bare Lambert surface (a miss, an emitter, a null surface, another
-//! material) leaves the packet and goes on one at a time from the same state and the same
-//! place in its sample stream, by [`walk`] itself.
+//! path does what the packet's lanes cannot do together (meets a miss, an emitter or a null
+//! surface; splits at a glossy vertex; meets anything but Lambert where the paths branch)
+//! leaves the packet and goes on one at a time from the same state and the same place in its
+//! sample stream, by [`walk`] itself.
 
 use glam::{Vec2, Vec3};
 
 use super::options::RussianRoulette;
 use super::path::{
-    power_heuristic, walk, PathResult, PathScene, PathState, PrevScatter, MAX_BRANCHES,
-    RR_MIN_DEPTH, RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
+    power_heuristic, walk, BeforeMirror, LightChoice, PathResult, PathScene, PathState,
+    PrevScatter, Vertex, MAX_BRANCHES, RR_MIN_DEPTH, RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
 };
 use crate::bxdf::local::cosine_hemisphere;
 use crate::geometry::SurfaceHit;
 use crate::lanes::{Lanes, MAX_LANES};
-use crate::math::{Frame, Ray};
-use crate::sampler::PacketSampler;
+use crate::material::{Bsdf, BsdfSample};
+use crate::math::Ray;
+use crate::medium::ShapeMedia;
+use crate::sampler::{PacketSampler, VertexPacket, VertexSamples};
 
 /// Whether `scene`'s camera paths may be traced in packets: no volumes (a packet's lanes all
-/// travel in none), no glossy splits and no lamp images (a packet's vertices are Lambert ones,
-/// which neither concerns). Any material, light or camera: lanes that meet what a packet does
-/// not shade leave it.
+/// travel in none). Any material, light or camera: lanes that meet what a packet does not
+/// follow leave it.
 pub fn covers<S: PathScene>(scene: &S) -> bool {
-    scene.volumes().media.is_empty()
-        && scene.volumes().camera.is_none()
-        && !scene.glossy_split()
-        && !scene.lights().has_mirror_images()
+    scene.volumes().media.is_empty() && scene.volumes().camera.is_none()
 }
 
 /// Three coordinates in lanes.
@@ -100,6 +102,16 @@ fn store3<L: Lanes>(v: V3<L>) -> [Vec3; MAX_LANES] {
 fn is_zero<L: Lanes>(x: L) -> L::M {
     let zero = L::splat(0.0);
     x.le(zero) & zero.le(x)
+}
+
+/// The mask of the lanes `set` names.
+#[inline(always)]
+fn mask_of<L: Lanes>(set: &[bool; MAX_LANES]) -> L::M {
+    let mut ones = [0.0; MAX_LANES];
+    for (one, &set) in ones.iter_mut().zip(set) {
+        *one = if set { 1.0 } else { 0.0 };
+    }
+    L::splat(0.0).lt(L::load(&ones))
 }
 
 /// Which lanes a mask sets.
@@ -196,25 +208,27 @@ impl<L: Lanes> LambertVertex<L> {
 }
 
 impl<L: Lanes> LambertVertex<L> {
-    /// [`direct_light`] at the live lanes' vertices: the light's choice and point and the
-    /// shadow ray one lane at a time, the rest in lanes.
+    /// [`direct_light`] at the vertices of the lanes `lanes` sets, with `draw`'s light choice
+    /// numbers and share: the light's choice and point and the shadow ray one lane at a time
+    /// (their rays counted in `rays`), the rest in lanes.
     #[inline(always)]
     fn direct_light<S: PathScene>(
         &self,
         scene: &S,
-        packet: &mut Packet<L>,
-        u_select: L,
+        lanes: &[bool; MAX_LANES],
+        rays: &mut [u32; MAX_LANES],
+        draw: &LightDraws,
         u: [L; 2],
         bsdf_count: f32,
     ) -> V3<L> {
         let zero = L::splat(0.0);
         let (p, facing) = (store3(self.p), store3(self.facing()));
-        let (select, ux, uy) = (u_select.values(), u[0].values(), u[1].values());
+        let (select, ux, uy) = (draw.u_select, u[0].values(), u[1].values());
         let mut wi = [Vec3::Z; MAX_LANES];
         let mut li = [Vec3::ZERO; MAX_LANES];
         let (mut pdf, mut dist, mut delta) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
         for i in 0..L::N {
-            if !packet.live[i] {
+            if !lanes[i] {
                 continue;
             }
             let u = Vec2::new(ux[i], uy[i]);
@@ -224,7 +238,8 @@ impl<L: Lanes> LambertVertex<L> {
                 delta[i] = if ls.delta { 1.0 } else { 0.0 };
             }
         }
-        let (wi, li, pdf, dist) = (load3(&wi), load3(&li), L::load(&pdf), L::load(&dist));
+        let (wi, li, dist) = (load3(&wi), load3(&li), L::load(&dist));
+        let pdf = L::load(&pdf) * L::load(&draw.share);
         let dark: L::M = is_zero(li[0]) & is_zero(li[1]) & is_zero(li[2]);
         let lit = !pdf.le(zero) & !dark;
         // The BSDF's value: Lambert's where the normals agree and wo and wi share a side.
@@ -248,8 +263,8 @@ impl<L: Lanes> LambertVertex<L> {
         let (origin, dir) = (store3(origin), store3(wi));
         let mut visible = [0.0; MAX_LANES];
         for i in 0..L::N {
-            if packet.live[i] && tested[i] {
-                packet.rays[i] += 1;
+            if lanes[i] && tested[i] {
+                rays[i] += 1;
                 let blocked = scene
                     .geometry()
                     .occluded(&Ray::new(origin[i], dir[i]), tmax[i]);
@@ -274,19 +289,28 @@ impl<L: Lanes> LambertVertex<L> {
     }
 }
 
-/// [`super::path::survives`] in lanes, for a broad vertex: the lanes the roulette keeps, and
-/// the throughput divided by their survival probability.
+/// The light choice numbers and shares of a packet's lane light samples
+/// ([`super::path::LightDraw`]'s).
+struct LightDraws {
+    u_select: [f32; MAX_LANES],
+    share: [f32; MAX_LANES],
+}
+
+/// [`super::path::survives`] in lanes, at vertices that scattered broadly where `broad` is
+/// set: the lanes the roulette keeps, and the throughput divided by their survival
+/// probability.
 #[inline(always)]
 fn survives<S: PathScene, L: Lanes>(
     scene: &S,
     depth: u32,
+    broad: L::M,
     u_rr: L,
     throughput: &mut V3<L>,
 ) -> L::M {
     let integrator = scene.integrator();
-    let continue_prob = match integrator.rr_strategy {
+    let (continue_prob, rouletted) = match integrator.rr_strategy {
         RussianRoulette::Probability if depth >= RR_MIN_DEPTH => {
-            L::splat(integrator.rr_continue_prob)
+            (L::splat(integrator.rr_continue_prob), L::mask(true))
         }
         RussianRoulette::Efficiency => {
             let t = *throughput;
@@ -297,23 +321,53 @@ fn survives<S: PathScene, L: Lanes>(
                 L::splat(RR_MIN_SURVIVAL),
                 largest,
             );
-            L::select(L::splat(1.0).lt(low), L::splat(1.0), low)
+            (L::select(L::splat(1.0).lt(low), L::splat(1.0), low), broad)
         }
         _ => return L::mask(true),
     };
     // What `u_rr >= continue_prob` ends (NaN included).
-    let kept = !continue_prob.le(u_rr);
+    let kept = !continue_prob.le(u_rr) | !rouletted;
+    let t = *throughput;
     *throughput = [
-        throughput[0] / continue_prob,
-        throughput[1] / continue_prob,
-        throughput[2] / continue_prob,
+        L::select(rouletted, t[0] / continue_prob, t[0]),
+        L::select(rouletted, t[1] / continue_prob, t[1]),
+        L::select(rouletted, t[2] / continue_prob, t[2]),
     ];
     kept
 }
 
-/// Camera paths in lanes between two vertices. Every lane still in the packet has met only
-/// Lambert vertices, so all are at the same depth, with the same branching count, and came
-/// from the same kind of vertex.
+/// What a lane's last vertex leaves the next one beyond its point, density and side (which
+/// the packet keeps in lanes): the rest of [`PrevScatter`].
+#[derive(Clone, Copy)]
+struct PrevLane {
+    specular: bool,
+    image_share: f32,
+    before_mirror: Option<BeforeMirror>,
+    /// Whether the vertex gathered light broadly (from the packet's `prev_facing` side).
+    broad: bool,
+}
+
+impl PrevLane {
+    /// The camera counts as specular: emitters its rays see are taken at full weight.
+    const CAMERA: Self = Self {
+        specular: true,
+        image_share: 0.0,
+        before_mirror: None,
+        broad: false,
+    };
+    /// A Lambert vertex shaded in lanes (its image share set apart).
+    const LAMBERT: Self = Self {
+        specular: false,
+        image_share: 0.0,
+        before_mirror: None,
+        broad: true,
+    };
+}
+
+/// Camera paths in lanes between two vertices. Every lane still in the packet has scattered
+/// at every vertex so far (null surfaces, volumes and splits make a lane leave), so all are at
+/// the same depth; they branch together at their first vertex (where `branches` > 1 only
+/// Lambert lanes stay) and may all still split or none.
 struct Packet<L: Lanes> {
     live: [bool; MAX_LANES],
     origin: V3<L>,
@@ -322,18 +376,34 @@ struct Packet<L: Lanes> {
     radiance: V3<L>,
     depth: u32,
     branches: usize,
+    /// Whether a glossy vertex may split the lanes' paths ([`PathState::may_split`]).
+    may_split: bool,
     prev_p: V3<L>,
     prev_pdf: L,
-    /// True for camera rays (no vertex before), false after a Lambert vertex.
-    prev_specular: bool,
-    /// After a Lambert vertex, the side it gathered light from.
+    /// After a broad vertex, the side it gathered light from.
     prev_facing: V3<L>,
+    prev: [PrevLane; MAX_LANES],
     /// The rays each lane traced in this packet.
     rays: [u32; MAX_LANES],
 }
 
 impl<L: Lanes> Packet<L> {
-    /// Lane `i`'s path as [`walk`] carries it.
+    /// Where lane `i`'s last ray was sampled, as [`walk`] carries it.
+    #[inline(always)]
+    fn prev_scatter(&self, i: usize, parts: &PacketParts) -> PrevScatter {
+        let prev = self.prev[i];
+        PrevScatter {
+            p: parts.prev_p[i],
+            pdf: parts.prev_pdf[i],
+            specular: prev.specular,
+            image_share: prev.image_share,
+            before_mirror: prev.before_mirror,
+            direct_counted: false,
+            facing: prev.broad.then_some(parts.prev_facing[i]),
+        }
+    }
+
+    /// Lane `i`'s path as [`walk`] carries it, with what its ray hits.
     #[inline(always)]
     fn lane_state(&self, i: usize, parts: &PacketParts, traced: Option<SurfaceHit>) -> PathState {
         PathState {
@@ -344,12 +414,9 @@ impl<L: Lanes> Packet<L> {
             medium: None,
             depth: self.depth,
             pass_through: 0,
-            may_split: false,
+            may_split: self.may_split,
             branches: self.branches,
-            prev: PrevScatter {
-                facing: (!self.prev_specular).then_some(parts.prev_facing[i]),
-                ..PrevScatter::plain(parts.prev_p[i], parts.prev_pdf[i], self.prev_specular)
-            },
+            prev: self.prev_scatter(i, parts),
         }
     }
 
@@ -409,11 +476,24 @@ impl PacketParts {
     }
 }
 
+/// A vertex shaded for one lane by [`Vertex`], as [`walk`] shades it.
+#[derive(Clone, Copy)]
+struct AloneStep {
+    image_share: f32,
+    /// The BSDF sample and the throughput's weight; None ends the path.
+    sample: Option<(BsdfSample, Vec3)>,
+    /// The side a broad vertex gathers light from.
+    broad: Option<Vec3>,
+    before_mirror: Option<BeforeMirror>,
+}
+
 /// Where a packet's paths branch ([`MAX_BRANCHES`]): the vertex its continuations start from.
 struct BranchPoint<L: Lanes> {
     vertex: LambertVertex<L>,
     throughput: V3<L>,
     roulette: L,
+    /// The share of each lane's light samples that went to lamp images.
+    image_share: [f32; MAX_LANES],
     /// The packet's stream after the vertex's own dimensions.
     sampler: PacketSampler<L>,
 }
@@ -445,10 +525,11 @@ pub fn trace_packet<S: PathScene, L: Lanes>(
         radiance: [zero; 3],
         depth: 0,
         branches: scene.first_vertex_branches().clamp(1, MAX_BRANCHES),
+        may_split: scene.glossy_split(),
         prev_p: origin,
         prev_pdf: zero,
-        prev_specular: true,
         prev_facing: [zero; 3],
+        prev: [PrevLane::CAMERA; MAX_LANES],
         rays: [0; MAX_LANES],
     };
     if let Some(branch) = walk_packet(scene, &mut packet, sampler, &mut out) {
@@ -483,13 +564,18 @@ fn branch_packet<S: PathScene, L: Lanes>(
         let bs = v.sample(dir);
         let cos = dot(bs.wi, v.ns).abs();
         let mut throughput = scale(times(branch.throughput, v.f), cos / bs.pdf);
-        let kept = bs.valid & survives(scene, parent.depth, u_rr, &mut throughput);
+        let broad = L::mask(true);
+        let kept = bs.valid & survives(scene, parent.depth, broad, u_rr, &mut throughput);
         let kept = lanes_set::<L>(kept);
         let mut live = [false; MAX_LANES];
         for i in 0..L::N {
             live[i] = parent.live[i] && kept[i];
         }
         let zero = L::splat(0.0);
+        let mut prev = [PrevLane::LAMBERT; MAX_LANES];
+        for (prev, &image_share) in prev.iter_mut().zip(&branch.image_share) {
+            prev.image_share = image_share;
+        }
         let mut continuation = Packet {
             live,
             origin: offset_origin(v.p, v.ng, bs.wi),
@@ -502,14 +588,153 @@ fn branch_packet<S: PathScene, L: Lanes>(
             radiance: [zero; 3],
             depth: parent.depth,
             branches: 1,
+            may_split: parent.may_split,
             prev_p: v.p,
             prev_pdf: count_f * bs.pdf,
-            prev_specular: false,
             prev_facing: facing,
+            prev,
             rays: [0; MAX_LANES],
         };
         let branched = walk_packet(scene, &mut continuation, &mut stream, out);
         debug_assert!(branched.is_none(), "a continuation branches once only");
+    }
+}
+
+/// A lane at a vertex: which, the packet's state lane by lane, and the BSDF samples its light
+/// sample is weighed against.
+struct LaneAt<'a> {
+    lane: usize,
+    parts: &'a PacketParts,
+    bsdf_count: f32,
+}
+
+/// What a packet's lanes meet at their next vertex, lane by lane.
+struct LaneHits {
+    p: [Vec3; MAX_LANES],
+    ng: [Vec3; MAX_LANES],
+    ns: [Vec3; MAX_LANES],
+    frame: [[Vec3; MAX_LANES]; 3],
+    f: [Vec3; MAX_LANES],
+    /// The lanes at a bare Lambert surface, shaded in lanes (but a light sample that goes to a
+    /// lamp image).
+    lambert: [bool; MAX_LANES],
+    /// The vertices shaded one lane at a time: any other surface.
+    alone: [Option<AloneStep>; MAX_LANES],
+    /// The light that lanes shaded one at a time bring (alone, or through lamp images).
+    lit_alone: [Option<Vec3>; MAX_LANES],
+    image_share: [f32; MAX_LANES],
+    draws: LightDraws,
+    /// The vertex's numbers lane by lane, once a lane is shaded alone.
+    by_lane: Option<[VertexSamples; MAX_LANES]>,
+}
+
+impl LaneHits {
+    #[inline(always)]
+    fn new<L: Lanes>(u: &VertexPacket<L>) -> Self {
+        Self {
+            p: [Vec3::ZERO; MAX_LANES],
+            ng: [Vec3::ZERO; MAX_LANES],
+            ns: [Vec3::ZERO; MAX_LANES],
+            frame: [[Vec3::ZERO; MAX_LANES]; 3],
+            f: [Vec3::ZERO; MAX_LANES],
+            lambert: [false; MAX_LANES],
+            alone: [None; MAX_LANES],
+            lit_alone: [None; MAX_LANES],
+            image_share: [0.0; MAX_LANES],
+            draws: LightDraws {
+                u_select: u.light_select.values(),
+                share: [1.0; MAX_LANES],
+            },
+            by_lane: None,
+        }
+    }
+
+    /// Takes in lane `at.lane`'s hit, with its BSDF (not a null one), where the lane may stay
+    /// in the packet: false where it leaves (where the paths may branch, anything but Lambert;
+    /// a glossy vertex that splits). Counts the lane's rays.
+    #[inline(always)]
+    fn meet<S: PathScene, L: Lanes>(
+        &mut self,
+        scene: &S,
+        packet: &mut Packet<L>,
+        at: &LaneAt,
+        hit: &SurfaceHit,
+        bsdf: &Bsdf,
+        u: &VertexPacket<L>,
+    ) -> bool {
+        let i = at.lane;
+        let wo = -at.parts.dir[i];
+        if packet.depth >= scene.max_depth() {
+            // The path ends here.
+            packet.rays[i] += 1;
+            return true;
+        }
+        let lights = scene.lights();
+        let lambert = bsdf.as_lambert();
+        if lambert.is_none() {
+            // A path branches at its first broad vertex, or keeps its branches past a specular
+            // one: only Lambert lanes branch together.
+            let splits = packet.may_split
+                && bsdf
+                    .glossy_cone(wo)
+                    .is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone));
+            if packet.branches > 1 || splits {
+                return false;
+            }
+        }
+        packet.rays[i] += 1;
+        (self.p[i], self.ng[i], self.ns[i]) = (hit.p, hit.ng, hit.ns);
+        let lambert_here = lambert.is_some();
+        if let Some((frame, ng, f)) = lambert {
+            self.lambert[i] = true;
+            (self.ng[i], self.f[i]) = (ng, f);
+            (self.frame[0][i], self.frame[1][i], self.frame[2][i]) = (frame.s, frame.t, frame.n);
+            if !lights.has_mirror_images() {
+                return true;
+            }
+        }
+        let us = match &self.by_lane {
+            Some(us) => us,
+            None => self.by_lane.insert(u.by_lane()),
+        };
+        let vertex = Vertex {
+            hit,
+            wo,
+            bsdf,
+            sides: ShapeMedia::default(),
+        };
+        let depth = packet.depth + 1;
+        let mut rays = 0;
+        if lambert_here {
+            let (choice, image_share) =
+                vertex.choose_light(scene, &us[i], depth, at.bsdf_count, &mut rays);
+            self.image_share[i] = image_share;
+            match choice {
+                LightChoice::Image(light) => self.lit_alone[i] = Some(light),
+                LightChoice::Lights(draw) => {
+                    (self.draws.u_select[i], self.draws.share[i]) = (draw.u_select, draw.share);
+                }
+            }
+        } else {
+            let (light, image_share) = vertex.light(scene, &us[i], depth, 1.0, &mut rays);
+            let sample = vertex.sample(&us[i]);
+            let before_mirror = match &sample {
+                Some((bs, _)) => {
+                    let prev = packet.prev_scatter(i, at.parts);
+                    vertex.mirror_after(lights, &prev, bs, false)
+                }
+                None => None,
+            };
+            self.lit_alone[i] = light;
+            self.alone[i] = Some(AloneStep {
+                image_share,
+                sample,
+                broad: bsdf.gathers_from(wo),
+                before_mirror,
+            });
+        }
+        packet.rays[i] += rays;
+        true
     }
 }
 
@@ -534,32 +759,39 @@ fn walk_packet<S: PathScene, L: Lanes>(
         let u = sampler.get_vertex();
         let mix = u.mix.values();
         let parts = PacketParts::of(packet);
-        let mut p = [Vec3::ZERO; MAX_LANES];
-        let mut ng = [Vec3::ZERO; MAX_LANES];
-        let mut ns = [Vec3::ZERO; MAX_LANES];
-        let mut frame = [[Vec3::ZERO; MAX_LANES]; 3];
-        let mut f = [Vec3::ZERO; MAX_LANES];
+        let branching = packet.branches > 1;
+        let bsdf_count = if branching {
+            packet.branches as f32
+        } else {
+            1.0
+        };
+        let mut hits = LaneHits::new(&u);
         for i in 0..L::N {
             if !packet.live[i] {
                 continue;
             }
             let ray = Ray::new(parts.origin[i], parts.dir[i]);
+            let wo = -ray.dir;
             let traced = geometry.intersect(&ray, f32::INFINITY);
-            let lambert = traced
-                .filter(|hit| lights.emitted(hit, -ray.dir) == Vec3::ZERO)
-                .and_then(|hit| Some((hit, scene.bsdf_at(&hit, mix[i]).as_lambert()?)));
-            let Some((hit, (shading, normal, value))) = lambert else {
+            let stays = match &traced {
+                Some(hit) if lights.emitted(hit, wo) == Vec3::ZERO => {
+                    let bsdf = scene.bsdf_at(hit, mix[i]);
+                    let at = LaneAt {
+                        lane: i,
+                        parts: &parts,
+                        bsdf_count,
+                    };
+                    !bsdf.is_pass_through() && hits.meet(scene, packet, &at, hit, &bsdf, &u)
+                }
+                _ => false,
+            };
+            if !stays {
                 // The path goes on alone from this ray and its hit, in its own stream.
                 packet.live[i] = false;
                 out[i].rays += packet.rays[i];
                 let state = packet.lane_state(i, &parts, traced);
                 walk(scene, state, &mut before.lane(i), &mut out[i]);
-                continue;
-            };
-            packet.rays[i] += 1;
-            (p[i], ng[i], ns[i], f[i]) = (hit.p, normal, hit.ns, value);
-            let Frame { s, t, n } = shading;
-            (frame[0][i], frame[1][i], frame[2][i]) = (s, t, n);
+            }
         }
         if !packet.live[..L::N].contains(&true) {
             return None;
@@ -571,49 +803,134 @@ fn walk_packet<S: PathScene, L: Lanes>(
         packet.depth += 1;
 
         let wo = negate(packet.dir);
-        let frame = [load3(&frame[0]), load3(&frame[1]), load3(&frame[2])];
+        let frame = [
+            load3(&hits.frame[0]),
+            load3(&hits.frame[1]),
+            load3(&hits.frame[2]),
+        ];
         let vertex = LambertVertex {
-            p: load3(&p),
-            ng: load3(&ng),
-            ns: load3(&ns),
-            f: load3(&f),
+            p: load3(&hits.p),
+            ng: load3(&hits.ng),
+            ns: load3(&hits.ns),
+            f: load3(&hits.f),
             wo,
             wo_local: [dot(wo, frame[0]), dot(wo, frame[1]), dot(wo, frame[2])],
             frame,
         };
-        let branching = packet.branches > 1;
-        let bsdf_count = if branching {
-            packet.branches as f32
+        // The lanes whose light sample goes to the lights, in lanes.
+        let mut to_lights = hits.lambert;
+        let mut any_alone = false;
+        for ((to_lights, lit), alone) in to_lights.iter_mut().zip(&hits.lit_alone).zip(&hits.alone)
+        {
+            *to_lights &= lit.is_none();
+            any_alone |= alone.is_some();
+        }
+        let mut rays = packet.rays;
+        let light = vertex.direct_light(
+            scene,
+            &to_lights,
+            &mut rays,
+            &hits.draws,
+            u.light,
+            bsdf_count,
+        );
+        packet.rays = rays;
+        let in_lanes = mask_of::<L>(&hits.lambert);
+        if hits.by_lane.is_some() {
+            let mut light_alone = [Vec3::ZERO; MAX_LANES];
+            let mut lit = hits.lambert;
+            for i in 0..L::N {
+                if let Some(l) = hits.lit_alone[i] {
+                    (light_alone[i], lit[i]) = (l, true);
+                }
+            }
+            let light = select3(mask_of::<L>(&to_lights), light, load3(&light_alone));
+            let radiance = plus(packet.radiance, times(packet.throughput, light));
+            packet.radiance = select3(mask_of::<L>(&lit), radiance, packet.radiance);
         } else {
-            1.0
-        };
-        let light = vertex.direct_light(scene, packet, u.light_select, u.light, bsdf_count);
-        packet.radiance = plus(packet.radiance, times(packet.throughput, light));
+            packet.radiance = plus(packet.radiance, times(packet.throughput, light));
+        }
         if branching {
             return Some(BranchPoint {
                 vertex,
                 throughput: packet.throughput,
                 roulette: u.roulette,
+                image_share: hits.image_share,
                 sampler: sampler.clone(),
             });
         }
 
         let bs = vertex.sample(u.bsdf);
         let cos = dot(bs.wi, vertex.ns).abs();
-        packet.throughput = times(packet.throughput, scale(vertex.f, cos / bs.pdf));
-        let kept = bs.valid & survives(scene, packet.depth, u.roulette, &mut packet.throughput);
+        let mut weight = scale(vertex.f, cos / bs.pdf);
+        let (mut wi, mut pdf, mut valid) = (bs.wi, bs.pdf, bs.valid);
+        let mut broad = L::mask(true);
+        let mut facing = vertex.facing();
+        if any_alone {
+            let mut a_wi = [Vec3::Z; MAX_LANES];
+            let mut a_weight = [Vec3::ONE; MAX_LANES];
+            let mut a_pdf = [0.0; MAX_LANES];
+            let mut a_valid = [false; MAX_LANES];
+            let mut a_broad = hits.lambert;
+            let mut a_facing = [Vec3::ZERO; MAX_LANES];
+            for i in 0..L::N {
+                let Some(step) = hits.alone[i] else {
+                    packet.prev[i] = PrevLane {
+                        image_share: hits.image_share[i],
+                        ..PrevLane::LAMBERT
+                    };
+                    continue;
+                };
+                let mut specular = false;
+                if let Some((s, w)) = step.sample {
+                    (a_wi[i], a_weight[i], a_pdf[i], a_valid[i]) = (s.wi, w, s.pdf, true);
+                    specular = s.specular;
+                }
+                if let Some(side) = step.broad {
+                    (a_broad[i], a_facing[i]) = (true, side);
+                }
+                packet.prev[i] = PrevLane {
+                    specular,
+                    image_share: step.image_share,
+                    before_mirror: step.before_mirror,
+                    broad: step.broad.is_some(),
+                };
+            }
+            wi = select3(in_lanes, wi, load3(&a_wi));
+            weight = select3(in_lanes, weight, load3(&a_weight));
+            pdf = L::select(in_lanes, pdf, L::load(&a_pdf));
+            valid = (in_lanes & valid) | mask_of::<L>(&a_valid);
+            broad = mask_of::<L>(&a_broad);
+            facing = select3(in_lanes, facing, load3(&a_facing));
+        } else {
+            for i in 0..L::N {
+                packet.prev[i] = PrevLane {
+                    image_share: hits.image_share[i],
+                    ..PrevLane::LAMBERT
+                };
+            }
+        }
+        packet.throughput = times(packet.throughput, weight);
+        let kept = valid
+            & survives(
+                scene,
+                packet.depth,
+                broad,
+                u.roulette,
+                &mut packet.throughput,
+            );
         packet.keep(kept, out);
         packet.prev_p = vertex.p;
-        packet.prev_pdf = bs.pdf;
-        packet.prev_specular = false;
-        packet.prev_facing = vertex.facing();
-        packet.origin = offset_origin(vertex.p, vertex.ng, bs.wi);
-        packet.dir = bs.wi;
+        packet.prev_pdf = pdf;
+        packet.prev_facing = facing;
+        packet.origin = offset_origin(vertex.p, vertex.ng, wi);
+        packet.dir = wi;
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use crate::integrator::path::PathScene;
     use std::sync::atomic::AtomicBool;
 
     use crate::assets::MemorySource;
@@ -624,8 +941,10 @@ mod tests {
     use crate::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
 
     /// A depth-of-field scene of our own: a thin lens, a checkered Lambert floor, a red
-    /// Lambert sphere, and what packets do not shade, which their lanes leave them for: a glass
-    /// sphere, a rough (Oren-Nayar) wall, a null lamp seen directly, the open sky.
+    /// Lambert sphere; what packets shade one lane at a time: a glass sphere, a rough
+    /// (Oren-Nayar) wall, a flat mirror with the lamp's image, a gold sphere (whose glossy
+    /// vertices split paths, which leave the packet); and what lanes leave packets for: a null
+    /// lamp seen directly, the open sky.
     const SCENE: &str = r#"LookAt 0 -4 1.2  0 0 0.6  0 0 1
 Camera "perspective" "float fov" [50] "float lensradius" [0.1] "float focaldistance" [3.5]
 Film "fleximage" "integer xresolution" [24] "integer yresolution" [16]
@@ -652,6 +971,15 @@ Translate 0.7 -0.4 0.4
 Shape "sphere" "float radius" [0.4]
 AttributeEnd
 AttributeBegin
+Material "mirror"
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-2.5 -2 0 -2.5 2 0 -2.5 2 2.5 -2.5 -2 2.5]
+AttributeEnd
+AttributeBegin
+Material "metal" "string name" ["gold"] "float uroughness" [0.05] "float vroughness" [0.05]
+Translate 0.3 0.9 0.35
+Shape "sphere" "float radius" [0.35]
+AttributeEnd
+AttributeBegin
 Material "null"
 AreaLightSource "area" "color L" [6 6 6] "float power" [0]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-0.5 -0.5 2 -0.5 0.5 2 0.5 0.5 2 0.5 -0.5 2]
@@ -674,6 +1002,11 @@ WorldEnd
         };
         let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
         assert!(super::covers(&scene), "packets cover the scene");
+        assert!(scene.glossy_split(), "the gold sphere splits paths");
+        assert!(
+            scene.lights().has_mirror_images(),
+            "the mirror shows the lamp"
+        );
         (scene.with_first_vertex_branches(branches), settings)
     }
 

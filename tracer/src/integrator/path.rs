@@ -15,7 +15,7 @@ use super::options::{IntegratorDesc, RussianRoulette};
 use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::lanes::Lanes;
 use crate::lights::{follows_plane, ImageWeights, Lights, IMAGE_SHARE};
-use crate::material::Bsdf;
+use crate::material::{Bsdf, BsdfSample};
 use crate::math::{offset_origin, Ray};
 use crate::medium::{Flight, MediumId, Phase, ShapeMedia, Volumes};
 use crate::sampler::{PixelSampler, VertexSamples};
@@ -156,12 +156,20 @@ pub(super) struct BeforeMirror {
     plane: u16,
 }
 
+/// Where a vertex's light sample goes ([`Vertex::choose_light`]).
+pub(super) enum LightChoice {
+    /// To a lamp image: the light it brings, weighed.
+    Image(Vec3),
+    /// To the lights, with this draw.
+    Lights(LightDraw),
+}
+
 /// A light sample's random numbers, the share of a vertex's light samples its kind (lights,
 /// or lamp images) gets, and the BSDF samples its MIS weight counts against it.
 #[derive(Clone, Copy)]
-struct LightDraw {
-    share: f32,
-    u_select: f32,
+pub(super) struct LightDraw {
+    pub(super) share: f32,
+    pub(super) u_select: f32,
     u: Vec2,
     /// The BSDF samples the vertex weighs its light sample against: 1, [`GLOSSY_SPLIT`] at a
     /// split vertex, the continuations' count at a branching one.
@@ -425,27 +433,14 @@ pub(super) fn walk<S: PathScene>(
         } else {
             1.0
         };
-        let mut image_share = 0.0;
-        if !bsdf.is_specular() {
-            // A path through a mirror needs one more vertex: none past the last.
-            let (draw, image) = if lights.has_mirror_images() && depth < max_depth {
-                split_light_sample(lights, hit.p, &u)
-            } else {
-                (LightDraw::lights_only(&u), None)
-            };
-            let light = match image {
-                Some(images) => {
-                    image_share = draw.share;
-                    let draw = LightDraw { bsdf_count, ..draw };
-                    direct_light_via_mirror(scene, &hit, wo, &bsdf, &images, draw, &mut rays)
-                }
-                None => {
-                    // What the lights leave (nothing where no image is seen).
-                    image_share = 1.0 - draw.share;
-                    let draw = LightDraw { bsdf_count, ..draw };
-                    direct_light(scene, &hit, wo, &bsdf, sides, draw, &mut rays)
-                }
-            };
+        let vertex = Vertex {
+            hit: &hit,
+            wo,
+            bsdf: &bsdf,
+            sides,
+        };
+        let (light, image_share) = vertex.light(scene, &u, depth, bsdf_count, &mut rays);
+        if let Some(light) = light {
             radiance += throughput * light;
         }
         if split {
@@ -474,14 +469,10 @@ pub(super) fn walk<S: PathScene>(
             branches = 1;
         }
 
-        let Some(bs) = bsdf.sample(wo, u.lobe, u.bsdf) else {
+        let Some((bs, weight)) = vertex.sample(&u) else {
             break;
         };
-        if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
-            break;
-        }
-        let cos = bs.wi.dot(hit.ns).abs();
-        throughput *= bs.f * (cos / bs.pdf);
+        throughput *= weight;
 
         if !survives(
             integrator,
@@ -493,20 +484,7 @@ pub(super) fn walk<S: PathScene>(
             break;
         }
 
-        // A mirror straight after a vertex that sampled lamp images (no null surface between).
-        let before_mirror =
-            if bs.specular && !prev.specular && prev.image_share > 0.0 && !crossed_null {
-                lights
-                    .mirror_plane(&hit)
-                    .filter(|&plane| follows_plane(bs.wi, lights.reflect_in_plane(plane, ray.dir)))
-                    .map(|plane| BeforeMirror {
-                        p: prev.p,
-                        pdf: prev.pdf,
-                        plane,
-                    })
-            } else {
-                None
-            };
+        let before_mirror = vertex.mirror_after(lights, &prev, &bs, crossed_null);
         prev = PrevScatter {
             p: hit.p,
             pdf: bs.pdf,
@@ -521,6 +499,111 @@ pub(super) fn walk<S: PathScene>(
     }
     out.radiance += radiance;
     out.rays += rays;
+}
+
+/// A surface vertex a path scatters at: what [`walk`] does there, and what a packet's lane
+/// that meets a material the packet does not shade in lanes has done for it
+/// ([`super::packet`]), the same operations either way.
+pub(super) struct Vertex<'a> {
+    pub(super) hit: &'a SurfaceHit,
+    /// The direction the path arrived from.
+    pub(super) wo: Vec3,
+    pub(super) bsdf: &'a Bsdf,
+    pub(super) sides: ShapeMedia,
+}
+
+impl Vertex<'_> {
+    /// The vertex's light sample (None at a specular vertex), weighed against `bsdf_count`
+    /// BSDF samples, and the share of its light samples that went to lamp images. `depth`
+    /// counts this vertex.
+    #[inline(always)]
+    pub(super) fn light<S: PathScene>(
+        &self,
+        scene: &S,
+        u: &VertexSamples,
+        depth: u32,
+        bsdf_count: f32,
+        rays: &mut u32,
+    ) -> (Option<Vec3>, f32) {
+        if self.bsdf.is_specular() {
+            return (None, 0.0);
+        }
+        let (choice, image_share) = self.choose_light(scene, u, depth, bsdf_count, rays);
+        let light = match choice {
+            LightChoice::Image(light) => light,
+            LightChoice::Lights(draw) => {
+                direct_light(scene, self.hit, self.wo, self.bsdf, self.sides, draw, rays)
+            }
+        };
+        (Some(light), image_share)
+    }
+
+    /// Where the light sample of this vertex (not a specular one) goes, and the share of its
+    /// light samples that went to lamp images: see [`Self::light`].
+    #[inline(always)]
+    pub(super) fn choose_light<S: PathScene>(
+        &self,
+        scene: &S,
+        u: &VertexSamples,
+        depth: u32,
+        bsdf_count: f32,
+        rays: &mut u32,
+    ) -> (LightChoice, f32) {
+        let lights = scene.lights();
+        let (hit, wo, bsdf) = (self.hit, self.wo, self.bsdf);
+        // A path through a mirror needs one more vertex: none past the last.
+        let (draw, image) = if lights.has_mirror_images() && depth < scene.max_depth() {
+            split_light_sample(lights, hit.p, u)
+        } else {
+            (LightDraw::lights_only(u), None)
+        };
+        let draw = LightDraw { bsdf_count, ..draw };
+        match image {
+            Some(images) => {
+                let light = direct_light_via_mirror(scene, hit, wo, bsdf, &images, draw, rays);
+                (LightChoice::Image(light), draw.share)
+            }
+            // What the lights leave (nothing where no image is seen).
+            None => (LightChoice::Lights(draw), 1.0 - draw.share),
+        }
+    }
+
+    /// The path's BSDF sample here and what its throughput is multiplied by; None where the
+    /// path ends (no sample, or one that carries nothing).
+    #[inline(always)]
+    pub(super) fn sample(&self, u: &VertexSamples) -> Option<(BsdfSample, Vec3)> {
+        let bs = self.bsdf.sample(self.wo, u.lobe, u.bsdf)?;
+        if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
+            return None;
+        }
+        let cos = bs.wi.dot(self.hit.ns).abs();
+        let weight = bs.f * (cos / bs.pdf);
+        Some((bs, weight))
+    }
+
+    /// The flat mirror this vertex is, when the path's sample `bs` reflects in it straight
+    /// after a vertex that sampled lamp images (`prev`; no null surface between).
+    #[inline(always)]
+    pub(super) fn mirror_after(
+        &self,
+        lights: &Lights,
+        prev: &PrevScatter,
+        bs: &BsdfSample,
+        crossed_null: bool,
+    ) -> Option<BeforeMirror> {
+        let after_images = !prev.specular && prev.image_share > 0.0;
+        if !bs.specular || !after_images || crossed_null {
+            return None;
+        }
+        lights
+            .mirror_plane(self.hit)
+            .filter(|&plane| follows_plane(bs.wi, lights.reflect_in_plane(plane, -self.wo)))
+            .map(|plane| BeforeMirror {
+                p: prev.p,
+                pdf: prev.pdf,
+                plane,
+            })
+    }
 }
 
 /// A camera path's first broad vertex where it branches ([`MAX_BRANCHES`]): what its
