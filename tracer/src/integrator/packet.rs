@@ -74,27 +74,43 @@ fn select3<L: Lanes>(m: L::M, a: V3<L>, b: V3<L>) -> V3<L> {
     ]
 }
 
-/// Per-lane vectors, as lanes (lanes past `L::N` are not read).
-#[inline(always)]
-fn load3<L: Lanes>(v: &[Vec3; MAX_LANES]) -> V3<L> {
-    let mut c = [[0.0; MAX_LANES]; 3];
-    for (i, v) in v.iter().enumerate() {
-        (c[0][i], c[1][i], c[2][i]) = (v.x, v.y, v.z);
-    }
-    [L::load(&c[0]), L::load(&c[1]), L::load(&c[2])]
-}
+/// Per-lane vectors as lanes hold them: a row of x, one of y, one of z, filled and read lane
+/// by lane (lanes past `L::N` are not read).
+#[derive(Clone, Copy)]
+struct Rows([[f32; MAX_LANES]; 3]);
 
-#[inline(always)]
-fn store3<L: Lanes>(v: V3<L>) -> [Vec3; MAX_LANES] {
-    let mut c = [[0.0; MAX_LANES]; 3];
-    for (lanes, out) in v.iter().zip(&mut c) {
-        lanes.store(out);
+impl Rows {
+    const fn splat(v: Vec3) -> Self {
+        Self([[v.x; MAX_LANES], [v.y; MAX_LANES], [v.z; MAX_LANES]])
     }
-    let mut out = [Vec3::ZERO; MAX_LANES];
-    for (i, v) in out.iter_mut().enumerate() {
-        *v = Vec3::new(c[0][i], c[1][i], c[2][i]);
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: Vec3) {
+        (self.0[0][i], self.0[1][i], self.0[2][i]) = (v.x, v.y, v.z);
     }
-    out
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.0[0][i], self.0[1][i], self.0[2][i])
+    }
+
+    #[inline(always)]
+    fn load<L: Lanes>(&self) -> V3<L> {
+        [
+            L::load(&self.0[0]),
+            L::load(&self.0[1]),
+            L::load(&self.0[2]),
+        ]
+    }
+
+    #[inline(always)]
+    fn of<L: Lanes>(v: V3<L>) -> Self {
+        let mut rows = [[0.0; MAX_LANES]; 3];
+        for (lanes, row) in v.iter().zip(&mut rows) {
+            lanes.store(row);
+        }
+        Self(rows)
+    }
 }
 
 /// `x == 0` (either zero).
@@ -222,10 +238,10 @@ impl<L: Lanes> LambertVertex<L> {
         bsdf_count: f32,
     ) -> V3<L> {
         let zero = L::splat(0.0);
-        let (p, facing) = (store3(self.p), store3(self.facing()));
+        let (p, facing) = (Rows::of(self.p), Rows::of(self.facing()));
         let (select, ux, uy) = (draw.u_select, u[0].values(), u[1].values());
-        let mut wi = [Vec3::Z; MAX_LANES];
-        let mut li = [Vec3::ZERO; MAX_LANES];
+        let mut wi = Rows::splat(Vec3::Z);
+        let mut li = Rows::splat(Vec3::ZERO);
         let (mut pdf, mut dist, mut delta) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
         for i in 0..L::N {
             if !lanes[i] {
@@ -233,12 +249,15 @@ impl<L: Lanes> LambertVertex<L> {
             }
             let u = Vec2::new(ux[i], uy[i]);
             // No sample: a density of 0, which ends the lane's light sample as `direct_light`.
-            if let Some(ls) = scene.lights().sample(p[i], Some(facing[i]), select[i], u) {
-                (wi[i], li[i], pdf[i], dist[i]) = (ls.wi, ls.li, ls.pdf, ls.dist);
+            let (at, side) = (p.get(i), Some(facing.get(i)));
+            if let Some(ls) = scene.lights().sample(at, side, select[i], u) {
+                (pdf[i], dist[i]) = (ls.pdf, ls.dist);
+                wi.set(i, ls.wi);
+                li.set(i, ls.li);
                 delta[i] = if ls.delta { 1.0 } else { 0.0 };
             }
         }
-        let (wi, li, dist) = (load3(&wi), load3(&li), L::load(&dist));
+        let (wi, li, dist) = (wi.load::<L>(), li.load::<L>(), L::load(&dist));
         let pdf = L::load(&pdf) * L::load(&draw.share);
         let dark: L::M = is_zero(li[0]) & is_zero(li[1]) & is_zero(li[2]);
         let lit = !pdf.le(zero) & !dark;
@@ -260,14 +279,14 @@ impl<L: Lanes> LambertVertex<L> {
         let finite = dist.abs().lt(L::splat(f32::INFINITY));
         let tmax = L::select(finite, short, L::splat(f32::INFINITY)).values();
         let tested = lanes_set::<L>(lit & reflects);
-        let (origin, dir) = (store3(origin), store3(wi));
+        let (origin, dir) = (Rows::of(origin), Rows::of(wi));
         let mut visible = [0.0; MAX_LANES];
         for i in 0..L::N {
             if lanes[i] && tested[i] {
                 rays[i] += 1;
                 let blocked = scene
                     .geometry()
-                    .occluded(&Ray::new(origin[i], dir[i]), tmax[i]);
+                    .occluded(&Ray::new(origin.get(i), dir.get(i)), tmax[i]);
                 visible[i] = if blocked { 0.0 } else { 1.0 };
             }
         }
@@ -393,13 +412,13 @@ impl<L: Lanes> Packet<L> {
     fn prev_scatter(&self, i: usize, parts: &PacketParts) -> PrevScatter {
         let prev = self.prev[i];
         PrevScatter {
-            p: parts.prev_p[i],
+            p: parts.prev_p.get(i),
             pdf: parts.prev_pdf[i],
             specular: prev.specular,
             image_share: prev.image_share,
             before_mirror: prev.before_mirror,
             direct_counted: false,
-            facing: prev.broad.then_some(parts.prev_facing[i]),
+            facing: prev.broad.then_some(parts.prev_facing.get(i)),
         }
     }
 
@@ -407,10 +426,10 @@ impl<L: Lanes> Packet<L> {
     #[inline(always)]
     fn lane_state(&self, i: usize, parts: &PacketParts, traced: Option<SurfaceHit>) -> PathState {
         PathState {
-            ray: Ray::new(parts.origin[i], parts.dir[i]),
+            ray: Ray::new(parts.origin.get(i), parts.dir.get(i)),
             traced: Some(traced),
-            throughput: parts.throughput[i],
-            radiance: parts.radiance[i],
+            throughput: parts.throughput.get(i),
+            radiance: parts.radiance.get(i),
             medium: None,
             depth: self.depth,
             pass_through: 0,
@@ -435,10 +454,10 @@ impl<L: Lanes> Packet<L> {
         if (0..L::N).all(|i| kept[i] || !self.live[i]) {
             return;
         }
-        let radiance = store3(self.radiance);
+        let radiance = Rows::of(self.radiance);
         for i in 0..L::N {
             if self.live[i] && !kept[i] {
-                self.finish(i, radiance[i], &mut out[i]);
+                self.finish(i, radiance.get(i), &mut out[i]);
             }
         }
     }
@@ -452,26 +471,26 @@ impl<L: Lanes> Packet<L> {
 
 /// A packet's state, lane by lane: what a lane leaving it takes along.
 struct PacketParts {
-    origin: [Vec3; MAX_LANES],
-    dir: [Vec3; MAX_LANES],
-    throughput: [Vec3; MAX_LANES],
-    radiance: [Vec3; MAX_LANES],
-    prev_p: [Vec3; MAX_LANES],
+    origin: Rows,
+    dir: Rows,
+    throughput: Rows,
+    radiance: Rows,
+    prev_p: Rows,
     prev_pdf: [f32; MAX_LANES],
-    prev_facing: [Vec3; MAX_LANES],
+    prev_facing: Rows,
 }
 
 impl PacketParts {
     #[inline(always)]
     fn of<L: Lanes>(packet: &Packet<L>) -> Self {
         Self {
-            origin: store3(packet.origin),
-            dir: store3(packet.dir),
-            throughput: store3(packet.throughput),
-            radiance: store3(packet.radiance),
-            prev_p: store3(packet.prev_p),
+            origin: Rows::of(packet.origin),
+            dir: Rows::of(packet.dir),
+            throughput: Rows::of(packet.throughput),
+            radiance: Rows::of(packet.radiance),
+            prev_p: Rows::of(packet.prev_p),
             prev_pdf: packet.prev_pdf.values(),
-            prev_facing: store3(packet.prev_facing),
+            prev_facing: Rows::of(packet.prev_facing),
         }
     }
 }
@@ -507,20 +526,22 @@ pub fn trace_packet<S: PathScene, L: Lanes>(
     sampler: &mut PacketSampler<L>,
 ) -> [PathResult; MAX_LANES] {
     let mut out = [PathResult::default(); MAX_LANES];
-    let mut origin = [Vec3::ZERO; MAX_LANES];
-    let mut dir = [Vec3::Z; MAX_LANES];
+    let mut origin = Rows::splat(Vec3::ZERO);
+    let mut dir = Rows::splat(Vec3::Z);
     let mut live = [false; MAX_LANES];
     for i in 0..L::N {
         if let Some(ray) = rays[i] {
-            (origin[i], dir[i], live[i]) = (ray.origin, ray.dir, true);
+            origin.set(i, ray.origin);
+            dir.set(i, ray.dir);
+            live[i] = true;
         }
     }
-    let origin = load3(&origin);
+    let origin = origin.load::<L>();
     let zero = L::splat(0.0);
     let mut packet = Packet {
         live,
         origin,
-        dir: load3(&dir),
+        dir: dir.load::<L>(),
         throughput: [L::splat(1.0); 3],
         radiance: [zero; 3],
         depth: 0,
@@ -610,11 +631,11 @@ struct LaneAt<'a> {
 
 /// What a packet's lanes meet at their next vertex, lane by lane.
 struct LaneHits {
-    p: [Vec3; MAX_LANES],
-    ng: [Vec3; MAX_LANES],
-    ns: [Vec3; MAX_LANES],
-    frame: [[Vec3; MAX_LANES]; 3],
-    f: [Vec3; MAX_LANES],
+    p: Rows,
+    ng: Rows,
+    ns: Rows,
+    frame: [Rows; 3],
+    f: Rows,
     /// The lanes at a bare Lambert surface, shaded in lanes (but a light sample that goes to a
     /// lamp image).
     lambert: [bool; MAX_LANES],
@@ -630,23 +651,38 @@ struct LaneHits {
 
 impl LaneHits {
     #[inline(always)]
-    fn new<L: Lanes>(u: &VertexPacket<L>) -> Self {
+    fn new() -> Self {
         Self {
-            p: [Vec3::ZERO; MAX_LANES],
-            ng: [Vec3::ZERO; MAX_LANES],
-            ns: [Vec3::ZERO; MAX_LANES],
-            frame: [[Vec3::ZERO; MAX_LANES]; 3],
-            f: [Vec3::ZERO; MAX_LANES],
+            p: Rows::splat(Vec3::ZERO),
+            ng: Rows::splat(Vec3::ZERO),
+            ns: Rows::splat(Vec3::ZERO),
+            frame: [Rows::splat(Vec3::ZERO); 3],
+            f: Rows::splat(Vec3::ZERO),
             lambert: [false; MAX_LANES],
             alone: [None; MAX_LANES],
             lit_alone: [None; MAX_LANES],
             image_share: [0.0; MAX_LANES],
             draws: LightDraws {
-                u_select: u.light_select.values(),
+                u_select: [0.0; MAX_LANES],
                 share: [1.0; MAX_LANES],
             },
             by_lane: None,
         }
+    }
+
+    /// Ready for the next vertex, whose numbers are `u`. The lanes' points, normals and
+    /// values are left as they were: a lane's are read only where this vertex sets them.
+    #[inline(always)]
+    fn reset<L: Lanes>(&mut self, u: &VertexPacket<L>) {
+        self.lambert = [false; MAX_LANES];
+        self.alone = [None; MAX_LANES];
+        self.lit_alone = [None; MAX_LANES];
+        self.image_share = [0.0; MAX_LANES];
+        self.draws = LightDraws {
+            u_select: u.light_select.values(),
+            share: [1.0; MAX_LANES],
+        };
+        self.by_lane = None;
     }
 
     /// Takes in lane `at.lane`'s hit, with its BSDF (not a null one), where the lane may stay
@@ -663,7 +699,7 @@ impl LaneHits {
         u: &VertexPacket<L>,
     ) -> bool {
         let i = at.lane;
-        let wo = -at.parts.dir[i];
+        let wo = -at.parts.dir.get(i);
         if packet.depth >= scene.max_depth() {
             // The path ends here.
             packet.rays[i] += 1;
@@ -683,12 +719,17 @@ impl LaneHits {
             }
         }
         packet.rays[i] += 1;
-        (self.p[i], self.ng[i], self.ns[i]) = (hit.p, hit.ng, hit.ns);
+        self.p.set(i, hit.p);
+        self.ng.set(i, hit.ng);
+        self.ns.set(i, hit.ns);
         let lambert_here = lambert.is_some();
         if let Some((frame, ng, f)) = lambert {
             self.lambert[i] = true;
-            (self.ng[i], self.f[i]) = (ng, f);
-            (self.frame[0][i], self.frame[1][i], self.frame[2][i]) = (frame.s, frame.t, frame.n);
+            self.ng.set(i, ng);
+            self.f.set(i, f);
+            self.frame[0].set(i, frame.s);
+            self.frame[1].set(i, frame.t);
+            self.frame[2].set(i, frame.n);
             if !lights.has_mirror_images() {
                 return true;
             }
@@ -751,6 +792,7 @@ fn walk_packet<S: PathScene, L: Lanes>(
     let geometry = scene.geometry();
     let lights = scene.lights();
     let max_depth = scene.max_depth();
+    let mut hits = LaneHits::new();
     loop {
         if !packet.live[..L::N].contains(&true) {
             return None;
@@ -765,12 +807,12 @@ fn walk_packet<S: PathScene, L: Lanes>(
         } else {
             1.0
         };
-        let mut hits = LaneHits::new(&u);
+        hits.reset(&u);
         for i in 0..L::N {
             if !packet.live[i] {
                 continue;
             }
-            let ray = Ray::new(parts.origin[i], parts.dir[i]);
+            let ray = Ray::new(parts.origin.get(i), parts.dir.get(i));
             let wo = -ray.dir;
             let traced = geometry.intersect(&ray, f32::INFINITY);
             let stays = match &traced {
@@ -804,15 +846,15 @@ fn walk_packet<S: PathScene, L: Lanes>(
 
         let wo = negate(packet.dir);
         let frame = [
-            load3(&hits.frame[0]),
-            load3(&hits.frame[1]),
-            load3(&hits.frame[2]),
+            hits.frame[0].load::<L>(),
+            hits.frame[1].load::<L>(),
+            hits.frame[2].load::<L>(),
         ];
         let vertex = LambertVertex {
-            p: load3(&hits.p),
-            ng: load3(&hits.ng),
-            ns: load3(&hits.ns),
-            f: load3(&hits.f),
+            p: hits.p.load::<L>(),
+            ng: hits.ng.load::<L>(),
+            ns: hits.ns.load::<L>(),
+            f: hits.f.load::<L>(),
             wo,
             wo_local: [dot(wo, frame[0]), dot(wo, frame[1]), dot(wo, frame[2])],
             frame,
@@ -837,14 +879,15 @@ fn walk_packet<S: PathScene, L: Lanes>(
         packet.rays = rays;
         let in_lanes = mask_of::<L>(&hits.lambert);
         if hits.by_lane.is_some() {
-            let mut light_alone = [Vec3::ZERO; MAX_LANES];
+            let mut light_alone = Rows::splat(Vec3::ZERO);
             let mut lit = hits.lambert;
-            for i in 0..L::N {
-                if let Some(l) = hits.lit_alone[i] {
-                    (light_alone[i], lit[i]) = (l, true);
+            for (i, (lit, alone)) in lit.iter_mut().zip(&hits.lit_alone).enumerate() {
+                if let Some(l) = *alone {
+                    light_alone.set(i, l);
+                    *lit = true;
                 }
             }
-            let light = select3(mask_of::<L>(&to_lights), light, load3(&light_alone));
+            let light = select3(mask_of::<L>(&to_lights), light, light_alone.load::<L>());
             let radiance = plus(packet.radiance, times(packet.throughput, light));
             packet.radiance = select3(mask_of::<L>(&lit), radiance, packet.radiance);
         } else {
@@ -867,12 +910,12 @@ fn walk_packet<S: PathScene, L: Lanes>(
         let mut broad = L::mask(true);
         let mut facing = vertex.facing();
         if any_alone {
-            let mut a_wi = [Vec3::Z; MAX_LANES];
-            let mut a_weight = [Vec3::ONE; MAX_LANES];
+            let mut a_wi = Rows::splat(Vec3::Z);
+            let mut a_weight = Rows::splat(Vec3::ONE);
             let mut a_pdf = [0.0; MAX_LANES];
             let mut a_valid = [false; MAX_LANES];
             let mut a_broad = hits.lambert;
-            let mut a_facing = [Vec3::ZERO; MAX_LANES];
+            let mut a_facing = Rows::splat(Vec3::ZERO);
             for i in 0..L::N {
                 let Some(step) = hits.alone[i] else {
                     packet.prev[i] = PrevLane {
@@ -883,11 +926,14 @@ fn walk_packet<S: PathScene, L: Lanes>(
                 };
                 let mut specular = false;
                 if let Some((s, w)) = step.sample {
-                    (a_wi[i], a_weight[i], a_pdf[i], a_valid[i]) = (s.wi, w, s.pdf, true);
+                    a_wi.set(i, s.wi);
+                    a_weight.set(i, w);
+                    (a_pdf[i], a_valid[i]) = (s.pdf, true);
                     specular = s.specular;
                 }
                 if let Some(side) = step.broad {
-                    (a_broad[i], a_facing[i]) = (true, side);
+                    a_broad[i] = true;
+                    a_facing.set(i, side);
                 }
                 packet.prev[i] = PrevLane {
                     specular,
@@ -896,12 +942,12 @@ fn walk_packet<S: PathScene, L: Lanes>(
                     broad: step.broad.is_some(),
                 };
             }
-            wi = select3(in_lanes, wi, load3(&a_wi));
-            weight = select3(in_lanes, weight, load3(&a_weight));
+            wi = select3(in_lanes, wi, a_wi.load::<L>());
+            weight = select3(in_lanes, weight, a_weight.load::<L>());
             pdf = L::select(in_lanes, pdf, L::load(&a_pdf));
             valid = (in_lanes & valid) | mask_of::<L>(&a_valid);
             broad = mask_of::<L>(&a_broad);
-            facing = select3(in_lanes, facing, load3(&a_facing));
+            facing = select3(in_lanes, facing, a_facing.load::<L>());
         } else {
             for i in 0..L::N {
                 packet.prev[i] = PrevLane {
