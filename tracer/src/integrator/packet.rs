@@ -621,6 +621,18 @@ fn branch_packet<S: PathScene, L: Lanes>(
     }
 }
 
+/// Where a packet's lanes scatter at a vertex: the BSDF samples' directions, densities and
+/// throughput weights, where they are valid, which vertices scattered broadly (and to which
+/// side).
+struct ScatterLanes<L: Lanes> {
+    weight: V3<L>,
+    wi: V3<L>,
+    pdf: L,
+    valid: L::M,
+    broad: L::M,
+    facing: V3<L>,
+}
+
 /// A lane at a vertex: which, the packet's state lane by lane, and the BSDF samples its light
 /// sample is weighed against.
 struct LaneAt<'a> {
@@ -777,6 +789,57 @@ impl LaneHits {
         packet.rays[i] += rays;
         true
     }
+
+    /// `lambert`'s lanes where the vertex was Lambert, the lone lanes' own samples elsewhere;
+    /// each lane's `prev` set for the next vertex.
+    #[inline(always)]
+    fn with_alone_lanes<L: Lanes>(
+        &self,
+        lambert: ScatterLanes<L>,
+        prev: &mut [PrevLane; MAX_LANES],
+    ) -> ScatterLanes<L> {
+        let in_lanes = mask_of::<L>(&self.lambert);
+        let mut wi = Rows::splat(Vec3::Z);
+        let mut weight = Rows::splat(Vec3::ONE);
+        let mut pdf = [0.0; MAX_LANES];
+        let mut valid = [false; MAX_LANES];
+        let mut broad = self.lambert;
+        let mut facing = Rows::splat(Vec3::ZERO);
+        for i in 0..L::N {
+            let Some(step) = self.alone[i] else {
+                prev[i] = PrevLane {
+                    image_share: self.image_share[i],
+                    ..PrevLane::LAMBERT
+                };
+                continue;
+            };
+            let mut specular = false;
+            if let Some((s, w)) = step.sample {
+                wi.set(i, s.wi);
+                weight.set(i, w);
+                (pdf[i], valid[i]) = (s.pdf, true);
+                specular = s.specular;
+            }
+            if let Some(side) = step.broad {
+                broad[i] = true;
+                facing.set(i, side);
+            }
+            prev[i] = PrevLane {
+                specular,
+                image_share: step.image_share,
+                before_mirror: step.before_mirror,
+                broad: step.broad.is_some(),
+            };
+        }
+        ScatterLanes {
+            weight: select3(in_lanes, lambert.weight, weight.load::<L>()),
+            wi: select3(in_lanes, lambert.wi, wi.load::<L>()),
+            pdf: L::select(in_lanes, lambert.pdf, L::load(&pdf)),
+            valid: (in_lanes & lambert.valid) | mask_of::<L>(&valid),
+            broad: mask_of::<L>(&broad),
+            facing: select3(in_lanes, lambert.facing, facing.load::<L>()),
+        }
+    }
 }
 
 /// Traces the packet on from its rays, adding each lane's light and rays to its `out`, until
@@ -877,7 +940,6 @@ fn walk_packet<S: PathScene, L: Lanes>(
             bsdf_count,
         );
         packet.rays = rays;
-        let in_lanes = mask_of::<L>(&hits.lambert);
         if hits.by_lane.is_some() {
             let mut light_alone = Rows::splat(Vec3::ZERO);
             let mut lit = hits.lambert;
@@ -905,57 +967,32 @@ fn walk_packet<S: PathScene, L: Lanes>(
 
         let bs = vertex.sample(u.bsdf);
         let cos = dot(bs.wi, vertex.ns).abs();
-        let mut weight = scale(vertex.f, cos / bs.pdf);
-        let (mut wi, mut pdf, mut valid) = (bs.wi, bs.pdf, bs.valid);
-        let mut broad = L::mask(true);
-        let mut facing = vertex.facing();
-        if any_alone {
-            let mut a_wi = Rows::splat(Vec3::Z);
-            let mut a_weight = Rows::splat(Vec3::ONE);
-            let mut a_pdf = [0.0; MAX_LANES];
-            let mut a_valid = [false; MAX_LANES];
-            let mut a_broad = hits.lambert;
-            let mut a_facing = Rows::splat(Vec3::ZERO);
-            for i in 0..L::N {
-                let Some(step) = hits.alone[i] else {
-                    packet.prev[i] = PrevLane {
-                        image_share: hits.image_share[i],
-                        ..PrevLane::LAMBERT
-                    };
-                    continue;
-                };
-                let mut specular = false;
-                if let Some((s, w)) = step.sample {
-                    a_wi.set(i, s.wi);
-                    a_weight.set(i, w);
-                    (a_pdf[i], a_valid[i]) = (s.pdf, true);
-                    specular = s.specular;
-                }
-                if let Some(side) = step.broad {
-                    a_broad[i] = true;
-                    a_facing.set(i, side);
-                }
-                packet.prev[i] = PrevLane {
-                    specular,
-                    image_share: step.image_share,
-                    before_mirror: step.before_mirror,
-                    broad: step.broad.is_some(),
-                };
-            }
-            wi = select3(in_lanes, wi, a_wi.load::<L>());
-            weight = select3(in_lanes, weight, a_weight.load::<L>());
-            pdf = L::select(in_lanes, pdf, L::load(&a_pdf));
-            valid = (in_lanes & valid) | mask_of::<L>(&a_valid);
-            broad = mask_of::<L>(&a_broad);
-            facing = select3(in_lanes, facing, a_facing.load::<L>());
+        let lambert = ScatterLanes {
+            weight: scale(vertex.f, cos / bs.pdf),
+            wi: bs.wi,
+            pdf: bs.pdf,
+            valid: bs.valid,
+            broad: L::mask(true),
+            facing: vertex.facing(),
+        };
+        let ScatterLanes {
+            weight,
+            wi,
+            pdf,
+            valid,
+            broad,
+            facing,
+        } = if any_alone {
+            hits.with_alone_lanes(lambert, &mut packet.prev)
         } else {
-            for i in 0..L::N {
-                packet.prev[i] = PrevLane {
-                    image_share: hits.image_share[i],
+            for (prev, &image_share) in packet.prev.iter_mut().zip(&hits.image_share) {
+                *prev = PrevLane {
+                    image_share,
                     ..PrevLane::LAMBERT
                 };
             }
-        }
+            lambert
+        };
         packet.throughput = times(packet.throughput, weight);
         let kept = valid
             & survives(
