@@ -301,14 +301,7 @@ impl<L: Lanes> VertexPacket<L> {
         let light = [self.light[0].values(), self.light[1].values()];
         let (lobe, roulette) = (self.lobe.values(), self.roulette.values());
         let bsdf = [self.bsdf[0].values(), self.bsdf[1].values()];
-        let mut out = [VertexSamples {
-            mix: 0.0,
-            light_select: 0.0,
-            light: Vec2::ZERO,
-            lobe: 0.0,
-            bsdf: Vec2::ZERO,
-            roulette: 0.0,
-        }; MAX_LANES];
+        let mut out = [VertexSamples::default(); MAX_LANES];
         for (i, v) in out.iter_mut().enumerate() {
             *v = VertexSamples {
                 mix: mix[i],
@@ -659,7 +652,7 @@ fn permutation_offset<U: U32Lanes>(i: U, len: u32, p: U) -> U {
 }
 
 /// The values a scattering vertex draws with [`PixelSampler::get_vertex`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VertexSamples {
     /// The component of a mix material.
     pub mix: f32,

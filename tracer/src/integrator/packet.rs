@@ -374,13 +374,16 @@ impl PrevLane {
         before_mirror: None,
         broad: false,
     };
-    /// A Lambert vertex shaded in lanes (its image share set apart).
-    const LAMBERT: Self = Self {
-        specular: false,
-        image_share: 0.0,
-        before_mirror: None,
-        broad: true,
-    };
+    /// A Lambert vertex shaded in lanes, `image_share` of whose light samples went to lamp
+    /// images.
+    const fn lambert(image_share: f32) -> Self {
+        Self {
+            specular: false,
+            image_share,
+            before_mirror: None,
+            broad: true,
+        }
+    }
 }
 
 /// Camera paths in lanes between two vertices. Every lane still in the packet has scattered
@@ -593,10 +596,7 @@ fn branch_packet<S: PathScene, L: Lanes>(
             live[i] = parent.live[i] && kept[i];
         }
         let zero = L::splat(0.0);
-        let mut prev = [PrevLane::LAMBERT; MAX_LANES];
-        for (prev, &image_share) in prev.iter_mut().zip(&branch.image_share) {
-            prev.image_share = image_share;
-        }
+        let prev = branch.image_share.map(PrevLane::lambert);
         let mut continuation = Packet {
             live,
             origin: offset_origin(v.p, v.ng, bs.wi),
@@ -807,10 +807,7 @@ impl LaneHits {
         let mut facing = Rows::splat(Vec3::ZERO);
         for i in 0..L::N {
             let Some(step) = self.alone[i] else {
-                prev[i] = PrevLane {
-                    image_share: self.image_share[i],
-                    ..PrevLane::LAMBERT
-                };
+                prev[i] = PrevLane::lambert(self.image_share[i]);
                 continue;
             };
             let mut specular = false;
@@ -930,16 +927,14 @@ fn walk_packet<S: PathScene, L: Lanes>(
             *to_lights &= lit.is_none();
             any_alone |= alone.is_some();
         }
-        let mut rays = packet.rays;
         let light = vertex.direct_light(
             scene,
             &to_lights,
-            &mut rays,
+            &mut packet.rays,
             &hits.draws,
             u.light,
             bsdf_count,
         );
-        packet.rays = rays;
         if hits.by_lane.is_some() {
             let mut light_alone = Rows::splat(Vec3::ZERO);
             let mut lit = hits.lambert;
@@ -985,12 +980,7 @@ fn walk_packet<S: PathScene, L: Lanes>(
         } = if any_alone {
             hits.with_alone_lanes(lambert, &mut packet.prev)
         } else {
-            for (prev, &image_share) in packet.prev.iter_mut().zip(&hits.image_share) {
-                *prev = PrevLane {
-                    image_share,
-                    ..PrevLane::LAMBERT
-                };
-            }
+            packet.prev = hits.image_share.map(PrevLane::lambert);
             lambert
         };
         packet.throughput = times(packet.throughput, weight);
