@@ -225,8 +225,10 @@ impl<L: Lanes> LambertVertex<L> {
 
 impl<L: Lanes> LambertVertex<L> {
     /// [`direct_light`] at the vertices of the lanes `lanes` sets, with `draw`'s light choice
-    /// numbers and share: the light's choice and point and the shadow ray one lane at a time
-    /// (their rays counted in `rays`), the rest in lanes.
+    /// numbers and share: in lanes, but the shadow rays (counted in `rays`) and, unless the
+    /// lights are a few plain triangle lamps ([`TriangleLamps`]), the light's choice and point.
+    ///
+    /// [`TriangleLamps`]: crate::lights::TriangleLamps
     #[inline(always)]
     fn direct_light<S: PathScene>(
         &self,
@@ -238,27 +240,15 @@ impl<L: Lanes> LambertVertex<L> {
         bsdf_count: f32,
     ) -> V3<L> {
         let zero = L::splat(0.0);
-        let (p, facing) = (Rows::of(self.p), Rows::of(self.facing()));
-        let (select, ux, uy) = (draw.u_select, u[0].values(), u[1].values());
-        let mut wi = Rows::splat(Vec3::Z);
-        let mut li = Rows::splat(Vec3::ZERO);
-        let (mut pdf, mut dist, mut delta) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
-        for i in 0..L::N {
-            if !lanes[i] {
-                continue;
+        let (wi, li, dist, pdf, delta) = match scene.lights().triangle_lamps() {
+            Some(lamps) => {
+                let s = lamps.sample(self.p, L::load(&draw.u_select), u);
+                let pdf = L::select(mask_of::<L>(lanes), s.pdf, zero);
+                (s.wi, s.li, s.dist, pdf, zero)
             }
-            let u = Vec2::new(ux[i], uy[i]);
-            // No sample: a density of 0, which ends the lane's light sample as `direct_light`.
-            let (at, side) = (p.get(i), Some(facing.get(i)));
-            if let Some(ls) = scene.lights().sample(at, side, select[i], u) {
-                (pdf[i], dist[i]) = (ls.pdf, ls.dist);
-                wi.set(i, ls.wi);
-                li.set(i, ls.li);
-                delta[i] = if ls.delta { 1.0 } else { 0.0 };
-            }
-        }
-        let (wi, li, dist) = (wi.load::<L>(), li.load::<L>(), L::load(&dist));
-        let pdf = L::load(&pdf) * L::load(&draw.share);
+            None => self.light_one_lane_at_a_time(scene, lanes, draw, u),
+        };
+        let pdf = pdf * L::load(&draw.share);
         let dark: L::M = is_zero(li[0]) & is_zero(li[1]) & is_zero(li[2]);
         let lit = !pdf.le(zero) & !dark;
         // The BSDF's value: Lambert's where the normals agree and wo and wi share a side.
@@ -296,7 +286,7 @@ impl<L: Lanes> LambertVertex<L> {
             zero,
         );
         let heuristic = power_heuristic(pdf, L::splat(bsdf_count) * bsdf_pdf);
-        let weight = L::select(zero.lt(L::load(&delta)), L::splat(1.0), heuristic);
+        let weight = L::select(zero.lt(delta), L::splat(1.0), heuristic);
         let k = dot(wi, self.ns).abs() * weight / pdf;
         let light = scale(times(self.f, li), k);
         let shown = zero.lt(L::load(&visible));
@@ -305,6 +295,47 @@ impl<L: Lanes> LambertVertex<L> {
             L::select(shown, light[1], zero),
             L::select(shown, light[2], zero),
         ]
+    }
+}
+
+impl<L: Lanes> LambertVertex<L> {
+    /// The lights' samples ([`super::path::PathScene::lights`]' `sample`) of the lanes `lanes`
+    /// sets, one lane at a time: direction, radiance, distance, density (0 where there is
+    /// none) and whether the light is a delta light (1) or not (0).
+    #[inline(always)]
+    fn light_one_lane_at_a_time<S: PathScene>(
+        &self,
+        scene: &S,
+        lanes: &[bool; MAX_LANES],
+        draw: &LightDraws,
+        u: [L; 2],
+    ) -> (V3<L>, V3<L>, L, L, L) {
+        let (p, facing) = (Rows::of(self.p), Rows::of(self.facing()));
+        let (select, ux, uy) = (draw.u_select, u[0].values(), u[1].values());
+        let mut wi = Rows::splat(Vec3::Z);
+        let mut li = Rows::splat(Vec3::ZERO);
+        let (mut pdf, mut dist, mut delta) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
+        for i in 0..L::N {
+            if !lanes[i] {
+                continue;
+            }
+            let u = Vec2::new(ux[i], uy[i]);
+            // No sample: a density of 0, which ends the lane's light sample as `direct_light`.
+            let (at, side) = (p.get(i), Some(facing.get(i)));
+            if let Some(ls) = scene.lights().sample(at, side, select[i], u) {
+                (pdf[i], dist[i]) = (ls.pdf, ls.dist);
+                wi.set(i, ls.wi);
+                li.set(i, ls.li);
+                delta[i] = if ls.delta { 1.0 } else { 0.0 };
+            }
+        }
+        (
+            wi.load::<L>(),
+            li.load::<L>(),
+            L::load(&dist),
+            L::load(&pdf),
+            L::load(&delta),
+        )
     }
 }
 
@@ -1057,12 +1088,18 @@ Material "null"
 AreaLightSource "area" "color L" [6 6 6] "float power" [0]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point P" [-0.5 -0.5 2 -0.5 0.5 2 0.5 0.5 2 0.5 -0.5 2]
 AttributeEnd
-WorldEnd
 "#;
 
-    fn scene(spp: u32, branches: usize) -> (RenderScene, RenderSettings) {
+    /// A light that makes the lamp's tables go (the light's choice and point one lane at a
+    /// time).
+    const POINT: &str = r#"LightSource "point" "point from" [1 -1 2.5] "color L" [0.5 0.5 0.5]"#;
+
+    /// The scene with `light` beside the lamp (its tables are sampled in lanes when there is
+    /// none).
+    fn scene(spp: u32, branches: usize, light: &str) -> (RenderScene, RenderSettings) {
         let mut source = MemorySource::new();
-        source.insert("main.lxs", SCENE.as_bytes().into());
+        let text = format!("{SCENE}{light}\nWorldEnd\n");
+        source.insert("main.lxs", text.as_bytes().into());
         let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
         assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
         let settings = RenderSettings {
@@ -1080,6 +1117,11 @@ WorldEnd
             scene.lights().has_mirror_images(),
             "the mirror shows the lamp"
         );
+        assert_eq!(
+            scene.lights().triangle_lamps().is_some(),
+            light.is_empty(),
+            "lamp tables with {light:?}"
+        );
         (scene.with_first_vertex_branches(branches), settings)
     }
 
@@ -1087,11 +1129,12 @@ WorldEnd
     /// left over) and of an adaptive round (nested samples 16 to 48 in blocks of the floor,
     /// the spheres and the wall) renders to the same buffer bytes and counts in packets of
     /// every lane type as one sample at a time, with one continuation per camera path and with
-    /// three.
+    /// three, with the lamp sampled from its tables in lanes and (beside a point light) one
+    /// lane at a time.
     fn packets_render_the_scalar_bytes<L: Lanes>() {
         let never = AtomicBool::new(false);
-        for branches in [1, 3] {
-            let (scene, settings) = scene(72, branches);
+        for (branches, light) in [(1, ""), (3, ""), (1, POINT), (3, POINT)] {
+            let (scene, settings) = scene(72, branches, light);
             let adaptive = WorkUnit {
                 index: 0,
                 x0: 0,
@@ -1107,7 +1150,10 @@ WorldEnd
             for unit in plan_units(&settings).iter().chain([&adaptive]) {
                 let (one, one_stats) = scene.render_unit_in::<f32>(unit, &never).unwrap();
                 let (lanes, lane_stats) = scene.render_unit_in::<L>(unit, &never).unwrap();
-                let at = format!("unit {unit:?}, {branches} continuations, {} lanes", L::N);
+                let at = format!(
+                    "unit {unit:?}, {branches} continuations, light {light:?}, {} lanes",
+                    L::N
+                );
                 assert_eq!(lane_stats, one_stats, "{at}");
                 assert_eq!(
                     bits(lanes.rgb.as_flattened()),

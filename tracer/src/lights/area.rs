@@ -280,6 +280,22 @@ impl AreaLight {
         }
     }
 
+    /// An untextured light on triangles: its triangles, their choice by area, its area and
+    /// radiance (what [`super::TriangleLamps`] tabulates). None for other lights.
+    pub fn plain_triangles(&self) -> Option<(&[TriangleSurface], &Distribution1D, f32, Vec3)> {
+        match (&self.emitter, &self.texture) {
+            (
+                Emitter::Triangles {
+                    triangles,
+                    by_area,
+                    area,
+                },
+                None,
+            ) => Some((triangles, by_area, *area, self.radiance)),
+            _ => None,
+        }
+    }
+
     pub fn area(&self) -> f32 {
         match &self.emitter {
             Emitter::Triangles { area, .. } => *area,

@@ -5,12 +5,12 @@ use glam::Vec2;
 use crate::math::{bin_at, count_f32};
 
 /// The largest f32 below 1: keeps remapped sample values in [0, 1).
-const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+pub(super) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Tables of at most this many bins are scanned, not searched: a scene's choice among a few
 /// lights, or of a lamp's few triangles, is made at every path vertex, and a compare per bin
 /// costs less there than the guide table's lookups and the search's branches.
-const SCANNED_BINS: usize = 8;
+pub(super) const SCANNED_BINS: usize = 8;
 
 /// A piecewise-constant density on [0, 1) with `len()` equal bins; also a discrete
 /// distribution over the bins.
@@ -71,6 +71,11 @@ impl Distribution1D {
 
     pub fn len(&self) -> usize {
         self.bins.len() - 1
+    }
+
+    /// Where each bin starts in the cumulative distribution, and a last value of 1.
+    pub fn starts(&self) -> impl Iterator<Item = f32> + '_ {
+        self.bins.iter().map(|b| b.cdf)
     }
 
     /// The probability of bin `i` as a discrete choice.

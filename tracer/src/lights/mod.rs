@@ -19,7 +19,8 @@
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
 //! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_cones` (which lamps a cone
-//! of directions may reach). A new kind is one new file, one line in `read` and one line in
+//! of directions may reach), `triangle_lamps` (a few plain triangle lamps sampled in lanes). A
+//! new kind is one new file, one line in `read` and one line in
 //! each `match` below.
 
 mod area;
@@ -36,6 +37,7 @@ mod sample;
 mod sky;
 mod spot;
 mod sun;
+mod triangle_lamps;
 
 #[cfg(test)]
 mod tests;
@@ -65,6 +67,7 @@ pub use sample::LightSample;
 pub use sky::{SkyLight, SkyModel};
 pub use spot::SpotLight;
 pub use sun::{sun_rgb, SunLight};
+pub use triangle_lamps::{LampSamples, TriangleLamps};
 
 use area::AreaLight;
 use distribution::Distribution1D;
@@ -238,6 +241,8 @@ pub struct Lights {
     images: MirrorImages,
     /// The area lights' bounding spheres, for [`Self::lamp_may_be_in`].
     lamp_cones: LampCones,
+    /// The lights as tables for packets, when they are a few plain triangle lamps.
+    triangle_lamps: Option<TriangleLamps>,
 }
 
 impl Lights {
@@ -320,10 +325,16 @@ impl Lights {
             .filter(|&i| matches!(lights[i as usize], Light::Infinite(_)))
             .collect();
         let lamp_boxes: Vec<(Vec3, Vec3)> = area_lights(&lights).map(|(_, l)| l.bounds()).collect();
+        let selection = Distribution1D::new(powers);
+        let lamps = lights.iter().map(|light| match light {
+            Light::Area(lamp) => Some(lamp),
+            _ => None,
+        });
         Ok(Self {
             lamp_cones: LampCones::new(&lamp_boxes),
+            triangle_lamps: TriangleLamps::new(lamps, &selection),
             lights,
-            selection: Distribution1D::new(powers),
+            selection,
             shape_light,
             infinite,
             images: Default::default(),
@@ -332,6 +343,12 @@ impl Lights {
 
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
+    }
+
+    /// The lights as tables a packet's lanes sample together ([`TriangleLamps::sample`] gives
+    /// [`Self::sample`]'s bits), when they are a few untextured triangle lamps.
+    pub fn triangle_lamps(&self) -> Option<&TriangleLamps> {
+        self.triangle_lamps.as_ref()
     }
 
     /// Samples a light as seen from `p` (with `u_select` choosing the light and `u` the point on

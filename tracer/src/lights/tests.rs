@@ -930,3 +930,119 @@ fn facing_samples_weighed_against_cosine_samples_estimate_what_a_surface_receive
         assert!(mean < 0.6, "{w}x{h}: variance ratios {ratios:?}");
     }
 }
+
+/// A flat fan of `n` triangles around the origin in the z = 0 plane, facing -z, of uneven
+/// sizes (so that the triangles' choice by area is not uniform).
+fn fan_facing_down(n: u32) -> Geometry {
+    let mut vertices = vec![Vec3::ZERO];
+    for k in 0..=n {
+        let angle = TAU * k as f32 / (n + 1) as f32;
+        let r = 0.3 + 0.1 * k as f32;
+        vertices.push(Vec3::new(r * angle.cos(), r * angle.sin(), 0.0));
+    }
+    let triangles = (1..=n).map(|k| [0, k + 1, k]).collect();
+    Geometry::Mesh(Arc::new(mesh(vertices, triangles)))
+}
+
+/// Packets sample a few plain triangle lamps in lanes: every lane type gives, lane by lane,
+/// the bits of `Lights::sample` (direction, radiance, density, distance; a density of 0 where
+/// it finds no sample), from points around and behind the lamps, with choice numbers across
+/// [0, 1) and at its ends.
+#[test]
+fn triangle_lamps_in_lanes_give_the_bits_of_one_sample_at_a_time() {
+    use crate::lanes::tests::{on_every_lane_type, OnLanes};
+    use crate::lanes::{Lanes, MAX_LANES};
+
+    let lamps = vec![
+        emitter(
+            square_facing_down(1.0),
+            Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)),
+            Vec3::new(3.0, 2.0, 1.0),
+        ),
+        emitter(
+            fan_facing_down(7),
+            Mat4::from_translation(Vec3::new(1.5, 0.5, 1.5)) * Mat4::from_rotation_x(0.4),
+            Vec3::new(0.5, 4.0, 2.0),
+        ),
+        emitter(
+            fan_facing_down(1),
+            Mat4::from_translation(Vec3::new(-1.0, 0.0, 1.0)),
+            Vec3::splat(9.0),
+        ),
+    ];
+    let (_, lights) = build(lamps, vec![]);
+    struct Agrees<'a>(&'a Lights);
+    impl OnLanes for Agrees<'_> {
+        fn run<L: Lanes>(&self) {
+            let lights = self.0;
+            let lamps = lights.triangle_lamps().expect("three plain triangle lamps");
+            let mut rng = fastrand::Rng::with_seed(5);
+            let (mut found, mut none) = (0, 0);
+            for round in 0..4000 {
+                let mut from = [[0.0; MAX_LANES]; 3];
+                let mut u = [[0.0; MAX_LANES]; 3];
+                for i in 0..L::N {
+                    for c in 0..3 {
+                        from[c][i] = rng.f32() * 6.0 - 3.0;
+                        u[c][i] = match (round + i) % 16 {
+                            0 => 0.0,
+                            1 => 1.0 - f32::EPSILON / 2.0,
+                            _ => rng.f32(),
+                        };
+                    }
+                }
+                let s = lamps.sample(
+                    from.map(|c| L::load(&c)),
+                    L::load(&u[0]),
+                    [L::load(&u[1]), L::load(&u[2])],
+                );
+                let (pdf, dist) = (s.pdf.values(), s.dist.values());
+                let (wi, li) = (s.wi.map(L::values), s.li.map(L::values));
+                for i in 0..L::N {
+                    let p = Vec3::new(from[0][i], from[1][i], from[2][i]);
+                    let one = lights.sample(p, None, u[0][i], Vec2::new(u[1][i], u[2][i]));
+                    let Some(one) = one else {
+                        assert_eq!(pdf[i], 0.0, "lane {i} from {p}: no sample alone");
+                        none += 1;
+                        continue;
+                    };
+                    found += 1;
+                    let lane = |v: [[f32; MAX_LANES]; 3]| Vec3::new(v[0][i], v[1][i], v[2][i]);
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(lane(wi)), bits(one.wi), "lane {i} from {p}");
+                    assert_eq!(bits(lane(li)), bits(one.li), "lane {i} from {p}");
+                    assert_eq!(pdf[i].to_bits(), one.pdf.to_bits(), "lane {i} from {p}");
+                    assert_eq!(dist[i].to_bits(), one.dist.to_bits(), "lane {i} from {p}");
+                    assert!(!one.delta);
+                }
+            }
+            assert!(found > 1000 && none > 500, "{found} samples, {none} none");
+        }
+    }
+    on_every_lane_type(&Agrees(&lights));
+}
+
+/// Only a few plain triangle lamps are tabulated for lanes: not a point light beside them, a
+/// sphere lamp, a lamp of more triangles than a scan covers, or no light at all.
+#[test]
+fn triangle_lamps_are_only_a_few_plain_triangle_lamps() {
+    let square = || emitter(square_facing_down(1.0), Mat4::IDENTITY, Vec3::ONE);
+    let tabulated = |shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>| {
+        build(shapes, lights).1.triangle_lamps().is_some()
+    };
+    assert!(tabulated(vec![square(), square()], vec![]));
+    assert!(!tabulated(vec![square()], vec![point(Vec3::Z, 1.0)]));
+    assert!(!tabulated(
+        vec![square(), emitter(sphere(0.5), Mat4::IDENTITY, Vec3::ONE)],
+        vec![]
+    ));
+    assert!(tabulated(
+        vec![emitter(fan_facing_down(8), Mat4::IDENTITY, Vec3::ONE)],
+        vec![]
+    ));
+    assert!(!tabulated(
+        vec![emitter(fan_facing_down(9), Mat4::IDENTITY, Vec3::ONE)],
+        vec![]
+    ));
+    assert!(!tabulated(vec![], vec![]));
+}
