@@ -296,9 +296,7 @@ impl<L: Lanes> LambertVertex<L> {
             L::select(shown, light[2], zero),
         ]
     }
-}
 
-impl<L: Lanes> LambertVertex<L> {
     /// The lights' samples ([`super::path::PathScene::lights`]' `sample`) of the lanes `lanes`
     /// sets, one lane at a time: direction, radiance, distance, density (0 where there is
     /// none) and whether the light is a delta light (1) or not (0).
