@@ -21,9 +21,10 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::bxdf::local::sample_disk_concentric;
+use crate::bxdf::local::concentric_disk;
 use crate::diag::SourcePos;
 use crate::film::FilmDesc;
+use crate::lanes::Lanes;
 use crate::math::Ray;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -183,60 +184,90 @@ impl Camera {
         }
     }
 
-    /// The screen-space point of a raster position.
-    fn screen(&self, film: Vec2) -> Vec2 {
-        let [x0, x1, y0, y1] = self.window;
-        Vec2::new(
-            x0 + film.x / self.width * (x1 - x0),
-            y1 - film.y / self.height * (y1 - y0),
-        )
-    }
-
     /// The world-space ray through raster position `film`, with `lens` in [0,1)^2 choosing the
     /// point on the lens. None where the camera sees nothing (outside the fisheye circle).
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Option<Ray> {
-        let (origin, dir) = match self.projection {
-            Projection::Perspective { tan_half_fov } => {
-                let s = self.screen(film);
-                let dir = Vec3::new(s.x * tan_half_fov, s.y * tan_half_fov, 1.0);
-                self.thin_lens(Vec3::ZERO, dir, lens)
-            }
-            Projection::Orthographic => {
-                let s = self.screen(film);
-                self.thin_lens(Vec3::new(s.x, s.y, 0.0), Vec3::Z, lens)
-            }
-            Projection::Fisheye { fov_radians } => {
-                let rx = 2.0 * film.x / self.width - 1.0;
-                let ry = 1.0 - 2.0 * film.y / self.height;
-                let r = (rx * rx + ry * ry).sqrt();
-                if r > 1.0 {
-                    return None;
-                }
-                let psi = r * fov_radians;
-                let alpha = ry.atan2(rx);
-                let (sin_psi, cos_psi) = psi.sin_cos();
-                let (sin_a, cos_a) = alpha.sin_cos();
-                (
-                    Vec3::ZERO,
-                    Vec3::new(sin_psi * cos_a, sin_psi * sin_a, cos_psi),
-                )
-            }
+        let Projection::Fisheye { fov_radians } = self.projection else {
+            let (origin, dir) = self.flat_rays::<f32>(film.to_array(), lens.to_array())?;
+            return Some(Ray::new(Vec3::from(origin), Vec3::from(dir)));
         };
-        let origin = self.camera_to_world.transform_point3(origin);
+        let rx = 2.0 * film.x / self.width - 1.0;
+        let ry = 1.0 - 2.0 * film.y / self.height;
+        let r = (rx * rx + ry * ry).sqrt();
+        if r > 1.0 {
+            return None;
+        }
+        let psi = r * fov_radians;
+        let alpha = ry.atan2(rx);
+        let (sin_psi, cos_psi) = psi.sin_cos();
+        let (sin_a, cos_a) = alpha.sin_cos();
+        let dir = Vec3::new(sin_psi * cos_a, sin_psi * sin_a, cos_psi);
+        let origin = self.camera_to_world.transform_point3(Vec3::ZERO);
         let dir = self.camera_to_world.transform_vector3(dir).normalize();
         Some(Ray::new(origin, dir))
     }
 
-    /// Moves a pinhole ray onto a lens point aimed at the same point of the focal plane. With
-    /// radius 0 the pinhole ray is returned untouched, so the image is exactly the pinhole one.
-    fn thin_lens(&self, origin: Vec3, dir: Vec3, lens: Vec2) -> (Vec3, Vec3) {
-        if self.lens_radius <= 0.0 {
-            return (origin, dir);
+    /// [`Self::generate_ray`] in lanes for a perspective or orthographic camera (every lane
+    /// gets the bits one lane gets): world-space origins and unit directions through raster
+    /// positions `film`, lens points chosen by `lens`. None for a fisheye camera.
+    #[inline(always)]
+    pub fn flat_rays<L: Lanes>(&self, film: [L; 2], lens: [L; 2]) -> Option<([L; 3], [L; 3])> {
+        // Loops and splats, not `map`: a closure would not inherit an AVX2 caller's features.
+        let [x0, x1, y0, y1] = self.window;
+        let (x0, x1, y0, y1) = (L::splat(x0), L::splat(x1), L::splat(y0), L::splat(y1));
+        // The screen-space point.
+        let sx = x0 + film[0] / L::splat(self.width) * (x1 - x0);
+        let sy = y1 - film[1] / L::splat(self.height) * (y1 - y0);
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let (origin, dir) = match self.projection {
+            Projection::Perspective { tan_half_fov } => {
+                let tan = L::splat(tan_half_fov);
+                ([zero; 3], [sx * tan, sy * tan, one])
+            }
+            Projection::Orthographic => ([sx, sy, zero], [zero, zero, one]),
+            Projection::Fisheye { .. } => return None,
+        };
+        // The thin lens moves a pinhole ray onto a lens point aimed at the same point of the
+        // focal plane. With radius 0 the pinhole ray is kept untouched, so the image is exactly
+        // the pinhole one.
+        let (origin, dir) = if self.lens_radius <= 0.0 {
+            (origin, dir)
+        } else {
+            let radius = L::splat(self.lens_radius);
+            let [lx, ly] = concentric_disk(lens);
+            let to_focus = L::splat(self.focal_distance) / dir[2];
+            let lens_point = [
+                origin[0] + lx * radius,
+                origin[1] + ly * radius,
+                origin[2] + zero,
+            ];
+            let mut towards = [zero; 3];
+            for c in 0..3 {
+                towards[c] = origin[c] + dir[c] * to_focus - lens_point[c];
+            }
+            (lens_point, towards)
+        };
+        // `Mat4::transform_point3`, `transform_vector3`, `Vec3::normalize`: their operations in
+        // their order.
+        let m = self.camera_to_world.to_cols_array_2d();
+        let mut axes = [[zero; 3]; 4];
+        for (axis, column) in axes.iter_mut().zip(m) {
+            for c in 0..3 {
+                axis[c] = L::splat(column[c]);
+            }
         }
-        let on_lens = sample_disk_concentric(lens) * self.lens_radius;
-        let focus = origin + dir * (self.focal_distance / dir.z);
-        let lens_point = origin + Vec3::new(on_lens.x, on_lens.y, 0.0);
-        (lens_point, focus - lens_point)
+        let mut world_origin = [zero; 3];
+        let mut world_dir = [zero; 3];
+        for c in 0..3 {
+            let along = axes[1][c] * dir[1] + axes[0][c] * dir[0];
+            world_dir[c] = axes[2][c] * dir[2] + along;
+            let at = axes[1][c] * origin[1] + axes[0][c] * origin[0];
+            world_origin[c] = axes[3][c] + (axes[2][c] * origin[2] + at);
+        }
+        let [dx, dy, dz] = world_dir;
+        let length = (dx * dx + dy * dy + dz * dz).sqrt();
+        let recip = one / length;
+        Some((world_origin, [dx * recip, dy * recip, dz * recip]))
     }
 }
 
@@ -261,6 +292,98 @@ mod tests {
             hither: 1e-3,
             yon: 1e30,
         }
+    }
+
+    /// The ray of a perspective or orthographic camera as glam's transforms give it (what the
+    /// camera computed before its rays were written over lanes).
+    fn glam_ray(cam: &Camera, film: Vec2, lens: Vec2) -> Ray {
+        let [x0, x1, y0, y1] = cam.window;
+        let s = Vec2::new(
+            x0 + film.x / cam.width * (x1 - x0),
+            y1 - film.y / cam.height * (y1 - y0),
+        );
+        let (origin, dir) = match cam.projection {
+            Projection::Perspective { tan_half_fov } => (
+                Vec3::ZERO,
+                Vec3::new(s.x * tan_half_fov, s.y * tan_half_fov, 1.0),
+            ),
+            _ => (Vec3::new(s.x, s.y, 0.0), Vec3::Z),
+        };
+        let (origin, dir) = if cam.lens_radius <= 0.0 {
+            (origin, dir)
+        } else {
+            let on_lens = crate::bxdf::local::sample_disk_concentric(lens) * cam.lens_radius;
+            let focus = origin + dir * (cam.focal_distance / dir.z);
+            let lens_point = origin + Vec3::new(on_lens.x, on_lens.y, 0.0);
+            (lens_point, focus - lens_point)
+        };
+        Ray::new(
+            cam.camera_to_world.transform_point3(origin),
+            cam.camera_to_world.transform_vector3(dir).normalize(),
+        )
+    }
+
+    /// Perspective and orthographic rays in lanes, with and without a lens, under a turned and
+    /// moved camera with an uneven screen window: every lane type gives, lane by lane, the bits of glam's transforms of the
+    /// camera-space ray; a fisheye camera has none in lanes.
+    #[test]
+    fn rays_in_lanes_are_glams_rays_bit_for_bit() {
+        use crate::lanes::tests::{on_every_lane_type, OnLanes};
+        use crate::lanes::MAX_LANES;
+
+        struct Agrees(Vec<Camera>);
+        impl OnLanes for Agrees {
+            fn run<L: Lanes>(&self) {
+                let mut rng = fastrand::Rng::with_seed(4);
+                for cam in &self.0 {
+                    for _ in 0..500 {
+                        let mut v = [[0.0; MAX_LANES]; 4];
+                        let scales = [cam.width, cam.height, 1.0, 1.0];
+                        for (row, scale) in v.iter_mut().zip(scales) {
+                            for value in &mut row[..L::N] {
+                                *value = rng.f32() * scale;
+                            }
+                        }
+                        let film = [L::load(&v[0]), L::load(&v[1])];
+                        let lens = [L::load(&v[2]), L::load(&v[3])];
+                        let (origin, dir) = cam.flat_rays(film, lens).expect("a flat camera");
+                        let (origin, dir) = (origin.map(L::values), dir.map(L::values));
+                        for i in 0..L::N {
+                            let want = glam_ray(
+                                cam,
+                                Vec2::new(v[0][i], v[1][i]),
+                                Vec2::new(v[2][i], v[3][i]),
+                            );
+                            let got = [origin, dir].map(|r| [r[0][i], r[1][i], r[2][i]]);
+                            let bits = |v: [f32; 3]| v.map(f32::to_bits);
+                            assert_eq!(bits(got[0]), bits(want.origin.to_array()), "{cam:?}");
+                            assert_eq!(bits(got[1]), bits(want.dir.to_array()), "{cam:?}");
+                        }
+                    }
+                }
+            }
+        }
+        let turned = Mat4::from_translation(Vec3::new(0.3, -4.0, 1.7))
+            * Mat4::from_rotation_z(0.7)
+            * Mat4::from_rotation_x(-1.2);
+        let camera = |kind, lens_radius| {
+            let desc = CameraDesc {
+                camera_to_world: turned,
+                screen_window: [-1.7, 1.7, -0.95, 0.95],
+                ..desc(kind, lens_radius)
+            };
+            Camera::new(&desc, 96, 54)
+        };
+        let perspective = CameraKind::Perspective { fov: 40.0 };
+        let cameras = vec![
+            camera(perspective.clone(), 0.0),
+            camera(perspective, 0.15),
+            camera(CameraKind::Orthographic, 0.0),
+            camera(CameraKind::Orthographic, 0.1),
+        ];
+        on_every_lane_type(&Agrees(cameras));
+        let fisheye = camera(CameraKind::Fisheye { fov: 180.0 }, 0.0);
+        assert!(fisheye.flat_rays([0.5f32; 2], [0.5; 2]).is_none());
     }
 
     #[test]

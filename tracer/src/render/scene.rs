@@ -301,16 +301,37 @@ impl RenderScene {
                             PacketSampler::<L>::new(x, y, index, self.settings.spp, seed)
                         };
                         let (film, lens) = sampler.get_camera();
+                        let at = [L::splat(x as f32) + film[0], L::splat(y as f32) + film[1]];
+                        // Not `Option::map`: a closure would not inherit the AVX2 caller's
+                        // features.
+                        #[allow(clippy::manual_map)]
+                        let flat = match self.camera.flat_rays(at, lens) {
+                            Some(([ox, oy, oz], [dx, dy, dz])) => Some((
+                                [ox.values(), oy.values(), oz.values()],
+                                [dx.values(), dy.values(), dz.values()],
+                            )),
+                            None => None,
+                        };
                         // Not `map`: a closure would not inherit the AVX2 caller's features.
-                        let film = [film[0].values(), film[1].values()];
-                        let lens = [lens[0].values(), lens[1].values()];
+                        let (film, lens) = (
+                            [film[0].values(), film[1].values()],
+                            [lens[0].values(), lens[1].values()],
+                        );
                         let mut rays = [None; MAX_LANES];
                         let mut us = [Vec2::ZERO; MAX_LANES];
                         for i in 0..L::N {
                             us[i] = Vec2::new(film[0][i], film[1][i]);
-                            let at = Vec2::new(x as f32 + us[i].x, y as f32 + us[i].y);
-                            let lens = Vec2::new(lens[0][i], lens[1][i]);
-                            rays[i] = self.camera.generate_ray(at, lens);
+                            rays[i] = match &flat {
+                                Some((o, d)) => Some(Ray::new(
+                                    Vec3::new(o[0][i], o[1][i], o[2][i]),
+                                    Vec3::new(d[0][i], d[1][i], d[2][i]),
+                                )),
+                                None => {
+                                    let at = Vec2::new(x as f32 + us[i].x, y as f32 + us[i].y);
+                                    let lens = Vec2::new(lens[0][i], lens[1][i]);
+                                    self.camera.generate_ray(at, lens)
+                                }
+                            };
                         }
                         let paths = packet::trace_packet(self, &rays, &mut sampler);
                         for i in 0..L::N {
