@@ -24,7 +24,7 @@ use glam::{Mat4, Vec2, Vec3};
 use crate::bxdf::local::concentric_disk;
 use crate::diag::SourcePos;
 use crate::film::FilmDesc;
-use crate::lanes::Lanes;
+use crate::lanes::{Lanes, MAX_LANES};
 use crate::math::Ray;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -205,6 +205,34 @@ impl Camera {
         let origin = self.camera_to_world.transform_point3(Vec3::ZERO);
         let dir = self.camera_to_world.transform_vector3(dir).normalize();
         Some(Ray::new(origin, dir))
+    }
+
+    /// The rays of a packet's samples at raster positions `film`, lens points chosen by `lens`
+    /// ([`Self::generate_ray`] lane by lane): in lanes ([`Self::flat_rays`]) but for a fisheye.
+    #[inline(always)]
+    pub fn packet_rays<L: Lanes>(&self, film: [L; 2], lens: [L; 2]) -> [Option<Ray>; MAX_LANES] {
+        let mut rays = [None; MAX_LANES];
+        // Not `Option::map` or closures: a closure would not inherit an AVX2 caller's features.
+        if let Some(([ox, oy, oz], [dx, dy, dz])) = self.flat_rays(film, lens) {
+            let (o, d) = (
+                [ox.values(), oy.values(), oz.values()],
+                [dx.values(), dy.values(), dz.values()],
+            );
+            for (i, ray) in rays.iter_mut().enumerate().take(L::N) {
+                let origin = Vec3::new(o[0][i], o[1][i], o[2][i]);
+                *ray = Some(Ray::new(origin, Vec3::new(d[0][i], d[1][i], d[2][i])));
+            }
+        } else {
+            let (film, lens) = (
+                [film[0].values(), film[1].values()],
+                [lens[0].values(), lens[1].values()],
+            );
+            for (i, ray) in rays.iter_mut().enumerate().take(L::N) {
+                let at = Vec2::new(film[0][i], film[1][i]);
+                *ray = self.generate_ray(at, Vec2::new(lens[0][i], lens[1][i]));
+            }
+        }
+        rays
     }
 
     /// [`Self::generate_ray`] in lanes for a perspective or orthographic camera (every lane

@@ -24,6 +24,7 @@ use super::path::{
 use crate::bxdf::local::cosine_hemisphere;
 use crate::geometry::SurfaceHit;
 use crate::lanes::{Lanes, MAX_LANES};
+use crate::lights::LightSamples;
 use crate::material::{Bsdf, BsdfSample};
 use crate::math::Ray;
 use crate::medium::ShapeMedia;
@@ -240,14 +241,21 @@ impl<L: Lanes> LambertVertex<L> {
         bsdf_count: f32,
     ) -> V3<L> {
         let zero = L::splat(0.0);
-        let (wi, li, dist, pdf, delta) = match scene.lights().triangle_lamps() {
+        let light = match scene.lights().triangle_lamps() {
             Some(lamps) => {
                 let s = lamps.sample(self.p, L::load(&draw.u_select), u);
                 let pdf = L::select(mask_of::<L>(lanes), s.pdf, zero);
-                (s.wi, s.li, s.dist, pdf, zero)
+                LightSamples { pdf, ..s }
             }
             None => self.light_one_lane_at_a_time(scene, lanes, draw, u),
         };
+        let LightSamples {
+            wi,
+            li,
+            pdf,
+            dist,
+            delta,
+        } = light;
         let pdf = pdf * L::load(&draw.share);
         let dark: L::M = is_zero(li[0]) & is_zero(li[1]) & is_zero(li[2]);
         let lit = !pdf.le(zero) & !dark;
@@ -298,8 +306,7 @@ impl<L: Lanes> LambertVertex<L> {
     }
 
     /// The lights' samples ([`super::path::PathScene::lights`]' `sample`) of the lanes `lanes`
-    /// sets, one lane at a time: direction, radiance, distance, density (0 where there is
-    /// none) and whether the light is a delta light (1) or not (0).
+    /// sets, one lane at a time (a density of 0 where there is none).
     #[inline(always)]
     fn light_one_lane_at_a_time<S: PathScene>(
         &self,
@@ -307,7 +314,7 @@ impl<L: Lanes> LambertVertex<L> {
         lanes: &[bool; MAX_LANES],
         draw: &LightDraws,
         u: [L; 2],
-    ) -> (V3<L>, V3<L>, L, L, L) {
+    ) -> LightSamples<L> {
         let (p, facing) = (Rows::of(self.p), Rows::of(self.facing()));
         let (select, ux, uy) = (draw.u_select, u[0].values(), u[1].values());
         let mut wi = Rows::splat(Vec3::Z);
@@ -327,13 +334,13 @@ impl<L: Lanes> LambertVertex<L> {
                 delta[i] = if ls.delta { 1.0 } else { 0.0 };
             }
         }
-        (
-            wi.load::<L>(),
-            li.load::<L>(),
-            L::load(&dist),
-            L::load(&pdf),
-            L::load(&delta),
-        )
+        LightSamples {
+            wi: wi.load::<L>(),
+            li: li.load::<L>(),
+            pdf: L::load(&pdf),
+            dist: L::load(&dist),
+            delta: L::load(&delta),
+        }
     }
 }
 

@@ -19,9 +19,8 @@
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
 //! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_cones` (which lamps a cone
-//! of directions may reach), `triangle_lamps` (a few plain triangle lamps sampled in lanes). A
-//! new kind is one new file, one line in `read` and one line in
-//! each `match` below.
+//! of directions may reach), `triangle_lamps` (a few plain triangle lamps sampled in lanes).
+//! A new kind is one new file, one line in `read` and one line in each `match` below.
 
 mod area;
 mod distant;
@@ -67,7 +66,7 @@ pub use sample::LightSample;
 pub use sky::{SkyLight, SkyModel};
 pub use spot::SpotLight;
 pub use sun::{sun_rgb, SunLight};
-pub use triangle_lamps::{LampSamples, TriangleLamps};
+pub use triangle_lamps::{LightSamples, TriangleLamps};
 
 use area::AreaLight;
 use distribution::Distribution1D;

@@ -14,13 +14,15 @@ use super::distribution::{Distribution1D, ONE_MINUS_EPSILON, SCANNED_BINS};
 /// Floats a triangle takes in [`TriangleLamps::triangles`]: three vertices and the normal.
 const TRIANGLE_FLOATS: usize = 12;
 
-/// Light samples of a packet's lanes ([`super::LightSample`]'s fields; never delta).
-pub struct LampSamples<L: Lanes> {
+/// Light samples of a packet's lanes ([`super::LightSample`]'s fields).
+pub struct LightSamples<L: Lanes> {
     pub wi: [L; 3],
     pub li: [L; 3],
     /// 0 where a lane has no sample (the point shows its back, or the density is not finite).
     pub pdf: L,
     pub dist: L,
+    /// 1 where the light is a delta light, else 0 (never, for lamps).
+    pub delta: L,
 }
 
 /// Tables of every lamp of a scene whose lights are all untextured lamps of at most
@@ -98,7 +100,7 @@ impl TriangleLamps {
     /// Light samples as seen from each lane's `from`: `u_select` chooses the lamp, `u` the
     /// triangle and the point on it ([`super::Lights::sample`] one lane at a time).
     #[inline(always)]
-    pub fn sample<L: Lanes>(&self, from: [L; 3], u_select: L, u: [L; 2]) -> LampSamples<L> {
+    pub fn sample<L: Lanes>(&self, from: [L; 3], u_select: L, u: [L; 2]) -> LightSamples<L> {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         // `Distribution1D::sample_discrete`: the last bin starting at or below u.
         let mut lamp = zero;
@@ -160,11 +162,12 @@ impl TriangleLamps {
         let cos_light = L::splat(-1.0) * (n[0] * wi[0] + n[1] * wi[1] + n[2] * wi[2]);
         let pdf = L::gather(&self.pdf_area, lamp) * dist2 / cos_light;
         let valid = zero.lt(cos_light) & pdf.abs().lt(L::splat(f32::INFINITY));
-        LampSamples {
+        LightSamples {
             wi,
             li,
             pdf: L::select(valid, pmf * pdf, zero),
             dist,
+            delta: zero,
         }
     }
 

@@ -16,7 +16,7 @@ use crate::geometry::{SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
 use crate::integrator::path::{trace_path, PathResult, PathScene, MAX_BRANCHES};
-use crate::lanes::{Lanes, MAX_LANES};
+use crate::lanes::Lanes;
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
 use crate::math::Ray;
@@ -302,41 +302,13 @@ impl RenderScene {
                         };
                         let (film, lens) = sampler.get_camera();
                         let at = [L::splat(x as f32) + film[0], L::splat(y as f32) + film[1]];
-                        // Not `Option::map`: a closure would not inherit the AVX2 caller's
-                        // features.
-                        #[allow(clippy::manual_map)]
-                        let flat = match self.camera.flat_rays(at, lens) {
-                            Some(([ox, oy, oz], [dx, dy, dz])) => Some((
-                                [ox.values(), oy.values(), oz.values()],
-                                [dx.values(), dy.values(), dz.values()],
-                            )),
-                            None => None,
-                        };
-                        // Not `map`: a closure would not inherit the AVX2 caller's features.
-                        let (film, lens) = (
-                            [film[0].values(), film[1].values()],
-                            [lens[0].values(), lens[1].values()],
-                        );
-                        let mut rays = [None; MAX_LANES];
-                        let mut us = [Vec2::ZERO; MAX_LANES];
-                        for i in 0..L::N {
-                            us[i] = Vec2::new(film[0][i], film[1][i]);
-                            rays[i] = match &flat {
-                                Some((o, d)) => Some(Ray::new(
-                                    Vec3::new(o[0][i], o[1][i], o[2][i]),
-                                    Vec3::new(d[0][i], d[1][i], d[2][i]),
-                                )),
-                                None => {
-                                    let at = Vec2::new(x as f32 + us[i].x, y as f32 + us[i].y);
-                                    let lens = Vec2::new(lens[0][i], lens[1][i]);
-                                    self.camera.generate_ray(at, lens)
-                                }
-                            };
-                        }
+                        let rays = self.camera.packet_rays(at, lens);
                         let paths = packet::trace_packet(self, &rays, &mut sampler);
+                        let film = [film[0].values(), film[1].values()];
                         for i in 0..L::N {
-                            let sample = (x, y, index + i as u32);
-                            self.add_sample(&mut sums, &mut stats, sample, us[i], paths[i]);
+                            let (sample, u) =
+                                ((x, y, index + i as u32), Vec2::new(film[0][i], film[1][i]));
+                            self.add_sample(&mut sums, &mut stats, sample, u, paths[i]);
                         }
                         index += L::N as u32;
                     }
