@@ -12,7 +12,7 @@
 //! path does what the packet's lanes cannot do together (meets a miss, an emitter or a null
 //! surface; splits at a glossy vertex; meets anything but Lambert where the paths branch)
 //! leaves the packet and goes on one at a time from the same state and the same place in its
-//! sample stream, by [`walk`] itself.
+//! sample stream, by [`walk`] itself; so do the last lanes of a packet down to [`FEW_LANES`].
 
 use glam::{Vec2, Vec3};
 
@@ -36,6 +36,13 @@ use crate::sampler::{PacketSampler, VertexPacket, VertexSamples};
 pub fn covers<S: PathScene>(scene: &S) -> bool {
     scene.volumes().media.is_empty() && scene.volumes().camera.is_none()
 }
+
+/// A packet whose live lanes are this few hands them to [`walk`]: shading in lanes costs
+/// what it costs for all `L::N`, and below three live lanes one path at a time is the
+/// cheaper (depth of field, Cornell and Captain Falcon 2-3% sooner than with no such bound,
+/// Mario even; bench/RESULTS.md, session 28). Paths live a few vertices, so most packets end
+/// with few lanes.
+const FEW_LANES: usize = 2;
 
 /// Three coordinates in lanes.
 type V3<L> = [L; 3];
@@ -463,10 +470,15 @@ impl<L: Lanes> Packet<L> {
 
     /// Lane `i`'s path as [`walk`] carries it, with what its ray hits.
     #[inline(always)]
-    fn lane_state(&self, i: usize, parts: &PacketParts, traced: Option<SurfaceHit>) -> PathState {
+    fn lane_state(
+        &self,
+        i: usize,
+        parts: &PacketParts,
+        traced: Option<Option<SurfaceHit>>,
+    ) -> PathState {
         PathState {
             ray: Ray::new(parts.origin.get(i), parts.dir.get(i)),
-            traced: Some(traced),
+            traced,
             throughput: parts.throughput.get(i),
             radiance: parts.radiance.get(i),
             medium: None,
@@ -476,6 +488,25 @@ impl<L: Lanes> Packet<L> {
             branches: self.branches,
             prev: self.prev_scatter(i, parts),
         }
+    }
+
+    /// Lane `i` leaves the packet and its path goes on alone by [`walk`] from the packet's
+    /// state (with what its ray hits, when traced already) and from `stream`'s place in the
+    /// lane's own sample stream; its light and rays go to `out`.
+    #[inline(always)]
+    fn go_on_alone<S: PathScene>(
+        &mut self,
+        scene: &S,
+        i: usize,
+        parts: &PacketParts,
+        traced: Option<Option<SurfaceHit>>,
+        stream: &PacketSampler<L>,
+        out: &mut PathResult,
+    ) {
+        self.live[i] = false;
+        out.rays += self.rays[i];
+        let state = self.lane_state(i, parts, traced);
+        walk(scene, state, &mut stream.lane(i), out);
     }
 
     /// Ends lane `i`: its light and rays go to `out`.
@@ -890,7 +921,13 @@ fn walk_packet<S: PathScene, L: Lanes>(
     let max_depth = scene.max_depth();
     let mut hits = LaneHits::new();
     loop {
-        if !packet.live[..L::N].contains(&true) {
+        if packet.live[..L::N].iter().filter(|&&live| live).count() <= FEW_LANES {
+            let parts = PacketParts::of(packet);
+            for (i, out) in out.iter_mut().enumerate().take(L::N) {
+                if packet.live[i] {
+                    packet.go_on_alone(scene, i, &parts, None, sampler, out);
+                }
+            }
             return None;
         }
         let before = sampler.clone();
@@ -924,11 +961,8 @@ fn walk_packet<S: PathScene, L: Lanes>(
                 _ => false,
             };
             if !stays {
-                // The path goes on alone from this ray and its hit, in its own stream.
-                packet.live[i] = false;
-                out[i].rays += packet.rays[i];
-                let state = packet.lane_state(i, &parts, traced);
-                walk(scene, state, &mut before.lane(i), &mut out[i]);
+                // From this ray and its hit.
+                packet.go_on_alone(scene, i, &parts, Some(traced), &before, &mut out[i]);
             }
         }
         if !packet.live[..L::N].contains(&true) {
