@@ -285,11 +285,14 @@ impl AliasTables {
     }
 
     /// In table `table`: the entry `u` (in [0, 1)) picks, its probability times `len` (its
-    /// density over [0, 1)), and `u` rescaled to [0, 1) within the entry.
-    pub fn sample(&self, table: usize, u: f32) -> (usize, f32, f32) {
+    /// density over [0, 1)), and `u` rescaled to [0, 1) within the entry. `reading(slot)` is
+    /// called with the entry about to be read, the one picked unless its alias is (as
+    /// [`Distribution2D::sample`]'s `reading`).
+    pub fn sample(&self, table: usize, u: f32, reading: impl FnOnce(usize)) -> (usize, f32, f32) {
         let n = self.len;
         let scaled = u.clamp(0.0, ONE_MINUS_EPSILON) * count_f32(n);
         let slot = bin_at(scaled, n);
+        reading(slot);
         self.cells[table * n + slot].pick(slot, scaled)
     }
 

@@ -109,13 +109,24 @@ impl FacingTables {
     }
 
     /// A point of the map in [0, 1)^2 for a surface facing light-space direction `facing`, and
-    /// its density there.
-    pub fn sample(&self, facing: Vec3, u: Vec2) -> Option<(Vec2, f32)> {
+    /// its density there. `reading(row, column)` is called with the distribution cell whose
+    /// record is about to be read, the cell picked unless its alias is: a caller that reads its
+    /// own data at the picked point can start loading it while the record's cache miss is
+    /// under way (as [`Distribution2D::sample`]'s `reading`).
+    pub fn sample(
+        &self,
+        facing: Vec3,
+        u: Vec2,
+        reading: impl FnOnce(usize, usize),
+    ) -> Option<(Vec2, f32)> {
         let (blocks_across, blocks_down) = self.blocks;
         let (uv, block_pdf) = self.tables[facing_bin(facing)].sample(u, |_, _| {})?;
         let (bx, fx) = split(uv.x, blocks_across);
         let (by, fy) = split(uv.y, blocks_down);
-        let (entry, density, within_x) = self.within.sample(by * blocks_across + bx, fx);
+        let block = self.block;
+        let (entry, density, within_x) = self.within.sample(by * blocks_across + bx, fx, |slot| {
+            reading(by * block + slot / block, bx * block + slot % block);
+        });
         let (x, y) = (
             bx * self.block + entry % self.block,
             by * self.block + entry / self.block,
@@ -212,6 +223,56 @@ pub(super) fn bin_centre(bin: usize) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sample reports the distribution cell whose record it reads (for the caller's
+    /// prefetch): the cell it picks unless the alias is taken, so always in the picked cell's
+    /// block, and the picked cell itself where every cell keeps its slot (an even map).
+    #[test]
+    fn a_sample_reports_the_cell_it_reads() {
+        // 8,192 cells: blocks of 2 x 2, so the block and the cell within it both matter.
+        let (across, down) = (128, 64);
+        let direction = |uv: Vec2| {
+            let (theta, phi) = (uv.y * std::f32::consts::PI, uv.x * std::f32::consts::TAU);
+            Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            )
+        };
+        let even = vec![1.0; across * down];
+        let varied: Vec<f32> = (0..across * down).map(|i| (i % 7 + i % 5) as f32).collect();
+        let mut rng = fastrand::Rng::with_seed(9);
+        for (func, exact) in [(even, true), (varied, false)] {
+            let tables = FacingTables::new(&func, across, down, direction);
+            assert_eq!(tables.block, 2);
+            let mut same = 0;
+            for _ in 0..20_000 {
+                let facing = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
+                let u = Vec2::new(rng.f32(), rng.f32());
+                let mut read = None;
+                let Some((uv, _)) =
+                    tables.sample(facing, u, |row, column| read = Some((row, column)))
+                else {
+                    continue;
+                };
+                let picked = (
+                    (uv.y * down as f32) as usize,
+                    (uv.x * across as f32) as usize,
+                );
+                let (row, column) = read.expect("a record was read");
+                assert_eq!(
+                    (row / 2, column / 2),
+                    (picked.0 / 2, picked.1 / 2),
+                    "{u} {facing}"
+                );
+                same += usize::from((row, column) == picked);
+                if exact {
+                    assert_eq!((row, column), picked, "{u} {facing}");
+                }
+            }
+            assert!(same > 0);
+        }
+    }
 
     #[test]
     fn every_direction_falls_in_the_bin_whose_centre_is_near_it() {

@@ -209,10 +209,14 @@ impl Environment {
                 ))
             }
             Some(map) => {
+                // The texels looked up below sit in the sampled cell nearly always: their load
+                // starts alongside the tables' own last cache miss.
                 let (uv, pdf_uv) = match facing {
-                    Some(n) => map.facing.sample(self.world_to_light * n, u)?,
-                    // The texels looked up below sit in the sampled cell nearly always: their
-                    // load starts alongside the distribution's own cache miss.
+                    Some(n) => map
+                        .facing
+                        .sample(self.world_to_light * n, u, |row, column| {
+                            map.prefetch_cell(row, column);
+                        })?,
                     None => map
                         .distribution
                         .sample(u, |row, column| map.prefetch_cell(row, column))?,
