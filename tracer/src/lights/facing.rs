@@ -245,7 +245,6 @@ mod tests {
         for (func, exact) in [(even, true), (varied, false)] {
             let tables = FacingTables::new(&func, across, down, direction);
             assert_eq!(tables.block, 2);
-            let mut same = 0;
             for _ in 0..20_000 {
                 let facing = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
                 let u = Vec2::new(rng.f32(), rng.f32());
@@ -265,12 +264,10 @@ mod tests {
                     (picked.0 / 2, picked.1 / 2),
                     "{u} {facing}"
                 );
-                same += usize::from((row, column) == picked);
                 if exact {
                     assert_eq!((row, column), picked, "{u} {facing}");
                 }
             }
-            assert!(same > 0);
         }
     }
 
