@@ -267,6 +267,7 @@ impl Camera {
             let lens_point = [
                 origin[0] + lx * radius,
                 origin[1] + ly * radius,
+                // glam's `origin + Vec3::new(x, y, 0.0)` adds the 0 (a -0 becomes +0).
                 origin[2] + zero,
             ];
             let mut towards = [zero; 3];
@@ -352,8 +353,8 @@ mod tests {
     }
 
     /// Perspective and orthographic rays in lanes, with and without a lens, under a turned and
-    /// moved camera with an uneven screen window: every lane type gives, lane by lane, the bits of glam's transforms of the
-    /// camera-space ray; a fisheye camera has none in lanes.
+    /// moved camera with an uneven screen window: every lane type gives, lane by lane, the bits
+    /// of glam's transforms of the camera-space ray; a fisheye camera has none in lanes.
     #[test]
     fn rays_in_lanes_are_glams_rays_bit_for_bit() {
         use crate::lanes::tests::{on_every_lane_type, OnLanes};

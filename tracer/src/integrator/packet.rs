@@ -468,7 +468,8 @@ impl<L: Lanes> Packet<L> {
         }
     }
 
-    /// Lane `i`'s path as [`walk`] carries it, with what its ray hits.
+    /// Lane `i`'s path as [`walk`] carries it, with what its ray hits (`None`: not traced
+    /// yet).
     #[inline(always)]
     fn lane_state(
         &self,
