@@ -32,7 +32,7 @@ fn sun_direction() -> Vec3 {
 /// Sky radiance towards `d` (z up): a blue gradient, a warm sun of about 3 degrees, dark ground.
 fn sky(d: Vec3) -> Vec3 {
     let sun = sun_direction();
-    if d.dot(sun) > (1.5f32).to_radians().cos() {
+    if d.dot(sun) > libm::cosf((1.5f32).to_radians()) {
         return Vec3::new(900.0, 800.0, 600.0);
     }
     if d.z < 0.0 {
@@ -52,9 +52,9 @@ fn latlong_direction(x: u32, y: u32) -> Vec3 {
     let phi = 2.0 * PI * u - PI;
     let theta = PI * v;
     Vec3::new(
-        theta.sin() * phi.cos(),
-        theta.sin() * phi.sin(),
-        theta.cos(),
+        libm::sinf(theta) * libm::cosf(phi),
+        libm::sinf(theta) * libm::sinf(phi),
+        libm::cosf(theta),
     )
 }
 
@@ -65,7 +65,7 @@ fn write_sky(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     for (x, y, px) in hdr.enumerate_pixels_mut() {
         let c = sky(latlong_direction(x, y));
         *px = image::Rgb(c.to_array());
-        let encode = |v: f32| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0 + 0.5) as u8;
+        let encode = |v: f32| (libm::powf(v.clamp(0.0, 1.0), 1.0 / 2.2) * 255.0 + 0.5) as u8;
         ldr.put_pixel(x, y, image::Rgb([encode(c.x), encode(c.y), encode(c.z)]));
     }
     image::DynamicImage::ImageRgb32F(hdr).save(dir.join("sky.hdr"))?;
@@ -77,14 +77,14 @@ fn write_sky(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
 /// A lumpy rock: a sphere of radius 1 displaced by a few octaves of sines.
 fn rock_point(theta: f32, phi: f32) -> Vec3 {
     let d = Vec3::new(
-        theta.sin() * phi.cos(),
-        theta.sin() * phi.sin(),
-        theta.cos(),
+        libm::sinf(theta) * libm::cosf(phi),
+        libm::sinf(theta) * libm::sinf(phi),
+        libm::cosf(theta),
     );
-    let bumps = 0.12 * (3.0 * d.x + 1.0).sin() * (4.0 * d.y).cos()
-        + 0.05 * (11.0 * d.z + 2.0 * d.x).sin()
-        + 0.02 * (29.0 * d.y).sin() * (31.0 * d.x).cos()
-        + 0.006 * (97.0 * d.z).sin();
+    let bumps = 0.12 * libm::sinf(3.0 * d.x + 1.0) * libm::cosf(4.0 * d.y)
+        + 0.05 * libm::sinf(11.0 * d.z + 2.0 * d.x)
+        + 0.02 * libm::sinf(29.0 * d.y) * libm::cosf(31.0 * d.x)
+        + 0.006 * libm::sinf(97.0 * d.z);
     d * (1.0 + bumps)
 }
 

@@ -113,7 +113,7 @@ impl CameraDesc {
                 "Camera: autofocus is not supported; focaldistance is used as given".into(),
             );
         }
-        let camera_to_world = world_to_camera.inverse();
+        let camera_to_world = crate::math::inverse(&world_to_camera);
         if !camera_to_world
             .to_cols_array()
             .iter()
@@ -166,7 +166,7 @@ impl Camera {
     pub fn new(desc: &CameraDesc, width: u32, height: u32) -> Self {
         let projection = match desc.kind {
             CameraKind::Perspective { fov } => Projection::Perspective {
-                tan_half_fov: (fov.to_radians() * 0.5).tan(),
+                tan_half_fov: libm::tanf(fov.to_radians() * 0.5),
             },
             CameraKind::Orthographic => Projection::Orthographic,
             CameraKind::Fisheye { fov } => Projection::Fisheye {
@@ -198,9 +198,9 @@ impl Camera {
             return None;
         }
         let psi = r * fov_radians;
-        let alpha = ry.atan2(rx);
-        let (sin_psi, cos_psi) = psi.sin_cos();
-        let (sin_a, cos_a) = alpha.sin_cos();
+        let alpha = libm::atan2f(ry, rx);
+        let (sin_psi, cos_psi) = libm::sincosf(psi);
+        let (sin_a, cos_a) = libm::sincosf(alpha);
         let dir = Vec3::new(sin_psi * cos_a, sin_psi * sin_a, cos_psi);
         let origin = self.camera_to_world.transform_point3(Vec3::ZERO);
         let dir = self.camera_to_world.transform_vector3(dir).normalize();

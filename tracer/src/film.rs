@@ -474,7 +474,7 @@ impl Film {
         let inv_gamma = 1.0 / film.gamma.max(1e-3);
         let mut img = image::RgbImage::new(self.frame.width, self.frame.height);
         for (px, c) in img.pixels_mut().zip(mapped) {
-            let encode = |v: f32| (v.clamp(0.0, 1.0).powf(inv_gamma) * 255.0 + 0.5) as u8;
+            let encode = |v: f32| (libm::powf(v.clamp(0.0, 1.0), inv_gamma) * 255.0 + 0.5) as u8;
             *px = image::Rgb([encode(c.x), encode(c.y), encode(c.z)]);
         }
         img
@@ -542,7 +542,7 @@ fn mean(&[r, g, b, w]: &[i64; 4]) -> Vec3 {
 /// LuxRender's tone mapping kernels, turning radiance in place into values to be gamma encoded.
 pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
     // The mid-grey LuxRender aims autolinear and linear exposure at.
-    let middle_grey = (118.0f32 / 255.0).powf(gamma);
+    let middle_grey = libm::powf(118.0f32 / 255.0, gamma);
     match *tonemap {
         ToneMap::AutoLinear => {
             let (sum, n) = radiance
@@ -571,9 +571,11 @@ pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
                 .iter()
                 .map(|&c| luminance(c))
                 .filter(|&y| y > 0.0 && y.is_finite())
-                .fold((0.0f64, 0u64), |(s, n), y| (s + f64::from(y).ln(), n + 1));
+                .fold((0.0f64, 0u64), |(s, n), y| {
+                    (s + libm::log(f64::from(y)), n + 1)
+                });
             let y_wa = if n > 0 {
-                (log_sum / n as f64).exp() as f32
+                libm::exp(log_sum / n as f64) as f32
             } else {
                 1.0
             };
@@ -591,7 +593,10 @@ pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
         ToneMap::Contrast { ywa } => {
             // Ward's contrast-based scale factor for display luminance 100 cd/m2.
             let ywa = ywa.max(1e-6);
-            let scale = ((1.219 + 50f32.powf(0.4)) / (1.219 + ywa.powf(0.4))).powf(2.5) / 100.0;
+            let scale = libm::powf(
+                (1.219 + libm::powf(50f32, 0.4)) / (1.219 + libm::powf(ywa, 0.4)),
+                2.5,
+            ) / 100.0;
             radiance.iter_mut().for_each(|c| *c *= scale);
         }
     }
@@ -732,7 +737,7 @@ mod tests {
     fn autolinear_maps_average_luminance_to_mid_grey() {
         let mut mapped = vec![Vec3::splat(2.0); 4];
         tone_map(&mut mapped, &ToneMap::AutoLinear, 2.2);
-        let expected = 1.25 * (118.0f32 / 255.0).powf(2.2);
+        let expected = 1.25 * libm::powf(118.0f32 / 255.0, 2.2);
         assert!((mapped[0].x - expected).abs() < 1e-5);
     }
 

@@ -363,7 +363,7 @@ fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
         FilterKind::Box => 1.0,
         FilterKind::Triangle => (radius - x.abs()).max(0.0),
         FilterKind::Gaussian { alpha } => {
-            ((-alpha * x * x).exp() - (-alpha * radius * radius).exp()).max(0.0)
+            (libm::expf(-alpha * x * x) - libm::expf(-alpha * radius * radius)).max(0.0)
         }
         FilterKind::Mitchell { b, c } => {
             let x = (2.0 * x / radius).abs();
@@ -385,7 +385,8 @@ fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
         FilterKind::BlackmanHarris => {
             // The window spans [-radius, radius].
             let t = 2.0 * PI * (x / (2.0 * radius) + 0.5);
-            0.35875 - 0.48829 * t.cos() + 0.14128 * (2.0 * t).cos() - 0.01168 * (3.0 * t).cos()
+            0.35875 - 0.48829 * libm::cosf(t) + 0.14128 * libm::cosf(2.0 * t)
+                - 0.01168 * libm::cosf(3.0 * t)
         }
         FilterKind::Sinc { tau } => {
             let x = x.abs();
@@ -396,7 +397,7 @@ fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
                 if v < 1e-5 {
                     1.0
                 } else {
-                    (PI * v).sin() / (PI * v)
+                    libm::sinf(PI * v) / (PI * v)
                 }
             };
             sinc(x) * sinc(x / tau)

@@ -1,6 +1,6 @@
 //! Small geometric helpers shared by every module.
 
-use glam::Vec3;
+use glam::{Affine3A, Mat4, Vec3};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
@@ -86,6 +86,20 @@ pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     } else {
         p - ng * eps
     }
+}
+
+/// `m`'s inverse, computed in f64 and rounded back. glam's f32 `Mat4` and `Affine3A` inverses
+/// take their SSE2, NEON or scalar form by target, each with its own order of operations, so
+/// their last bits differed between x86-64 and aarch64 workers (the seed depth-of-field
+/// scene's spheres); glam's f64 matrices are the same scalar code on every target. clippy.toml
+/// keeps the f32 inverses out.
+pub fn inverse(m: &Mat4) -> Mat4 {
+    m.as_dmat4().inverse().as_mat4()
+}
+
+/// [`inverse`] of an affine transform.
+pub fn affine_inverse(a: &Affine3A) -> Affine3A {
+    a.as_daffine3().inverse().as_affine3a()
 }
 
 /// `x.floor()` as an integer, for |x| < 2^31, without the libm call baseline x86-64 makes for
@@ -225,13 +239,16 @@ mod tests {
     fn atan2_is_within_its_error_of_libm() {
         let mut worst = 0.0f64;
         let mut check = |y: f32, x: f32| {
-            let exact = f64::from(y).atan2(f64::from(x));
+            let exact = libm::atan2(f64::from(y), f64::from(x));
             worst = worst.max((f64::from(atan2(y, x)) - exact).abs());
         };
         for k in 0..62_832 {
             let angle = k as f64 * 1e-4 - std::f64::consts::PI;
             for radius in [1e-6f64, 0.37, 1.0, 3.3e3, 1e6] {
-                check((radius * angle.sin()) as f32, (radius * angle.cos()) as f32);
+                check(
+                    (radius * libm::sin(angle)) as f32,
+                    (radius * libm::cos(angle)) as f32,
+                );
             }
         }
         for a in [
@@ -263,7 +280,7 @@ mod tests {
         ] {
             assert_eq!(
                 atan2(y, x).to_bits(),
-                y.atan2(x).to_bits(),
+                libm::atan2f(y, x).to_bits(),
                 "atan2({y}, {x})"
             );
         }

@@ -221,7 +221,7 @@ impl ShapeDesc {
     pub fn world_area(&self) -> f32 {
         let shape = self;
         let m = shape.object_to_world;
-        let area_scale = Mat3::from_mat4(m).determinant().abs().powf(2.0 / 3.0);
+        let area_scale = libm::powf(Mat3::from_mat4(m).determinant().abs(), 2.0 / 3.0);
         let phi = |deg: f32| deg.clamp(0.0, 360.0).to_radians();
         match &shape.geometry {
             Geometry::Mesh(mesh) => mesh

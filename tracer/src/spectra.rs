@@ -108,7 +108,7 @@ fn cie_xyz(spectrum: impl Fn(f64) -> f64, range: (f64, f64), step: f64) -> DVec3
 fn planck(lambda_nm: f64, t: f64) -> f64 {
     const C2: f64 = 1.438_776_9e-2; // hc/k in m K
     let l = lambda_nm * 1e-9;
-    1.0 / (l.powi(5) * ((C2 / (l * t)).exp() - 1.0))
+    1.0 / (l.powi(5) * (libm::exp(C2 / (l * t)) - 1.0))
 }
 
 /// The CIE 1931 2-degree colour matching functions, multi-lobe Gaussian fit of Wyman, Sloan
@@ -116,7 +116,7 @@ fn planck(lambda_nm: f64, t: f64) -> f64 {
 fn cie_1931(l: f64) -> (f64, f64, f64) {
     let g = |x: f64, mu: f64, s1: f64, s2: f64| {
         let t = (x - mu) / if x < mu { s1 } else { s2 };
-        (-0.5 * t * t).exp()
+        libm::exp(-0.5 * t * t)
     };
     let x = 1.056 * g(l, 599.8, 37.9, 31.0) + 0.362 * g(l, 442.0, 16.0, 26.7)
         - 0.065 * g(l, 501.1, 20.4, 26.2);

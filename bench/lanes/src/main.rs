@@ -182,7 +182,7 @@ fn main() -> Result<()> {
     if let Some(path) = &args.output {
         let bytes = reference
             .iter()
-            .flat_map(|p| p.map(|c| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0) as u8))
+            .flat_map(|p| p.map(|c| (libm::powf(c / (1.0 + c), 1.0 / 2.2) * 255.0) as u8))
             .collect();
         let png = image::RgbImage::from_raw(args.width as u32, args.height as u32, bytes)
             .context("image size")?;

@@ -293,7 +293,7 @@ fn bounce_rays(geometry: &SceneGeometry, camera: &[BenchRay]) -> Vec<BenchRay> {
             let z = rng.f32();
             let phi = std::f32::consts::TAU * rng.f32();
             let s = (1.0 - z * z).max(0.0).sqrt();
-            let local = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+            let local = Vec3::new(s * libm::cosf(phi), s * libm::sinf(phi), z);
             let dir = Frame::from_normal(n).to_world(local).normalize();
             let offset = 1e-4 * (1.0 + hit.p.abs().max_element());
             BenchRay {

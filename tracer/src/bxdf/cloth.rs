@@ -83,7 +83,7 @@ impl Yarn {
                 s.weft_area,
             ),
         };
-        if area <= 0.0 || self.width * umax.sin() >= self.length || self.kappa < -1.0 {
+        if area <= 0.0 || self.width * libm::sinf(umax) >= self.length || self.kappa < -1.0 {
             return 0.0;
         }
         let value = if self.psi == 0.0 {
@@ -102,13 +102,13 @@ impl Yarn {
         }
         let sum = wi + wo;
         let h = sum.normalize_or_zero();
-        let u_h = h.y.atan2(h.z);
+        let u_h = libm::atan2f(h.y, h.z);
         let half_band = umax * s.highlight_width;
         if u_h.abs() >= umax || (u_h - at.x).abs() >= half_band {
             return 0.0;
         }
-        let (sin_u, cos_u) = u_h.sin_cos();
-        let (sin_v, cos_v) = at.y.sin_cos();
+        let (sin_u, cos_u) = libm::sincosf(u_h);
+        let (sin_v, cos_v) = libm::sincosf(at.y);
         let n = Vec3::new(sin_v, sin_u * cos_v, cos_u * cos_v).normalize_or_zero();
         let t = Vec3::new(0.0, cos_u, -sin_u);
         let end = (1.0 - s.smoothing) * umax;
@@ -128,23 +128,23 @@ impl Yarn {
     fn staple(&self, s: &Scattering, at: Vec2, umax: f32, wi: Vec3, wo: Vec3) -> f32 {
         let sum = wi + wo;
         let h = sum.normalize_or_zero();
-        let (sin_u, cos_u) = at.x.sin_cos();
+        let (sin_u, cos_u) = libm::sincosf(at.x);
         let across = h.y * sin_u + h.z * cos_u;
-        let d =
-            (h.y * cos_u - h.z * sin_u) / ((h.x * h.x + across * across).sqrt() * self.psi.tan());
+        let d = (h.y * cos_u - h.z * sin_u)
+            / ((h.x * h.x + across * across).sqrt() * libm::tanf(self.psi));
         // NaN (a degenerate half vector) fails too.
         if d.is_nan() || d.abs() >= 1.0 {
             return 0.0;
         }
-        let v_h = (-across).atan2(h.x) + d.acos();
+        let v_h = libm::atan2f(-across, h.x) + libm::acosf(d);
         if (v_h - at.y).abs() >= FRAC_PI_2 * s.highlight_width {
             return 0.0;
         }
-        let (sin_v, cos_v) = v_h.sin_cos();
+        let (sin_v, cos_v) = libm::sincosf(v_h);
         let n = Vec3::new(sin_v, sin_u * cos_v, cos_u * cos_v).normalize_or_zero();
         let r = self.radius_of_curvature(at.x.abs(), umax);
         let a = 0.5 * self.width;
-        let geometry = a * (r + a * cos_v) / (sum.length() * n.dot(h) * self.psi.sin().abs());
+        let geometry = a * (r + a * cos_v) / (sum.length() * n.dot(h) * libm::sinf(self.psi).abs());
         let value = geometry * phase(s, wi, wo) * seeliger(n.dot(wi), n.dot(wo));
         // The band spread over the segment's v range.
         value * 2.0 * umax / s.highlight_width
@@ -153,27 +153,27 @@ impl Yarn {
     /// Radius of curvature of the spine at inclination u: an arc of an ellipse, parabola or
     /// hyperbola by kappa (Irawan's thesis, section 5.3).
     fn radius_of_curvature(&self, u: f32, umax: f32) -> f32 {
-        let rhat = 1.0 + self.kappa * (1.0 + 1.0 / umax.tan());
+        let rhat = 1.0 + self.kappa * (1.0 + 1.0 / libm::tanf(umax));
         let a = 0.5 * self.width;
-        let reach = 0.5 * self.length - a * umax.sin();
+        let reach = 0.5 * self.length - a * libm::sinf(umax);
         if rhat == 1.0 {
-            0.5 * self.length / umax.sin() - a
+            0.5 * self.length / libm::sinf(umax) - a
         } else if rhat > 0.0 {
-            let bhat = reach / (rhat * umax.tan()).atan().sin();
+            let bhat = reach / libm::sinf(libm::atanf(rhat * libm::tanf(umax)));
             let ahat = bhat / rhat;
-            let t = (rhat * u.tan()).atan();
-            let (st, ct) = t.sin_cos();
-            (bhat * bhat * ct * ct + ahat * ahat * st * st).powf(1.5) / (ahat * bhat)
+            let t = libm::atanf(rhat * libm::tanf(u));
+            let (st, ct) = libm::sincosf(t);
+            libm::powf(bhat * bhat * ct * ct + ahat * ahat * st * st, 1.5) / (ahat * bhat)
         } else if rhat < 0.0 {
-            let bhat = reach / (-(rhat * umax.tan()).atanh()).sinh();
+            let bhat = reach / libm::sinhf(-(rhat * libm::tanf(umax)).atanh());
             let ahat = bhat / rhat;
-            let t = -(rhat * u.tan()).atanh();
-            let (sh, ch) = (t.sinh(), t.cosh());
-            -(bhat * bhat * ch * ch + ahat * ahat * sh * sh).powf(1.5) / (ahat * bhat)
+            let t = -(rhat * libm::tanf(u)).atanh();
+            let (sh, ch) = (libm::sinhf(t), libm::coshf(t));
+            -libm::powf(bhat * bhat * ch * ch + ahat * ahat * sh * sh, 1.5) / (ahat * bhat)
         } else {
-            let ahat = reach / (2.0 * umax.tan());
-            let t = u.tan();
-            2.0 * ahat * (1.0 + t * t).powf(1.5)
+            let ahat = reach / (2.0 * libm::tanf(umax));
+            let t = libm::tanf(u);
+            2.0 * ahat * libm::powf(1.0 + t * t, 1.5)
         }
     }
 }
@@ -193,7 +193,7 @@ fn von_mises(cos_x: f32, b: f32) -> f32 {
             + t * (3.515_623
                 + t * (3.089_942_4
                     + t * (1.206_749_2 + t * (0.265_973_2 + t * (0.036_076_8 + t * 0.004_581_3)))));
-        (b * cos_x).exp() / (2.0 * PI * i0)
+        libm::expf(b * cos_x) / (2.0 * PI * i0)
     } else {
         let t = 3.75 / b;
         // I0(b) = exp(b) / sqrt(b) * poly(t).
@@ -204,7 +204,7 @@ fn von_mises(cos_x: f32, b: f32) -> f32 {
                         + t * (0.009_162_81
                             + t * (-0.020_577_06
                                 + t * (0.026_355_37 + t * (-0.016_476_33 + t * 0.003_923_77)))))));
-        (b * (cos_x - 1.0)).exp() * b.sqrt() / (2.0 * PI * poly)
+        libm::expf(b * (cos_x - 1.0)) * b.sqrt() / (2.0 * PI * poly)
     }
 }
 

@@ -118,7 +118,7 @@ mod tests {
                 let z = u.x;
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let phi = 2.0 * PI * u.y;
-                let wi = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                let wi = Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), z);
                 let wm = (wo + wi).normalize();
                 f64::from(distrib.d(wm) * distrib.g(wo, wi) / (4.0 * mu))
             })

@@ -73,7 +73,7 @@ pub fn concentric_disk<L: Lanes>(u: [L; 2]) -> [L; 2] {
 pub fn sample_disk_polar(u: Vec2) -> Vec2 {
     let r = u.x.sqrt();
     let theta = 2.0 * PI * u.y;
-    Vec2::new(theta.cos(), theta.sin()) * r
+    Vec2::new(libm::cosf(theta), libm::sinf(theta)) * r
 }
 
 /// Cosine-weighted direction in the upper hemisphere (Malley's method).
@@ -116,8 +116,8 @@ mod tests {
                 } else {
                     (0.0, 0.0)
                 };
-                let exact = (r * theta.cos(), r * theta.sin());
-                let error = (f64::from(d.x) - exact.0).hypot(f64::from(d.y) - exact.1);
+                let exact = (r * libm::cos(theta), r * libm::sin(theta));
+                let error = libm::hypot(f64::from(d.x) - exact.0, f64::from(d.y) - exact.1);
                 assert!(error < 4e-7, "{u} -> {d}, exactly {exact:?}");
             }
         }

@@ -69,7 +69,7 @@ impl Velvet {
         }
         // The light travels along -wi and leaves along wo.
         let phase = polynomial(self.p, (-wi).dot(wo)) * self.norm / (4.0 * PI);
-        let scattered = -(-self.thickness * (1.0 / cos_i + 1.0 / cos_o)).exp_m1();
+        let scattered = -libm::expm1f(-self.thickness * (1.0 / cos_i + 1.0 / cos_o));
         self.r * (phase * scattered / (cos_i + cos_o))
     }
 

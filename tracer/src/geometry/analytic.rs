@@ -85,8 +85,8 @@ impl AnalyticShape {
                     radius,
                     z_min,
                     z_max,
-                    theta_z_min: (z_min / radius).clamp(-1.0, 1.0).acos(),
-                    theta_z_max: (z_max / radius).clamp(-1.0, 1.0).acos(),
+                    theta_z_min: libm::acosf((z_min / radius).clamp(-1.0, 1.0)),
+                    theta_z_max: libm::acosf((z_max / radius).clamp(-1.0, 1.0)),
                     phi_max: phi_range(phimax)?,
                 }
             }
@@ -134,7 +134,7 @@ impl AnalyticShape {
             shape,
             quadric,
             object_to_world,
-            world_to_object: object_to_world.inverse(),
+            world_to_object: crate::math::affine_inverse(&object_to_world),
             normal_to_world: linear.inverse().transpose(),
             linear_transpose: linear.transpose(),
             abs_det: det.abs(),
@@ -303,7 +303,7 @@ impl AnalyticShape {
                 phi_max,
                 ..
             } => {
-                let theta = (p.z / radius).clamp(-1.0, 1.0).acos();
+                let theta = libm::acosf((p.z / radius).clamp(-1.0, 1.0));
                 let v = (theta - theta_z_min) / (theta_z_max - theta_z_min);
                 // dp/dtheta = (z cos phi, z sin phi, -r sin theta), with r sin theta = rho,
                 // cos phi = x / rho, sin phi = y / rho (no trigonometry on the hot path; at a
@@ -395,7 +395,7 @@ impl AnalyticShape {
     /// World-space area: exact under similarity transforms, otherwise the object area scaled
     /// by |det|^(2/3) (used only to estimate a light's power).
     pub fn area(&self) -> f32 {
-        self.object_area() * self.abs_det.powf(2.0 / 3.0)
+        self.object_area() * libm::powf(self.abs_det, 2.0 / 3.0)
     }
 
     /// A point sampled uniformly by object-space area; `pdf_area` is the density in world
@@ -412,7 +412,7 @@ impl AnalyticShape {
                 // Archimedes: z uniform gives uniform area on a sphere zone.
                 let z = z_min + u.x * (z_max - z_min);
                 let rho = (radius * radius - z * z).max(0.0).sqrt();
-                let (sin, cos) = (u.y * phi_max).sin_cos();
+                let (sin, cos) = libm::sincosf(u.y * phi_max);
                 let p = Vec3A::new(rho * cos, rho * sin, z);
                 (p, p / radius)
             }
@@ -424,7 +424,7 @@ impl AnalyticShape {
             } => {
                 let r2 = inner_radius * inner_radius;
                 let rho = (r2 + u.x * (radius * radius - r2)).sqrt();
-                let (sin, cos) = (u.y * phi_max).sin_cos();
+                let (sin, cos) = libm::sincosf(u.y * phi_max);
                 (Vec3A::new(rho * cos, rho * sin, height), Vec3A::Z)
             }
             Quadric::Cylinder {
@@ -434,7 +434,7 @@ impl AnalyticShape {
                 phi_max,
             } => {
                 let z = z_min + u.x * (z_max - z_min);
-                let (sin, cos) = (u.y * phi_max).sin_cos();
+                let (sin, cos) = libm::sincosf(u.y * phi_max);
                 (
                     Vec3A::new(radius * cos, radius * sin, z),
                     Vec3A::new(cos, sin, 0.0),

@@ -41,7 +41,7 @@ impl InfinitePlane {
             shape,
             point: object_to_world.translation,
             n: n.into(),
-            world_to_object: object_to_world.inverse(),
+            world_to_object: crate::math::affine_inverse(&object_to_world),
             object_to_world,
             axes: Frame::from_normal(normal),
         })

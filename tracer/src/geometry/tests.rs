@@ -247,7 +247,7 @@ fn sphere_hits_have_pbrt_t_normal_uv_and_tangent() {
     );
 
     // phi = 90 degrees -> u = 0.25; z = 2 sin(30 deg) = 1: theta = 60 degrees -> v = 2/3.
-    let target = Vec3::new(0.0, 2.0 * 30f32.to_radians().cos(), 1.0);
+    let target = Vec3::new(0.0, 2.0 * libm::cosf(30f32.to_radians()), 1.0);
     let hit = geometry
         .intersect(
             &Ray::new(centre + target + Vec3::Y * 5.0, -Vec3::Y),
@@ -578,7 +578,7 @@ fn quadric_area_sampling_density_integrates_to_the_world_area() {
         .map(|i| {
             // Area element of the spheroid x = sin t cos p, y = sin t sin p, z = 2 cos t.
             let t = (f64::from(i) + 0.5) / 2000.0 * std::f64::consts::PI;
-            let (s, c) = t.sin_cos();
+            let (s, c) = libm::sincos(t);
             2.0 * std::f64::consts::PI * s * (4.0 * s * s + c * c).sqrt() * std::f64::consts::PI
                 / 2000.0
         })
@@ -605,12 +605,12 @@ fn bumpy_sphere(segments: u32) -> TriangleMesh {
         let theta = i as f32 / rows as f32 * PI;
         for j in 0..columns {
             let phi = j as f32 / columns as f32 * 2.0 * PI;
-            let r = 1.0 + 0.05 * (7.0 * theta).sin() * (9.0 * phi).sin();
+            let r = 1.0 + 0.05 * libm::sinf(7.0 * theta) * libm::sinf(9.0 * phi);
             positions.push(
                 r * Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
+                    libm::sinf(theta) * libm::cosf(phi),
+                    libm::sinf(theta) * libm::sinf(phi),
+                    libm::cosf(theta),
                 ),
             );
         }

@@ -238,7 +238,9 @@ impl AreaLight {
                     textures: Arc::clone(textures),
                     l,
                     scale,
-                    world_to_object: Affine3A::from_mat4(object_to_world).inverse(),
+                    world_to_object: crate::math::affine_inverse(&Affine3A::from_mat4(
+                        object_to_world,
+                    )),
                 };
                 (mean * scale, Some(texture))
             }
@@ -470,7 +472,7 @@ fn sample_sphere_cone(
     let cos_alpha =
         sin2_theta / sin_max + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
     let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
+    let (sin_phi, cos_phi) = libm::sincosf(TAU * u.y);
     let frame = Frame::from_normal((centre - from).normalize());
     let outward = frame.to_world(-Vec3::new(
         sin_alpha * cos_phi,

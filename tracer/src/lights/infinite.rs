@@ -201,7 +201,7 @@ impl Environment {
             None => {
                 let z = 1.0 - 2.0 * u.x;
                 let r = (1.0 - z * z).max(0.0).sqrt();
-                let (sin, cos) = (TAU * u.y).sin_cos();
+                let (sin, cos) = libm::sincosf(TAU * u.y);
                 Some((
                     Vec3::new(r * cos, r * sin, z),
                     1.0 / (4.0 * PI),
@@ -333,7 +333,7 @@ impl LatLongMap {
         // axis. Sampling that blur keeps the density positive wherever the lookup is.
         let mut func = vec![0.0f32; w * h];
         for y in 0..h {
-            let sin_theta = ((y as f32 + 0.5) / h as f32 * PI).sin();
+            let sin_theta = libm::sinf((y as f32 + 0.5) / h as f32 * PI);
             for x in 0..w {
                 let mut sum = 0.0;
                 for (dy, wy) in [(-1i64, 0.125f32), (0, 0.75), (1, 0.125)] {
@@ -390,12 +390,12 @@ impl LatLongMap {
     }
 
     fn direction_by(convention: LatLongConvention, uv: Vec2) -> (Vec3, f32) {
-        let (sin_theta, cos_theta) = (uv.y * PI).sin_cos();
+        let (sin_theta, cos_theta) = libm::sincosf(uv.y * PI);
         let phi = match convention {
             LatLongConvention::Seed => uv.x * TAU - PI,
             LatLongConvention::LuxRender => uv.x * TAU,
         };
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        let (sin_phi, cos_phi) = libm::sincosf(phi);
         (
             Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta),
             sin_theta,
@@ -413,7 +413,7 @@ impl LatLongMap {
         let mut sum = Vec3::ZERO;
         for y in 0..h {
             let (t0, t1) = (y as f32 / h as f32 * PI, (y + 1) as f32 / h as f32 * PI);
-            let solid_angle = TAU / w as f32 * (t0.cos() - t1.cos());
+            let solid_angle = TAU / w as f32 * (libm::cosf(t0) - libm::cosf(t1));
             let row: Vec3 = (y * w..(y + 1) * w).map(|i| self.image.texel(i)).sum();
             sum += row * solid_angle;
         }

@@ -49,8 +49,9 @@ impl LampCones {
                 if dist <= radius {
                     return true;
                 }
-                let reach = cone.half + (radius / dist).asin();
-                reach >= std::f32::consts::PI || cone.axis.dot(to_centre) >= reach.cos() * dist
+                let reach = cone.half + libm::asinf(radius / dist);
+                reach >= std::f32::consts::PI
+                    || cone.axis.dot(to_centre) >= libm::cosf(reach) * dist
             })
     }
 }
@@ -79,8 +80,8 @@ mod tests {
             let half = next() * 0.8;
             let cone = Cone { axis, half };
             let to_centre = (centre - p).normalize();
-            let angle = axis.dot(to_centre).clamp(-1.0, 1.0).acos();
-            let sphere_angle = (radius / 4.0).asin();
+            let angle = libm::acosf(axis.dot(to_centre).clamp(-1.0, 1.0));
+            let sphere_angle = libm::asinf(radius / 4.0);
             let touches = angle <= half + sphere_angle - 1e-3;
             let says = cones.may_reach(p, &cone);
             if touches {

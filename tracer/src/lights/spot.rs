@@ -71,8 +71,8 @@ impl SpotLight {
                 message: "LightSource \"spot\": \"from\" and \"to\" must differ".into(),
             });
         };
-        let cos_total = cone_angle.to_radians().cos();
-        let cos_falloff_start = (cone_angle - cone_delta_angle).to_radians().cos();
+        let cos_total = libm::cosf(cone_angle.to_radians());
+        let cos_falloff_start = libm::cosf((cone_angle - cone_delta_angle).to_radians());
         let gain = normalised_gain(
             e.gain,
             params.float("power", DEFAULT_POWER)?,
@@ -129,8 +129,8 @@ impl SpotCone {
                 intensity,
             },
             direction: direction.normalize_or(Vec3::Z),
-            cos_total: cone.to_radians().cos(),
-            cos_falloff_start: start.to_radians().cos(),
+            cos_total: libm::cosf(cone.to_radians()),
+            cos_falloff_start: libm::cosf(start.to_radians()),
         }
     }
 

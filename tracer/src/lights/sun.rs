@@ -99,7 +99,7 @@ impl SunLight {
 
     /// The disc's radiance: gain / relsize^2 x the sun's at its elevation.
     pub fn radiance(&self) -> Vec3 {
-        let theta = self.to_sun.normalize_or_zero().z.clamp(-1.0, 1.0).acos();
+        let theta = libm::acosf(self.to_sun.normalize_or_zero().z.clamp(-1.0, 1.0));
         sun_rgb(theta, self.turbidity) * (self.gain / (self.relsize * self.relsize))
     }
 
@@ -178,7 +178,7 @@ impl SunDisc {
         let h = u.x * self.one_minus_cos;
         let cos = 1.0 - h;
         let sin = (h * (2.0 - h)).max(0.0).sqrt();
-        let (sp, cp) = (TAU * u.y).sin_cos();
+        let (sp, cp) = libm::sincosf(TAU * u.y);
         let dir = self
             .frame
             .to_world(Vec3::new(sin * cp, sin * sp, cos))
@@ -201,7 +201,7 @@ impl SunDisc {
 pub fn sun_rgb(theta: f32, turbidity: f32) -> Vec3 {
     let theta = f64::from(theta);
     // Relative optical mass; not meaningful below the horizon (negative or not a number).
-    let m = 1.0 / (theta.cos() + 0.00094 * (1.6386 - theta).powf(-1.253));
+    let m = 1.0 / (libm::cos(theta) + 0.00094 * libm::pow(1.6386 - theta, -1.253));
     if theta >= std::f64::consts::FRAC_PI_2 || !(m > 0.0 && m.is_finite()) {
         return Vec3::ZERO;
     }
@@ -217,15 +217,15 @@ pub fn sun_rgb(theta: f32, turbidity: f32) -> Vec3 {
         .map(|i| {
             let lambda = 350.0 + 5.0 * f64::from(i);
             let um = lambda / 1000.0;
-            let rayleigh = (-m * 0.008735 * um.powf(-4.08)).exp();
-            let aerosol = (-m * beta * um.powf(-ALPHA)).exp();
-            let ozone = (-m * lerp_table(&OZONE_K, lambda) * OZONE_CM).exp();
+            let rayleigh = libm::exp(-m * 0.008735 * libm::pow(um, -4.08));
+            let aerosol = libm::exp(-m * beta * libm::pow(um, -ALPHA));
+            let ozone = libm::exp(-m * lerp_table(&OZONE_K, lambda) * OZONE_CM);
             let kg = lerp_table(&GAS_K, lambda);
-            let gas = (-1.41 * kg * m / (1.0 + 118.93 * kg * m).powf(0.45)).exp();
+            let gas = libm::exp(-1.41 * kg * m / libm::pow(1.0 + 118.93 * kg * m, 0.45));
             let kwa = lerp_table(&WATER_K, lambda);
-            let water = (-0.2385 * kwa * WATER_CM * m
-                / (1.0 + 20.07 * kwa * WATER_CM * m).powf(0.45))
-            .exp();
+            let water = libm::exp(
+                -0.2385 * kwa * WATER_CM * m / libm::pow(1.0 + 20.07 * kwa * WATER_CM * m, 0.45),
+            );
             solar(lambda) * rayleigh * aerosol * ozone * gas * water
         })
         .collect();

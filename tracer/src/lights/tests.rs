@@ -106,7 +106,7 @@ fn square_emitter_irradiance_matches_the_form_factor() {
     // F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))].
     let x = side / 2.0 / h;
     let s = (1.0 + x * x).sqrt();
-    let corner = (2.0 * x / s * (x / s).atan()) / (2.0 * PI);
+    let corner = (2.0 * x / s * libm::atanf(x / s)) / (2.0 * PI);
     let expected = radiance * PI * 4.0 * corner;
     for c in 0..3 {
         assert!(
@@ -124,7 +124,7 @@ fn square_emitter_irradiance_matches_the_form_factor() {
     let p = Vec3::new(0.0, d * 0.5, -d * 0.75f32.sqrt());
     let to_light = -p.normalize();
     let e = irradiance(&lights, p, to_light, 100_000, 2);
-    let expected = side * side * (30f32).to_radians().cos() / (d * d);
+    let expected = side * side * libm::cosf((30f32).to_radians()) / (d * d);
     assert!(
         rel_err(e.x, expected) < 0.02,
         "E = {}, expected {expected}",
@@ -279,7 +279,11 @@ fn delta_lights_follow_their_definitions() {
     });
     let (_, lights) = build(vec![], vec![spot]);
     let at_angle = |deg: f32| {
-        let p = Vec3::new(deg.to_radians().sin(), 0.0, -deg.to_radians().cos()) * 2.0;
+        let p = Vec3::new(
+            libm::sinf(deg.to_radians()),
+            0.0,
+            -libm::cosf(deg.to_radians()),
+        ) * 2.0;
         lights
             .sample(p, None, 0.5, Vec2::ZERO)
             .map_or(0.0, |s| s.li.x)
@@ -291,8 +295,7 @@ fn delta_lights_follow_their_definitions() {
     );
     assert_eq!(at_angle(31.0), 0.0);
     // Halfway in cosine between cos 30 and cos 20 the smoothstep is 1/2.
-    let mid = (0.5 * (30f32.to_radians().cos() + 20f32.to_radians().cos()))
-        .acos()
+    let mid = libm::acosf(0.5 * (libm::cosf(30f32.to_radians()) + libm::cosf(20f32.to_radians())))
         .to_degrees();
     assert!((at_angle(mid) - 1.0).abs() < 1e-3, "{}", at_angle(mid));
 
@@ -360,9 +363,9 @@ fn env_lights(source: &MemorySource, light: LightDesc, convention: LatLongConven
 
 fn spherical(theta: f32, phi: f32) -> Vec3 {
     Vec3::new(
-        theta.sin() * phi.cos(),
-        theta.sin() * phi.sin(),
-        theta.cos(),
+        libm::sinf(theta) * libm::cosf(phi),
+        libm::sinf(theta) * libm::sinf(phi),
+        libm::cosf(theta),
     )
 }
 
@@ -406,12 +409,12 @@ fn latlong_marker_shows_in_the_direction_each_convention_puts_it() {
             let s = lights
                 .sample(Vec3::ZERO, None, 0.5, Vec2::new(rng.f32(), rng.f32()))
                 .unwrap();
-            let phi = s.wi.y.atan2(s.wi.x);
+            let phi = libm::atan2f(s.wi.y, s.wi.x);
             let u = match convention {
                 LatLongConvention::Seed => (PI + phi) / (2.0 * PI),
                 LatLongConvention::LuxRender => phi.rem_euclid(2.0 * PI) / (2.0 * PI),
             };
-            let (column, row) = ((u * 8.0) as u32, (s.wi.z.acos() / PI * 4.0) as u32);
+            let (column, row) = ((u * 8.0) as u32, (libm::acosf(s.wi.z) / PI * 4.0) as u32);
             assert!(
                 (5..=7).contains(&column) && row <= 2,
                 "{convention:?}: {}",
@@ -612,7 +615,7 @@ fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
         let radiance = s.radiance();
         assert_eq!(
             radiance,
-            sun_rgb(to_sun.z.acos(), 2.0) / (relsize * relsize)
+            sun_rgb(libm::acosf(to_sun.z), 2.0) / (relsize * relsize)
         );
         let (_, lights) = build(vec![], vec![LightDesc::Sun(s)]);
         // The cone's solid angle 2 pi (1 - cos theta_max), in f64.
@@ -629,9 +632,9 @@ fn sun_irradiance_is_its_radiance_times_its_solid_angle_whatever_its_size() {
         }
         // Tilted 60 degrees away from the sun, cos 60 of it.
         let tilted = Frame::from_normal(to_sun).to_world(Vec3::new(
-            60f32.to_radians().sin(),
+            libm::sinf(60f32.to_radians()),
             0.0,
-            60f32.to_radians().cos(),
+            libm::cosf(60f32.to_radians()),
         ));
         let e60 = irradiance(&lights, Vec3::ZERO, tilted, 20_000, 32).as_dvec3();
         assert!((e60.y / (0.5 * expected.y) - 1.0).abs() < 2e-3, "{e60}");
@@ -670,13 +673,13 @@ fn sun_colour_and_brightness_follow_the_atmosphere() {
 /// Zenith luminance of Preetham's model, cd/m^2.
 fn preetham_zenith_luminance(theta_s: f32, t: f32) -> f32 {
     let chi = (4.0 / 9.0 - t / 120.0) * (PI - 2.0 * theta_s);
-    ((4.0453 * t - 4.9710) * chi.tan() - 0.2155 * t + 2.4192) * 1000.0
+    ((4.0453 * t - 4.9710) * libm::tanf(chi) - 0.2155 * t + 2.4192) * 1000.0
 }
 
 #[test]
 fn sky_radiance_matches_the_models_at_zenith_and_horizon() {
     let sundir = Vec3::new(0.0, 0.6, 0.8);
-    let theta_s = sundir.normalize().z.acos();
+    let theta_s = libm::acosf(sundir.normalize().z);
     // Preetham: the zenith luminance is the model's own formula.
     let desc = sky(PREETHAM, sundir, 3.0, Mat4::IDENTITY);
     let (_, lights) = build(vec![], vec![LightDesc::Sky(desc.clone())]);
@@ -741,7 +744,7 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
             let z = 1.0 - 2.0 * rng.f32();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = 2.0 * PI * rng.f32();
-            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let dir = Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), z);
             pdf_sum += f64::from(lights.pdf_environment(dir, None));
         }
         let total = pdf_sum / f64::from(n) * 4.0 * std::f64::consts::PI;
@@ -769,12 +772,12 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
             for j in 0..np {
                 let phi = (j as f64 + 0.5) / np as f64 * std::f64::consts::TAU;
                 let d = Vec3::new(
-                    (theta.sin() * phi.cos()) as f32,
-                    (theta.sin() * phi.sin()) as f32,
-                    theta.cos() as f32,
+                    (libm::sin(theta) * libm::cos(phi)) as f32,
+                    (libm::sin(theta) * libm::sin(phi)) as f32,
+                    libm::cos(theta) as f32,
                 );
                 quadrature += f64::from(luminance(model(d)))
-                    * theta.sin()
+                    * libm::sin(theta)
                     * (std::f64::consts::PI / nt as f64)
                     * (std::f64::consts::TAU / np as f64);
             }
@@ -791,7 +794,7 @@ fn sky_sampling_density_integrates_to_one_and_matches_evaluation() {
 fn spotted_map(w: u32, h: u32) -> impl Fn(u32, u32) -> [u8; 3] {
     move |x, y| {
         let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
-        let base = 40.0 + 30.0 * (fx * 2.0 * PI).sin() * (fy * PI).cos();
+        let base = 40.0 + 30.0 * libm::sinf(fx * 2.0 * PI) * libm::cosf(fy * PI);
         let (sx, sy) = (x * 64 / w, y * 32 / h);
         let spot = if (20..23).contains(&sx) && (8..10).contains(&sy) {
             200.0
@@ -829,7 +832,7 @@ fn receives(lights: &Lights, n: Vec3, facing: Option<Vec3>, rounds: u32) -> (DVe
             }
         }
         let (r1, r2) = (rng.f32(), rng.f32());
-        let (sin_phi, cos_phi) = (TAU * r2).sin_cos();
+        let (sin_phi, cos_phi) = libm::sincosf(TAU * r2);
         let r = r1.sqrt();
         let wi = frame.to_world(Vec3::new(r * cos_phi, r * sin_phi, (1.0 - r1).sqrt()));
         let cos = wi.dot(n);
@@ -859,7 +862,7 @@ fn map_integral(
             y as f64 / h as f64 * std::f64::consts::PI,
             (y + 1) as f64 / h as f64 * std::f64::consts::PI,
         );
-        let solid_angle = std::f64::consts::TAU / w as f64 * (t0.cos() - t1.cos());
+        let solid_angle = std::f64::consts::TAU / w as f64 * (libm::cos(t0) - libm::cos(t1));
         let theta = (y as f32 + 0.5) / h as f32 * PI;
         for x in 0..w {
             let phi = (x as f32 + 0.5) / w as f32 * TAU - PI;
@@ -938,7 +941,7 @@ fn fan_facing_down(n: u32) -> Geometry {
     for k in 0..=n {
         let angle = TAU * k as f32 / (n + 1) as f32;
         let r = 0.3 + 0.1 * k as f32;
-        vertices.push(Vec3::new(r * angle.cos(), r * angle.sin(), 0.0));
+        vertices.push(Vec3::new(r * libm::cosf(angle), r * libm::sinf(angle), 0.0));
     }
     let triangles = (1..=n).map(|k| [0, k + 1, k]).collect();
     Geometry::Mesh(Arc::new(mesh(vertices, triangles)))

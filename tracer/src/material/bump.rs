@@ -285,7 +285,7 @@ mod tests {
                 let z = 2.0 * a - 1.0;
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let phi = std::f32::consts::TAU * b;
-                Vec3::new(r * phi.cos(), r * phi.sin(), z)
+                Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), z)
             })
             .collect();
         let (mut through, mut differs) = (0, 0);

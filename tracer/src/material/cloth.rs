@@ -351,7 +351,7 @@ impl Preset {
         let glint = if self.fineness > 0.0 {
             let fibre = (center + xy) * self.fineness;
             let xi = tea_float(word(fibre.x), word(fibre.y));
-            (-xi.ln()).min(MAX_GLINT)
+            (-libm::logf(xi)).min(MAX_GLINT)
         } else {
             1.0
         };

@@ -31,7 +31,7 @@ fn measured_normalization(preset: &'static Preset, n: u32) -> f64 {
 /// The direction at cos(theta) = `cos`, azimuth `phi`.
 fn direction(cos: f32, phi: f32) -> Vec3 {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+    Vec3::new(sin * libm::cosf(phi), sin * libm::sinf(phi), cos)
 }
 
 /// The largest directional albedo of the normalised highlight (no glint) over `points` points

@@ -375,9 +375,9 @@ fn leaf_cases() -> Vec<(&'static str, MaterialDesc)> {
 fn outgoing() -> Vec<Vec3> {
     let mut dirs = Vec::new();
     for deg in [0.0f32, 30.0, 60.0, 80.0, 88.0] {
-        let (s, co) = deg.to_radians().sin_cos();
+        let (s, co) = libm::sincosf(deg.to_radians());
         let phi = 0.7f32;
-        let w = Vec3::new(s * phi.cos(), s * phi.sin(), co);
+        let w = Vec3::new(s * libm::cosf(phi), s * libm::sinf(phi), co);
         dirs.push(w);
         dirs.push(Vec3::new(w.x, w.y, -w.z));
     }
@@ -392,7 +392,7 @@ fn uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), z)
 }
 
 /// What `sample` measures over `n` draws.
@@ -726,8 +726,8 @@ fn glass_reflects_four_percent_at_normal_incidence_and_totally_beyond_critical_a
     let (r, _) = reflected_energy(&bsdf, -Vec3::Z);
     assert!((r - 0.04).abs() < 1e-3, "R inside {r}");
 
-    let critical = (1.0f32 / 1.5).asin();
-    let inside = |angle: f32| Vec3::new(angle.sin(), 0.0, -angle.cos());
+    let critical = libm::asinf(1.0f32 / 1.5);
+    let inside = |angle: f32| Vec3::new(libm::sinf(angle), 0.0, -libm::cosf(angle));
     let (r, t) = reflected_energy(&bsdf, inside(critical + 0.02));
     assert!(
         (r - 1.0).abs() < 1e-6 && t == 0.0,
@@ -737,11 +737,11 @@ fn glass_reflects_four_percent_at_normal_incidence_and_totally_beyond_critical_a
     assert!(t > 0.5, "below critical: T {t}");
 
     // Refraction obeys Snell's law.
-    let wo = Vec3::new(0.5f32.sin(), 0.0, 0.5f32.cos());
+    let wo = Vec3::new(libm::sinf(0.5f32), 0.0, libm::cosf(0.5f32));
     let bs = bsdf.sample(wo, 0.99, Vec2::ZERO).unwrap();
     let sin_t = (1.0 - bs.wi.z * bs.wi.z).sqrt();
     assert!(
-        (sin_t * 1.5 - 0.5f32.sin()).abs() < 1e-5 && bs.wi.x < 0.0,
+        (sin_t * 1.5 - libm::sinf(0.5f32)).abs() < 1e-5 && bs.wi.x < 0.0,
         "{}",
         bs.wi
     );

@@ -139,6 +139,12 @@ pub fn read_color(
 /// A zero coefficient is no extinction even over an infinite distance (LuxRender's rule,
 /// which also keeps 0 x inf from making a NaN).
 pub fn transmittance(sigma_t: Vec3, distance: f32) -> Vec3 {
-    let channel = |s: f32| if s > 0.0 { (-s * distance).exp() } else { 1.0 };
+    let channel = |s: f32| {
+        if s > 0.0 {
+            libm::expf(-s * distance)
+        } else {
+            1.0
+        }
+    };
     Vec3::new(channel(sigma_t.x), channel(sigma_t.y), channel(sigma_t.z))
 }

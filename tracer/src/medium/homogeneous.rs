@@ -109,7 +109,7 @@ impl Homogeneous {
                 weight: self.transmittance(length),
             };
         }
-        let distance = -(1.0 - u).max(f32::MIN_POSITIVE).ln() / k;
+        let distance = -libm::logf((1.0 - u).max(f32::MIN_POSITIVE)) / k;
         // The drawn density is k exp(-k d) for a scattering at d and exp(-k length) for none;
         // the true weights are sigma_s exp(-sigma_t d) and exp(-sigma_t length).
         let excess = self.sigma_t() - Vec3::splat(k);

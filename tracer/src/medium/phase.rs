@@ -69,7 +69,7 @@ impl Phase {
         let axis = -wo;
         let t1 = axis.any_orthonormal_vector();
         let t2 = axis.cross(t1);
-        (axis * c + (t1 * phi.cos() + t2 * phi.sin()) * s).normalize()
+        (axis * c + (t1 * libm::cosf(phi) + t2 * libm::sinf(phi)) * s).normalize()
     }
 }
 
@@ -79,9 +79,9 @@ mod tests {
 
     fn unit(theta: f32, phi: f32) -> Vec3 {
         Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.sin() * phi.sin(),
-            theta.cos(),
+            libm::sinf(theta) * libm::cosf(phi),
+            libm::sinf(theta) * libm::sinf(phi),
+            libm::cosf(theta),
         )
     }
 
@@ -102,7 +102,7 @@ mod tests {
             let mut pdf_sum = 0.0f64;
             for i in 0..nt {
                 let theta = (i as f32 + 0.5) * PI / nt as f32;
-                let dw = theta.sin() * (PI / nt as f32) * (2.0 * PI / np as f32);
+                let dw = libm::sinf(theta) * (PI / nt as f32) * (2.0 * PI / np as f32);
                 for j in 0..np {
                     let wi = unit(theta, (j as f32 + 0.5) * 2.0 * PI / np as f32);
                     sum += phase.eval(wo, wi) * dw;

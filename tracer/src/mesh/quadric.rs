@@ -255,7 +255,7 @@ mod tests {
         // written as 2 pi integral of sqrt(k z) sqrt(1 + k / (4 z)) dz = pi/6 sqrt(k)
         // [(4z + k)^(3/2)] from zmin to zmax.
         let k = r * r / zmax;
-        let f = |z: f64| (4.0 * z + k).powf(1.5);
+        let f = |z: f64| libm::pow(4.0 * z + k, 1.5);
         let exact = PI / 6.0 * k.sqrt() * (f(zmax) - f(zmin));
         let a = mesh_area(&p.tessellate());
         assert!(

@@ -647,8 +647,8 @@ impl Rings {
                     let mut t = Vec3::ZERO;
                     for k in 0..n {
                         let angle = std::f32::consts::TAU * k as f32 / n as f32;
-                        s += angle.cos() * p(k);
-                        t += angle.sin() * p(k);
+                        s += libm::cosf(angle) * p(k);
+                        t += libm::sinf(angle) * p(k);
                     }
                     (s, t)
                 } else {
@@ -659,9 +659,11 @@ impl Rings {
                         4 => -p(0) + 2.0 * p(1) + 2.0 * p(2) - p(3) - 2.0 * centre,
                         _ => {
                             let theta = std::f32::consts::PI / (n - 1) as f32;
-                            let mut t = theta.sin() * (p(0) + p(n - 1));
+                            let mut t = libm::sinf(theta) * (p(0) + p(n - 1));
                             for k in 1..n - 1 {
-                                t += (2.0 * theta.cos() - 2.0) * (k as f32 * theta).sin() * p(k);
+                                t += (2.0 * libm::cosf(theta) - 2.0)
+                                    * libm::sinf(k as f32 * theta)
+                                    * p(k);
                             }
                             -t
                         }
@@ -906,7 +908,7 @@ mod tests {
         let mut positions = vec![Vec3::new(0.0, 0.0, lift)];
         for k in 0..6 {
             let a = std::f32::consts::TAU * k as f32 / 6.0;
-            positions.push(Vec3::new(a.cos(), a.sin(), 0.0));
+            positions.push(Vec3::new(libm::cosf(a), libm::sinf(a), 0.0));
         }
         let indices = (0..6u32).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
         let uvs = positions.iter().map(|p| [p.x, p.y]).collect();
@@ -1078,11 +1080,11 @@ mod tests {
         for c in corners {
             assert!(sharp.positions.iter().any(|q| (*c - *q).length() < 1e-6));
         }
-        let inradius = (std::f32::consts::PI / 6.0).cos();
+        let inradius = libm::cosf(std::f32::consts::PI / 6.0);
         let on_edge = |p: &Vec3| {
             (0..6).any(|k| {
                 let angle = std::f32::consts::TAU * (k as f32 + 0.5) / 6.0;
-                let n = Vec3::new(angle.cos(), angle.sin(), 0.0);
+                let n = Vec3::new(libm::cosf(angle), libm::sinf(angle), 0.0);
                 (p.dot(n) - inradius).abs() < 1e-5
             })
         };

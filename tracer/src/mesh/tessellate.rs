@@ -17,14 +17,14 @@ pub fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
     let (rows, grid): (u32, Box<SurfacePoint>) = match *geometry {
         Geometry::Sphere { radius, phimax, .. } => {
             let (z0, z1) = geometry.sphere_z_range()?;
-            let (th0, th1) = ((z0 / radius).acos(), (z1 / radius).acos());
+            let (th0, th1) = (libm::acosf(z0 / radius), libm::acosf(z1 / radius));
             let phimax = phimax.clamp(0.0, 360.0).to_radians();
             let f = move |u: f32, v: f32| {
                 let (phi, theta) = (u * phimax, th0 + v * (th1 - th0));
                 let n = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
+                    libm::sinf(theta) * libm::cosf(phi),
+                    libm::sinf(theta) * libm::sinf(phi),
+                    libm::cosf(theta),
                 );
                 (n * radius, n)
             };
@@ -39,7 +39,10 @@ pub fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
             let phimax = phimax.clamp(0.0, 360.0).to_radians();
             let f = move |u: f32, v: f32| {
                 let (phi, r) = (u * phimax, radius - v * (radius - inner_radius));
-                (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
+                (
+                    Vec3::new(r * libm::cosf(phi), r * libm::sinf(phi), height),
+                    Vec3::Z,
+                )
             };
             (1, Box::new(f))
         }
@@ -52,7 +55,7 @@ pub fn tessellate(geometry: &Geometry, segments: u32) -> Option<TriangleMesh> {
             let phimax = phimax.clamp(0.0, 360.0).to_radians();
             let f = move |u: f32, v: f32| {
                 let phi = u * phimax;
-                let n = Vec3::new(phi.cos(), phi.sin(), 0.0);
+                let n = Vec3::new(libm::cosf(phi), libm::sinf(phi), 0.0);
                 (n * radius + Vec3::Z * (zmin + v * (zmax - zmin)), n)
             };
             (1, Box::new(f))

@@ -352,7 +352,7 @@ impl<'s> Builder<'s> {
                 }
                 if keyword == "Camera" {
                     self.named_coords
-                        .insert("camera".into(), self.ctm.inverse());
+                        .insert("camera".into(), crate::math::inverse(&self.ctm));
                 }
                 let mut options = std::mem::take(&mut self.options);
                 let read = options.read(self, keyword, ty, params, pos);
@@ -994,7 +994,7 @@ pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
         dir.extend(0.0),
         eye.extend(1.0),
     );
-    let world_to_camera = camera_to_world.inverse();
+    let world_to_camera = crate::math::inverse(&camera_to_world);
     world_to_camera
         .to_cols_array()
         .iter()

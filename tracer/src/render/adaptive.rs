@@ -414,11 +414,11 @@ pub fn sample_map(round: &Round, settings: &RenderSettings) -> (image::GrayImage
     let spp = samples_per_pixel(round, settings);
     let least = spp.iter().copied().min().unwrap_or(0).max(1);
     let most = spp.iter().copied().max().unwrap_or(0).max(1);
-    let steps = 1.0 + f64::from(most / least).log2();
+    let steps = 1.0 + libm::log2(f64::from(most / least));
     let grey = spp
         .iter()
         .map(|&n| {
-            let v = (1.0 + (f64::from(n.max(1)) / f64::from(least)).log2()) / steps;
+            let v = (1.0 + libm::log2(f64::from(n.max(1)) / f64::from(least))) / steps;
             (v.clamp(0.0, 1.0) * 255.0).round() as u8
         })
         .collect();

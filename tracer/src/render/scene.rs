@@ -125,7 +125,7 @@ impl RenderScene {
             world_to_object: desc
                 .shapes
                 .iter()
-                .map(|s| glam::Affine3A::from_mat4(s.object_to_world).inverse())
+                .map(|s| crate::math::affine_inverse(&glam::Affine3A::from_mat4(s.object_to_world)))
                 .collect(),
             glossy_split: glossy_split(desc),
             first_vertex_branches: 1,

@@ -29,6 +29,6 @@ pub fn read(params: &ParamList) -> Result<Constant, ParseError> {
         .max(1e-3);
     let energy = f64::from(params.float("energy", DEFAULT_ENERGY)?);
     Ok(Constant {
-        value: spectrum_rgb(|l| energy * (-0.5 * ((l - mean) / width).powi(2)).exp()),
+        value: spectrum_rgb(|l| energy * libm::exp(-0.5 * ((l - mean) / width).powi(2))),
     })
 }

@@ -88,7 +88,7 @@ pub enum Mapping2D {
 
 /// Azimuth of `p` around z in [0, 2pi) (LuxRender's SphericalPhi).
 fn spherical_phi(p: Vec3) -> f32 {
-    let phi = p.y.atan2(p.x);
+    let phi = libm::atan2f(p.y, p.x);
     if phi < 0.0 {
         phi + TAU
     } else {
@@ -106,7 +106,7 @@ impl Mapping2D {
         let mapping = params.string_or("mapping", DEFAULT_MAPPING)?;
         Ok(match mapping.as_str() {
             "spherical" | "cylindrical" => {
-                let world_to_texture = ctx.ctm().inverse();
+                let world_to_texture = crate::math::inverse(&ctx.ctm());
                 let uscale = params.float("uscale", DEFAULT_SCALE)?;
                 let vscale = params.float("vscale", DEFAULT_SCALE)?;
                 let udelta = params.float("udelta", DEFAULT_DELTA)?;
@@ -134,7 +134,7 @@ impl Mapping2D {
                 params.ignore("uscale");
                 params.ignore("vscale");
                 Mapping2D::Planar {
-                    world_to_texture: ctx.ctm().inverse(),
+                    world_to_texture: crate::math::inverse(&ctx.ctm()),
                     v1: params.vec3("v1", DEFAULT_V1)?,
                     v2: params.vec3("v2", DEFAULT_V2)?,
                     udelta: params.float("udelta", DEFAULT_DELTA)?,
@@ -175,7 +175,7 @@ impl Mapping2D {
                 vdelta,
             } => {
                 let p = world_to_texture.transform_point3(at.p).normalize_or_zero();
-                let theta = p.z.clamp(-1.0, 1.0).acos();
+                let theta = libm::acosf(p.z.clamp(-1.0, 1.0));
                 Vec2::new(uscale, vscale) * Vec2::new(spherical_phi(p) / TAU, theta / PI)
                     + Vec2::new(udelta, vdelta)
             }

@@ -68,7 +68,7 @@ impl Marble {
         let o = &self.octaves;
         let p = o.mapping.map(at) * self.scale;
         let marble = p.y + self.variation * fbm(p, o.roughness, o.octaves);
-        let t = 0.5 + 0.5 * marble.sin();
+        let t = 0.5 + 0.5 * libm::sinf(marble);
         // Six overlapping cubic segments over the nine control points.
         let segments = (PALETTE.len() - 3) as f32;
         let first = ((t * segments).floor() as usize).min(PALETTE.len() - 4);

@@ -21,7 +21,7 @@ fn texel_bytes(x: u32, y: u32) -> [u8; 3] {
 
 fn texel_linear(x: u32, y: u32, gamma: f32) -> Vec3 {
     let [r, g, b] = texel_bytes(x, y);
-    Vec3::new(r as f32, g as f32, b as f32).map(|v| (v / 255.0).powf(gamma))
+    Vec3::new(r as f32, g as f32, b as f32).map(|v| libm::powf(v / 255.0, gamma))
 }
 
 fn png() -> Arc<[u8]> {

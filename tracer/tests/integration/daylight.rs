@@ -38,11 +38,12 @@ fn sky_irradiance(sky: &SkyLight) -> Vec3 {
         for j in 0..np {
             let phi = (j as f64 + 0.5) / np as f64 * TAU;
             let d = glam::DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos(),
+                libm::sin(theta) * libm::cos(phi),
+                libm::sin(theta) * libm::sin(phi),
+                libm::cos(theta),
             );
-            let weight = theta.cos() * theta.sin() * (PI / 2.0 / nt as f64) * (TAU / np as f64);
+            let weight =
+                libm::cos(theta) * libm::sin(theta) * (PI / 2.0 / nt as f64) * (TAU / np as f64);
             sum += model(d.as_vec3()).as_dvec3() * weight;
         }
     }

@@ -86,7 +86,11 @@ fn bvh_and_lights_on_real_scenes() {
                     -hit.ng
                 };
                 let (r, phi) = (rng.f32().sqrt(), rng.f32() * std::f32::consts::TAU);
-                let local = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - r * r).max(0.0).sqrt());
+                let local = Vec3::new(
+                    r * libm::cosf(phi),
+                    r * libm::sinf(phi),
+                    (1.0 - r * r).max(0.0).sqrt(),
+                );
                 let dir = Frame::from_normal(n).to_world(local).normalize();
                 Some(Ray::new(offset_origin(hit.p, hit.ng, dir), dir))
             })

@@ -162,7 +162,7 @@ fn the_shapes_scene_parses_to_meshes_of_the_right_size() {
     let frustum = PI * (0.7 + 0.35) * slant(0.35, 0.9);
     // x^2 + y^2 = k z, k = r^2 / zmax: pi sqrt(k) / 6 ((4 zmax + k)^(3/2) - k^(3/2)).
     let k: f32 = 0.49 / 1.4;
-    let paraboloid = PI * k.sqrt() / 6.0 * ((4.0 * 1.4 + k).powf(1.5) - k.powf(1.5));
+    let paraboloid = PI * k.sqrt() / 6.0 * (libm::powf(4.0 * 1.4 + k, 1.5) - libm::powf(k, 1.5));
     for (shape, exact) in desc.shapes[5..8].iter().zip([cone, frustum, paraboloid]) {
         let a = shape.world_area();
         assert!((a / exact - 1.0).abs() < 0.01, "{a} vs {exact}");

@@ -151,10 +151,10 @@ impl SkyLight {
         let texels: Vec<Vec3> = (0..h)
             .into_par_iter()
             .flat_map_iter(|y| {
-                let (sin_theta, cos_theta) = ((y as f32 + 0.5) / h as f32 * PI).sin_cos();
+                let (sin_theta, cos_theta) = libm::sincosf((y as f32 + 0.5) / h as f32 * PI);
                 let model = &model;
                 (0..w).map(move |x| {
-                    let (sin_phi, cos_phi) = ((x as f32 + 0.5) / w as f32 * TAU).sin_cos();
+                    let (sin_phi, cos_phi) = libm::sincosf((x as f32 + 0.5) / w as f32 * TAU);
                     model(Vec3::new(
                         sin_theta * cos_phi,
                         sin_theta * sin_phi,

@@ -61,10 +61,10 @@ pub struct Preetham {
 impl Preetham {
     /// `sun`: unit light-space direction towards the sun.
     pub fn new(sun: Vec3, turbidity: f32, consts: [f32; 5]) -> Self {
-        let theta_s = sun.z.clamp(-1.0, 1.0).acos();
+        let theta_s = libm::acosf(sun.z.clamp(-1.0, 1.0));
         let t = turbidity;
         let chi = (4.0 / 9.0 - t / 120.0) * (PI - 2.0 * theta_s);
-        let zenith_y = ((4.0453 * t - 4.9710) * chi.tan() - 0.2155 * t + 2.4192) * 1000.0;
+        let zenith_y = ((4.0453 * t - 4.9710) * libm::tanf(chi) - 0.2155 * t + 2.4192) * 1000.0;
         let (th, th2, th3, t2) = (theta_s, theta_s * theta_s, theta_s.powi(3), t * t);
         let zenith_x = (0.00166 * th3 - 0.00375 * th2 + 0.00209 * th) * t2
             + (-0.02903 * th3 + 0.06377 * th2 - 0.03202 * th + 0.00394) * t
@@ -110,8 +110,8 @@ impl Preetham {
 
     /// Radiance (linear sRGB, cd/m^2 scale) from unit light-space direction `dir`.
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let theta = dir.z.clamp(-1.0, 1.0).acos().min(HORIZON_THETA);
-        let gamma = dir.dot(self.sun).clamp(-1.0, 1.0).acos();
+        let theta = libm::acosf(dir.z.clamp(-1.0, 1.0)).min(HORIZON_THETA);
+        let gamma = libm::acosf(dir.dot(self.sun).clamp(-1.0, 1.0));
         let [lum, x, y] =
             std::array::from_fn(|i| self.zenith[i] * perez_f(&self.perez[i], theta, gamma));
         if y <= 0.0 || !y.is_finite() || !lum.is_finite() {
@@ -125,7 +125,7 @@ impl Preetham {
 /// The Perez sky distribution for coefficients A..E at zenith angle `theta` and angle `gamma`
 /// from the sun.
 fn perez_f(c: &[f32; 5], theta: f32, gamma: f32) -> f32 {
-    let cos_gamma = gamma.cos();
-    (1.0 + c[0] * (c[1] / theta.cos()).exp())
-        * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * cos_gamma * cos_gamma)
+    let cos_gamma = libm::cosf(gamma);
+    (1.0 + c[0] * libm::expf(c[1] / libm::cosf(theta)))
+        * (1.0 + c[2] * libm::expf(c[3] * gamma) + c[4] * cos_gamma * cos_gamma)
 }

@@ -54,7 +54,7 @@ impl Blend {
                 t * t * (3.0 - 2.0 * t)
             }
             "diag" => (2.0 + x + y) / 4.0,
-            "radial" => y.atan2(x) / TAU + 0.5,
+            "radial" => libm::atan2f(y, x) / TAU + 0.5,
             kind => {
                 let s = (1.0 - (x * x + y * y + p.z * p.z).sqrt()).max(0.0);
                 if kind == "halo" {

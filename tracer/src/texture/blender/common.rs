@@ -141,7 +141,7 @@ impl Wave {
     pub fn eval(self, a: f32) -> f32 {
         use std::f32::consts::TAU;
         match self {
-            Wave::Sin => 0.5 + 0.5 * a.sin(),
+            Wave::Sin => 0.5 + 0.5 * libm::sinf(a),
             Wave::Saw => {
                 // Blender truncates towards zero, then folds negatives up.
                 let mut r = a - (a / TAU).trunc() * TAU;

@@ -38,25 +38,25 @@ impl Magic {
 
     pub fn pattern(&self, p: Vec3) -> Pattern {
         let turb = self.turbulence / 5.0;
-        let mut x = ((p.x + p.y + p.z) * 5.0).sin();
-        let mut y = ((-p.x + p.y - p.z) * 5.0).cos();
-        let mut z = -((-p.x - p.y + p.z) * 5.0).cos();
+        let mut x = libm::sinf((p.x + p.y + p.z) * 5.0);
+        let mut y = libm::cosf((-p.x + p.y - p.z) * 5.0);
+        let mut z = -libm::cosf((-p.x - p.y + p.z) * 5.0);
         if self.depth > 0 {
             x *= turb;
             y *= turb;
             z *= turb;
             // Each level replaces one coordinate by a wave of the three, in Blender's order.
             let levels: [Level; 10] = [
-                |x, y, z| (1, -(x - y + z).cos()),
-                |x, y, z| (0, (x - y - z).cos()),
-                |x, y, z| (2, (-x - y - z).sin()),
-                |x, y, z| (0, -(-x + y - z).cos()),
-                |x, y, z| (1, -(-x + y + z).sin()),
-                |x, y, z| (1, -(-x + y + z).cos()),
-                |x, y, z| (0, (x + y + z).cos()),
-                |x, y, z| (2, (x + y - z).sin()),
-                |x, y, z| (0, -(-x - y + z).cos()),
-                |x, y, z| (1, -(x - y + z).sin()),
+                |x, y, z| (1, -libm::cosf(x - y + z)),
+                |x, y, z| (0, libm::cosf(x - y - z)),
+                |x, y, z| (2, libm::sinf(-x - y - z)),
+                |x, y, z| (0, -libm::cosf(-x + y - z)),
+                |x, y, z| (1, -libm::sinf(-x + y + z)),
+                |x, y, z| (1, -libm::cosf(-x + y + z)),
+                |x, y, z| (0, libm::cosf(x + y + z)),
+                |x, y, z| (2, libm::sinf(x + y - z)),
+                |x, y, z| (0, -libm::cosf(-x - y + z)),
+                |x, y, z| (1, -libm::sinf(x - y + z)),
             ];
             for level in levels.iter().take(self.depth.clamp(1, 10) as usize) {
                 let (axis, v) = level(x, y, z);

@@ -103,7 +103,7 @@ impl Metric {
                 let q = a * a;
                 (q * q).element_sum().sqrt().sqrt()
             }
-            Metric::Minkowski(e) => a.powf(e).element_sum().powf(1.0 / e),
+            Metric::Minkowski(e) => libm::powf(a.powf(e).element_sum(), 1.0 / e),
         }
     }
 }
@@ -265,7 +265,7 @@ impl Fractal {
 
     pub fn fbm(&self, mut p: Vec3) -> f32 {
         let (n, rmd) = self.octaves();
-        let step = self.lacunarity.powf(-self.h);
+        let step = libm::powf(self.lacunarity, -self.h);
         let (mut value, mut pwr) = (0.0, 1.0);
         for _ in 0..n {
             value += self.basis.signed(p) * pwr;
@@ -280,7 +280,7 @@ impl Fractal {
 
     pub fn multifractal(&self, mut p: Vec3) -> f32 {
         let (n, rmd) = self.octaves();
-        let step = self.lacunarity.powf(-self.h);
+        let step = libm::powf(self.lacunarity, -self.h);
         let (mut value, mut pwr) = (1.0, 1.0);
         for _ in 0..n {
             value *= pwr * self.basis.signed(p) + 1.0;
@@ -295,7 +295,7 @@ impl Fractal {
 
     pub fn hetero_terrain(&self, mut p: Vec3, offset: f32) -> f32 {
         let (n, rmd) = self.octaves();
-        let step = self.lacunarity.powf(-self.h);
+        let step = libm::powf(self.lacunarity, -self.h);
         let mut pwr = step;
         let mut value = offset + self.basis.signed(p);
         p *= self.lacunarity;
@@ -312,7 +312,7 @@ impl Fractal {
 
     pub fn hybrid_multifractal(&self, mut p: Vec3, offset: f32, gain: f32) -> f32 {
         let (n, rmd) = self.octaves();
-        let step = self.lacunarity.powf(-self.h);
+        let step = libm::powf(self.lacunarity, -self.h);
         let mut pwr = step;
         let mut result = self.basis.signed(p) + offset;
         let mut weight = gain * result;
@@ -335,7 +335,7 @@ impl Fractal {
 
     pub fn ridged_multifractal(&self, mut p: Vec3, offset: f32, gain: f32) -> f32 {
         let (n, _) = self.octaves();
-        let step = self.lacunarity.powf(-self.h);
+        let step = libm::powf(self.lacunarity, -self.h);
         let mut pwr = step;
         let mut signal = offset - self.basis.signed(p).abs();
         signal *= signal;
