@@ -17,7 +17,7 @@
 # otherwise it says why and exits 77, the usual "skipped" code. Exits 0 when every check passed,
 # 1 when one failed.
 #
-# Environment: YAT_BIN (the x86-64 yat binary; default target/debug/yat, built when missing),
+# Environment: YAT_BIN (the x86-64 yat binary, built from this tree; default: cargo build -p yat),
 # YAT_SEED_SCENES (default ../shared/seed-project/scenes beside the repository).
 set -euo pipefail
 
@@ -98,10 +98,11 @@ fi
 
 # ---------------------------------------------------------------------------------- builds
 cd "$repo"
-x86=${YAT_BIN:-$target_dir/debug/yat}
-if [[ ! -x $x86 ]]; then
+x86=${YAT_BIN:-}
+if [[ -z $x86 ]]; then
     say "building the x86-64 yat"
     cargo build --locked -p yat --bin yat >&2
+    x86=$target_dir/debug/yat
 fi
 say "building the aarch64 yat"
 CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc \
