@@ -109,7 +109,10 @@ CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc \
     cargo build --locked --target "$TARGET" -p yat --bin yat >&2
 arm_bin=$target_dir/$TARGET/debug/yat
 arm() { QEMU_LD_PREFIX=/usr/aarch64-linux-gnu qemu-aarch64 "$arm_bin" "$@"; }
-[[ $(arm --version) == "$("$x86" --version)" ]] || fail "the aarch64 build does not run under qemu-aarch64"
+arm_version=$(arm --version) || fail "the aarch64 build does not run under qemu-aarch64"
+x86_version=$("$x86" --version)
+# The versions name the renderer build: both binaries come from the same sources.
+[[ $arm_version == "$x86_version" ]] || fail "the builds differ: $x86_version (x86-64), $arm_version (aarch64)"
 
 tmp=$(mktemp -d /tmp/yat-aarch64-test.XXXXXX)
 render_flags=(-q --spp 4 --seed 1 --resolution 40x24 --threads 2 --exr --preview-every 0 --checkpoint-every 0)

@@ -728,6 +728,7 @@ fn seed_sessions() -> Vec<Session> {
                     max_blob_bytes: 1 << 30,
                     features: vec!["tls".into(), "disk-cache".into()],
                     software: "yat 0.1.0".into(),
+                    renderer_build: yat_tracer::RENDERER_BUILD.into(),
                 }
                 .encode_to_vec(),
             ),

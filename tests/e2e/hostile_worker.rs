@@ -22,6 +22,8 @@ enum Misbehaviour {
     NeverAnswers,
     /// Advertises a message limit of one byte.
     TinyMessageLimit,
+    /// Names another renderer build than the coordinator's.
+    OtherBuild,
     /// Answers every unit with these RGB and weight sums in every pixel.
     Pixels { rgb: f32, weight: f32 },
     /// Answers with a sample buffer one pixel short.
@@ -110,6 +112,10 @@ impl yat_proto::RenderNode for FakeNode {
             max_blob_bytes: 1 << 30,
             features: Vec::new(),
             software,
+            renderer_build: match misbehaviour {
+                Misbehaviour::OtherBuild => "0123456789abcdef".into(),
+                _ => yat_tracer::RENDERER_BUILD.into(),
+            },
         }))
     }
 
@@ -201,6 +207,7 @@ impl yat_proto::RenderNode for FakeNode {
             }
             Misbehaviour::FailsAtOnce
             | Misbehaviour::TinyMessageLimit
+            | Misbehaviour::OtherBuild
             | Misbehaviour::LoadFails => return Err(Status::internal("no")),
         };
         Ok(Response::new(reply))
@@ -414,6 +421,26 @@ fn a_worker_with_a_one_byte_message_limit_is_refused() {
         .contains("accepts messages of 1 bytes"));
     bench.alone(
         Misbehaviour::TinyMessageLimit,
+        Some("4"),
+        "no worker can render this scene",
+    );
+}
+
+/// A worker of another renderer build could render other bits: refused at the handshake, so the
+/// image stays the in-process one.
+#[test]
+fn a_worker_of_another_renderer_build_is_refused() {
+    let bench = Bench::new(Misbehaviour::OtherBuild);
+    let (fake, _) = bench.with_honest(Misbehaviour::OtherBuild);
+    assert_eq!(bench.fake.requests(), 1, "refused at the handshake");
+    let gone = fake["gone"].as_str().unwrap();
+    assert!(
+        gone.contains("renderer build 0123456789abcdef")
+            && gone.contains(yat_tracer::RENDERER_BUILD),
+        "{gone}"
+    );
+    bench.alone(
+        Misbehaviour::OtherBuild,
         Some("4"),
         "no worker can render this scene",
     );

@@ -45,3 +45,8 @@ pub mod sampler;
 pub mod shape;
 pub mod spectra;
 pub mod texture;
+
+/// This build of the renderer: a hash of its sources and of the workspace's manifest and locked
+/// dependencies (tracer/build.rs). Builds with the same name render the same bits on any CPU
+/// (docs/architecture.md, "Determinism rules"); a coordinator refuses workers of another.
+pub const RENDERER_BUILD: &str = env!("YAT_RENDERER_BUILD");

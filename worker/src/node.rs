@@ -145,6 +145,7 @@ impl Node {
             max_blob_bytes: caps.max_blob_bytes,
             features: caps.features.clone(),
             software: format!("yat {}", env!("CARGO_PKG_VERSION")),
+            renderer_build: yat_tracer::RENDERER_BUILD.into(),
         })
     }
 

@@ -105,6 +105,8 @@ impl RenderNode for FakeWorker {
             max_blob_bytes: 1 << 31,
             features: Vec::new(),
             software: "yat-farm-sim".into(),
+            // The coordinator's own build, which it requires of its workers.
+            renderer_build: yat_tracer::RENDERER_BUILD.into(),
         }))
     }
 

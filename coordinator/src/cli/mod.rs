@@ -9,12 +9,24 @@ pub mod render;
 pub mod seconds;
 pub mod worker;
 
+use std::sync::LazyLock;
+
 use clap::{Parser, Subcommand};
+
+/// `yat --version`: the package version and the renderer build, which every machine of a
+/// distributed render must share (a coordinator refuses workers of another).
+static VERSION: LazyLock<String> = LazyLock::new(|| {
+    format!(
+        "{} (renderer build {})",
+        env!("CARGO_PKG_VERSION"),
+        yat_tracer::RENDERER_BUILD
+    )
+});
 
 #[derive(Parser)]
 #[command(
     name = "yat",
-    version,
+    version = VERSION.as_str(),
     about = "YAT: a path tracer for LuxRender scenes, on one machine or many"
 )]
 pub struct Cli {

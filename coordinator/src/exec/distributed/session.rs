@@ -77,13 +77,18 @@ pub struct WorkerInfo {
     pub max_blob_bytes: u64,
 }
 
-/// The worker's reply to the handshake, checked: the same protocol version as ours, at least
-/// one thread, names of a sane length, a message limit that fits a unit's reply.
+/// The worker's reply to the handshake, checked: the same protocol version and renderer build
+/// as ours, at least one thread, names of a sane length, a message limit that fits a unit's
+/// reply.
 pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<WorkerInfo, String> {
-    if reply.hostname.len() > MAX_NAME_BYTES || reply.software.len() > MAX_NAME_BYTES {
+    let longest = [&reply.hostname, &reply.software, &reply.renderer_build]
+        .iter()
+        .map(|name| name.len())
+        .max()
+        .unwrap_or(0);
+    if longest > MAX_NAME_BYTES {
         return Err(format!(
-            "worker {address} sends a host or software name of {} bytes (at most {MAX_NAME_BYTES})",
-            reply.hostname.len().max(reply.software.len())
+            "worker {address} sends a host, software or build name of {longest} bytes (at most {MAX_NAME_BYTES})"
         ));
     }
     let software = peer_text(&reply.software, MAX_NAME_CHARS);
@@ -91,6 +96,19 @@ pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<Work
         return Err(format!(
             "worker {address} ({software}) speaks protocol version {}, this coordinator version {}",
             reply.protocol_version, PROTOCOL_VERSION
+        ));
+    }
+    if reply.renderer_build != yat_tracer::RENDERER_BUILD {
+        // Another build may compute other bits: its units would break the promise that the
+        // image is the same bytes however it is rendered.
+        let theirs = match reply.renderer_build.as_str() {
+            "" => "an unnamed renderer build (an older yat)".to_string(),
+            build => format!("renderer build {}", peer_text(build, MAX_NAME_CHARS)),
+        };
+        return Err(format!(
+            "worker {address} ({software}) runs {theirs}, this coordinator renderer build {}: \
+             run the same yat on every machine of a render",
+            yat_tracer::RENDERER_BUILD
         ));
     }
     if reply.threads == 0 {
@@ -486,6 +504,7 @@ mod tests {
             threads: 2,
             hostname: "node-1".into(),
             software: "yat 9.9".into(),
+            renderer_build: yat_tracer::RENDERER_BUILD.into(),
             max_message_bytes: 8 << 20,
             max_blob_bytes: 1 << 30,
             features: Vec::new(),
@@ -500,6 +519,39 @@ mod tests {
         let message = check_handshake("h:1", &reply).unwrap_err();
         assert!(message.contains(&format!("version {}", PROTOCOL_VERSION + 1)));
         assert!(message.contains(&format!("version {PROTOCOL_VERSION}")));
+    }
+
+    /// A worker of another renderer build may render other bits: refused, naming both builds;
+    /// an older worker, which names none, is told apart; a build name is printed safe.
+    #[test]
+    fn another_renderer_build_is_refused_naming_both() {
+        let ours = yat_tracer::RENDERER_BUILD;
+        assert_eq!(ours.len(), 16, "{ours}");
+        let other = pb::HandshakeReply {
+            renderer_build: "0123456789abcdef".into(),
+            ..honest()
+        };
+        let message = check_handshake("h:1", &other).unwrap_err();
+        assert!(
+            message.contains("renderer build 0123456789abcdef"),
+            "{message}"
+        );
+        assert!(
+            message.contains(&format!("coordinator renderer build {ours}")),
+            "{message}"
+        );
+        let older = pb::HandshakeReply {
+            renderer_build: String::new(),
+            ..honest()
+        };
+        let message = check_handshake("h:1", &older).unwrap_err();
+        assert!(message.contains("an older yat"), "{message}");
+        let hostile = pb::HandshakeReply {
+            renderer_build: "\x1b[2J".into(),
+            ..honest()
+        };
+        let message = check_handshake("h:1", &hostile).unwrap_err();
+        assert!(!message.contains('\x1b'), "{message:?}");
     }
 
     #[test]
@@ -532,6 +584,10 @@ mod tests {
             },
             pb::HandshakeReply {
                 software: "s".repeat(1 << 20),
+                ..honest()
+            },
+            pb::HandshakeReply {
+                renderer_build: "b".repeat(MAX_NAME_BYTES + 1),
                 ..honest()
             },
         ] {
