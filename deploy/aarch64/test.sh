@@ -26,6 +26,8 @@ readonly TARGET=aarch64-unknown-linux-gnu
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/../.." && pwd)
 target_dir=${CARGO_TARGET_DIR:-$repo/target}
+# shellcheck source=../stop-processes.sh
+source "$here/../stop-processes.sh"
 
 now_ms() { date +%s%3N; }
 test_start=$(now_ms)
@@ -55,13 +57,7 @@ fail() {
 cleanup() {
     local status=$?
     trap - EXIT
-    local pid
-    for pid in "${workers[@]}"; do
-        kill -TERM "$pid" 2>/dev/null || true
-    done
-    for pid in "${workers[@]}"; do
-        timeout 30 tail --pid="$pid" -f /dev/null 2>/dev/null || kill -KILL "$pid" 2>/dev/null || true
-    done
+    stop_processes 30 "${workers[@]}"
     [[ -n $tmp ]] && rm -rf "$tmp"
     exit "$status"
 }

@@ -26,6 +26,8 @@ readonly SKIPPED=77
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/../.." && pwd)
 batch_script=$here/yat-render.sbatch
+# shellcheck source=../stop-processes.sh
+source "$here/../stop-processes.sh"
 
 now_ms() { date +%s%3N; }
 test_start=$(now_ms)
@@ -83,13 +85,7 @@ cleanup() {
         done
     fi
     # Only the daemons this script started, by their process ids.
-    local pid
-    for pid in "${daemons[@]}"; do
-        kill -TERM "$pid" 2>/dev/null || true
-    done
-    for pid in "${daemons[@]}"; do
-        timeout 15 tail --pid="$pid" -f /dev/null 2>/dev/null || kill -KILL "$pid" 2>/dev/null || true
-    done
+    stop_processes 15 "${daemons[@]}"
     if [[ -n $tmp ]]; then
         if [[ ${YAT_SLURM_TEST_KEEP:-} == 1 ]]; then
             say "kept $tmp"
