@@ -90,8 +90,8 @@ pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
 
 /// `m`'s inverse, computed in f64 and rounded back. glam's f32 `Mat4` and `Affine3A` inverses
 /// take their SSE2, NEON or scalar form by target, each with its own order of operations, so
-/// their last bits differed between x86-64 and aarch64 workers (the seed depth-of-field
-/// scene's spheres); glam's f64 matrices are the same scalar code on every target. clippy.toml
+/// their last bits differed between x86-64 and aarch64 workers (the seed depth-of-field scene,
+/// scenes/exported); glam's f64 matrices are the same scalar code on every target. clippy.toml
 /// keeps the f32 inverses out.
 pub fn inverse(m: &Mat4) -> Mat4 {
     m.as_dmat4().inverse().as_mat4()
@@ -230,6 +230,24 @@ mod tests {
             }
         }
         assert_eq!(floor_to_int(f32::NAN), 0);
+    }
+
+    /// The f64 inverses undo an exporter's kind of transform (turned, unevenly scaled, moved)
+    /// to within float rounding, as matrices and as affine transforms.
+    #[test]
+    fn inverses_undo_the_transform() {
+        let m = Mat4::from_scale_rotation_translation(
+            Vec3::new(0.5, 2.0, 0.3),
+            glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0),
+            Vec3::new(4.0, -2.5, 0.7),
+        );
+        assert!((inverse(&m) * m).abs_diff_eq(Mat4::IDENTITY, 1e-5));
+        assert!((m * inverse(&m)).abs_diff_eq(Mat4::IDENTITY, 1e-5));
+        let a = Affine3A::from_mat4(m);
+        let p = Vec3::new(-1.5, 0.25, 3.0);
+        let back = affine_inverse(&a).transform_point3(a.transform_point3(p));
+        assert!(back.abs_diff_eq(p, 1e-5), "{back}");
+        assert!(Mat4::from(affine_inverse(&a)).abs_diff_eq(inverse(&m), 1e-6));
     }
 
     /// Against f64's atan2 around the whole circle (every 1e-4 rad, at radii from 1e-6 to 1e6,
