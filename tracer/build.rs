@@ -1,7 +1,8 @@
 //! Names this build of the renderer: `YAT_RENDERER_BUILD`, a hash of the crate's sources and
-//! manifest and of the workspace's manifest and locked dependency versions. Two builds with the same name
-//! render the same bits (the float rules in docs/architecture.md make the compiler, profile
-//! and CPU irrelevant); a coordinator refuses workers whose build differs from its own.
+//! manifest and of the workspace's manifest and locked dependency versions. Two builds with the
+//! same name render the same bits (the determinism rules in docs/architecture.md make the build
+//! profile and the CPU irrelevant); a coordinator refuses workers whose build differs from its
+//! own.
 
 use std::fs;
 use std::path::{Path, PathBuf};
