@@ -108,8 +108,10 @@ CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc \
     CARGO_PROFILE_DEV_OPT_LEVEL=0 CARGO_PROFILE_DEV_DEBUG=0 \
     cargo build --locked --target "$TARGET" -p yat --bin yat >&2
 arm_bin=$target_dir/$TARGET/debug/yat
-arm() { QEMU_LD_PREFIX=/usr/aarch64-linux-gnu qemu-aarch64 "$arm_bin" "$@"; }
-arm_version=$(arm --version) || fail "the aarch64 build does not run under qemu-aarch64"
+arm=(env QEMU_LD_PREFIX=/usr/aarch64-linux-gnu qemu-aarch64 "$arm_bin")
+# Every render is bounded: a hang fails the test instead of holding CI.
+readonly RENDER_SECONDS=300
+arm_version=$("${arm[@]}" --version) || fail "the aarch64 build does not run under qemu-aarch64"
 x86_version=$("$x86" --version)
 # The versions name the renderer build: both binaries come from the same sources.
 [[ $arm_version == "$x86_version" ]] || fail "the builds differ: $x86_version (x86-64), $arm_version (aarch64)"
@@ -139,9 +141,10 @@ fi
 differ=()
 for scene in "${scenes[@]}"; do
     name=$(basename "$scene" .lxs)
-    "$x86" render "$scene" "${render_flags[@]}" -o "$tmp/$name-x86.png" 2>>"$tmp/x86.log" ||
-        fail "$scene: the x86-64 render failed"
-    arm render "$scene" "${render_flags[@]}" -o "$tmp/$name-arm.png" 2>>"$tmp/arm.log" ||
+    timeout "$RENDER_SECONDS" "$x86" render "$scene" "${render_flags[@]}" -o "$tmp/$name-x86.png" \
+        2>>"$tmp/x86.log" || fail "$scene: the x86-64 render failed"
+    timeout "$RENDER_SECONDS" "${arm[@]}" render "$scene" "${render_flags[@]}" -o "$tmp/$name-arm.png" \
+        2>>"$tmp/arm.log" ||
         fail "$scene: the aarch64 render failed"
     cmp -s "$tmp/$name-x86.exr" "$tmp/$name-arm.exr" || differ+=("$scene")
 done
@@ -155,7 +158,7 @@ say "PASS: ${#scenes[@]} scenes, the same EXR bytes from the x86-64 and the aarc
 # An aarch64 worker serving an x86-64 coordinator: its sample buffers, merged, give the bytes of
 # the in-process render. (Beside an x86-64 worker it would mostly lose the end game's races,
 # running under emulation, and have few of its own results merged.)
-arm worker --listen 127.0.0.1:0 --threads 2 >"$tmp/arm-worker.out" 2>"$tmp/arm-worker.log" &
+"${arm[@]}" worker --listen 127.0.0.1:0 --threads 2 >"$tmp/arm-worker.out" 2>"$tmp/arm-worker.log" &
 workers+=($!)
 arm_worker=
 for _ in $(seq 600); do
@@ -169,9 +172,9 @@ done
 [[ -n $arm_worker ]] || fail "the aarch64 worker did not start listening"
 scene=scenes/dof/dof-0.1.lxs
 cluster_flags=(-q --spp 8 --seed 1 --resolution 96x54 --exr --preview-every 0 --checkpoint-every 0)
-"$x86" render "$scene" "${cluster_flags[@]}" --threads 2 -o "$tmp/alone.png" 2>>"$tmp/x86.log" ||
-    fail "the in-process render failed"
-"$x86" render "$scene" "${cluster_flags[@]}" --workers "$arm_worker" \
+timeout "$RENDER_SECONDS" "$x86" render "$scene" "${cluster_flags[@]}" --threads 2 \
+    -o "$tmp/alone.png" 2>>"$tmp/x86.log" || fail "the in-process render failed"
+timeout "$RENDER_SECONDS" "$x86" render "$scene" "${cluster_flags[@]}" --workers "$arm_worker" \
     --workers-json "$tmp/workers.json" -o "$tmp/worker.png" 2>"$tmp/coordinator.log" ||
     fail "the render on the aarch64 worker failed"
 python3 - "$tmp/workers.json" <<'EOF' || fail "the aarch64 worker's units were not all merged"

@@ -165,9 +165,9 @@ impl Yarn {
             let (st, ct) = libm::sincosf(t);
             libm::powf(bhat * bhat * ct * ct + ahat * ahat * st * st, 1.5) / (ahat * bhat)
         } else if rhat < 0.0 {
-            let bhat = reach / libm::sinhf(-(rhat * libm::tanf(umax)).atanh());
+            let bhat = reach / libm::sinhf(-libm::atanhf(rhat * libm::tanf(umax)));
             let ahat = bhat / rhat;
-            let t = -(rhat * libm::tanf(u)).atanh();
+            let t = -libm::atanhf(rhat * libm::tanf(u));
             let (sh, ch) = (libm::sinhf(t), libm::coshf(t));
             -libm::powf(bhat * bhat * ch * ch + ahat * ahat * sh * sh, 1.5) / (ahat * bhat)
         } else {
