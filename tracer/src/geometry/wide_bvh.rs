@@ -16,7 +16,7 @@ use obvhs::cwbvh::CwBvh;
 
 use super::hit::PrimHit;
 #[cfg(target_arch = "x86_64")]
-use super::simd::{Avx2, Sse};
+use super::simd::{Avx2, Avx512, Sse};
 use super::simd::{Isa, Scalar};
 use super::triangle::TriangleEdges;
 use super::wide_node::{
@@ -192,6 +192,9 @@ impl WideBvh {
         match self.isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `isa` is only ever set to an instruction set the CPU was detected to run.
+            Some(Isa::Avx512) => unsafe { self.closest_avx512(&ray, tmax, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
             Some(Isa::Avx2) => unsafe { self.closest_avx2(&ray, tmax, other) },
             #[cfg(target_arch = "x86_64")]
             Some(Isa::Sse) => self.closest_with::<Sse>(&ray, tmax, other),
@@ -215,6 +218,9 @@ impl WideBvh {
         match self.isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `closest`.
+            Some(Isa::Avx512) => unsafe { self.any_avx512(&ray, tmax, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
             Some(Isa::Avx2) => unsafe { self.any_avx2(&ray, tmax, other) },
             #[cfg(target_arch = "x86_64")]
             Some(Isa::Sse) => self.any_with::<Sse>(&ray, tmax, other),
@@ -242,6 +248,28 @@ impl WideBvh {
         other: impl FnMut(u32, f32) -> bool,
     ) -> bool {
         self.any_with::<Avx2>(ray, tmax, other)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn closest_avx512(
+        &self,
+        ray: &TraversalRay,
+        tmax: f32,
+        other: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<PrimHit> {
+        self.closest_with::<Avx512>(ray, tmax, other)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn any_avx512(
+        &self,
+        ray: &TraversalRay,
+        tmax: f32,
+        other: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        self.any_with::<Avx512>(ray, tmax, other)
     }
 
     #[inline(always)]

@@ -7,8 +7,8 @@
 //!
 //! Determinism: every kernel computes, lane by lane, exactly the scalar operations written in
 //! [`slab_lane`] and [`triangle_lane`] (same operations, same order, no fused multiply-add), so
-//! the scalar, SSE and AVX2 paths return bit-identical results and workers on different CPUs
-//! render the same image bytes.
+//! the scalar, SSE, AVX2 and AVX-512 paths return bit-identical results and workers on
+//! different CPUs render the same image bytes.
 
 use obvhs::aabb::Aabb;
 

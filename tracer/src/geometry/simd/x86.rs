@@ -1,12 +1,13 @@
 //! The x86-64 kernels: the triangle test on 4 SSE lanes (SSE2 is part of x86-64), the slab
-//! test on 8 AVX2 lanes or on two halves of 4 SSE lanes. Each lane performs exactly the
+//! test on 8 AVX2 lanes (its comparison into a mask register with AVX-512) or on two halves of
+//! 4 SSE lanes. Each lane performs exactly the
 //! operations of `wide_node::slab_lane` and `wide_node::triangle_lane`, in the same order and
 //! without fused multiply-add; `minps`/`maxps` return their second operand on ties, as the
 //! scalar code's comparisons do.
 //!
 //! The kernels are `#[inline(always)]` without `#[target_feature]`: the traversal instantiates
-//! them inside a function compiled with AVX2 enabled (`wide_bvh`), chosen only after run-time
-//! detection, so every intrinsic below inlines into AVX2 code.
+//! them inside a function compiled with AVX2 (or AVX-512) enabled (`wide_bvh`), chosen only
+//! after run-time detection, so every intrinsic below inlines into that code.
 
 use std::arch::x86_64::*;
 
@@ -184,41 +185,81 @@ impl Kernel for Avx2 {
 
     #[inline(always)]
     fn slabs(node: &Node, ray: &Avx2Ray, tmax: f32, tnear: &mut [f32; WIDTH]) -> u32 {
-        // SAFETY: AVX2 as above; each load reads one bound row of 8 floats and the store
-        // writes `tnear`'s 8 floats.
+        let (near, far) = slab_near_far(node, ray, tmax);
+        // SAFETY: AVX2 as above; the store writes `tnear`'s 8 floats.
         unsafe {
-            macro_rules! plane {
-                ($row:expr, $axis:expr) => {
-                    _mm256_mul_ps(
-                        _mm256_sub_ps(
-                            _mm256_loadu_ps(node.bounds[$row].as_ptr()),
-                            ray.origin[$axis],
-                        ),
-                        ray.inv_dir[$axis],
-                    )
-                };
-            }
-            let (n0, n1, n2) = (
-                plane!(ray.near_row[0], 0),
-                plane!(ray.near_row[1], 1),
-                plane!(ray.near_row[2], 2),
-            );
-            let (f0, f1, f2) = (
-                plane!(ray.far_row[0], 0),
-                plane!(ray.far_row[1], 1),
-                plane!(ray.far_row[2], 2),
-            );
-            let near = _mm256_max_ps(
-                _mm256_max_ps(n0, n1),
-                _mm256_max_ps(n2, _mm256_setzero_ps()),
-            );
-            let far = _mm256_mul_ps(
-                _mm256_min_ps(_mm256_min_ps(f0, f1), f2),
-                _mm256_set1_ps(SLAB_ROBUST),
-            );
-            let far = _mm256_min_ps(far, _mm256_set1_ps(tmax));
             _mm256_storeu_ps(tnear.as_mut_ptr(), near);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
+        }
+    }
+
+    #[inline(always)]
+    fn triangles(packet: &Packet, ray: &Avx2Ray, tmax: f32, hits: &mut PacketHits) -> u32 {
+        triangles4(packet, &ray.tri, tmax, hits)
+    }
+}
+
+/// The eight slabs' entry and exit distances on one 8-lane register (exit clipped to tmax), for
+/// the AVX2 and AVX-512 kernels.
+#[inline(always)]
+fn slab_near_far(node: &Node, ray: &Avx2Ray, tmax: f32) -> (__m256, __m256) {
+    // SAFETY: only inlined into functions compiled with AVX2 after detection (see the module's
+    // doc); each load reads one bound row of 8 floats.
+    unsafe {
+        macro_rules! plane {
+            ($row:expr, $axis:expr) => {
+                _mm256_mul_ps(
+                    _mm256_sub_ps(
+                        _mm256_loadu_ps(node.bounds[$row].as_ptr()),
+                        ray.origin[$axis],
+                    ),
+                    ray.inv_dir[$axis],
+                )
+            };
+        }
+        let (n0, n1, n2) = (
+            plane!(ray.near_row[0], 0),
+            plane!(ray.near_row[1], 1),
+            plane!(ray.near_row[2], 2),
+        );
+        let (f0, f1, f2) = (
+            plane!(ray.far_row[0], 0),
+            plane!(ray.far_row[1], 1),
+            plane!(ray.far_row[2], 2),
+        );
+        let near = _mm256_max_ps(
+            _mm256_max_ps(n0, n1),
+            _mm256_max_ps(n2, _mm256_setzero_ps()),
+        );
+        let far = _mm256_mul_ps(
+            _mm256_min_ps(_mm256_min_ps(f0, f1), f2),
+            _mm256_set1_ps(SLAB_ROBUST),
+        );
+        (near, _mm256_min_ps(far, _mm256_set1_ps(tmax)))
+    }
+}
+
+/// AVX-512 (F and VL): the AVX2 kernel's arithmetic with its comparisons made straight into
+/// mask registers, run inside traversal functions compiled for AVX-512, where the ray and the
+/// node's planes have 32 vector registers instead of 16. Only run there, after detection.
+pub struct Avx512;
+
+impl Kernel for Avx512 {
+    type Ray = Avx2Ray;
+
+    #[inline(always)]
+    fn prepare(ray: &TraversalRay) -> Avx2Ray {
+        Avx2::prepare(ray)
+    }
+
+    #[inline(always)]
+    fn slabs(node: &Node, ray: &Avx2Ray, tmax: f32, tnear: &mut [f32; WIDTH]) -> u32 {
+        let (near, far) = slab_near_far(node, ray, tmax);
+        // SAFETY: AVX-512 F and VL, detected by the caller; the store writes `tnear`'s 8
+        // floats.
+        unsafe {
+            _mm256_storeu_ps(tnear.as_mut_ptr(), near);
+            u32::from(_mm256_cmp_ps_mask::<_CMP_LE_OQ>(near, far))
         }
     }
 
