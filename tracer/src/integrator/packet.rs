@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3};
 
 use super::options::RussianRoulette;
 use super::path::{
-    power_heuristic, walk, BeforeMirror, LightChoice, PathResult, PathScene, PathState,
+    power_heuristic, walk, BeforeMirror, BsdfCounts, LightChoice, PathResult, PathScene, PathState,
     PrevScatter, Vertex, MAX_BRANCHES, RR_MIN_DEPTH, RR_MIN_SURVIVAL, RR_THROUGHPUT_SCALE,
 };
 use crate::bxdf::local::cosine_hemisphere;
@@ -463,7 +463,7 @@ impl<L: Lanes> Packet<L> {
             specular: prev.specular,
             image_share: prev.image_share,
             before_mirror: prev.before_mirror,
-            direct_counted: false,
+            lamps_counted: false,
             facing: prev.broad.then_some(parts.prev_facing.get(i)),
         }
     }
@@ -827,8 +827,13 @@ impl LaneHits {
         let depth = packet.depth + 1;
         let mut rays = 0;
         if lambert_here {
-            let (choice, image_share) =
-                vertex.choose_light(scene, &us[i], depth, at.bsdf_count, &mut rays);
+            let (choice, image_share) = vertex.choose_light(
+                scene,
+                &us[i],
+                depth,
+                BsdfCounts::all(at.bsdf_count),
+                &mut rays,
+            );
             self.image_share[i] = image_share;
             match choice {
                 LightChoice::Image(light) => self.lit_alone[i] = Some(light),
@@ -837,7 +842,8 @@ impl LaneHits {
                 }
             }
         } else {
-            let (light, image_share) = vertex.light(scene, &us[i], depth, 1.0, &mut rays);
+            let (light, image_share) =
+                vertex.light(scene, &us[i], depth, BsdfCounts::ONE, &mut rays);
             let sample = vertex.sample(&us[i]);
             let before_mirror = match &sample {
                 Some((bs, _)) => {

@@ -54,6 +54,17 @@ impl LampCones {
                     || cone.axis.dot(to_centre) >= libm::cosf(reach) * dist
             })
     }
+
+    /// Whether a ray from `p` along the unit `dir` may hit a lamp: a cone of no width.
+    pub fn may_reach_along(&self, p: Vec3, dir: Vec3) -> bool {
+        self.may_reach(
+            p,
+            &Cone {
+                axis: dir,
+                half: 0.0,
+            },
+        )
+    }
 }
 
 #[cfg(test)]
@@ -98,5 +109,30 @@ mod tests {
             half: 3.2,
         };
         assert!(cones.may_reach(p, &wide));
+    }
+
+    /// Rays from shading points around a 1x1 lamp at every point of the lamp (a glossy split's
+    /// samples that hit it) are all said to reach it; rays turned well away from it are not.
+    #[test]
+    fn a_ray_at_a_lamp_is_never_missed() {
+        let lamp = (Vec3::new(-0.5, -0.5, 4.0), Vec3::new(0.5, 0.5, 4.0));
+        let cones = LampCones::new(&[lamp]);
+        let mut state = 777u64;
+        let mut next = || {
+            state = crate::sampler::mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..20_000 {
+            let p = Vec3::new(next() * 6.0 - 3.0, next() * 6.0 - 3.0, next() * 3.0);
+            let target = Vec3::new(next() - 0.5, next() - 0.5, 4.0);
+            let dir = (target - p).normalize();
+            assert!(cones.may_reach_along(p, dir), "from {p} towards {target}");
+            // Every shading point is below the lamp's sphere: the reverse points away from it.
+            let away = -dir;
+            assert!(
+                !cones.may_reach_along(p, away),
+                "from {p} away along {away}"
+            );
+        }
     }
 }

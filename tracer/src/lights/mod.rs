@@ -463,6 +463,11 @@ impl Lights {
         self.lamp_cones.may_reach(p, cone)
     }
 
+    /// Whether a ray from `p` along `dir` may reach an area light (false is never wrong).
+    pub fn lamp_may_be_along(&self, p: Vec3, dir: Vec3) -> bool {
+        self.lamp_cones.may_reach_along(p, dir)
+    }
+
     /// Whether the scene has lamp images (most have none).
     #[inline]
     pub fn has_mirror_images(&self) -> bool {
