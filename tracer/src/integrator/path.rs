@@ -865,7 +865,7 @@ struct SplitLight {
 /// the light sample as one BSDF sample ([`BsdfCounts`]): a sample that cannot reach a lamp's
 /// bounding sphere is then not traced at all. When the split's samples took the environment
 /// too, Mario's error was the same (4 seeds, 16 spp: 0.000631 against 0.000627 now) for 15%
-/// more rays and a third more time. It once went on with the split's first sample instead,
+/// more rays and 17% more time. It once went on with the split's first sample instead,
 /// saving a ray: but sample `j` of every camera sample's split draw lies in the same
 /// `1 / GLOSSY_SPLIT` of its first number, so a pixel's paths all went on through one strip
 /// of the lobe, and Mario's hat (which sees the lamp in its own crown) kept its noise from 16
