@@ -8,7 +8,7 @@
 //! | `rrcontinueprob` | float | 0.65 |
 //! | `includeenvironment` | bool | true |
 //! | `mirrorimages` (YAT's own) | bool | true: lamps are also sampled through flat mirrors ([`crate::lights::ImageSample`]) |
-//! | `glossysplit` (YAT's own) | bool | true: a path's first glossy vertex that may see a lamp takes several BSDF samples for its direct light ([`crate::integrator::GLOSSY_SPLIT`]) |
+//! | `glossysplit` (YAT's own) | bool | true: a path's first glossy vertex that may see a lamp takes several BSDF samples for the lamps it sees directly ([`crate::integrator::GLOSSY_SPLIT`]) |
 //!
 //! Without a `SurfaceIntegrator` statement the scene renders with `"path"` and these defaults.
 
