@@ -67,10 +67,10 @@ pub const MAX_BRANCHES: usize = 4;
 const MAX_PASS_THROUGH: u32 = 64;
 
 /// BSDF samples a path's first glossy vertex that may see a lamp takes for the lamps it sees
-/// directly (the path goes on with a sample of its own, which finds the environment). A lamp in a narrow lobe is a bright
-/// patch that one sample finds or misses: Mario's metal figure held some 60% of its image's
-/// error at 16 spp in those highlights, and the floor's speckles are the same highlights seen
-/// from the floor. Measured on Mario (480x270, 16 spp, instructions by callgrind; when the path
+/// directly (the path goes on with a sample of its own, which finds the environment). A lamp
+/// in a narrow lobe is a bright patch that one sample finds or misses: Mario's metal figure
+/// held some 60% of its image's error at 16 spp in those highlights, and the floor's speckles
+/// are the same highlights seen from the floor. Measured on Mario (480x270, 16 spp, instructions by callgrind; when the path
 /// went on with one of the split's samples): 4 samples cut the error to 0.55 for 1.08 times the
 /// work, 8 to 0.46 for 1.17, 16 to 0.44 for 1.35.
 pub const GLOSSY_SPLIT: usize = 8;
@@ -172,8 +172,7 @@ pub(super) struct LightDraw {
     pub(super) share: f32,
     pub(super) u_select: f32,
     u: Vec2,
-    /// The BSDF samples the vertex weighs its light sample against: 1, [`GLOSSY_SPLIT`] at a
-    /// split vertex, the continuations' count at a branching one.
+    /// The BSDF samples the vertex weighs its light sample against.
     bsdf_count: BsdfCounts,
 }
 

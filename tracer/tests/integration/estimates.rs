@@ -41,8 +41,22 @@ pub fn quad(material: &str, points: [&str; 4]) -> String {
 
 /// The scene `text` (which must parse without warnings) built for a `size` x `size` render.
 pub fn build(text: &str, size: u32, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {
+    build_with(text, &[], size, spp, seed)
+}
+
+/// [`build`], the scene reading `files` (name, bytes) beside it.
+pub fn build_with(
+    text: &str,
+    files: &[(&str, &[u8])],
+    size: u32,
+    spp: u32,
+    seed: u64,
+) -> (RenderScene, RenderSettings) {
     let mut source = MemorySource::new();
     source.insert("main.lxs", text.as_bytes().into());
+    for (name, bytes) in files {
+        source.insert(*name, (*bytes).into());
+    }
     let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
     assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let settings = RenderSettings {

@@ -1,5 +1,5 @@
 //! Paths split at their first glossy vertex that may see a lamp (`GLOSSY_SPLIT` BSDF samples
-//! for the light it sees directly, in `tracer/src/integrator/path.rs`): the estimate keeps the
+//! for the lamps it sees directly, in `tracer/src/integrator/path.rs`): the estimate keeps the
 //! one-sample path tracer's mean and its highlights are less noisy.
 
 use glam::Vec3;
@@ -145,4 +145,54 @@ fn a_split_vertex_path_sees_the_whole_lobe() {
 #[test]
 fn a_split_vertex_path_keeps_the_mean() {
     estimates::assert_same_mean(|split, seed| render(&ceiling_scene(split), 512, seed));
+}
+
+/// An equirectangular sky, black but for its top row: a bright cap of 5.6 degrees around the
+/// zenith, about as wide as a glossy lobe, so the light samples that find it are about as
+/// likely as the lobe's BSDF samples.
+fn zenith_cap_map() -> Vec<u8> {
+    let sky = image::Rgb32FImage::from_fn(64, 32, |_, y| {
+        image::Rgb([if y == 0 { 20.0 } else { 0.0 }; 3])
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image::DynamicImage::from(sky)
+        .write_to(&mut bytes, image::ImageFormat::Hdr)
+        .unwrap();
+    bytes.into_inner()
+}
+
+/// A metal floor (alpha 0.08) under that sky and a small null lamp beside the zenith, inside
+/// the lobes of the floor's middle, which split and reflect the cap.
+fn cap_scene(split: bool) -> String {
+    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
+    format!(
+        "{}\
+         LightSource \"infinite\" \"string mapname\" [\"sky.hdr\"]\n\
+         AttributeBegin\n\
+         Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \"float uroughness\" [0.08] \"float vroughness\" [0.08]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
+           \"point P\" [-3 -3 0  3 -3 0  3 3 0  -3 3 0]\n\
+         AttributeEnd\n\
+         AttributeBegin\n\
+         Material \"null\"\n\
+         AreaLightSource \"area\" \"color L\" [5 5 5] \"float power\" [0]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
+           \"point P\" [0.3 -0.15 2  0.3 0.15 2  0.6 0.15 2  0.6 -0.15 2]\n\
+         AttributeEnd\n\
+         WorldEnd\n",
+        estimates::looking_down(SIZE, &integrator)
+    )
+}
+
+/// A split vertex's light sample of an environment map is weighed against the path's one BSDF
+/// sample, which finds the environment (the split's eight look for lamps only): with the eight
+/// counted there instead, the cap's light goes missing from the metal.
+#[test]
+fn splitting_keeps_the_mean_of_the_sky_in_the_lobe() {
+    let sky = zenith_cap_map();
+    estimates::assert_same_mean(|split, seed| {
+        let files: [(&str, &[u8]); 1] = [("sky.hdr", &sky)];
+        let (scene, settings) = estimates::build_with(&cap_scene(split), &files, SIZE, 512, seed);
+        estimates::radiance(&scene, &settings)
+    });
 }
