@@ -165,23 +165,20 @@ fn zenith_cap_map() -> Vec<u8> {
 /// the lobes of the floor's middle, which split and reflect the cap.
 fn cap_scene(split: bool) -> String {
     let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
-    format!(
-        "{}\
-         LightSource \"infinite\" \"string mapname\" [\"sky.hdr\"]\n\
-         AttributeBegin\n\
-         Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \"float uroughness\" [0.08] \"float vroughness\" [0.08]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-           \"point P\" [-3 -3 0  3 -3 0  3 3 0  -3 3 0]\n\
-         AttributeEnd\n\
-         AttributeBegin\n\
-         Material \"null\"\n\
-         AreaLightSource \"area\" \"color L\" [5 5 5] \"float power\" [0]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-           \"point P\" [0.3 -0.15 2  0.3 0.15 2  0.6 0.15 2  0.6 -0.15 2]\n\
-         AttributeEnd\n\
-         WorldEnd\n",
-        estimates::looking_down(SIZE, &integrator)
-    )
+    let metal = "Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \
+                 \"float uroughness\" [0.08] \"float vroughness\" [0.08]";
+    let lamp = format!("Material \"null\"\n{}", estimates::LAMP);
+    [
+        estimates::looking_down(SIZE, &integrator),
+        "LightSource \"infinite\" \"string mapname\" [\"sky.hdr\"]\n".to_owned(),
+        estimates::quad(metal, estimates::FLOOR),
+        estimates::quad(
+            &lamp,
+            ["0.3 -0.15 2", "0.3 0.15 2", "0.6 0.15 2", "0.6 -0.15 2"],
+        ),
+        "WorldEnd\n".to_owned(),
+    ]
+    .concat()
 }
 
 /// A split vertex's light sample of an environment map is weighed against the path's one BSDF
