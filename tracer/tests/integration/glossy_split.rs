@@ -9,12 +9,26 @@ use super::estimates::{self, seed_difference};
 
 const SIZE: u32 = 40;
 
+/// The camera of [`estimates::looking_down`] with a path integrator of depth 3, splitting or
+/// not.
+fn camera(split: bool) -> String {
+    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
+    estimates::looking_down(SIZE, &integrator)
+}
+
+/// A grey metal with GGX roughness `alpha`.
+fn metal(alpha: f32) -> String {
+    format!(
+        "Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \
+         \"float uroughness\" [{alpha}] \"float vroughness\" [{alpha}]"
+    )
+}
+
 /// The camera looks down on a floor whose left half is a rough metal (alpha 0.05) and right
 /// half grey matte. A lamp (null material, as LuxBlend exports them: the camera sees through
 /// its back) hangs over the left, where the metal reflects it to the camera, and the matte half
 /// sees its highlight on the metal too; a dim sky lights everything. Depth 3.
 fn scene(split: bool) -> String {
-    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
     format!(
         "{}\
          LightSource \"infinite\" \"color L\" [0.1 0.1 0.1]\n\
@@ -35,7 +49,7 @@ fn scene(split: bool) -> String {
            \"point P\" [-1 -0.4 1.5  -1 0.4 1.5  -0.3 0.4 1.5  -0.3 -0.4 1.5]\n\
          AttributeEnd\n\
          WorldEnd\n",
-        estimates::looking_down(SIZE, &integrator)
+        camera(split)
     )
 }
 
@@ -109,13 +123,10 @@ fn only_scenes_with_lamps_and_metals_split() {
 /// whose back it sees) and goes on to the ceiling, where its light sample finds the lamp. All
 /// the light comes through the path's own BSDF sample, none through the split's. Depth 3.
 fn ceiling_scene(split: bool) -> String {
-    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
-    let metal = "Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \
-                 \"float uroughness\" [0.05] \"float vroughness\" [0.05]";
     let lamp = format!("Material \"null\"\n{}", estimates::LAMP);
     [
-        estimates::looking_down(SIZE, &integrator),
-        estimates::quad(metal, estimates::FLOOR),
+        camera(split),
+        estimates::quad(&metal(0.05), estimates::FLOOR),
         estimates::quad(&lamp, ["1 -0.3 4", "1.6 -0.3 4", "1.6 0.3 4", "1 0.3 4"]),
         estimates::quad(
             estimates::MATTE_FLOOR,
@@ -164,14 +175,11 @@ fn zenith_cap_map() -> Vec<u8> {
 /// A metal floor (alpha 0.08) under that sky and a small null lamp beside the zenith, inside
 /// the lobes of the floor's middle, which split and reflect the cap.
 fn cap_scene(split: bool) -> String {
-    let integrator = format!("\"integer maxdepth\" [3] \"bool glossysplit\" [\"{split}\"]");
-    let metal = "Material \"metal2\" \"color fresnel\" [0.8 0.8 0.8] \
-                 \"float uroughness\" [0.08] \"float vroughness\" [0.08]";
     let lamp = format!("Material \"null\"\n{}", estimates::LAMP);
     [
-        estimates::looking_down(SIZE, &integrator),
+        camera(split),
         "LightSource \"infinite\" \"string mapname\" [\"sky.hdr\"]\n".to_owned(),
-        estimates::quad(metal, estimates::FLOOR),
+        estimates::quad(&metal(0.08), estimates::FLOOR),
         estimates::quad(
             &lamp,
             ["0.3 -0.15 2", "0.3 0.15 2", "0.6 0.15 2", "0.6 -0.15 2"],
