@@ -55,15 +55,25 @@ impl LampCones {
             })
     }
 
-    /// Whether a ray from `p` along the unit `dir` may hit a lamp: a cone of no width.
+    /// Whether a ray from `p` along the unit `dir` may hit a lamp: it passes within a lamp's
+    /// sphere (its closest approach to the centre, ahead of `p`, is within the radius; or `p` is
+    /// inside). Without [`Self::may_reach`]'s arcsine and cosine: a glossy split asks this for
+    /// each of its samples. The radius is widened by a thousandth against rounding: a yes only
+    /// costs a traced ray.
     pub fn may_reach_along(&self, p: Vec3, dir: Vec3) -> bool {
-        self.may_reach(
-            p,
-            &Cone {
-                axis: dir,
-                half: 0.0,
-            },
-        )
+        self.too_many
+            || self.spheres.iter().any(|&(centre, radius)| {
+                let to_centre = centre - p;
+                let reach = radius * 1.001;
+                let dist_sq = to_centre.length_squared();
+                if dist_sq <= reach * reach {
+                    return true;
+                }
+                // The offset of the centre from the ray's line, not dist^2 - along^2, which
+                // cancels for a lamp far away compared with its size.
+                let along = dir.dot(to_centre);
+                along > 0.0 && (to_centre - dir * along).length_squared() <= reach * reach
+            })
     }
 }
 
@@ -133,6 +143,21 @@ mod tests {
                 !cones.may_reach_along(p, away),
                 "from {p} away along {away}"
             );
+        }
+        // From two thousand lamp sizes away, rays at the lamp's corners (on its sphere) are
+        // still said to reach it, and rays passing 1% of its radius outside the sphere are not.
+        let far = LampCones::new(&[(Vec3::new(-0.5, -0.5, 2000.0), Vec3::new(0.5, 0.5, 2000.0))]);
+        let radius = 0.5f32.sqrt();
+        for corner in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+            let p = Vec3::new(3.0, -2.0, 0.0);
+            let to_corner = Vec3::new(corner.0, corner.1, 2000.0) - p;
+            assert!(
+                far.may_reach_along(p, to_corner.normalize()),
+                "corner {corner:?}"
+            );
+            let outside = Vec3::new(corner.0, corner.1, 0.0).normalize() * radius * 1.01;
+            let past = (Vec3::new(outside.x, outside.y, 2000.0) - p).normalize();
+            assert!(!far.may_reach_along(p, past), "past corner {corner:?}");
         }
     }
 }
