@@ -173,7 +173,7 @@ pub(super) struct LightDraw {
     pub(super) u_select: f32,
     u: Vec2,
     /// The BSDF samples the vertex weighs its light sample against.
-    bsdf_count: BsdfCounts,
+    bsdf_counts: BsdfCounts,
 }
 
 /// The BSDF samples a vertex's light sample is weighed against: 1, the continuations' count at
@@ -199,6 +199,16 @@ impl BsdfCounts {
             environment: count,
         }
     }
+
+    /// The count for a light sample from a lamp, or from the environment (`at_infinity`: an
+    /// environment map, a sky or its sun disc).
+    fn for_light(&self, at_infinity: bool) -> f32 {
+        if at_infinity {
+            self.environment
+        } else {
+            self.lamps
+        }
+    }
 }
 
 impl LightDraw {
@@ -207,7 +217,7 @@ impl LightDraw {
             share,
             u_select,
             u,
-            bsdf_count: BsdfCounts::ONE,
+            bsdf_counts: BsdfCounts::ONE,
         }
     }
 
@@ -451,7 +461,7 @@ pub(super) fn walk<S: PathScene>(
             && (bsdf.glossy_cone(wo)).is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone));
         let broad = bsdf.gathers_from(wo);
         let branching = !split && branches > 1 && broad.is_some();
-        let bsdf_count = if split {
+        let bsdf_counts = if split {
             BsdfCounts::SPLIT
         } else if branching {
             BsdfCounts::all(branches as f32)
@@ -464,7 +474,7 @@ pub(super) fn walk<S: PathScene>(
             bsdf: &bsdf,
             sides,
         };
-        let (light, image_share) = vertex.light(scene, &u, depth, bsdf_count, &mut rays);
+        let (light, image_share) = vertex.light(scene, &u, depth, bsdf_counts, &mut rays);
         if let Some(light) = light {
             radiance += throughput * light;
         }
@@ -538,7 +548,7 @@ pub(super) struct Vertex<'a> {
 }
 
 impl Vertex<'_> {
-    /// The vertex's light sample (None at a specular vertex), weighed against `bsdf_count`
+    /// The vertex's light sample (None at a specular vertex), weighed against `bsdf_counts`
     /// BSDF samples, and the share of its light samples that went to lamp images. `depth`
     /// counts this vertex.
     #[inline(always)]
@@ -547,13 +557,13 @@ impl Vertex<'_> {
         scene: &S,
         u: &VertexSamples,
         depth: u32,
-        bsdf_count: BsdfCounts,
+        bsdf_counts: BsdfCounts,
         rays: &mut u32,
     ) -> (Option<Vec3>, f32) {
         if self.bsdf.is_specular() {
             return (None, 0.0);
         }
-        let (choice, image_share) = self.choose_light(scene, u, depth, bsdf_count, rays);
+        let (choice, image_share) = self.choose_light(scene, u, depth, bsdf_counts, rays);
         let light = match choice {
             LightChoice::Image(light) => light,
             LightChoice::Lights(draw) => {
@@ -571,7 +581,7 @@ impl Vertex<'_> {
         scene: &S,
         u: &VertexSamples,
         depth: u32,
-        bsdf_count: BsdfCounts,
+        bsdf_counts: BsdfCounts,
         rays: &mut u32,
     ) -> (LightChoice, f32) {
         let lights = scene.lights();
@@ -582,7 +592,10 @@ impl Vertex<'_> {
         } else {
             (LightDraw::lights_only(u), None)
         };
-        let draw = LightDraw { bsdf_count, ..draw };
+        let draw = LightDraw {
+            bsdf_counts,
+            ..draw
+        };
         match image {
             Some(images) => {
                 let light = direct_light_via_mirror(scene, hit, wo, bsdf, &images, draw, rays);
@@ -840,11 +853,7 @@ fn direct_light<S: PathScene>(
     let weight = if ls.delta {
         1.0
     } else {
-        let count = if ls.dist.is_infinite() {
-            draw.bsdf_count.environment
-        } else {
-            draw.bsdf_count.lamps
-        };
+        let count = draw.bsdf_counts.for_light(ls.dist.is_infinite());
         power_heuristic(ls.pdf, count * bsdf.pdf(wo, ls.wi))
     };
     tr * f * ls.li * (ls.wi.dot(hit.ns).abs() * weight / ls.pdf)
@@ -1011,7 +1020,7 @@ fn direct_light_via_mirror<S: PathScene>(
         return Vec3::ZERO;
     }
     let pdf = draw.share * s.pdf;
-    let weight = power_heuristic(pdf, draw.bsdf_count.lamps * bsdf.pdf(wo, s.wi));
+    let weight = power_heuristic(pdf, draw.bsdf_counts.lamps * bsdf.pdf(wo, s.wi));
     tr * f * reflectance * s.li * (s.wi.dot(hit.ns).abs() * weight / pdf)
 }
 
