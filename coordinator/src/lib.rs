@@ -14,6 +14,7 @@ pub mod exec;
 pub mod interim;
 pub mod isa;
 pub mod job;
+pub mod logging;
 pub mod manifest;
 pub mod render_report;
 pub mod sanitize;

@@ -4,26 +4,19 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use yat::cli::{self, Cli, Command};
+use yat::logging;
 use yat::shutdown::{Interrupted, INTERRUPTED_EXIT_CODE};
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_env("YAT_LOG")
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
-        )
-        .with_writer(std::io::stderr)
-        .init();
-    if let Err(e) = yat::isa::start() {
-        eprintln!("Error: {e}");
-        return ExitCode::FAILURE;
-    }
-    let result = match Cli::parse().command {
-        Command::Render(args) => cli::render::run(*args),
-        Command::Worker(args) => cli::worker::run(*args),
-        Command::Check(args) => cli::check::run(args),
-        Command::ExportLuxcore(args) => cli::export::run(args),
-    };
+    let command = Cli::parse().command;
+    // A worker is a server: its start, its sessions and its drain are worth a line each.
+    logging::init(match command {
+        Command::Worker(_) => "warn,yat_worker=info",
+        _ => "warn",
+    });
+    let result = run(command);
+    // The log's last lines before the error that ends the process.
+    logging::flush();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -34,5 +27,15 @@ fn main() -> ExitCode {
                 1
             })
         }
+    }
+}
+
+fn run(command: Command) -> anyhow::Result<()> {
+    yat::isa::start().map_err(anyhow::Error::msg)?;
+    match command {
+        Command::Render(args) => cli::render::run(*args),
+        Command::Worker(args) => cli::worker::run(*args),
+        Command::Check(args) => cli::check::run(args),
+        Command::ExportLuxcore(args) => cli::export::run(args),
     }
 }

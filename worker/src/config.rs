@@ -30,8 +30,19 @@ pub mod defaults {
     pub const CONNECTION_IDLE_SECONDS: u64 = 60;
     /// The longest a request may take, whatever it is (a huge scene's build included).
     pub const REQUEST_TIMEOUT_SECONDS: u64 = 3600;
-    /// Connections served at once; further ones wait in the listen backlog.
+    /// Connections served at once; further ones wait in the listen backlog. The worker lowers
+    /// it to what its descriptor limit leaves room for.
     pub const MAX_CONNECTIONS: usize = 256;
+    /// How long a new connection has to send a request that passes the token check.
+    pub const HANDSHAKE_SECONDS: u64 = 10;
+    /// Connections from one address (an IPv6 /64) that have not authenticated yet.
+    pub const MAX_UNAUTHENTICATED_PER_ADDRESS: usize = 8;
+
+    /// Connections that have not authenticated yet, all addresses together: a quarter of the
+    /// connection cap, so strangers cannot take the slots of token holders.
+    pub fn max_unauthenticated(max_connections: usize) -> usize {
+        (max_connections / 4).max(1)
+    }
     /// Requests served at once on one connection (a coordinator keeps 2 per render thread).
     pub const MAX_STREAMS_PER_CONNECTION: u32 = 256;
 
@@ -75,11 +86,16 @@ pub struct WorkerConfig {
     pub throttle: Duration,
 }
 
-/// How many connections and requests a worker serves at once, and when it gives up on a silent
-/// peer.
+/// How many connections and requests a worker serves at once, how many of those may be
+/// strangers still, and when it gives up on a silent or unauthenticated peer.
 #[derive(Clone, Debug)]
 pub struct NetworkLimits {
     pub max_connections: usize,
+    /// Connections not yet authenticated, in total; `None`: [`defaults::max_unauthenticated`]
+    /// of the connection cap in force.
+    pub max_unauthenticated: Option<usize>,
+    pub max_unauthenticated_per_address: usize,
+    pub handshake_timeout: Duration,
     pub max_streams_per_connection: u32,
     pub connection_idle: Duration,
     pub blob_idle: Duration,
@@ -90,6 +106,9 @@ impl Default for NetworkLimits {
     fn default() -> Self {
         Self {
             max_connections: defaults::MAX_CONNECTIONS,
+            max_unauthenticated: None,
+            max_unauthenticated_per_address: defaults::MAX_UNAUTHENTICATED_PER_ADDRESS,
+            handshake_timeout: Duration::from_secs(defaults::HANDSHAKE_SECONDS),
             max_streams_per_connection: defaults::MAX_STREAMS_PER_CONNECTION,
             connection_idle: Duration::from_secs(defaults::CONNECTION_IDLE_SECONDS),
             blob_idle: Duration::from_secs(defaults::BLOB_IDLE_SECONDS),

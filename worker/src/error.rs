@@ -100,6 +100,14 @@ pub enum ServeError {
          --tls-cert, --tls-key and --tls-client-ca, or --insecure to serve anyway"
     )]
     Exposed { address: SocketAddr },
+    #[error("cannot read or raise the process's file descriptor limit")]
+    DescriptorLimit(#[source] std::io::Error),
+    #[error(
+        "the file descriptor limit leaves no room for connections once the descriptors open \
+         and {} kept for files are counted: raise it (ulimit -n)",
+        crate::descriptors::DESCRIPTOR_HEADROOM
+    )]
+    NoRoomForConnections,
     #[error("cannot read the listener's address")]
     Listener(#[source] std::io::Error),
     #[error(transparent)]

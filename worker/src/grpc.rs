@@ -11,6 +11,9 @@ use yat_proto::pb;
 use crate::error::NodeError;
 use crate::node::Node;
 
+/// The service as served.
+pub type RenderService = yat_proto::RenderNodeServer<GrpcNode>;
+
 pub struct GrpcNode {
     node: Arc<Node>,
     /// How long a PutBlob stream may go without a chunk.

@@ -3,12 +3,16 @@
 //! bound until a shutdown future the caller passes resolves (`yat worker` binds its `--listen`
 //! address and passes Ctrl-C/SIGTERM; tests bind port 0 and pass what they like).
 
+mod admission;
+mod availability;
 mod blobs;
 mod config;
 mod connection;
+mod descriptors;
 mod error;
 mod grpc;
 mod loaded_scene;
+mod log_limit;
 mod node;
 mod pool;
 mod scenes;

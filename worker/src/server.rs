@@ -4,7 +4,7 @@
 //!
 //! The health service (`grpc.health.v1`, for `""` and `yat.render.v1.RenderNode`) is outside
 //! the token check: orchestrators' probes cannot send metadata, and it reveals nothing but
-//! SERVING or NOT_SERVING.
+//! SERVING or NOT_SERVING (`availability.rs`).
 
 use std::future::Future;
 use std::net::SocketAddr;
@@ -14,13 +14,14 @@ use std::time::Duration;
 use tokio::net::TcpListener;
 use tonic::service::interceptor::InterceptedService;
 use tonic::transport::{Certificate, Identity, Server, ServerTlsConfig};
-use tonic_health::server::HealthReporter;
-use tonic_health::ServingStatus;
 use yat_proto::auth::RequireToken;
 use yat_proto::{RenderNodeServer, DEFAULT_MAX_MESSAGE_BYTES};
 
-use crate::config::{NetworkLimits, WorkerConfig};
-use crate::connection;
+use crate::admission::{Admission, AdmissionLimits};
+use crate::availability::Availability;
+use crate::config::{defaults, NetworkLimits, WorkerConfig};
+use crate::connection::{self, Acceptor, Authenticate, ConnectionTimeouts};
+use crate::descriptors::{ConnectionCap, DESCRIPTOR_HEADROOM};
 use crate::error::ServeError;
 use crate::grpc::GrpcNode;
 use crate::node::Node;
@@ -33,8 +34,6 @@ const KEEPALIVE_TIMEOUT: Duration = Duration::from_secs(20);
 /// After the drain, how long the last replies get to leave before the server stops regardless
 /// of connections still open.
 const REPLY_GRACE: Duration = Duration::from_secs(2);
-
-type RenderService = RenderNodeServer<GrpcNode>;
 
 /// A worker ready to serve: its caches opened and its render threads started.
 pub struct Worker {
@@ -80,8 +79,29 @@ impl Worker {
     ) -> Result<(), ServeError> {
         let address = listener.local_addr().map_err(ServeError::Listener)?;
         self.check_exposure(address)?;
+        let network = &self.network;
+        let cap = ConnectionCap::of_this_process(network.max_connections)
+            .map_err(ServeError::DescriptorLimit)?
+            .ok_or(ServeError::NoRoomForConnections)?;
+        let admission_limits = AdmissionLimits {
+            total: network
+                .max_unauthenticated
+                .unwrap_or_else(|| defaults::max_unauthenticated(cap.connections)),
+            per_peer: network.max_unauthenticated_per_address,
+        };
+        if cap.connections < network.max_connections {
+            tracing::warn!(
+                "serving {} connections at most, not {}: the descriptor limit is {} with {} \
+                 open and {DESCRIPTOR_HEADROOM} kept for files (raise it with ulimit -n)",
+                cap.connections,
+                network.max_connections,
+                cap.descriptor_limit,
+                cap.in_use
+            );
+        }
         tracing::info!(
-            "{} thread(s){}{}{}",
+            "{} thread(s){}{}{}; at most {} connections, {} of them unauthenticated ({} per \
+             address, {} s to authenticate)",
             self.node.capabilities().threads,
             if self.tls.is_some() { ", TLS" } else { "" },
             if self.tls_client_ca.is_some() {
@@ -93,16 +113,22 @@ impl Worker {
                 ", token required"
             } else {
                 ""
-            }
+            },
+            cap.connections,
+            admission_limits.total,
+            admission_limits.per_peer,
+            network.handshake_timeout.as_secs_f64(),
         );
         let (health, health_service) = tonic_health::server::health_reporter();
-        health.set_serving::<RenderService>().await;
+        let availability = Arc::new(Availability::new(health).await);
         let service =
             RenderNodeServer::new(GrpcNode::new(self.node.clone(), self.network.blob_idle))
                 .max_decoding_message_size(DEFAULT_MAX_MESSAGE_BYTES)
                 .max_encoding_message_size(DEFAULT_MAX_MESSAGE_BYTES);
-        let service = InterceptedService::new(service, RequireToken::new(self.token.as_deref()));
-        let network = &self.network;
+        let service = InterceptedService::new(
+            service,
+            Authenticate(RequireToken::new(self.token.as_deref())),
+        );
         let mut server = Server::builder()
             .http2_keepalive_interval(Some(KEEPALIVE_INTERVAL.min(network.connection_idle / 3)))
             .http2_keepalive_timeout(Some(KEEPALIVE_TIMEOUT))
@@ -116,14 +142,22 @@ impl Worker {
             }
             server = server.tls_config(tls).map_err(ServeError::Tls)?;
         }
-        let incoming =
-            connection::accept(listener, network.max_connections, network.connection_idle);
+        let incoming = connection::accept(Acceptor {
+            listener,
+            max_connections: cap.connections,
+            admission: Admission::new(admission_limits),
+            timeouts: ConnectionTimeouts {
+                idle: network.connection_idle,
+                handshake: network.handshake_timeout,
+            },
+            availability: availability.clone(),
+        });
         let (drained, drained_rx) = tokio::sync::oneshot::channel();
         let node = self.node.clone();
         let drain_period = self.drain;
         let stop = async move {
             shutdown.await;
-            drain(&node, &health, drain_period).await;
+            drain(&node, &availability, drain_period).await;
             let _ = drained.send(());
         };
         let serving = server
@@ -147,11 +181,8 @@ impl Worker {
 }
 
 /// The steps of a drain, logged.
-async fn drain(node: &Node, health: &HealthReporter, period: Duration) {
-    health.set_not_serving::<RenderService>().await;
-    health
-        .set_service_status("", ServingStatus::NotServing)
-        .await;
+async fn drain(node: &Node, availability: &Availability, period: Duration) {
+    availability.drain().await;
     let units = node.begin_drain();
     tracing::info!(
         "draining: {} units finishing, {} handed back",

@@ -6,7 +6,6 @@
 use std::time::Duration;
 
 use tokio::io::AsyncReadExt;
-use tokio::net::TcpStream;
 use tonic::Code;
 use yat_proto::hash::sha256_hex;
 use yat_proto::pb;
@@ -155,10 +154,11 @@ async fn idle_connections_and_streams_are_closed_and_an_honest_client_gets_in() 
     })
     .await;
     let before = resident_bytes();
-    // 300 sockets opened and left silent: more than the 64 connections served at once.
+    // 300 sockets opened by a stranger and left silent: more than the 64 connections served
+    // at once.
     let mut idle = Vec::new();
     for _ in 0..300 {
-        idle.push(TcpStream::connect(worker.address).await.unwrap());
+        idle.push(connect_from_elsewhere(worker.address).await.unwrap());
     }
     // 200 uploads that never send their first chunk, on one HTTP/2 connection.
     let mut client = worker.client(Some(TOKEN));
@@ -217,6 +217,11 @@ async fn a_flood_of_huge_units_is_capped_and_abandoned_units_stop() {
     let worker = Served::start(WorkerConfig {
         threads: 2,
         max_queued_units: 24,
+        // The token holder below opens 50 connections at the same instant.
+        network: NetworkLimits {
+            max_unauthenticated_per_address: 64,
+            ..NetworkLimits::default()
+        },
         ..hostile_config()
     })
     .await;

@@ -57,9 +57,24 @@ pub struct WorkerArgs {
     /// After SIGTERM or Ctrl-C, how long units already rendering may take to finish.
     #[arg(long, default_value_t = defaults::DRAIN_SECONDS)]
     pub drain_seconds: u64,
-    /// Connections served at once; more wait until one closes.
+    /// Connections served at once; more wait until one closes. Lowered to what the file
+    /// descriptor limit leaves room for (the limit less the descriptors open at start and 64
+    /// kept for files), and said so at start.
     #[arg(long, default_value_t = defaults::MAX_CONNECTIONS)]
     pub max_connections: usize,
+    /// Connections that have not yet sent a request with the token, all addresses together;
+    /// at the cap, a new one closes the oldest of the address with the most [default: a
+    /// quarter of the connection cap].
+    #[arg(long)]
+    pub max_unauthenticated: Option<usize>,
+    /// Connections from one address (an IPv6 /64) that have not yet sent a request with the
+    /// token; more are closed at once.
+    #[arg(long, default_value_t = defaults::MAX_UNAUTHENTICATED_PER_ADDRESS)]
+    pub max_unauthenticated_per_address: usize,
+    /// Close a connection that has not sent a request with the token within this many seconds
+    /// of its accept (health probes need none; they close sooner).
+    #[arg(long, default_value_t = defaults::HANDSHAKE_SECONDS, value_parser = clap::value_parser!(u64).range(1..))]
+    pub handshake_seconds: u64,
     /// Requests served at once on one connection.
     #[arg(long, default_value_t = defaults::MAX_STREAMS_PER_CONNECTION)]
     pub max_streams_per_connection: u32,
@@ -98,6 +113,9 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         drain: Duration::from_secs(args.drain_seconds),
         network: NetworkLimits {
             max_connections: args.max_connections,
+            max_unauthenticated: args.max_unauthenticated,
+            max_unauthenticated_per_address: args.max_unauthenticated_per_address,
+            handshake_timeout: Duration::from_secs(args.handshake_seconds),
             max_streams_per_connection: args.max_streams_per_connection,
             connection_idle: Duration::from_secs(args.connection_idle_seconds),
             blob_idle: Duration::from_secs(args.blob_idle_seconds),
@@ -150,7 +168,7 @@ async fn first_signal() {
     tokio::spawn(async {
         signalled().await;
         tracing::warn!("second signal: stopping without finishing the drain");
-        std::process::exit(i32::from(INTERRUPTED_EXIT_CODE));
+        crate::logging::exit(i32::from(INTERRUPTED_EXIT_CODE));
     });
 }
 
@@ -159,6 +177,6 @@ fn exit_when_stdin_closes() {
     std::thread::spawn(|| {
         let _ = std::io::copy(&mut std::io::stdin().lock(), &mut std::io::sink());
         tracing::info!("standard input closed, exiting");
-        std::process::exit(0);
+        crate::logging::exit(0);
     });
 }

@@ -78,6 +78,15 @@ pub fn chunks(hash: &str, size: u64, parts: &[&'static [u8]]) -> Vec<pb::BlobChu
         .collect()
 }
 
+/// A stranger's host on loopback: connections from 127.0.0.2, so the worker's allowance of
+/// unauthenticated connections per address does not count them against the tests' own clients
+/// on 127.0.0.1.
+pub async fn connect_from_elsewhere(address: SocketAddr) -> std::io::Result<tokio::net::TcpStream> {
+    let socket = tokio::net::TcpSocket::new_v4()?;
+    socket.bind("127.0.0.2:0".parse().unwrap())?;
+    socket.connect(address).await
+}
+
 /// Uploads [`SCENE`] and loads it as a 16x16 image of `spp` samples per pixel; the scene id.
 pub async fn load_scene(client: &mut Client, spp: u32) -> String {
     let hash = sha256_hex(SCENE);
