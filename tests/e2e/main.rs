@@ -10,6 +10,7 @@ mod drain;
 mod files;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;
+mod hostile_peer;
 mod hostile_worker;
 mod isa;
 #[path = "../fixtures/lit_sphere.rs"]

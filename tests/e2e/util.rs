@@ -139,15 +139,29 @@ impl Worker {
     }
 
     pub fn start_on(listen: &str, extra: &[&str]) -> Self {
-        let mut child = Command::new(YAT)
+        Self::spawn(Self::command(listen, extra))
+    }
+
+    /// `yat worker` on `listen` with one render thread and these extra arguments, its standard
+    /// output piped (the parent reads the address from it) and its standard error inherited,
+    /// logging warnings.
+    pub fn command(listen: &str, extra: &[&str]) -> Command {
+        let mut command = Command::new(YAT);
+        command
             .args(["worker", "--listen", listen, "--threads", "1"])
             .args(extra)
             .env_remove("YAT_TOKEN")
+            // Warnings only: a worker's start and sessions would fill the test log.
+            .env("YAT_LOG", "warn")
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("start yat worker");
+            .stderr(Stdio::inherit());
+        command
+    }
+
+    /// Starts `command` (see [`Worker::command`]) and reads the address it listens on.
+    pub fn spawn(mut command: Command) -> Self {
+        let mut child = command.spawn().expect("start yat worker");
         let mut stdout = BufReader::new(child.stdout.take().unwrap());
         let mut line = String::new();
         stdout.read_line(&mut line).unwrap();
@@ -161,6 +175,11 @@ impl Worker {
             child,
             _stdout: stdout,
         }
+    }
+
+    /// The worker's standard error, when its command piped it.
+    pub fn take_stderr(&mut self) -> Option<std::process::ChildStderr> {
+        self.child.stderr.take()
     }
 
     pub fn pid(&self) -> u32 {
