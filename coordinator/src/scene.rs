@@ -7,9 +7,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use yat_tracer::assets::FsSource;
-use yat_tracer::budget::{BuildBudget, BuildGuard};
+use yat_tracer::budget::{BuildBudget, BuildGuard, Limit};
 use yat_tracer::desc::SceneDesc;
+use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene_guarded;
+use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderScene, RenderSettings};
 
 /// A scene file parsed, with where its files come from.
@@ -74,6 +76,36 @@ impl ParsedScene {
             parse_time,
             budget,
         })
+    }
+
+    /// Bytes the film of a render of `settings` (an adaptive one's if `adaptive`) takes here:
+    /// the coordinator's, whether it renders in-process or merges workers' units.
+    pub fn film_bytes(&self, settings: &RenderSettings, adaptive: bool) -> u64 {
+        let frame = FilmFrame {
+            width: settings.width,
+            height: settings.height,
+            border: self.desc.filter.border(),
+        };
+        Film::memory_bytes(frame, adaptive)
+    }
+
+    /// Fails unless the film of [`Self::film_bytes`] fits the memory budget with what the
+    /// parse estimated for the scene.
+    pub fn check_film(&self, settings: &RenderSettings, adaptive: bool) -> anyhow::Result<()> {
+        let film = self.film_bytes(settings, adaptive);
+        self.desc
+            .spent
+            .clone()
+            .spend(&self.budget, Limit::MemoryBytes, film)
+            .with_context(|| {
+                format!(
+                    "cannot render {}: its {}x{} film ({}) with the scene",
+                    self.path.display(),
+                    settings.width,
+                    settings.height,
+                    Limit::MemoryBytes.amount(film)
+                )
+            })
     }
 
     /// Builds the scene for an in-process render, under the budget it was parsed with.

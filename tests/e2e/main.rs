@@ -15,6 +15,7 @@ mod hostile_worker;
 mod isa;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;
+mod memory;
 mod resume;
 mod status;
 mod util;

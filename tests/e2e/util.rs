@@ -2,6 +2,7 @@
 //! folder, `yat worker` processes on loopback ports, and `yat render` runs.
 
 use std::io::{BufRead, BufReader};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Output, Stdio};
 
@@ -142,6 +143,13 @@ impl Worker {
         Self::spawn(Self::command(listen, extra))
     }
 
+    /// [`Worker::start`] in an address space of `bytes` (RLIMIT_AS).
+    pub fn start_in_address_space(bytes: u64, extra: &[&str]) -> Self {
+        let mut command = Self::command("127.0.0.1:0", extra);
+        limit_address_space(&mut command, bytes);
+        Self::spawn(command)
+    }
+
     /// `yat worker` on `listen` with one render thread and these extra arguments, its standard
     /// output piped (the parent reads the address from it) and its standard error inherited,
     /// logging warnings.
@@ -247,6 +255,25 @@ impl Drop for Worker {
             .status();
         let _ = self.child.kill();
         let _ = self.child.wait();
+    }
+}
+
+/// Runs `command`'s process in an address space of `bytes` (RLIMIT_AS): an allocation beyond
+/// it fails, and Rust's allocation-failure handler aborts the process.
+pub fn limit_address_space(command: &mut Command, bytes: u64) {
+    // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+    unsafe {
+        command.pre_exec(move || {
+            let limit = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        });
     }
 }
 

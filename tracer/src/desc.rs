@@ -10,6 +10,7 @@
 //! here.
 
 pub use crate::assets::{AssetKind, AssetRef};
+pub use crate::budget::BudgetMeter;
 pub use crate::camera::{CameraDesc, CameraKind};
 pub use crate::diag::{SourcePos, Warning};
 pub use crate::film::{FilmDesc, ToneMap};
@@ -40,4 +41,7 @@ pub struct SceneDesc {
     pub warnings: Vec<Warning>,
     /// Every file read or referenced besides the main file, in first-use order, no repeats.
     pub assets: Vec<AssetRef>,
+    /// What the parse counted against the build budget, figure by figure (the build's memory
+    /// estimate among them); nothing for a description made otherwise.
+    pub spent: BudgetMeter,
 }

@@ -265,6 +265,22 @@ impl Film {
         }
     }
 
+    /// Bytes a film of `frame` (an adaptive render's if `adaptive`) takes at most: its sums,
+    /// a copy of them while a checkpoint is written, and the radiance and image a file is
+    /// written from.
+    pub fn memory_bytes(frame: FilmFrame, adaptive: bool) -> u64 {
+        let pixels = u64::from(frame.width) * u64::from(frame.height);
+        let sum = std::mem::size_of::<[i64; 4]>() as u64;
+        let sums = if adaptive {
+            pixels * sum * (frame.source_planes() as u64 + 1)
+                + block_count(&frame) as u64 * std::mem::size_of::<u32>() as u64
+        } else {
+            pixels * sum
+        };
+        let output = pixels * 2 * std::mem::size_of::<Vec3>() as u64;
+        2 * sums + output
+    }
+
     /// The film of an adaptive render: it keeps its sums per source plane, the sums of the
     /// odd-index samples and each block's samples, and takes only buffers of masked units.
     pub fn adaptive(frame: FilmFrame) -> Self {

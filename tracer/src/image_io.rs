@@ -290,6 +290,69 @@ fn palette_indices(codes: &[[u8; 4]]) -> Option<(Vec<[u8; 4]>, Vec<u8>)> {
     Some((colours, indices))
 }
 
+/// What the decoder's own buffers and the allocator's rounding add while an image decodes, per
+/// texel, rounded up (measured: docs/security.md, "build budget").
+const DECODER_BYTES_PER_TEXEL: u64 = 1;
+
+/// What an image takes in memory: the bytes its texels keep, and the most that making them
+/// holds besides (the decoder's buffer and the conversions before the texels are tiled).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageCost {
+    pub kept: u64,
+    pub transient: u64,
+}
+
+impl ImageCost {
+    /// What [`decode`] takes for a file of `width` x `height` texels of `color`, from its header.
+    /// 8-bit files keep 4 bytes a texel (fewer when they have at most 256 colours, which only
+    /// the decoding tells); while decoding, the decoder's buffer and the codes are held with
+    /// the RGB copy the codes are made from, then with the tiles before they are aligned.
+    /// Other files keep linear floats, made through an RGB float copy and the row-major texels.
+    pub fn decode(width: u32, height: u32, color: image::ColorType) -> Self {
+        let texels = u64::from(width) * u64::from(height);
+        let tiled = Tiling::new(width).tiles(height) as u64 * TILE_TEXELS as u64;
+        let buffer = texels * u64::from(color.bytes_per_pixel());
+        if is_8_bit(color) {
+            let code = std::mem::size_of::<[u8; 4]>() as u64;
+            Self {
+                kept: tiled * code,
+                transient: buffer
+                    + texels * (code + DECODER_BYTES_PER_TEXEL)
+                    + (texels * 3).max(tiled * code),
+            }
+        } else {
+            let linear = std::mem::size_of::<Vec3>() as u64;
+            Self {
+                kept: tiled * linear,
+                transient: buffer + texels * (2 * linear + DECODER_BYTES_PER_TEXEL),
+            }
+        }
+    }
+
+    /// What [`RgbImage::from_linear`] takes for `width` x `height` texels: its tiles, and the
+    /// row-major texels it is given.
+    pub fn linear(width: u32, height: u32) -> Self {
+        let texels = u64::from(width) * u64::from(height);
+        let tiled = Tiling::new(width).tiles(height) as u64 * TILE_TEXELS as u64;
+        let linear = std::mem::size_of::<Vec3>() as u64;
+        Self {
+            kept: tiled * linear,
+            transient: texels * linear,
+        }
+    }
+}
+
+/// Whether [`decode`] keeps a file of `color` as 8-bit codes.
+fn is_8_bit(color: image::ColorType) -> bool {
+    matches!(
+        color,
+        image::ColorType::L8
+            | image::ColorType::La8
+            | image::ColorType::Rgb8
+            | image::ColorType::Rgba8
+    )
+}
+
 #[derive(Debug, thiserror::Error)]
 #[error("cannot decode image \"{path}\": {source}")]
 pub struct DecodeError {
@@ -317,10 +380,7 @@ pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeEr
     };
     let (width, height) = (img.width(), img.height());
     let texels = match img.color() {
-        image::ColorType::L8
-        | image::ColorType::La8
-        | image::ColorType::Rgb8
-        | image::ColorType::Rgba8 => {
+        color if is_8_bit(color) => {
             let linear = Box::new(std::array::from_fn(|v| linearise(v as f32 / 255.0)));
             let codes: Vec<_> = img
                 .to_rgb8()

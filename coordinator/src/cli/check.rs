@@ -9,10 +9,12 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use yat_tracer::budget::Limit;
 use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
 use yat_tracer::diag::{Severity, Warning};
+use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use super::budget::BudgetArgs;
 use crate::scene::{ParsedScene, Warnings};
@@ -42,6 +44,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<()> {
             scene.parse_time.as_secs_f64()
         )
     );
+    print!("{}", memory(&scene));
     let differences = differences(&scene.desc.warnings);
     print!("{}", listing(&scene.desc.warnings, differences));
     if args.strict && differences > 0 {
@@ -92,6 +95,28 @@ fn listing(warnings: &[Warning], differences: u64) -> String {
         "{differences} statements or parameters not rendered as LuxRender would"
     );
     s
+}
+
+/// The build's memory estimate against the budget, and the film an in-process render of the
+/// file's resolution adds.
+fn memory(scene: &ParsedScene) -> String {
+    let mib = |bytes: u64| Limit::MemoryBytes.amount(bytes);
+    let build = scene.desc.spent.spent(Limit::MemoryBytes);
+    let settings = RenderSettings::resolve(&scene.desc, &RenderOverrides::default());
+    let film = scene.film_bytes(&settings, false);
+    let limit = scene.budget.max(Limit::MemoryBytes);
+    let limit = if limit == u64::MAX {
+        "no limit".to_string()
+    } else {
+        format!("limit {} ({})", mib(limit), Limit::MemoryBytes.flag())
+    };
+    format!(
+        "memory       {} estimated to build, {} more for the {}x{} film in-process; {limit}\n",
+        mib(build),
+        mib(film),
+        settings.width,
+        settings.height
+    )
 }
 
 /// Numbers as a person reads them: LuxRender's "infinite" 1e30 stays short.

@@ -155,6 +155,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         a.check()
             .with_context(|| format!("cannot render {}", args.scene.display()))?;
     }
+    scene.check_film(&settings, adaptive.is_some())?;
     let output_png = match &args.output {
         Some(output) => output.clone(),
         None => {

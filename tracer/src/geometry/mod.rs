@@ -9,6 +9,7 @@
 //! separately.
 
 mod analytic;
+mod footprint;
 mod hit;
 mod plane;
 mod simd;
@@ -32,6 +33,7 @@ use crate::shape::Geometry;
 use crate::shape::ShapeDesc;
 
 pub use analytic::AnalyticShape;
+pub use footprint::placed_bytes;
 pub use hit::{PrimHit, SurfaceHit, SurfaceSample};
 pub use simd::Isa;
 pub use triangle::TriangleSurface;
@@ -88,8 +90,10 @@ impl SceneGeometry {
         let mut meshes = Vec::new();
         let mut analytic = Vec::new();
         let mut planes = Vec::new();
-        let mut aabbs = Vec::new();
-        let mut prims = Vec::new();
+        // One of each per primitive: reserved, so that they never hold spare capacity.
+        let primitives: u64 = shapes.iter().map(|s| s.geometry.primitive_count()).sum();
+        let mut aabbs = Vec::with_capacity(primitives as usize);
+        let mut prims = Vec::with_capacity(primitives as usize);
         for (index, shape) in shapes.iter().enumerate() {
             let index = index as u32;
             let m = &shape.object_to_world;

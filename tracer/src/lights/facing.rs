@@ -28,7 +28,7 @@ pub(super) const FACING_BINS: usize = 6 * BINS_PER_EDGE * BINS_PER_EDGE;
 
 /// The most blocks a bin's table holds (16 bytes each: 32 KiB a table, 1.7 MiB for all): the
 /// tables of the surfaces in view stay in cache.
-const MAX_FACING_CELLS: usize = 2048;
+pub(super) const MAX_FACING_CELLS: usize = 2048;
 
 /// The largest f32 below 1.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -22,16 +22,16 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
-use crate::image_io::{self, Edge, RgbImage};
+use crate::image_io::{self, Edge, ImageCost, RgbImage};
 use crate::math::{atan2, luminance};
-use crate::parse::context::ParseContext;
+use crate::parse::context::{ImageUse, ParseContext};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::distribution::Distribution2D;
 use super::emission::{emits, Emission};
 use super::error::LightError;
-use super::facing::FacingTables;
+use super::facing::{FacingTables, FACING_BINS, MAX_FACING_CELLS};
 
 /// `mapping`: the only one modelled.
 pub const DEFAULT_MAPPING: &str = "latlong";
@@ -80,7 +80,7 @@ impl InfiniteLight {
         let gamma = params.float("gamma", DEFAULT_GAMMA)?;
         let map = match params.string("mapname")? {
             Some(filename) if !filename.is_empty() => {
-                ctx.check_image(&filename, pos)?;
+                ctx.check_image(&filename, ImageUse::Environment, pos)?;
                 Some(EnvMapDesc { filename, gamma })
             }
             _ => None,
@@ -295,6 +295,28 @@ struct LatLongMap {
 /// noise hardly at all, and it stays unbiased (any density that is positive wherever light
 /// is, is; and where it is not, the path's BSDF samples are weighted in fully).
 const MAX_DISTRIBUTION_CELLS: usize = 1 << 17;
+
+/// Bytes a distribution cell's records take, kept and while they are built (the cell's sum,
+/// its alias records in the map's distribution and in the facing tables' per-block tables, the
+/// facing tables' weights and directions, the alias construction's f64 temporaries), rounded up.
+const BYTES_PER_CELL: u64 = 128;
+/// Bytes of one facing table's record per block, with its temporaries, rounded up.
+const BYTES_PER_FACING_BLOCK: u64 = 32;
+
+/// What a `width` x `height` map takes as an environment: `image` (its texels), its sampling
+/// tables, and while they are built, the luminance and the blurred density per texel.
+pub fn map_cost(image: ImageCost, width: u32, height: u32) -> ImageCost {
+    let texels = u64::from(width) * u64::from(height);
+    let (across, down) = distribution_cells(width as usize, height as usize);
+    let cells = (across * down) as u64;
+    let tables =
+        cells * BYTES_PER_CELL + (FACING_BINS * MAX_FACING_CELLS) as u64 * BYTES_PER_FACING_BLOCK;
+    let per_texel = 2 * std::mem::size_of::<f32>() as u64;
+    ImageCost {
+        kept: image.kept + tables,
+        transient: image.transient.max(texels * per_texel),
+    }
+}
 
 /// Cells across and down for a `w` x `h` map: texels in blocks of the least power-of-two side
 /// that keeps them within [`MAX_DISTRIBUTION_CELLS`] (a 4x4 block is one tile of the image's

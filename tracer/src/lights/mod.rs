@@ -59,7 +59,7 @@ use crate::texture::Textures;
 pub use area::AreaLightParams;
 pub use distant::DistantLight;
 pub use error::LightError;
-pub use infinite::{EnvMapDesc, InfiniteLight, LatLongConvention};
+pub use infinite::{map_cost, EnvMapDesc, InfiniteLight, LatLongConvention};
 pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
 pub use point::PointLight;
 pub use sample::LightSample;

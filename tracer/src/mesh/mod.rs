@@ -22,3 +22,19 @@ pub struct TriangleMesh {
     pub uvs: Option<Vec<[f32; 2]>>,
     pub indices: Vec<[u32; 3]>,
 }
+
+impl TriangleMesh {
+    /// Bytes a vertex takes: its position, and its normal and uv where the mesh has them.
+    pub fn bytes_per_vertex(&self) -> u64 {
+        let size = |present: bool, bytes: usize| if present { bytes as u64 } else { 0 };
+        size(true, std::mem::size_of::<Vec3>())
+            + size(self.normals.is_some(), std::mem::size_of::<Vec3>())
+            + size(self.uvs.is_some(), std::mem::size_of::<[f32; 2]>())
+    }
+
+    /// Bytes the mesh's arrays hold.
+    pub fn heap_bytes(&self) -> u64 {
+        self.positions.len() as u64 * self.bytes_per_vertex()
+            + self.indices.len() as u64 * std::mem::size_of::<[u32; 3]>() as u64
+    }
+}

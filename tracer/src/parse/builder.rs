@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 
-use super::context::{ParseContext, TexBinding};
+use super::context::{ImageUse, ParseContext, TexBinding};
 use super::error::ParseError;
 use super::luxrender_ignores::luxrender_ignores;
 use super::options::OptionsState;
@@ -20,13 +20,16 @@ use crate::budget::{BudgetMeter, BuildGuard, Limit};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::SourcePos as Pos;
 use crate::diag::{Severity, Warning};
-use crate::lights::{AreaLightParams, SkyLight};
+use crate::geometry::placed_bytes;
+use crate::image_io::ImageCost;
+use crate::lights::{map_cost, AreaLightParams, SkyLight};
 use crate::material::{Glass, Matte};
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::shape::Geometry;
 use crate::texture::{self, Defined, Scale};
+use image::ImageDecoder;
 
 /// Include files may nest this deep (the main file is depth 0).
 pub const MAX_INCLUDE_DEPTH: usize = 32;
@@ -122,6 +125,11 @@ pub struct Builder<'s> {
     warned: HashMap<String, usize>,
     assets: Vec<AssetRef>,
     asset_set: HashSet<AssetRef>,
+    /// Image headers read so far: (width, height, colour type) by path.
+    image_headers: HashMap<String, (u32, u32, image::ColorType)>,
+    /// Image textures counted against the memory budget, by (path, gamma's bits): each is
+    /// decoded once.
+    texture_images: HashSet<(String, u32)>,
 }
 
 /// Exporter parameters the seed scenes (LuxBlend) write everywhere and that change nothing
@@ -186,6 +194,8 @@ impl<'s> Builder<'s> {
             warned: HashMap::new(),
             assets: Vec::new(),
             asset_set: HashSet::new(),
+            image_headers: HashMap::new(),
+            texture_images: HashSet::new(),
         }
     }
 
@@ -196,6 +206,22 @@ impl<'s> Builder<'s> {
     pub(super) fn spend(&mut self, limit: Limit, amount: u64, pos: &Pos) -> Result<(), ParseError> {
         self.spent
             .spend(self.guard.budget, limit, amount)
+            .map_err(|exceeded| ParseError::OverBudget {
+                pos: pos.clone(),
+                exceeded,
+            })
+    }
+
+    /// Adds what an image costs in memory (kept, and transient while it is made) to the build
+    /// budget for the statement at `pos`.
+    fn spend_image(&mut self, cost: ImageCost, pos: &Pos) -> Result<(), ParseError> {
+        self.spent
+            .spend_with_transient(
+                self.guard.budget,
+                Limit::MemoryBytes,
+                cost.kept,
+                cost.transient,
+            )
             .map_err(|exceeded| ParseError::OverBudget {
                 pos: pos.clone(),
                 exceeded,
@@ -445,6 +471,9 @@ impl<'s> Builder<'s> {
                     .filter(|l| matches!(l, LightDesc::Sky(_)))
                     .count();
                 self.spend(Limit::Texels, skies as u64 * SkyLight::TABLE_TEXELS, pos)?;
+                for _ in 0..skies {
+                    self.spend_image(SkyLight::table_cost(), pos)?;
+                }
                 self.lights.extend(lights);
                 self.warn_unused(&params);
             }
@@ -665,6 +694,13 @@ impl<'s> Builder<'s> {
         let Some(geometry) = Geometry::read(self, ty, params, pos)? else {
             return Ok(());
         };
+        // The object-space mesh is kept with the description. One the PLY cache also holds
+        // was counted when its file was read.
+        if let Geometry::Mesh(mesh) = &geometry {
+            if Arc::strong_count(mesh) == 1 {
+                self.spend(Limit::MemoryBytes, mesh.heap_bytes(), pos)?;
+            }
+        }
         let material = match self.gs.material {
             Some(id) => id,
             None => self.default_material(),
@@ -698,6 +734,7 @@ impl<'s> Builder<'s> {
     ) -> Result<(), ParseError> {
         let primitives = shape.desc.geometry.primitive_count();
         self.spend(Limit::Primitives, primitives, pos)?;
+        self.spend(Limit::MemoryBytes, placed_bytes(&shape.desc.geometry), pos)?;
         let mut desc = shape.desc;
         desc.object_to_world = instance * desc.object_to_world;
         if !desc.object_to_world.is_finite() {
@@ -787,6 +824,7 @@ impl<'s> Builder<'s> {
             volumes: self.volumes,
             warnings: self.warnings,
             assets: self.assets,
+            spent: self.spent,
         })
     }
 }
@@ -882,6 +920,8 @@ impl ParseContext for Builder<'_> {
         };
         if self.asset_set.insert(r.clone()) {
             self.assets.push(r);
+            // A worker holds the files it was sent until its build ends.
+            self.spend(Limit::MemoryBytes, bytes.len() as u64, pos)?;
         }
         Ok(bytes)
     }
@@ -897,6 +937,7 @@ impl ParseContext for Builder<'_> {
             path: path.to_string(),
             message,
         })?;
+        self.spend(Limit::MemoryBytes, mesh.heap_bytes(), pos)?;
         let mesh = Arc::new(mesh);
         self.ply_meshes.insert(path.to_string(), mesh.clone());
         Ok(mesh)
@@ -959,26 +1000,47 @@ impl ParseContext for Builder<'_> {
             .collect())
     }
 
-    fn check_image(&mut self, path: &str, pos: &Pos) -> Result<(), ParseError> {
-        let already = self.asset_set.contains(&AssetRef {
-            path: path.to_string(),
-            kind: AssetKind::Image,
-        });
-        let bytes = self.read_asset(path, AssetKind::Image, pos)?;
-        if already {
-            return Ok(());
+    fn check_image(&mut self, path: &str, purpose: ImageUse, pos: &Pos) -> Result<(), ParseError> {
+        let (width, height, color) = match self.image_headers.get(path) {
+            Some(&header) => header,
+            None => {
+                let bytes = self.read_asset(path, AssetKind::Image, pos)?;
+                let header = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+                    .with_guessed_format()
+                    .map_err(|e| e.to_string())
+                    .and_then(|r| r.into_decoder().map_err(|e| e.to_string()))
+                    .map(|d| {
+                        let (width, height) = d.dimensions();
+                        (width, height, d.color_type())
+                    })
+                    .map_err(|message| ParseError::Image {
+                        pos: pos.clone(),
+                        path: path.to_string(),
+                        message,
+                    })?;
+                self.image_headers.insert(path.to_string(), header);
+                // Counted from the header, before anything is decoded.
+                self.spend(
+                    Limit::Texels,
+                    u64::from(header.0) * u64::from(header.1),
+                    pos,
+                )?;
+                header
+            }
+        };
+        let decoded = ImageCost::decode(width, height, color);
+        match purpose {
+            ImageUse::Texture { gamma } => {
+                if self
+                    .texture_images
+                    .insert((path.to_string(), gamma.to_bits()))
+                {
+                    self.spend_image(decoded, pos)?;
+                }
+            }
+            ImageUse::Environment => self.spend_image(map_cost(decoded, width, height), pos)?,
         }
-        let (width, height) = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-            .with_guessed_format()
-            .map_err(|e| e.to_string())
-            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
-            .map_err(|message| ParseError::Image {
-                pos: pos.clone(),
-                path: path.to_string(),
-                message,
-            })?;
-        // Counted from the header, before anything is decoded.
-        self.spend(Limit::Texels, u64::from(width) * u64::from(height), pos)
+        Ok(())
     }
 }
 

@@ -23,6 +23,15 @@ pub enum TexBinding {
     Fresnel(Fresnel),
 }
 
+/// What an image file is read for: each use decodes it its own way.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ImageUse {
+    /// An image texture's texels at this gamma (decoded once per file and gamma).
+    Texture { gamma: f32 },
+    /// An infinite light's map, with its sampling tables (decoded for each light).
+    Environment,
+}
+
 pub trait ParseContext {
     /// Records a warning of kind `key`: the first occurrence of a kind with its message, later
     /// ones as positions of it (so `yat check` lists and counts every occurrence while a render
@@ -88,8 +97,14 @@ pub trait ParseContext {
         pos: &SourcePos,
     ) -> Result<Arc<[u8]>, ParseError>;
 
-    /// Checks that an image file exists and its header decodes, and records it as an asset.
-    fn check_image(&mut self, path: &str, pos: &SourcePos) -> Result<(), ParseError>;
+    /// Checks that an image file exists and its header decodes, records it as an asset, and
+    /// counts what decoding it for `purpose` will take against the build budget.
+    fn check_image(
+        &mut self,
+        path: &str,
+        purpose: ImageUse,
+        pos: &SourcePos,
+    ) -> Result<(), ParseError>;
 
     /// The triangle mesh of a PLY file, read, validated and recorded as an asset on first use
     /// and shared by every later shape that names the same file.

@@ -57,11 +57,10 @@ pub fn parse_scene_guarded(
         error,
     })?;
     let mut b = builder::Builder::new(source, guard);
-    b.spend(
-        Limit::ParsedBytes,
-        bytes.len() as u64,
-        &SourcePos::new(main, 0, 0),
-    )?;
+    let start = SourcePos::new(main, 0, 0);
+    b.spend(Limit::ParsedBytes, bytes.len() as u64, &start)?;
+    // Held while it is parsed, and on a worker until its build ends.
+    b.spend(Limit::MemoryBytes, bytes.len() as u64, &start)?;
     b.run_file(main, &bytes)?;
     b.finish()
 }

@@ -7,12 +7,12 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::assets::AssetSource;
-use crate::budget::{BudgetMeter, BuildGuard, Cancelled, Limit, OverBudget};
+use crate::budget::{BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::{Geometry, MaterialDesc, SceneDesc};
 use crate::film::{unit_sum, SampleBuffer};
 use crate::filter::PixelFilter;
-use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
 use crate::integrator::path::{trace_path, PathResult, PathScene, MAX_BRANCHES};
@@ -39,6 +39,24 @@ pub enum BuildError {
     OverBudget(#[from] OverBudget),
     #[error(transparent)]
     Cancelled(#[from] Cancelled),
+}
+
+/// Checks `desc` against `guard`'s budget. A description the parser made was counted there,
+/// statement by statement (`desc.spent`), and is checked again against this budget; what the
+/// count misses of its shapes (all of them, for a description made otherwise) is counted here.
+fn check_budget(desc: &SceneDesc, guard: BuildGuard) -> Result<(), OverBudget> {
+    let mut meter = desc.spent.clone();
+    let shapes = || desc.shapes.iter().map(|s| &s.geometry);
+    let primitives: u64 = shapes().map(Geometry::primitive_count).sum();
+    let placed: u64 = shapes().map(placed_bytes).sum();
+    for (limit, amount) in [
+        (Limit::Primitives, primitives),
+        (Limit::MemoryBytes, placed),
+    ] {
+        let counted = meter.spent(limit);
+        meter.spend(guard.budget, limit, amount.saturating_sub(counted))?;
+    }
+    Ok(())
 }
 
 /// Samples rendered between two looks at a unit's cancel flag.
@@ -77,18 +95,16 @@ impl RenderScene {
         Self::build_guarded(desc, source, settings, BuildGuard::default())
     }
 
-    /// Builds the scene under `guard`: the primitives are counted against the budget before
-    /// anything is allocated for them (a description that came from the parser was counted
-    /// there already, statement by statement), and the cancel flag is checked between the
-    /// stages. Images are decoded under the `image` crate's allocation limit.
+    /// Builds the scene under `guard`: the primitives and their memory are counted against the
+    /// budget before anything is allocated for them, and the cancel flag is checked between
+    /// the stages. Images are decoded under the `image` crate's allocation limit.
     pub fn build_guarded(
         desc: &SceneDesc,
         source: &dyn AssetSource,
         settings: &RenderSettings,
         guard: BuildGuard,
     ) -> Result<Self, BuildError> {
-        let primitives = desc.shapes.iter().map(|s| s.geometry.primitive_count());
-        BudgetMeter::default().spend(guard.budget, Limit::Primitives, primitives.sum())?;
+        check_budget(desc, guard)?;
         guard.check_cancel()?;
         let mut geometry = SceneGeometry::build(&desc.shapes);
         geometry.cross_in_occlusion(

@@ -28,7 +28,7 @@ use super::common::{Declared, TexturePoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::image_io::{Edge, RgbImage};
-use crate::parse::context::ParseContext;
+use crate::parse::context::{ImageUse, ParseContext};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
@@ -69,7 +69,8 @@ impl ImageMap {
                 message: format!("Texture \"{name}\": imagemap needs \"string filename\""),
             });
         };
-        ctx.check_image(&filename, pos)?;
+        let gamma = params.float("gamma", DEFAULT_GAMMA)?;
+        ctx.check_image(&filename, ImageUse::Texture { gamma }, pos)?;
         let wrap = match params.string_or("wrap", DEFAULT_WRAP)?.as_str() {
             "repeat" => Wrap::Repeat,
             "black" => Wrap::Black,
@@ -91,7 +92,7 @@ impl ImageMap {
             }
         }
         Ok(ImageMap {
-            gamma: params.float("gamma", DEFAULT_GAMMA)?,
+            gamma,
             gain: params.float("gain", DEFAULT_GAIN)?,
             wrap,
             mapping: Mapping2D::read(params, pos, ctx)?,

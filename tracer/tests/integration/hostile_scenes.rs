@@ -155,6 +155,106 @@ fn the_build_counts_primitives_of_a_description_it_is_handed() {
     );
 }
 
+/// A budget of `mib` MiB of memory, the counts' defaults.
+fn memory_guard(budget: &BuildBudget) -> BuildGuard<'_> {
+    BuildGuard {
+        budget,
+        ..BuildGuard::default()
+    }
+}
+
+fn memory_budget(mib: u64) -> BuildBudget {
+    BuildBudget {
+        max_memory_bytes: mib << 20,
+        ..BuildBudget::DEFAULT
+    }
+}
+
+/// An object instanced so often that its triangles stay far under the primitive limit but its
+/// built copies do not fit the memory budget: refused at the ObjectInstance that goes over,
+/// each instance counted, with the figure and the flag.
+#[test]
+fn instances_under_the_primitive_limit_are_refused_at_the_memory_budget() {
+    let files = hostile::instanced_strips(2000);
+    let budget = memory_budget(64);
+    let err = parse_scene_guarded("main.lxs", &source(&files), memory_guard(&budget)).unwrap_err();
+    let (over, pos) = over_budget(&err);
+    assert_eq!(over.limit, Limit::MemoryBytes);
+    assert_eq!(over.max, 64 << 20);
+    // Some 300 of the 2000 instances fit (512 triangles each, hundreds of bytes a triangle
+    // once built): the instance that went over is named, not the object.
+    let line: u32 = pos.split(':').nth(1).unwrap().parse().unwrap();
+    assert!(
+        pos.starts_with("main.lxs:") && (100..1000).contains(&line),
+        "{pos}"
+    );
+    let message = err.to_string();
+    assert!(
+        message.contains("--max-memory-mib") && message.contains("64.0 MiB"),
+        "{message}"
+    );
+    const { assert!(512 * 2000 < BuildBudget::DEFAULT.max_primitives) };
+    // Within a larger budget, the same scene parses, and its estimate is what it was refused on.
+    let desc = parse_scene("main.lxs", &source(&files)).unwrap();
+    assert!(desc.spent.spent(Limit::MemoryBytes) > 64 << 20);
+}
+
+/// A small PNG whose image is large (under the texel limit): refused from its header at the
+/// Texture statement, before it is decoded.
+#[test]
+fn a_small_png_of_a_large_image_is_refused_at_the_memory_budget() {
+    let png = hostile::uniform_png(4096, 4096);
+    assert!(png.len() < 256 << 10, "{} bytes", png.len());
+    const { assert!(4096 * 4096 < BuildBudget::DEFAULT.max_texels) };
+    let files = hostile::image_texture(png);
+    let budget = memory_budget(128);
+    let started = Instant::now();
+    let err = parse_scene_guarded("main.lxs", &source(&files), memory_guard(&budget)).unwrap_err();
+    assert!(started.elapsed() < QUICKLY);
+    let (over, pos) = over_budget(&err);
+    assert_eq!(over.limit, Limit::MemoryBytes);
+    assert!(pos.starts_with("main.lxs:6:"), "{pos}");
+    // 4 bytes a texel kept, 11 more while decoding.
+    assert!(over.reached >= 15 * 4096 * 4096, "{over}");
+    assert!(err.to_string().contains("--max-memory-mib"), "{err}");
+    // Within a budget that holds its estimate, it is decoded and built.
+    let budget = memory_budget(512);
+    let desc = parse_scene_guarded("main.lxs", &source(&files), memory_guard(&budget)).unwrap();
+    RenderScene::build_guarded(
+        &desc,
+        &source(&files),
+        &settings(&desc),
+        memory_guard(&budget),
+    )
+    .unwrap();
+}
+
+/// A description not made by the parser has counted nothing: the build counts its shapes'
+/// memory itself before placing them.
+#[test]
+fn the_build_counts_memory_of_a_description_it_is_handed() {
+    let files = hostile::instanced_strips(400);
+    let mut desc = parse_scene("main.lxs", &source(&files)).unwrap();
+    let estimate = desc.spent.spent(Limit::MemoryBytes);
+    desc.spent = Default::default();
+    let budget = BuildBudget {
+        max_memory_bytes: estimate / 2,
+        ..BuildBudget::DEFAULT
+    };
+    let err = RenderScene::build_guarded(
+        &desc,
+        &source(&files),
+        &settings(&desc),
+        memory_guard(&budget),
+    )
+    .err()
+    .expect("over budget");
+    assert!(
+        matches!(&err, BuildError::OverBudget(o) if o.limit == Limit::MemoryBytes),
+        "{err}"
+    );
+}
+
 fn settings(desc: &SceneDesc) -> RenderSettings {
     RenderSettings {
         width: desc.film.xresolution,

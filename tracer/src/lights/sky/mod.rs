@@ -31,13 +31,13 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use crate::diag::SourcePos;
-use crate::image_io::RgbImage;
+use crate::image_io::{ImageCost, RgbImage};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::emits;
-use super::infinite::{Environment, LatLongConvention};
+use super::infinite::{map_cost, Environment, LatLongConvention};
 
 pub use hosek::Hosek;
 pub use preetham::Preetham;
@@ -77,6 +77,15 @@ impl SkyLight {
     /// sampling distribution): counted against the build budget like an image map's, so a
     /// small file repeating `LightSource "sky"` cannot ask for gigabytes.
     pub const TABLE_TEXELS: u64 = TABLE_WIDTH as u64 * TABLE_HEIGHT as u64;
+
+    /// What the table takes in memory: linear texels and an environment map's sampling tables.
+    pub fn table_cost() -> ImageCost {
+        map_cost(
+            ImageCost::linear(TABLE_WIDTH, TABLE_HEIGHT),
+            TABLE_WIDTH,
+            TABLE_HEIGHT,
+        )
+    }
 
     /// Reads `sky` (`hosek` false) or `sky2` (`hosek` true).
     pub(crate) fn read(
