@@ -481,18 +481,33 @@ fn a_worker_of_another_renderer_build_is_refused() {
     );
 }
 
+/// Values no render gives: not finite, beyond the film's range, and the plausible ones the
+/// bench scene's blackmanharris filter rules out: a negative weight sum (it weighs no sample
+/// negatively), and a weight sum of 1 in every pixel (the region's edge, two pixels from the
+/// tile, gets at most 8 samples x 0.022, the filter at 1.5 pixels, from each tile pixel within
+/// reach).
 #[test]
 fn non_finite_negative_or_huge_sums_are_refused() {
     let bench = Bench::new(Misbehaviour::FailsAtOnce);
-    for (rgb, weight) in [
-        (f32::NAN, 1.0),
-        (0.5, f32::INFINITY),
-        (0.5, -1e6),
-        (f32::MAX, 1.0),
-        (-1e30, 1.0),
+    for (rgb, weight, why) in [
+        (f32::NAN, 1.0, "is not finite"),
+        (0.5, f32::INFINITY, "is not finite"),
+        (0.5, -1e6, "negative weight sum"),
+        (f32::MAX, 1.0, "exceeds what the film holds"),
+        (-1e30, 1.0, "exceeds what the film holds"),
+        (0.5, -0.5, "negative weight sum"),
+        (
+            0.5,
+            1.0,
+            "exceeds the weight sum the unit's samples can give the pixel",
+        ),
     ] {
-        let (fake, _) = bench.with_honest(Misbehaviour::Pixels { rgb, weight });
+        let (fake, stderr) = bench.with_honest(Misbehaviour::Pixels { rgb, weight });
         assert!(fake["failures"].as_u64().unwrap() >= 1, "{fake:#}");
+        assert!(
+            stderr.contains(why),
+            "({rgb}, {weight}): {why:?} not in\n{stderr}"
+        );
     }
     let stderr = bench.alone(
         Misbehaviour::Pixels {

@@ -494,7 +494,7 @@ fn accept(
     (reply, took): (pb::RenderUnitReply, Duration),
 ) -> Result<(), SessionError> {
     let received = reply.encoded_len() as u64;
-    let (buffer, stats) = result_from_wire(unit, &shared.frame, &reply)
+    let (buffer, stats) = result_from_wire(unit, &shared.frame, &shared.weights, &reply)
         .map_err(|e| SessionError::BadReply(e.to_string()))?;
     shared.deadline.observe(took);
     let first = shared.schedule.complete(&unit);
