@@ -28,6 +28,10 @@ impl PreviewFile {
             every,
         }
     }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
 }
 
 /// The render's interim outputs; either file may be off.

@@ -30,11 +30,15 @@ pub struct RenderJob {
     pub quiet: bool,
     /// The preview and the checkpoint, written as the render goes.
     pub interim: InterimOutputs,
-    /// Set by Ctrl-C or SIGTERM when checkpoints are on: the render stops, saved.
+    /// Set by Ctrl-C or SIGTERM: the render stops, saving what it can (the checkpoint, the
+    /// preview) and saying what is lost.
     pub interrupt: Interrupt,
     /// `--time-limit`: when an adaptive render stops at a round boundary.
     pub deadline: Option<Instant>,
 }
+
+/// What a render that stops short says when nothing was merged.
+const NOTHING_RENDERED: &str = "nothing had been rendered yet";
 
 /// Why a render with `--time-limit` stopped short (its executor's error, turned into an
 /// outcome by [`RenderJob::timed_out`]).
@@ -154,7 +158,7 @@ impl RenderJob {
     ) -> anyhow::Result<RenderOutcome> {
         let kept = self
             .keep(checkpoint)
-            .unwrap_or_else(|| "checkpoints are off: nothing is kept".into());
+            .unwrap_or_else(|| NOTHING_RENDERED.into());
         let Some(completed) = completed else {
             anyhow::bail!("--time-limit reached before a round was complete: no image; {kept}");
         };
@@ -180,7 +184,8 @@ impl RenderJob {
         let kept = self.keep(checkpoint);
         match (self.interrupt.is_set(), kept) {
             (true, kept) => Interrupted {
-                kept: kept.unwrap_or_else(|| "nothing had been rendered yet".into()),
+                cause: self.interrupt.cause(),
+                kept: kept.unwrap_or_else(|| NOTHING_RENDERED.into()),
             }
             .into(),
             (false, Some(kept)) => anyhow::anyhow!("{why:#}\n{kept}"),
@@ -188,40 +193,57 @@ impl RenderJob {
         }
     }
 
-    /// Saves what a render that stops short merged, for the same command to resume: the
-    /// checkpoint and the preview (every merged unit in it); says where, or None when there is
-    /// nothing to keep or checkpoints are off.
+    /// Saves what a render that stops short merged: the checkpoint, for the same command to
+    /// resume, and the preview (every merged unit in it); says where, or, with checkpoints off,
+    /// that the merged samples are lost to the next run (and which preview shows them). None
+    /// when nothing was merged.
     fn keep(&self, checkpoint: &Checkpoint) -> Option<String> {
         let something =
             checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
+        if !something {
+            return None;
+        }
         // The best image so far, every merged unit in it: the preview, when previews are on.
         let preview = crate::interim::Due {
-            preview: something,
+            preview: true,
             checkpoint: false,
-            status_image: something && self.interim.status.serving(),
+            status_image: self.interim.status.serving(),
         };
-        for e in self
+        let failed = self
             .interim
             .stage(preview, checkpoint, &self.scene.desc.film)
-            .finish()
-        {
+            .finish();
+        let preview = self.interim.preview.as_ref().filter(|_| failed.is_empty());
+        for e in failed {
             eprintln!("{e:#}");
         }
-        match &self.interim.checkpoint {
-            Some(file) if something => Some(match file.save(checkpoint) {
-                Ok(()) => {
-                    let (done, total) = checkpoint.samples(&self.settings, self.adaptive.as_ref());
-                    format!(
-                        "{:.1}% of the samples{} are kept in {}; the same command resumes the render",
-                        100.0 * done as f64 / total.max(1) as f64,
-                        if self.adaptive.is_some() { " (at most)" } else { "" },
-                        file.path().display()
-                    )
-                }
+        let (done, total) = checkpoint.samples(&self.settings, self.adaptive.as_ref());
+        let share = format!(
+            "{:.1}% of the samples{}",
+            100.0 * done as f64 / total.max(1) as f64,
+            if self.adaptive.is_some() {
+                " (at most)"
+            } else {
+                ""
+            },
+        );
+        Some(match &self.interim.checkpoint {
+            Some(file) => match file.save(checkpoint) {
+                Ok(()) => format!(
+                    "{share} are kept in {}; the same command resumes the render",
+                    file.path().display()
+                ),
                 Err(e) => format!("{e:#}"),
-            }),
-            _ => None,
-        }
+            },
+            None => format!(
+                "checkpoints are off (--checkpoint-every 0), so the {share} merged ({done} \
+                 samples) are lost: the same command starts over{}",
+                preview.map_or(String::new(), |p| format!(
+                    "; {} shows them",
+                    p.path().display()
+                ))
+            ),
+        })
     }
 
     /// Writes the final image, the PNG (and the linear EXR when asked) exactly the same way for

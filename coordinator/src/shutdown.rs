@@ -2,46 +2,65 @@
 //! the error of a render they stopped ([`Interrupted`]), or a future a server awaits
 //! ([`signalled`]).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use anyhow::Context;
 use tokio::signal::unix::SignalKind;
 
-/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render with
-/// its checkpoint saved, a second one ends the process at once.
+/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render,
+/// saving what it merged where it can and saying what is lost; a second one ends the process
+/// at once.
 #[derive(Clone, Default)]
-pub struct Interrupt(Arc<AtomicBool>);
+pub struct Interrupt {
+    set: Arc<AtomicBool>,
+    /// The number of the signal that set it.
+    signal: Arc<AtomicUsize>,
+}
 
 /// Exit status of a render stopped by a signal (128 + SIGINT, as shells report it).
 pub const INTERRUPTED_EXIT_CODE: u8 = 130;
 
 impl Interrupt {
     pub fn install() -> anyhow::Result<Self> {
-        let flag = Arc::new(AtomicBool::new(false));
+        let interrupt = Self::default();
         for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
             // Registered first, so it sees the flag as the previous signal left it.
             signal_hook::flag::register_conditional_shutdown(
                 signal,
                 i32::from(INTERRUPTED_EXIT_CODE),
-                flag.clone(),
+                interrupt.set.clone(),
             )
             .context("cannot watch for Ctrl-C")?;
-            signal_hook::flag::register(signal, flag.clone()).context("cannot watch for Ctrl-C")?;
+            signal_hook::flag::register(signal, interrupt.set.clone())
+                .context("cannot watch for Ctrl-C")?;
+            signal_hook::flag::register_usize(signal, interrupt.signal.clone(), signal as usize)
+                .context("cannot watch for Ctrl-C")?;
         }
-        Ok(Self(flag))
+        Ok(interrupt)
     }
 
     pub fn is_set(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        self.set.load(Ordering::Relaxed)
+    }
+
+    /// The signal that set the flag, as a user knows it.
+    pub fn cause(&self) -> &'static str {
+        match self.signal.load(Ordering::Relaxed) as i32 {
+            signal_hook::consts::SIGTERM => "SIGTERM",
+            _ => "Ctrl-C (SIGINT)",
+        }
     }
 }
 
 /// The error of a render stopped by Ctrl-C or SIGTERM; `main` exits with
 /// [`INTERRUPTED_EXIT_CODE`] on it.
 #[derive(Debug, thiserror::Error)]
-#[error("interrupted: {kept}")]
+#[error("interrupted by {cause}; {kept}")]
 pub struct Interrupted {
+    /// The signal, as [`Interrupt::cause`] names it.
+    pub cause: &'static str,
+    /// What became of the samples merged before it.
     pub kept: String,
 }
 

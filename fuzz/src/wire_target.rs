@@ -19,6 +19,7 @@
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 use fastrand::Rng;
 use prost::Message;
@@ -32,6 +33,7 @@ use yat_proto::hash::{is_sha256_hex, sha256_hex, Sha256Stream};
 use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::desc::{FilmDesc, ToneMap};
 use yat_tracer::film::Film;
+use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter, WeightBounds};
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
@@ -341,7 +343,8 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 return 2;
             }
             let _stats = UnitStats::from(reply.stats.unwrap_or_default());
-            let Ok(buffer) = decode_pixels(unit, &frame_for(settings), &reply.pixels) else {
+            let Ok(buffer) = decode_pixels(unit, &frame_for(settings), &WEIGHTS, &reply.pixels)
+            else {
                 return 3;
             };
             let Some(film) = &mut state.film else {
@@ -412,16 +415,24 @@ fn decoded<M>(message: Result<M, prost::DecodeError>, then: impl FnOnce(M) -> u6
     message.map_or(0, |m| 1 + then(m))
 }
 
-/// The border of the buffers a session's coordinator expects: a 2-pixel-wide filter's (as the
-/// seed scenes' blackmanharris), so replies exercise overlapping borders.
-const BORDER: [u32; 2] = [2, 2];
+/// The filter of the scene a session's coordinator renders: the seed scenes' blackmanharris of
+/// half-width 2, so replies exercise overlapping borders.
+const FILTER: FilterDesc = FilterDesc {
+    kind: FilterKind::BlackmanHarris,
+    xwidth: 2.0,
+    ywidth: 2.0,
+};
+
+/// What [`FILTER`] lets a sample weigh a pixel, tabulated once.
+static WEIGHTS: LazyLock<WeightBounds> =
+    LazyLock::new(|| PixelFilter::new(&FILTER).weight_bounds());
 
 /// The frame of the settings' film.
 fn frame_for(settings: &RenderSettings) -> FilmFrame {
     FilmFrame {
         width: settings.width,
         height: settings.height,
-        border: BORDER,
+        border: FILTER.border(),
     }
 }
 
@@ -660,14 +671,20 @@ fn seed_sessions() -> Vec<Session> {
             block_mask: None,
         };
         // The tile and the border, clipped to the image.
+        let [border, _] = FILTER.border();
         let side = |lo: u32, hi: u32, end: u32| {
-            ((hi + BORDER[0]).min(end) - lo.saturating_sub(BORDER[0])) as usize
+            ((hi + border).min(end) - lo.saturating_sub(border)) as usize
         };
         let pixels = side(tile.0, tile.2, width) * side(tile.1, tile.3, height);
         let reply = pb::RenderUnitReply {
             index: 3,
+            // Radiance sums between 0.5 and 2 and zero weight sums: what every pixel may hold.
             pixels: (0..pixels * BYTES_PER_PIXEL)
-                .map(|i| if i % 4 == 3 { 0x3f } else { (i * 7) as u8 })
+                .map(|i| match (i % BYTES_PER_PIXEL, i % 4) {
+                    (12.., _) => 0,
+                    (_, 3) => 0x3f,
+                    _ => (i * 7) as u8,
+                })
                 .collect::<Vec<u8>>()
                 .into(),
             stats: Some(pb::UnitStats {

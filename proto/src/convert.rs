@@ -1,10 +1,13 @@
 //! Conversions between the wire messages and the tracer's types, with the checks a peer's
 //! message must pass before anything is allocated from it.
 
+use std::ops::Range;
+
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{SampleBuffer, MAX_SUM};
-use yat_tracer::render::unit::{FilmFrame, MAX_MASKED_SIDE};
+use yat_tracer::filter::WeightBounds;
+use yat_tracer::render::unit::{FilmFrame, PixelRect, BLOCK_SIZE, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::pb;
@@ -208,17 +211,17 @@ pub fn pixels_len(unit: &WorkUnit, frame: &FilmFrame) -> usize {
 
 /// Reads a sample buffer of `unit` back from its wire form, checking what an honest render can
 /// produce: the length of its region of `frame` ([`pixels_len`]); finite values; sums
-/// the film can hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums no
-/// larger than every sample that can reach the pixel weighing 1 (a sample gives each pixel a
-/// weight of at most 1 in magnitude, see `filter.rs`: the unit's samples per pixel times the
-/// pixels within the border, the odd half at most half of them, rounded up); zeros for the
-/// pixels no sample of the unit reaches (beyond the border of the blocks a mask leaves on).
-/// Radiance has no bound short of the film's: a bright but finite sum is indistinguishable from
-/// a firefly. Negative sums are honest (filters with negative lobes weigh some samples
-/// negatively).
+/// the film can hold (under [`MAX_SUM`], so one value cannot saturate it); weight sums no larger
+/// in magnitude than the unit's samples can give each pixel through the scene's filter
+/// (`weights`, see [`max_weight_sums`]), and none negative when the filter weighs no sample
+/// negatively; zeros for the pixels no sample of the unit reaches (beyond the border of the
+/// pixels it renders). Radiance has no bound short of the film's: a bright but finite sum is
+/// indistinguishable from a firefly. Negative sums are honest under filters with negative
+/// lobes (mitchell, sinc).
 pub fn decode_pixels(
     unit: WorkUnit,
     frame: &FilmFrame,
+    weights: &WeightBounds,
     bytes: &[u8],
 ) -> Result<SampleBuffer, WireError> {
     let expected = pixels_len(&unit, frame);
@@ -229,14 +232,9 @@ pub fn decode_pixels(
             expected,
         });
     }
-    let [bx, by] = frame.border;
-    let reach = f64::from(2 * bx + 1) * f64::from(2 * by + 1);
-    let samples = f64::from(unit.sample_end - unit.sample_start) * reach;
-    let odd = f64::from((unit.sample_end / 2).saturating_sub(unit.sample_start / 2)) * reach;
     let mut buffer = SampleBuffer::new(unit, frame);
-    let region = buffer.region;
-    let region_width = region.width() as usize;
-    let n = region.pixel_count();
+    let n = buffer.region.pixel_count();
+    let limits = max_weight_sums(&unit, buffer.region, weights);
     for (pixel, px) in bytes.chunks_exact(BYTES_PER_PIXEL).enumerate() {
         let values: [f32; 4] =
             std::array::from_fn(|i| f32::from_le_bytes(px[4 * i..4 * i + 4].try_into().unwrap()));
@@ -256,21 +254,24 @@ pub fn decode_pixels(
         }
         let half = pixel >= buffer.weight.len();
         let i = pixel % n;
-        let max_weight = if half { odd } else { samples };
+        let max_weight = limits[i][usize::from(half)];
+        // No sample that reaches the pixel weighs it: its radiance sums are zero too.
+        if max_weight == 0.0 && values.iter().any(|&v| v != 0.0) {
+            return Err(refuse(
+                values[3],
+                "lies beyond the reach of every pixel the unit renders",
+            ));
+        }
+        if values[3] < 0.0 && !weights.negative {
+            return Err(refuse(
+                values[3],
+                "is a negative weight sum, and the scene's filter weighs no sample negatively",
+            ));
+        }
         if f64::from(values[3].abs()) > max_weight {
             return Err(refuse(
                 values[3],
-                "exceeds the unit's samples per pixel as a weight sum",
-            ));
-        }
-        let (x, y) = (
-            region.x0 + (i % region_width) as u32,
-            region.y0 + (i / region_width) as u32,
-        );
-        if !unit.reaches(x, y, frame.border) && values.iter().any(|&v| v != 0.0) {
-            return Err(refuse(
-                values[3],
-                "lies beyond the reach of the blocks the unit's mask leaves on",
+                "exceeds the weight sum the unit's samples can give the pixel",
             ));
         }
         let (rgb, weight, at) = if half {
@@ -284,12 +285,86 @@ pub fn decode_pixels(
     Ok(buffer)
 }
 
+/// The relative rounding of one f32 operation.
+const F32_ROUNDING: f64 = 1.0 / (1u64 << 24) as f64;
+
+/// Per pixel of `region` (row-major), the largest weight sum in magnitude that `unit`'s samples
+/// can give it, of all its samples and of its odd-index ones: for each pixel the unit renders,
+/// its samples times the largest weight a sample there gives this one (the product of the two
+/// axes' bounds at their offsets, [`WeightBounds`]). A unit's buffer adds its n terms in f32:
+/// each addition rounds up by at most a factor 1 + 2^-24, and each term's weights and their
+/// product a few times more, so the sum stays under exp((n + 16) 2^-24) times that bound. Zero
+/// where no sample that reaches the pixel can weigh it.
+pub fn max_weight_sums(
+    unit: &WorkUnit,
+    region: PixelRect,
+    weights: &WeightBounds,
+) -> Vec<[f64; 2]> {
+    let rendered = match unit.mask {
+        None => vec![(unit.x0, unit.y0, unit.x1, unit.y1)],
+        Some(mask) => unit
+            .tile_blocks()
+            .filter(|&(_, _, bit)| mask & bit != 0)
+            .map(|(x, y, _)| {
+                let end = |v: u32, tile_end: u32| (v + BLOCK_SIZE).min(tile_end);
+                (x, y, end(x, unit.x1), end(y, unit.y1))
+            })
+            .collect(),
+    };
+    // Per pixel: the sum of the bounds of the rendered pixels that reach it, and their count.
+    let mut reach = vec![(0.0, 0); region.pixel_count()];
+    for (x0, y0, x1, y1) in rendered {
+        let columns = axis_reach(&weights.x, region.x0..region.x1, x0..x1);
+        let rows = axis_reach(&weights.y, region.y0..region.y1, y0..y1);
+        for (row, &(wy, ny)) in reach.chunks_exact_mut(columns.len()).zip(&rows) {
+            for (pixel, &(wx, nx)) in row.iter_mut().zip(&columns) {
+                pixel.0 += wx * wy;
+                pixel.1 += nx * ny;
+            }
+        }
+    }
+    let samples = [
+        unit.sample_end - unit.sample_start,
+        (unit.sample_end / 2).saturating_sub(unit.sample_start / 2),
+    ]
+    .map(f64::from);
+    reach
+        .into_iter()
+        .map(|(bound, pixels): (f64, u64)| {
+            samples.map(|s| {
+                let terms = s * pixels as f64;
+                s * bound * libm::exp((terms + 16.0) * F32_ROUNDING)
+            })
+        })
+        .collect()
+}
+
+/// Along one axis, for each pixel of `pixels`: the sum of the largest weights (`max`, by
+/// offset from -border to border) a sample in each pixel of `sources` gives it, and how many
+/// of those lie within the border.
+fn axis_reach(max: &[f32], pixels: Range<u32>, sources: Range<u32>) -> Vec<(f64, u64)> {
+    let border = (max.len() / 2) as i64;
+    pixels
+        .map(|p| {
+            let p = i64::from(p);
+            let near =
+                (p - border).max(sources.start.into())..(p + border + 1).min(sources.end.into());
+            let bound = near
+                .clone()
+                .map(|q| f64::from(max[(p - q + border) as usize]))
+                .sum();
+            (bound, near.count() as u64)
+        })
+        .collect()
+}
+
 /// A worker's reply to `unit`, checked: the unit's own index, a sample buffer that
 /// [`decode_pixels`] accepts, and counters an honest render of the unit gives (exactly its
 /// samples, no more dropped than taken, rays within [`MAX_RAYS_PER_SAMPLE`] per sample).
 pub fn result_from_wire(
     unit: WorkUnit,
     frame: &FilmFrame,
+    weights: &WeightBounds,
     reply: &pb::RenderUnitReply,
 ) -> Result<(SampleBuffer, UnitStats), WireError> {
     if reply.index != unit.index {
@@ -298,7 +373,7 @@ pub fn result_from_wire(
             got: reply.index,
         });
     }
-    let buffer = decode_pixels(unit, frame, &reply.pixels)?;
+    let buffer = decode_pixels(unit, frame, weights, &reply.pixels)?;
     let stats = UnitStats::from(reply.stats.unwrap_or_default());
     let samples = unit.sample_count();
     let wrong = |reason: String| WireError::Stats {
@@ -328,7 +403,36 @@ pub fn result_from_wire(
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
+    use yat_tracer::assets::MemorySource;
+    use yat_tracer::filter::{
+        FilterDesc, FilterKind, PixelFilter, DEFAULT_MITCHELL_B, DEFAULT_MITCHELL_C,
+    };
+    use yat_tracer::parse::parse_scene;
+    use yat_tracer::render::{plan_units, RenderScene};
+
     use super::*;
+
+    const MITCHELL: FilterKind = FilterKind::Mitchell {
+        b: DEFAULT_MITCHELL_B,
+        c: DEFAULT_MITCHELL_C,
+    };
+
+    fn weights_of(kind: FilterKind, xwidth: f32, ywidth: f32) -> WeightBounds {
+        PixelFilter::new(&FilterDesc {
+            kind,
+            xwidth,
+            ywidth,
+        })
+        .weight_bounds()
+    }
+
+    /// A box filter reaching `border` pixels: every sample weighs each pixel within it 1.
+    fn box_weights([bx, by]: [u32; 2]) -> WeightBounds {
+        let width = |b: u32| b as f32 + 0.5;
+        weights_of(FilterKind::Box, width(bx), width(by))
+    }
 
     fn settings() -> RenderSettings {
         RenderSettings {
@@ -415,7 +519,8 @@ mod tests {
         };
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 6 * BYTES_PER_PIXEL);
-        let back = decode_pixels(unit, &frame, &bytes).unwrap();
+        let weights = box_weights(frame.border);
+        let back = decode_pixels(unit, &frame, &weights, &bytes).unwrap();
         let bits = |b: &SampleBuffer| {
             b.rgb
                 .iter()
@@ -425,7 +530,7 @@ mod tests {
                 .collect::<Vec<_>>()
         };
         assert_eq!(bits(&back), bits(&buffer));
-        assert!(decode_pixels(unit, &frame, &bytes[1..]).is_err());
+        assert!(decode_pixels(unit, &frame, &weights, &bytes[1..]).is_err());
     }
 
     /// A unit's buffer covers its tile and the filter's border, clipped to the film: the tile's
@@ -449,22 +554,27 @@ mod tests {
         };
         // Columns 0..6 (7 clipped to the film), rows 0..3 (-1 clipped).
         assert_eq!(pixels_len(&unit, &frame), 6 * 3 * BYTES_PER_PIXEL);
+        let weights = box_weights(frame.border);
         let mut buffer = SampleBuffer::new(unit, &frame);
-        // A corner pixel of the border: up to 4 samples from each of 5 x 3 pixels, weight < 1.
-        buffer.rgb[2 * 6] = [1.0, 2.0, 3.0];
-        buffer.weight[2 * 6] = 30.0;
+        // Pixel (2, 2), below the tile: 4 samples from each of the 3 x 1 tile pixels within the
+        // border, each weighing 1 under this box.
+        buffer.rgb[2 * 6 + 2] = [1.0, 2.0, 3.0];
+        buffer.weight[2 * 6 + 2] = 12.0;
         let bytes = encode_pixels(&buffer);
-        assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
+        assert_eq!(
+            decode_pixels(unit, &frame, &weights, &bytes).unwrap(),
+            buffer
+        );
         let tile_only = 3 * 2 * BYTES_PER_PIXEL;
-        assert!(decode_pixels(unit, &frame, &bytes[..tile_only]).is_err());
+        assert!(decode_pixels(unit, &frame, &weights, &bytes[..tile_only]).is_err());
         let unclipped = FilmFrame {
             width: 100,
             ..frame
         };
-        assert!(decode_pixels(unit, &unclipped, &bytes).is_err());
-        // More weight than every sample within the border weighing 1 is a lie.
-        buffer.weight[2 * 6] = 4.0 * 15.0 + 1.0;
-        assert!(decode_pixels(unit, &frame, &encode_pixels(&buffer)).is_err());
+        assert!(decode_pixels(unit, &unclipped, &weights, &bytes).is_err());
+        // More weight than those samples give is a lie.
+        buffer.weight[2 * 6 + 2] = 12.01;
+        assert!(decode_pixels(unit, &frame, &weights, &encode_pixels(&buffer)).is_err());
     }
 
     #[test]
@@ -507,6 +617,7 @@ mod tests {
         // in (6, 4), (78, 6) in no active block. Without a border a pixel gets only its own
         // block's samples: one source plane.
         let frame = FilmFrame::unbordered(s.width, s.height);
+        let weights = box_weights(frame.border);
         let pixels = 28 * 18;
         let mut buffer = SampleBuffer::new(unit, &frame);
         assert_eq!(buffer.half_rgb.len(), pixels);
@@ -519,18 +630,22 @@ mod tests {
         buffer.half_weight[0] = 2.0;
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 2 * pixels * BYTES_PER_PIXEL);
-        assert_eq!(decode_pixels(unit, &frame, &bytes).unwrap(), buffer);
-        assert!(decode_pixels(unit, &frame, &bytes[..pixels * BYTES_PER_PIXEL]).is_err());
+        assert_eq!(
+            decode_pixels(unit, &frame, &weights, &bytes).unwrap(),
+            buffer
+        );
+        let one_plane = &bytes[..pixels * BYTES_PER_PIXEL];
+        assert!(decode_pixels(unit, &frame, &weights, one_plane).is_err());
         let mut heavy_half = buffer.clone();
         heavy_half.half_weight[0] = 3.0;
         assert!(
-            decode_pixels(unit, &frame, &encode_pixels(&heavy_half)).is_err(),
+            decode_pixels(unit, &frame, &weights, &encode_pixels(&heavy_half)).is_err(),
             "3 of 2 odd samples"
         );
         let mut outside = buffer.clone();
         outside.rgb[6 * 28 + 6] = [0.1, 0.0, 0.0];
         assert!(
-            decode_pixels(unit, &frame, &encode_pixels(&outside)).is_err(),
+            decode_pixels(unit, &frame, &weights, &encode_pixels(&outside)).is_err(),
             "a masked-out pixel"
         );
 
@@ -541,6 +656,7 @@ mod tests {
             border: [2, 2],
             ..frame
         };
+        let weights = box_weights(frame.border);
         assert_eq!(frame.source_planes(), 4);
         let region = frame.region(&unit);
         assert_eq!(
@@ -559,10 +675,229 @@ mod tests {
                 let i = plane * region.pixel_count() + at(x, y);
                 buffer.rgb[i] = [0.1, 0.0, 0.0];
                 buffer.weight[i] = 0.5;
-                let decoded = decode_pixels(unit, &frame, &encode_pixels(&buffer));
+                let decoded = decode_pixels(unit, &frame, &weights, &encode_pixels(&buffer));
                 assert_eq!(decoded.is_ok(), reached, "({x}, {y}) in plane {plane}");
             }
         }
+    }
+
+    /// A 4x4 tile of 8 samples per pixel at (4, 4) of a 16x16 film, with a filter reaching 2
+    /// pixels: its buffer covers (2, 2) to (10, 10).
+    fn bordered_unit() -> (WorkUnit, FilmFrame) {
+        let unit = WorkUnit {
+            index: 9,
+            x0: 4,
+            y0: 4,
+            x1: 8,
+            y1: 8,
+            sample_start: 8,
+            sample_end: 16,
+            mask: None,
+        };
+        let frame = FilmFrame {
+            width: 16,
+            height: 16,
+            border: [2, 2],
+        };
+        (unit, frame)
+    }
+
+    /// `unit`'s buffer with `weight` (and some radiance) at `(x, y)`, checked under `weights`.
+    fn weighing(
+        (unit, frame): (WorkUnit, FilmFrame),
+        weights: &WeightBounds,
+        (x, y): (u32, u32),
+        weight: f32,
+    ) -> Result<SampleBuffer, WireError> {
+        let mut buffer = SampleBuffer::new(unit, &frame);
+        let region = buffer.region;
+        let at = ((y - region.y0) * region.width() + x - region.x0) as usize;
+        buffer.rgb[at] = [0.5, 0.25, 0.125];
+        buffer.weight[at] = weight;
+        decode_pixels(unit, &frame, weights, &encode_pixels(&buffer))
+    }
+
+    /// A negative weight sum is a lie under a filter that weighs no sample negatively, refused
+    /// naming the pixel; under mitchell's or sinc's negative lobes it is honest. Zero is honest
+    /// under any filter.
+    #[test]
+    fn negative_weights_are_refused_unless_the_filter_has_negative_lobes() {
+        let (x, y) = (3, 5);
+        // Pixel (3, 5) is the 14th of the region's row 3.
+        let pixel = 3 * 8 + 1;
+        for (kind, width, negative) in [
+            (FilterKind::Box, 2.5, false),
+            (FilterKind::Triangle, 2.0, false),
+            (FilterKind::Gaussian { alpha: 2.0 }, 2.0, false),
+            (FilterKind::BlackmanHarris, 2.0, false),
+            (MITCHELL, 2.0, true),
+            (FilterKind::Mitchell { b: 0.0, c: 0.5 }, 2.0, true),
+            (FilterKind::Sinc { tau: 3.0 }, 2.0, true),
+        ] {
+            let weights = weights_of(kind, width, width);
+            assert_eq!(weights.negative, negative, "{kind:?}");
+            for zero in [0.0, -0.0] {
+                assert!(weighing(bordered_unit(), &weights, (x, y), zero).is_ok());
+            }
+            let decoded = weighing(bordered_unit(), &weights, (x, y), -0.25);
+            match decoded {
+                Ok(_) => assert!(negative, "{kind:?}: a negative weight accepted"),
+                Err(WireError::PixelValue {
+                    index: 9,
+                    pixel: p,
+                    value,
+                    reason,
+                }) => {
+                    assert!(!negative, "{kind:?}: refused: {reason}");
+                    assert_eq!((p, value), (pixel, -0.25), "{kind:?}");
+                    assert!(reason.contains("negative"), "{reason}");
+                }
+                Err(e) => panic!("{kind:?}: {e}"),
+            }
+        }
+    }
+
+    /// A weight sum above what the unit's samples give the pixel through the filter is refused,
+    /// where the bound over every pixel within the border weighing 1 would let it pass.
+    #[test]
+    fn weight_sums_beyond_what_the_samples_can_give_are_refused() {
+        let gaussian = weights_of(FilterKind::Gaussian { alpha: 2.0 }, 2.0, 2.0);
+        // The region's corner (2, 2) gets only the tile's corner (4, 4), two pixels away on
+        // each axis, where a sample weighs at most 0.0114^2 (the gaussian at 1.49 pixels): 8
+        // samples give at most 1.04e-3.
+        let corner = (2, 2);
+        assert!(weighing(bordered_unit(), &gaussian, corner, 1e-3).is_ok());
+        let refused = weighing(bordered_unit(), &gaussian, corner, 1.1e-3).unwrap_err();
+        assert!(
+            refused.to_string().contains("exceeds the weight sum"),
+            "{refused}"
+        );
+        // The tile's (6, 6) gets 4 x 4 tile pixels, at most (1 + 2 x 0.616 + 0.0114)^2 = 5.03
+        // per sample: 40.3 in all.
+        let inside = (6, 6);
+        assert!(weighing(bordered_unit(), &gaussian, inside, 40.0).is_ok());
+        assert!(weighing(bordered_unit(), &gaussian, inside, 41.0).is_err());
+        assert!(weighing(bordered_unit(), &gaussian, inside, -41.0).is_err());
+        // Under a box every sample within the border weighs 1: 8 x 16 at (6, 6).
+        let box_filter = box_weights([2, 2]);
+        assert!(weighing(bordered_unit(), &box_filter, inside, 128.0).is_ok());
+        // A sum in f32 may round past the exact bound: one step above it is honest.
+        let rounded_up = 128.0f32.next_up();
+        assert!(weighing(bordered_unit(), &box_filter, inside, rounded_up).is_ok());
+        assert!(weighing(bordered_unit(), &box_filter, inside, 128.01).is_err());
+        // Under mitchell the bound holds negative sums too.
+        let mitchell = weights_of(MITCHELL, 2.0, 2.0);
+        assert!(weighing(bordered_unit(), &mitchell, corner, -1e-3).is_ok());
+        assert!(weighing(bordered_unit(), &mitchell, corner, -0.5).is_err());
+    }
+
+    /// A small scene with `filter` as its `PixelFilter` statement: a lit sphere on a floor.
+    fn filtered_scene(filter: &str, width: u32, height: u32) -> (RenderScene, RenderSettings) {
+        let text = format!(
+            "Film \"fleximage\" \"integer xresolution\" [{width}] \"integer yresolution\" [{height}]\n\
+             PixelFilter {filter}\n\
+             LookAt 0 -3 1  0 0 0.3  0 0 1\n\
+             Camera \"perspective\" \"float fov\" [50]\n\
+             WorldBegin\n\
+             AttributeBegin\n\
+             AreaLightSource \"area\" \"color L\" [4 4 4]\n\
+             Translate 0.6 0.2 1.6\n\
+             Shape \"sphere\" \"float radius\" 0.3\n\
+             AttributeEnd\n\
+             Material \"matte\" \"color Kd\" [0.6 0.6 0.6]\n\
+             Shape \"sphere\" \"float radius\" 0.5\n\
+             Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \
+             \"point P\" [-4 -4 -0.5  4 -4 -0.5  4 4 -0.5  -4 4 -0.5]\n\
+             WorldEnd\n"
+        );
+        let mut source = MemorySource::new();
+        source.insert("scene.lxs", Arc::from(text.as_bytes()));
+        let desc = parse_scene("scene.lxs", &source).unwrap();
+        let settings = RenderSettings {
+            width,
+            height,
+            spp: 24,
+            max_depth: 4,
+            seed: 3,
+            latlong: LatLongConvention::LuxRender,
+        };
+        let scene = RenderScene::build(&desc, &source, &settings).unwrap();
+        (scene, settings)
+    }
+
+    /// Honest buffers pass under every filter kind, widths from a box's own pixel to the
+    /// widest, the plan's units and a tile inside the film, uniform and masked (an odd sample
+    /// range); under a box of
+    /// half-width 0.5 every sample weighs 1, so honest sums meet the bound.
+    #[test]
+    fn honest_buffers_pass_under_every_filter() {
+        let filters = [
+            "\"box\"",
+            "\"box\" \"float xwidth\" [1.5] \"float ywidth\" [0.7]",
+            "\"triangle\"",
+            "\"gaussian\" \"float alpha\" [0.5] \"float xwidth\" [3]",
+            "\"mitchell\"",
+            "\"mitchell\" \"float B\" [1] \"float C\" [0]",
+            "\"catmullrom\"",
+            "\"blackmanharris\"",
+            "\"sinc\"",
+            "\"triangle\" \"float xwidth\" [8] \"float ywidth\" [8]",
+        ];
+        // A tile inside the film, uniform and masked (7 x 8 blocks: no bit of the eighth column).
+        let masks = [
+            None,
+            Some(u64::MAX),
+            Some(0x0000_0018_2400_0081),
+            Some(1 << 9),
+        ];
+        for filter in filters {
+            let (scene, settings) = filtered_scene(filter, 40, 36);
+            let frame = scene.frame();
+            let weights = PixelFilter::new(&scene.desc().filter).weight_bounds();
+            let inner = masks.iter().map(|&mask| WorkUnit {
+                index: 0,
+                x0: 6,
+                y0: 3,
+                x1: 34,
+                y1: 33,
+                sample_start: 3,
+                sample_end: 14,
+                mask: mask.map(|m| m & 0x7f7f_7f7f_7f7f_7f7f),
+            });
+            let mut tightest = 0.0f64;
+            for unit in plan_units(&settings).into_iter().chain(inner) {
+                let (buffer, _) = scene.render_unit(&unit);
+                let decoded = decode_pixels(unit, &frame, &weights, &encode_pixels(&buffer));
+                assert_eq!(decoded.unwrap(), buffer, "{filter}: {unit:?}");
+                let limits = max_weight_sums(&unit, buffer.region, &weights);
+                let n = buffer.region.pixel_count();
+                let sums = buffer.weight.iter().chain(&buffer.half_weight);
+                for (i, &w) in sums.enumerate() {
+                    let limit = limits[i % n][usize::from(i >= buffer.weight.len())];
+                    if limit > 0.0 {
+                        tightest = tightest.max(f64::from(w.abs()) / limit);
+                    }
+                }
+            }
+            println!(
+                "{filter} (negative weights: {}): honest weight sums reach {tightest:.4} of \
+                 the bound",
+                weights.negative
+            );
+            if filter == "\"box\"" {
+                assert!(tightest > 0.9999, "{tightest}");
+            }
+        }
+    }
+
+    /// `reply` to `unit` of a 2x1 film, checked under a mitchell filter of half-width 0.5 (it
+    /// reaches no neighbour, and weighs some samples negatively).
+    fn check_2x1(
+        unit: WorkUnit,
+        reply: &pb::RenderUnitReply,
+    ) -> Result<(SampleBuffer, UnitStats), WireError> {
+        let weights = weights_of(MITCHELL, 0.5, 0.5);
+        result_from_wire(unit, &FilmFrame::unbordered(2, 1), &weights, reply)
     }
 
     /// A 2x1 tile of 4 samples per pixel whose second pixel's values are `values`, encoded.
@@ -608,8 +943,7 @@ mod tests {
             [-0.0, f32::MIN_POSITIVE, 0.0, 0.0],
         ] {
             let (unit, reply) = reply_with(values);
-            let (buffer, stats) =
-                result_from_wire(unit, &FilmFrame::unbordered(2, 1), &reply).unwrap();
+            let (buffer, stats) = check_2x1(unit, &reply).unwrap();
             assert_eq!(buffer.rgb[1], [values[0], values[1], values[2]]);
             assert_eq!(buffer.weight[1], values[3]);
             assert_eq!(stats.samples, 8);
@@ -631,7 +965,7 @@ mod tests {
             [1.0, 1.0, 1.0, 1e30],
         ] {
             let (unit, reply) = reply_with(values);
-            let error = result_from_wire(unit, &FilmFrame::unbordered(2, 1), &reply).unwrap_err();
+            let error = check_2x1(unit, &reply).unwrap_err();
             assert!(
                 matches!(
                     error,
@@ -654,7 +988,7 @@ mod tests {
             ..reply.clone()
         };
         assert!(matches!(
-            result_from_wire(unit, &FilmFrame::unbordered(2, 1), &other),
+            check_2x1(unit, &other),
             Err(WireError::OtherUnit { asked: 5, got: 6 })
         ));
         let short = pb::RenderUnitReply {
@@ -662,7 +996,7 @@ mod tests {
             ..reply.clone()
         };
         assert!(matches!(
-            result_from_wire(unit, &FilmFrame::unbordered(2, 1), &short),
+            check_2x1(unit, &short),
             Err(WireError::PixelsLength { .. })
         ));
         for (samples, rays, dropped) in [(7, 40, 0), (9, 40, 0), (8, 40, 9), (8, u64::MAX, 0)] {
@@ -675,10 +1009,7 @@ mod tests {
                 ..reply.clone()
             };
             assert!(
-                matches!(
-                    result_from_wire(unit, &FilmFrame::unbordered(2, 1), &lying),
-                    Err(WireError::Stats { .. })
-                ),
+                matches!(check_2x1(unit, &lying), Err(WireError::Stats { .. })),
                 "{samples} {rays} {dropped}"
             );
         }
@@ -686,6 +1017,6 @@ mod tests {
             stats: None,
             ..reply
         };
-        assert!(result_from_wire(unit, &FilmFrame::unbordered(2, 1), &without_stats).is_err());
+        assert!(check_2x1(unit, &without_stats).is_err());
     }
 }

@@ -11,6 +11,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use tonic::{Request, Response, Status, Streaming};
+use yat_proto::hash::Sha256Stream;
 use yat_proto::{pb, RenderNodeServer, PROTOCOL_VERSION};
 
 use crate::util::*;
@@ -36,6 +37,9 @@ enum Misbehaviour {
     FailsAtOnce,
     /// Answers LoadScene with INTERNAL.
     LoadFails,
+    /// Lists the first blob it is asked about as missing [`REPEATS`] times, then answers
+    /// LoadScene with INTERNAL (one session is all it gets).
+    RepeatsMissingBlob,
     /// Escape sequences in its host name, software name and error messages.
     Escapes,
     /// Refuses every unit as a draining worker does.
@@ -43,6 +47,9 @@ enum Misbehaviour {
 }
 
 const ESCAPES: &str = "\x1b]0;pwn\x07\x1b[2J";
+
+/// How often [`Misbehaviour::RepeatsMissingBlob`] lists its blob.
+const REPEATS: usize = 2000;
 
 /// The border of the bench scene's units' buffers: its blackmanharris filter is 2 pixels wide.
 const BORDER: u32 = 2;
@@ -52,6 +59,10 @@ struct FakeState {
     /// The image size of the scene loaded last.
     image: Mutex<(u32, u32)>,
     requests: AtomicU64,
+    /// The blob its HasBlobs reply listed, and each PutBlob stream received: the hash its
+    /// first chunk names and the SHA-256 of the bytes.
+    listed: Mutex<Option<String>>,
+    uploads: Mutex<Vec<(String, String)>>,
     units_in_flight: AtomicU64,
     max_units_in_flight: AtomicU64,
 }
@@ -121,18 +132,38 @@ impl yat_proto::RenderNode for FakeNode {
 
     async fn has_blobs(
         &self,
-        _: Request<pb::HasBlobsRequest>,
+        request: Request<pb::HasBlobsRequest>,
     ) -> Result<Response<pb::HasBlobsReply>, Status> {
         self.0.count();
-        // Claims every file, so the scene is never uploaded to it.
-        Ok(Response::new(pb::HasBlobsReply::default()))
+        let missing = match self.0.misbehaviour() {
+            Misbehaviour::RepeatsMissingBlob => {
+                let first = request.into_inner().sha256.into_iter().next();
+                let first = first.unwrap_or_default();
+                *self.0.listed.lock().unwrap() = Some(first.clone());
+                vec![first; REPEATS]
+            }
+            // Claims every file, so the scene is never uploaded to it.
+            _ => Vec::new(),
+        };
+        Ok(Response::new(pb::HasBlobsReply { missing }))
     }
 
     async fn put_blob(
         &self,
-        _: Request<Streaming<pb::BlobChunk>>,
+        request: Request<Streaming<pb::BlobChunk>>,
     ) -> Result<Response<pb::PutBlobReply>, Status> {
         self.0.count();
+        let mut stream = request.into_inner();
+        let mut named = String::new();
+        let mut bytes = Sha256Stream::default();
+        while let Some(chunk) = stream.message().await? {
+            if named.is_empty() {
+                named = chunk.sha256;
+            }
+            bytes.update(&chunk.data);
+        }
+        let upload = (named, bytes.finish_hex());
+        self.0.uploads.lock().unwrap().push(upload);
         Ok(Response::new(pb::PutBlobReply::default()))
     }
 
@@ -143,7 +174,7 @@ impl yat_proto::RenderNode for FakeNode {
         self.0.count();
         let settings = request.into_inner().settings.unwrap_or_default();
         *self.0.image.lock().unwrap() = (settings.width, settings.height);
-        if let Misbehaviour::LoadFails = self.0.misbehaviour() {
+        if let Misbehaviour::LoadFails | Misbehaviour::RepeatsMissingBlob = self.0.misbehaviour() {
             return Err(Status::internal("out of luck"));
         }
         Ok(Response::new(pb::LoadSceneReply {
@@ -208,7 +239,8 @@ impl yat_proto::RenderNode for FakeNode {
             Misbehaviour::FailsAtOnce
             | Misbehaviour::TinyMessageLimit
             | Misbehaviour::OtherBuild
-            | Misbehaviour::LoadFails => return Err(Status::internal("no")),
+            | Misbehaviour::LoadFails
+            | Misbehaviour::RepeatsMissingBlob => return Err(Status::internal("no")),
         };
         Ok(Response::new(reply))
     }
@@ -235,6 +267,8 @@ impl FakeWorker {
             misbehaviour: Mutex::new(misbehaviour),
             image: Mutex::new((0, 0)),
             requests: AtomicU64::new(0),
+            listed: Mutex::new(None),
+            uploads: Mutex::new(Vec::new()),
             units_in_flight: AtomicU64::new(0),
             max_units_in_flight: AtomicU64::new(0),
         });
@@ -266,6 +300,7 @@ impl FakeWorker {
     fn become_(&self, misbehaviour: Misbehaviour) {
         *self.state.misbehaviour.lock().unwrap() = misbehaviour;
         self.state.requests.store(0, Ordering::SeqCst);
+        self.state.uploads.lock().unwrap().clear();
         self.state.max_units_in_flight.store(0, Ordering::SeqCst);
     }
 
@@ -446,18 +481,33 @@ fn a_worker_of_another_renderer_build_is_refused() {
     );
 }
 
+/// Values no render gives: not finite, beyond the film's range, and the plausible ones the
+/// bench scene's blackmanharris filter rules out: a negative weight sum (it weighs no sample
+/// negatively), and a weight sum of 1 in every pixel (the region's edge, two pixels from the
+/// tile, gets at most 8 samples x 0.022, the filter at 1.5 pixels, from each tile pixel within
+/// reach).
 #[test]
 fn non_finite_negative_or_huge_sums_are_refused() {
     let bench = Bench::new(Misbehaviour::FailsAtOnce);
-    for (rgb, weight) in [
-        (f32::NAN, 1.0),
-        (0.5, f32::INFINITY),
-        (0.5, -1e6),
-        (f32::MAX, 1.0),
-        (-1e30, 1.0),
+    for (rgb, weight, why) in [
+        (f32::NAN, 1.0, "is not finite"),
+        (0.5, f32::INFINITY, "is not finite"),
+        (0.5, -1e6, "negative weight sum"),
+        (f32::MAX, 1.0, "exceeds what the film holds"),
+        (-1e30, 1.0, "exceeds what the film holds"),
+        (0.5, -0.5, "negative weight sum"),
+        (
+            0.5,
+            1.0,
+            "exceeds the weight sum the unit's samples can give the pixel",
+        ),
     ] {
-        let (fake, _) = bench.with_honest(Misbehaviour::Pixels { rgb, weight });
+        let (fake, stderr) = bench.with_honest(Misbehaviour::Pixels { rgb, weight });
         assert!(fake["failures"].as_u64().unwrap() >= 1, "{fake:#}");
+        assert!(
+            stderr.contains(why),
+            "({rgb}, {weight}): {why:?} not in\n{stderr}"
+        );
     }
     let stderr = bench.alone(
         Misbehaviour::Pixels {
@@ -557,5 +607,26 @@ fn a_draining_worker_costs_no_failure_and_is_tried_again() {
     assert!(
         stderr.matches("draining").count() >= 2,
         "tried again after the drain: {stderr}"
+    );
+}
+
+/// A worker that lists one of the scene's files as missing 2000 times receives it once, whole:
+/// one PutBlob stream naming that file and carrying its bytes. It then fails to load the scene,
+/// so that one session is the render's only upload to it.
+#[test]
+fn a_blob_listed_again_and_again_is_uploaded_once() {
+    let bench = Bench::new(Misbehaviour::RepeatsMissingBlob);
+    bench.with_honest(Misbehaviour::RepeatsMissingBlob);
+    let listed = bench.fake.state.listed.lock().unwrap().clone().unwrap();
+    let uploads = bench.fake.state.uploads.lock().unwrap().clone();
+    assert_eq!(
+        uploads,
+        [(listed.clone(), listed)],
+        "one upload of the listed blob"
+    );
+    assert_eq!(
+        bench.fake.requests(),
+        4,
+        "handshake, blob query, one upload, load"
     );
 }

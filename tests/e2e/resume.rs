@@ -23,20 +23,22 @@ fn long_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
 /// Waits until `checkpoint` holds something other than `before` (a newer save), the render
 /// still running.
 fn wait_for_new_checkpoint(render: &mut Child, checkpoint: &Path, before: Option<&[u8]>) {
+    wait_until(render, "saved a checkpoint", || {
+        std::fs::read(checkpoint).is_ok_and(|bytes| Some(bytes.as_slice()) != before)
+    });
+}
+
+/// Waits until `done` (the render has `what`), the render still running.
+fn wait_until(render: &mut Child, what: &str, done: impl Fn() -> bool) {
     let started = Instant::now();
-    loop {
-        if let Ok(bytes) = std::fs::read(checkpoint) {
-            if Some(bytes.as_slice()) != before {
-                return;
-            }
-        }
+    while !done() {
         assert!(
             render.try_wait().unwrap().is_none(),
-            "the render ended before it saved a checkpoint"
+            "the render ended before it {what}"
         );
         assert!(
             started.elapsed() < Duration::from_secs(60),
-            "no checkpoint saved"
+            "the render has not {what} in 60 s"
         );
         std::thread::sleep(Duration::from_millis(10));
     }
@@ -138,6 +140,69 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
     assert!(
         !out.with_extension("preview.png").exists(),
         "and so is the preview"
+    );
+}
+
+/// With checkpoints off, SIGTERM stops a render as with them on, and says what that costs: exit
+/// status 130, the signal named, the merged samples lost to the next run and the preview that
+/// shows them; no checkpoint, no final image.
+#[test]
+fn sigterm_with_checkpoints_off_says_the_merged_samples_are_lost() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let out = dir.path().join("off.png");
+    let preview = out.with_extension("preview.png");
+    let mut render = long_render(
+        &scene,
+        &out,
+        &[
+            "--threads",
+            "2",
+            "--checkpoint-every",
+            "0",
+            "--preview-every",
+            "0.05",
+        ],
+    )
+    .spawn()
+    .unwrap();
+    // An in-process render writes its preview after merging a unit.
+    wait_until(&mut render, "merged a unit", || preview.exists());
+    signal(&render, "TERM");
+    let stopped = render.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&stopped.stderr);
+    assert_eq!(stopped.status.code(), Some(130), "{stderr}");
+    let line = stderr
+        .lines()
+        .find(|l| l.contains("interrupted by SIGTERM; "))
+        .unwrap_or_else(|| panic!("no word of the signal:\n{stderr}"));
+    let shown_in = format!(
+        " samples) are lost: the same command starts over; {} shows them",
+        preview.display()
+    );
+    let (percent, samples) = line
+        .split_once("interrupted by SIGTERM; checkpoints are off (--checkpoint-every 0), so the ")
+        .and_then(|(_, rest)| rest.strip_suffix(&shown_in))
+        .and_then(|rest| rest.split_once("% of the samples merged ("))
+        .and_then(|(percent, samples)| {
+            Some((percent.parse::<f64>().ok()?, samples.parse::<u64>().ok()?))
+        })
+        .unwrap_or_else(|| panic!("{line}"));
+    // 256 spp over 128 x 96 pixels, in 8 passes over 64x64 and 64x32 tiles: units of 131072 or
+    // 65536 samples; at least one of them merged, not all.
+    let (total, smallest) = (256 * 128 * 96, 32 * 64 * 32);
+    assert!(
+        samples >= smallest && samples < total && samples % smallest == 0,
+        "{line}"
+    );
+    let share = 100.0 * samples as f64 / total as f64;
+    assert!((percent - share).abs() < 0.06, "{line}");
+    assert!(!out.exists(), "no final image from a stopped render");
+    assert!(!out.with_extension("resume").exists(), "checkpoints off");
+    let shown = image::open(&preview).unwrap().to_rgb8();
+    assert!(
+        shown.pixels().any(|p| p.0 != [0, 0, 0]),
+        "the preview shows them"
     );
 }
 

@@ -198,6 +198,30 @@ impl AxisWeights {
         }
     }
 
+    /// The largest weight in magnitude a sample gives the pixel k pixels from its own, for k in
+    /// -border..=border (index k + border). A sample at u in [0, 1) of its pixel gives it the
+    /// weight at |k + 0.5 - u|, which lies in [|k| - 0.5, |k| + 0.5] (from 0 for k = 0), and a
+    /// weight is interpolated between the two table entries around its offset: the largest
+    /// entry from the one before that range to the one after bounds it.
+    fn max_weights(&self) -> Vec<f32> {
+        let b = i64::from(self.border);
+        (-b..=b)
+            .map(|k| {
+                let k = k.unsigned_abs() as f32;
+                let near = ((k - 0.5).max(0.0) * self.steps_per_pixel) as usize;
+                let far = ((k + 0.5) * self.steps_per_pixel) as usize + 2;
+                self.table[near.saturating_sub(1)..=far.min(TABLE_SIZE)]
+                    .iter()
+                    .fold(0.0f32, |m, v| m.max(v.abs()))
+            })
+            .collect()
+    }
+
+    /// Whether some weight is negative: some table entry is (a weight lies between two).
+    fn has_negative_weights(&self) -> bool {
+        self.table.iter().any(|&v| v < 0.0)
+    }
+
     /// The weight at `offset` pixels from the sample (what `weights4` computes four at a time).
     #[cfg(any(test, not(target_arch = "x86_64")))]
     fn weight(&self, offset: f32) -> f32 {
@@ -344,6 +368,30 @@ impl PixelFilter {
     pub fn taps_y(&self, y: u32, u: f32, lo: u32, hi: u32) -> Taps {
         self.y.taps(y, u, lo, hi)
     }
+
+    /// What the filter lets one sample add to a pixel's weight sum: the bounds an honest unit's
+    /// buffer keeps.
+    pub fn weight_bounds(&self) -> WeightBounds {
+        WeightBounds {
+            negative: self.x.has_negative_weights() || self.y.has_negative_weights(),
+            x: self.x.max_weights(),
+            y: self.y.max_weights(),
+        }
+    }
+}
+
+/// What one sample can add to the weight sum of a pixel, by the pixel's offset from the
+/// sample's own: a pixel's weight sum over a unit's samples is bounded by these, and is never
+/// negative when no weight is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WeightBounds {
+    /// Whether some sample may weigh a pixel negatively (mitchell's and sinc's lobes, for most
+    /// of their parameters; box, triangle, gaussian and blackmanharris never do).
+    pub negative: bool,
+    /// Per axis, for offsets k from -border to border (index k + border): the largest weight in
+    /// magnitude along that axis (a sample's weight is the product of its two axes').
+    pub x: Vec<f32>,
+    pub y: Vec<f32>,
 }
 
 impl FilterDesc {
@@ -477,6 +525,57 @@ mod tests {
                     four[j].to_bits(),
                     axis.weight(k[j] + 0.5).to_bits(),
                     "{k:?}"
+                );
+            }
+        }
+    }
+
+    /// Every weight a sample gives a pixel is within the bound for its offset, and at least 0
+    /// for the filters without negative lobes; the bounds are those weights' largest (within
+    /// the table's interpolation), not a loose guess.
+    #[test]
+    fn weight_bounds_hold_every_weight_and_say_which_filters_weigh_negatively() {
+        let mitchell = FilterKind::Mitchell {
+            b: DEFAULT_MITCHELL_B,
+            c: DEFAULT_MITCHELL_C,
+        };
+        let catmullrom = FilterKind::Mitchell { b: 0.0, c: 0.5 };
+        for (kind, radius, negative) in [
+            (FilterKind::Box, 0.5, false),
+            (FilterKind::Box, 2.5, false),
+            (FilterKind::Triangle, 2.0, false),
+            (FilterKind::Gaussian { alpha: 2.0 }, 2.0, false),
+            (FilterKind::Gaussian { alpha: 0.5 }, 3.3, false),
+            (FilterKind::BlackmanHarris, 2.0, false),
+            (FilterKind::BlackmanHarris, 4.0, false),
+            (mitchell, 2.0, true),
+            (mitchell, 0.5, true),
+            (catmullrom, 2.0, true),
+            (FilterKind::Sinc { tau: 3.0 }, 4.0, true),
+            (FilterKind::Sinc { tau: 3.0 }, 0.9, false),
+            (FilterKind::Triangle, MAX_WIDTH, false),
+        ] {
+            let filter = filter(kind, radius);
+            let bounds = filter.weight_bounds();
+            assert_eq!(bounds.negative, negative, "{kind:?} {radius}");
+            let border = filter.x.border;
+            assert_eq!(bounds.x.len(), 2 * border as usize + 1);
+            assert_eq!(bounds.x, bounds.y, "{kind:?} {radius}");
+            let mut largest = vec![0.0f32; bounds.x.len()];
+            for i in 0..1000 {
+                let u = (i as f32 / 1000.0).min(1.0f32.next_down());
+                let taps = filter.taps_x(20, u, 0, 40);
+                for (j, &w) in taps.weights().iter().enumerate() {
+                    let at = (taps.first + j as u32 + border - 20) as usize;
+                    assert!(w.abs() <= bounds.x[at], "{kind:?} {radius}: {w} at {at}");
+                    assert!(negative || w >= 0.0, "{kind:?} {radius}: {w}");
+                    largest[at] = largest[at].max(w.abs());
+                }
+            }
+            for (bound, seen) in bounds.x.iter().zip(&largest) {
+                assert!(
+                    bound - seen <= 0.05,
+                    "{kind:?} {radius}: {bounds:?}, {largest:?}"
                 );
             }
         }

@@ -218,11 +218,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             let identity = RenderIdentity::of(&m.load_request(&settings), adaptive.as_ref());
             CheckpointFile::beside(&output_png, identity, checkpoint_every)
         });
-    let interrupt = if checkpoint.is_some() {
-        Interrupt::install()?
-    } else {
-        Interrupt::default()
-    };
+    let interrupt = Interrupt::install()?;
     let job = RenderJob {
         scene,
         settings,

@@ -63,30 +63,6 @@ impl WorkUnit {
             })
     }
 
-    /// Whether a sample the unit takes can reach the pixel (x, y) through a filter reaching
-    /// `border` pixels: a pixel it renders lies within the border of it.
-    pub fn reaches(&self, x: u32, y: u32, border: [u32; 2]) -> bool {
-        let [bx, by] = border;
-        let (x0, x1) = (
-            x.saturating_sub(bx).max(self.x0),
-            x.saturating_add(bx).saturating_add(1).min(self.x1),
-        );
-        let (y0, y1) = (
-            y.saturating_sub(by).max(self.y0),
-            y.saturating_add(by).saturating_add(1).min(self.y1),
-        );
-        if x0 >= x1 || y0 >= y1 {
-            return false;
-        }
-        // The window's pixels are rendered block by block: look at one pixel of each block it
-        // overlaps.
-        let blocks = |lo: u32, hi: u32, origin: u32| {
-            ((lo - origin) / BLOCK_SIZE..=(hi - 1 - origin) / BLOCK_SIZE)
-                .map(move |b| (origin + b * BLOCK_SIZE).max(lo))
-        };
-        blocks(y0, y1, self.y0).any(|py| blocks(x0, x1, self.x0).any(|px| self.renders(px, py)))
-    }
-
     /// Pixels the unit renders: the tile's, or those of its active blocks.
     pub fn active_pixel_count(&self) -> usize {
         match self.mask {

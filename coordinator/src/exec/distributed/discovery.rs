@@ -547,6 +547,7 @@ mod tests {
     fn roster() -> Roster {
         use super::super::schedule::{Schedule, UnitDeadline};
         use crate::manifest::SceneManifest;
+        use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter};
         Roster::new(Arc::new(Shared {
             schedule: Schedule::new(Vec::new(), |_| false, true),
             deadline: UnitDeadline::new(None),
@@ -557,6 +558,12 @@ mod tests {
             },
             load_request: Default::default(),
             frame: yat_tracer::render::unit::FilmFrame::unbordered(1, 1),
+            weights: PixelFilter::new(&FilterDesc {
+                kind: FilterKind::Box,
+                xwidth: 0.5,
+                ywidth: 0.5,
+            })
+            .weight_bounds(),
             events: tokio::sync::mpsc::unbounded_channel().0,
         }))
     }

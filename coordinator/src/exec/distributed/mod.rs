@@ -21,6 +21,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use tokio::sync::mpsc;
+use yat_tracer::filter::PixelFilter;
 
 use crate::job::{RenderJob, RenderOutcome};
 use crate::manifest::SceneManifest;
@@ -86,6 +87,7 @@ pub fn render(
         deadline: UnitDeadline::new(config.unit_deadline),
         load_request: manifest.load_request(&job.settings),
         frame: start.film().frame(),
+        weights: PixelFilter::new(&job.scene.desc.filter).weight_bounds(),
         manifest,
         events,
     });

@@ -4,10 +4,11 @@
 //! back to the queue. A worker asked to leave (its address gone from DNS: a pod deleted, a node
 //! scaled away) takes no more units and finishes the ones it holds, which its drain allows.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use prost::bytes::Bytes;
 use prost::Message;
 use tokio::sync::watch;
 use tokio::task::JoinSet;
@@ -298,13 +299,8 @@ async fn upload_missing_blobs(
         sha256: blobs.keys().cloned().collect(),
     };
     node.update(|r| r.bytes_sent += query.encoded_len() as u64);
-    for hash in client.missing_blobs(query).await? {
-        let bytes = blobs.get(&hash).ok_or_else(|| {
-            SessionError::BadReply(format!(
-                "the worker asked for blob {}, which is not ours",
-                peer_text(&hash, MAX_NAME_CHARS)
-            ))
-        })?;
+    let missing = client.missing_blobs(query).await?;
+    for (hash, bytes) in blobs_to_upload(blobs, &missing).map_err(SessionError::BadReply)? {
         if bytes.len() as u64 > worker.max_blob_bytes {
             return Err(SessionError::Permanent(format!(
                 "a scene file of {} bytes exceeds the worker's limit of {} (--max-blob-mib)",
@@ -313,7 +309,7 @@ async fn upload_missing_blobs(
             )));
         }
         let sent = client
-            .put_blob(&hash, bytes, worker.max_message_bytes)
+            .put_blob(hash, bytes, worker.max_message_bytes)
             .await?;
         node.update(|r| {
             r.bytes_sent += sent;
@@ -321,6 +317,29 @@ async fn upload_missing_blobs(
         });
     }
     Ok(())
+}
+
+/// The blobs of `blobs` a worker's reply lists as missing, each once (in the order first
+/// listed): a session uploads each of the scene's files at most once, however often a reply
+/// repeats it. A hash that is not one of ours makes the reply a bad one, said in the error.
+fn blobs_to_upload<'a>(
+    blobs: &'a HashMap<String, Bytes>,
+    missing: &[String],
+) -> Result<Vec<(&'a str, &'a Bytes)>, String> {
+    let mut listed = HashSet::new();
+    let mut upload = Vec::new();
+    for hash in missing {
+        let (hash, bytes) = blobs.get_key_value(hash).ok_or_else(|| {
+            format!(
+                "the worker asked for blob {}, which is not ours",
+                peer_text(hash, MAX_NAME_CHARS)
+            )
+        })?;
+        if listed.insert(hash) {
+            upload.push((hash.as_str(), bytes));
+        }
+    }
+    Ok(upload)
 }
 
 /// Units this session holds; whatever is still held when it ends goes back to the queue. Known
@@ -475,7 +494,7 @@ fn accept(
     (reply, took): (pb::RenderUnitReply, Duration),
 ) -> Result<(), SessionError> {
     let received = reply.encoded_len() as u64;
-    let (buffer, stats) = result_from_wire(unit, &shared.frame, &reply)
+    let (buffer, stats) = result_from_wire(unit, &shared.frame, &shared.weights, &reply)
         .map_err(|e| SessionError::BadReply(e.to_string()))?;
     shared.deadline.observe(took);
     let first = shared.schedule.complete(&unit);
@@ -600,6 +619,37 @@ mod tests {
         };
         assert!(check_handshake("h:1", &tight).is_ok());
         assert!(min_message_bytes() >= 16 * 64 * 64 && min_message_bytes() >= 128 << 10);
+    }
+
+    /// A reply that lists a blob again and again gets it once; one that lists a blob that is
+    /// not the scene's is a bad reply, naming it safely.
+    #[test]
+    fn each_missing_blob_is_uploaded_once() {
+        let blobs: HashMap<String, Bytes> = [("a", "A"), ("b", "BB"), ("c", "CCC")]
+            .into_iter()
+            .map(|(hash, bytes)| (hash.to_string(), Bytes::from(bytes)))
+            .collect();
+        let hashes = |upload: Vec<(&str, &Bytes)>| -> Vec<String> {
+            upload
+                .into_iter()
+                .map(|(hash, bytes)| {
+                    assert_eq!(bytes, &blobs[hash]);
+                    hash.to_string()
+                })
+                .collect()
+        };
+        let listed = |hashes: &[&str]| hashes.iter().map(|h| h.to_string()).collect::<Vec<_>>();
+        let repeated = vec!["b".to_string(); 2000];
+        assert_eq!(hashes(blobs_to_upload(&blobs, &repeated).unwrap()), ["b"]);
+        let mixed = listed(&["c", "a", "c", "a", "c"]);
+        assert_eq!(hashes(blobs_to_upload(&blobs, &mixed).unwrap()), ["c", "a"]);
+        assert!(blobs_to_upload(&blobs, &[]).unwrap().is_empty());
+        let foreign = listed(&["a", "\x1b[2Jz"]);
+        let message = blobs_to_upload(&blobs, &foreign).unwrap_err();
+        assert!(
+            message.contains("[2Jz") && !message.contains('\x1b'),
+            "{message:?}"
+        );
     }
 
     #[test]

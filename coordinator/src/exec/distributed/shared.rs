@@ -4,6 +4,7 @@
 use tokio::sync::mpsc::UnboundedSender;
 use yat_proto::pb;
 use yat_tracer::film::SampleBuffer;
+use yat_tracer::filter::WeightBounds;
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::UnitStats;
 
@@ -29,6 +30,8 @@ pub struct Shared {
     pub load_request: pb::LoadSceneRequest,
     /// The film's size and the border of every unit's buffer: what a reply must cover.
     pub frame: FilmFrame,
+    /// What the scene's filter lets a sample weigh a pixel: what a reply's weight sums may be.
+    pub weights: WeightBounds,
     pub events: UnboundedSender<Event>,
 }
 
