@@ -382,7 +382,7 @@ state=$(wait_job_end "$job" 60) || fail "cancelled job $job did not end within 6
 [[ $state == CANCELLED ]] || fail "cancelled job $job ended $state"
 [[ -e $tmp/long.resume && ! -e $tmp/long.png ]] ||
     fail "the cancelled job left no checkpoint, or an image"
-grep -q "interrupted: .* kept in" "$tmp/jobs/job-$job.log" ||
+grep -q "interrupted by SIGTERM; .* kept in" "$tmp/jobs/job-$job.log" ||
     fail "job $job's coordinator did not save on SIGTERM"
 submit "$tmp/long.png" "${long[@]}"
 state=$(wait_job_end "$job" 300) || fail "resubmitted job $job did not end within 300 s"

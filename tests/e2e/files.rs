@@ -3,11 +3,11 @@
 //! refused; a scene cannot choose the output folder; a symlink or a FIFO planted at the
 //! checkpoint is neither followed nor read; settings beyond the limits name the limit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::hostile::{self, Files};
+use crate::hostile;
 use crate::util::*;
 
 /// The address space a `yat` refusing a hostile scene runs in: a build without budget would
@@ -16,27 +16,6 @@ const ADDRESS_SPACE: u64 = 2 << 30;
 
 /// Generous for a debug build on a loaded machine; each refusal takes well under a second.
 const QUICKLY: Duration = Duration::from_secs(20);
-
-fn write_files(dir: &Path, files: &Files) -> PathBuf {
-    for (name, bytes) in files {
-        std::fs::write(dir.join(name), bytes).unwrap();
-    }
-    dir.join(&files[0].0)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-/// Runs `command` under the address-space limit, failing the test if it takes longer than
-/// `QUICKLY`.
-fn run_bounded(mut command: Command) -> Output {
-    limit_address_space(&mut command, ADDRESS_SPACE);
-    let started = Instant::now();
-    let output = command.output().expect("run yat");
-    assert!(started.elapsed() < QUICKLY, "took {:?}", started.elapsed());
-    output
-}
 
 /// Each bomb: `yat render` refuses it, naming the limit's flag and the file:line where it was
 /// reached, quickly and within 2 GiB of address space.
@@ -58,8 +37,12 @@ fn hostile_scenes_are_refused_at_the_build_budget() {
         let dir = tempfile::tempdir().unwrap();
         let scene = write_files(dir.path(), &files);
         let out = dir.path().join("out.png");
-        let output = run_bounded(render_command(&scene, &out, &unbounded_memory));
-        let err = stderr(&output);
+        let output = run_in_address_space(
+            render_command(&scene, &out, &unbounded_memory),
+            ADDRESS_SPACE,
+            QUICKLY,
+        );
+        let err = stderr_of(&output);
         assert!(!output.status.success(), "{flag}: rendered");
         assert_eq!(output.status.code(), Some(1), "{flag}: {err}");
         assert!(
@@ -94,9 +77,9 @@ fn budget_flags_set_the_limits() {
         let output = check(&[flag, low]);
         assert!(!output.status.success(), "{flag} {low}");
         assert!(
-            stderr(&output).contains(flag),
+            stderr_of(&output).contains(flag),
             "{flag}: {}",
-            stderr(&output)
+            stderr_of(&output)
         );
     }
 }
@@ -116,7 +99,7 @@ fn a_worker_enforces_its_own_budget() {
     )
     .output()
     .unwrap();
-    let err = stderr(&output);
+    let err = stderr_of(&output);
     assert!(!output.status.success(), "{err}");
     assert!(err.contains("--max-primitives"), "{err}");
     assert!(!out.exists());
@@ -129,7 +112,7 @@ fn an_output_named_like_a_side_file_is_refused() {
     let before = std::fs::read_dir(dir.path()).unwrap().count();
     for name in ["x.resume", "x.preview.png", "x.exr"] {
         let output = render(&scene, &dir.path().join(name), &[]);
-        let err = stderr(&output);
+        let err = stderr_of(&output);
         assert!(!output.status.success(), "{name}: rendered");
         assert!(
             err.contains("choose a name ending in .png"),
@@ -167,7 +150,7 @@ fn a_film_filename_cannot_leave_the_current_folder() {
             .output()
             .unwrap();
         assert_success(&output);
-        let err = stderr(&output);
+        let err = stderr_of(&output);
         let name = Path::new(filename).file_name().unwrap().to_str().unwrap();
         assert!(
             err.contains("current folder") && err.contains(&format!("{name}.png")),
@@ -187,9 +170,9 @@ fn a_film_filename_cannot_leave_the_current_folder() {
         .unwrap();
     assert!(!output.status.success());
     assert!(
-        stderr(&output).contains("names no file"),
+        stderr_of(&output).contains("names no file"),
         "{}",
-        stderr(&output)
+        stderr_of(&output)
     );
 }
 
@@ -243,9 +226,9 @@ fn planted_symlinks_at_the_side_files_are_not_followed() {
     let output = wait_at_most(child, Duration::from_secs(120));
     assert_success(&output);
     assert!(
-        stderr(&output).contains("not a regular file"),
+        stderr_of(&output).contains("not a regular file"),
         "{}",
-        stderr(&output)
+        stderr_of(&output)
     );
     assert_eq!(std::fs::read(&precious).unwrap(), b"do not touch");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
@@ -273,9 +256,9 @@ fn a_fifo_at_the_checkpoint_does_not_hang_the_render() {
     let output = wait_at_most(child, Duration::from_secs(60));
     assert_success(&output);
     assert!(
-        stderr(&output).contains("not a regular file"),
+        stderr_of(&output).contains("not a regular file"),
         "{}",
-        stderr(&output)
+        stderr_of(&output)
     );
     assert!(out.is_file());
 }
@@ -298,8 +281,8 @@ fn settings_beyond_the_limits_name_the_limit() {
     ];
     for (settings, limit) in cases {
         let command = render_command_with(&scene, &out, &settings, &[]);
-        let output = run_bounded(command);
+        let output = run_in_address_space(command, ADDRESS_SPACE, QUICKLY);
         assert!(!output.status.success(), "{settings:?}");
-        assert!(stderr(&output).contains(limit), "{}", stderr(&output));
+        assert!(stderr_of(&output).contains(limit), "{}", stderr_of(&output));
     }
 }

@@ -4,8 +4,7 @@
 //! and by a worker, which refuses that LoadScene and goes on rendering other scenes.
 
 use std::os::unix::process::ExitStatusExt;
-use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 use std::time::{Duration, Instant};
 
 use crate::hostile::{self, Files};
@@ -32,30 +31,10 @@ fn hostile_scenes() -> [(&'static str, Files, &'static str); 2] {
     ]
 }
 
-fn write_files(dir: &Path, files: &Files) -> std::path::PathBuf {
-    for (name, bytes) in files {
-        std::fs::write(dir.join(name), bytes).unwrap();
-    }
-    dir.join(&files[0].0)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-/// Runs `command` in [`ADDRESS_SPACE`], failing the test if it takes longer than `QUICKLY`.
-fn run_limited(mut command: Command) -> Output {
-    limit_address_space(&mut command, ADDRESS_SPACE);
-    let started = Instant::now();
-    let output = command.output().expect("run yat");
-    assert!(started.elapsed() < QUICKLY, "took {:?}", started.elapsed());
-    output
-}
-
 /// Asserts that `output` is a clean refusal at the memory budget: exit status 1 (no signal),
 /// the statement's position, the figure and the flag.
 fn assert_refused(name: &str, output: &Output, at: &str) {
-    let err = stderr(output);
+    let err = stderr_of(output);
     assert_eq!(output.status.signal(), None, "{name}: killed: {err}");
     assert_eq!(output.status.code(), Some(1), "{name}: {err}");
     assert!(
@@ -72,7 +51,8 @@ fn an_in_process_render_refuses_what_its_address_space_cannot_hold() {
         let dir = tempfile::tempdir().unwrap();
         let scene = write_files(dir.path(), &files);
         let out = dir.path().join("out.png");
-        let output = run_limited(render_command(&scene, &out, &[]));
+        let output =
+            run_in_address_space(render_command(&scene, &out, &[]), ADDRESS_SPACE, QUICKLY);
         assert_refused(name, &output, at);
         assert!(!out.exists());
     }

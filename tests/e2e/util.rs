@@ -5,6 +5,7 @@ use std::io::{BufRead, BufReader};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Output, Stdio};
+use std::time::Duration;
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
@@ -275,6 +276,28 @@ pub fn limit_address_space(command: &mut Command, bytes: u64) {
             }
         });
     }
+}
+
+/// Writes a scene's files into `dir`; the main file is the first. Returns its path.
+pub fn write_files(dir: &Path, files: &crate::hostile::Files) -> PathBuf {
+    for (name, bytes) in files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    dir.join(&files[0].0)
+}
+
+pub fn stderr_of(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Runs `command` in an address space of `bytes`, failing the test if it takes `within` or
+/// longer.
+pub fn run_in_address_space(mut command: Command, bytes: u64, within: Duration) -> Output {
+    limit_address_space(&mut command, bytes);
+    let started = std::time::Instant::now();
+    let output = command.output().expect("run yat");
+    assert!(started.elapsed() < within, "took {:?}", started.elapsed());
+    output
 }
 
 /// `yat render SCENE -o OUT --exr` with the test settings and `extra` arguments.
