@@ -45,7 +45,8 @@ impl Captured {
     }
 }
 
-fn soft_descriptor_limit() -> libc::rlimit {
+/// The soft and hard limits on open descriptors.
+fn descriptor_limit() -> libc::rlimit {
     let mut limit = libc::rlimit {
         rlim_cur: 0,
         rlim_max: 0,
@@ -69,7 +70,7 @@ fn exhaust_descriptors() -> Vec<File> {
     let open = std::fs::read_dir("/proc/self/fd").unwrap().count() as u64;
     set_descriptor_limit(&libc::rlimit {
         rlim_cur: open + 16,
-        ..soft_descriptor_limit()
+        ..descriptor_limit()
     });
     let mut files = Vec::new();
     loop {
@@ -115,7 +116,7 @@ async fn out_of_descriptors_the_worker_says_not_serving_logs_once_and_serves_aga
     // A socket made while descriptors were free, connected once they are not: its connection
     // waits in the listen backlog, and every accept of it fails with EMFILE.
     let waiting = tokio::net::TcpSocket::new_v4().unwrap();
-    let limit = soft_descriptor_limit();
+    let limit = descriptor_limit();
     let files = exhaust_descriptors();
     let _waiting = waiting.connect(worker.address).await.unwrap();
     let exhausted = Instant::now();
