@@ -357,11 +357,13 @@ mod tests {
     /// of glam's transforms of the camera-space ray; a fisheye camera has none in lanes.
     #[test]
     fn rays_in_lanes_are_glams_rays_bit_for_bit() {
-        use crate::lanes::tests::{on_every_lane_type, OnLanes};
+        use crate::lanes::tests::on_every_lane_type;
+        use crate::lanes::OnLanes;
         use crate::lanes::MAX_LANES;
 
         struct Agrees(Vec<Camera>);
         impl OnLanes for Agrees {
+            type Output = ();
             fn run<L: Lanes>(&self) {
                 let mut rng = fastrand::Rng::with_seed(4);
                 for cam in &self.0 {

@@ -1,10 +1,10 @@
 //! Lane types: code written once over [`Lanes`] runs one value at a time (`f32`, with `u32`
-//! integers) or several per instruction ([`Arr`], and on x86-64 `Avx2`). Every operation is one
+//! integers) or several per instruction ([`Arr`], and on x86-64 AVX2's eight, which only code
+//! run through [`Avx2Cpu`] gets: its operations are AVX2 instructions). Every operation is one
 //! IEEE-exact or wrap-around operation per lane (add, subtract, multiply, divide, square root,
 //! compare, select, integer multiply, shift, bit reversal; no fused multiply-add), so every lane
 //! type gives the scalar type's bits, and a render that runs 8 paths per instruction on one
-//! node and one at a time on another writes the same image (issue 20's point 4; what it gains,
-//! `bench/lanes`).
+//! node and one at a time on another writes the same image (what it gains: `bench/lanes`).
 //!
 //! Code over an intrinsics type must be inlined into a function compiled with its target
 //! features, chosen after run-time detection; helpers must be `#[inline(always)]` functions, not
@@ -419,11 +419,42 @@ impl<const N: usize> U32Lanes for ArrU32<N> {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-pub use avx2::Avx2;
+/// Code written over [`Lanes`], run on the lane type a caller picks: a render of a unit, a
+/// check in the tests. Its `run` should be `#[inline(always)]`, so that run through
+/// [`Avx2Cpu::run`] it is compiled for AVX2.
+pub trait OnLanes {
+    type Output;
+    fn run<L: Lanes>(&self) -> Self::Output;
+}
 
-/// Eight lanes in AVX2 registers through `std::arch`; only for functions compiled with
-/// `#[target_feature(enable = "avx2")]` that run after `is_x86_feature_detected!("avx2")`.
+/// Proof that this CPU runs AVX2, and the only way to code on AVX2 lanes: their safe
+/// operations are AVX2 instructions, so the type is private and only [`Self::run`] names it.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub struct Avx2Cpu(());
+
+#[cfg(target_arch = "x86_64")]
+impl Avx2Cpu {
+    /// The proof, where the CPU has AVX2.
+    pub fn detect() -> Option<Self> {
+        std::arch::is_x86_feature_detected!("avx2").then_some(Self(()))
+    }
+
+    /// Runs `code` on eight AVX2 lanes, compiled for AVX2.
+    pub fn run<C: OnLanes>(self, code: &C) -> C::Output {
+        // SAFETY: `self` exists only where the CPU has AVX2.
+        unsafe { run_avx2(code) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn run_avx2<C: OnLanes>(code: &C) -> C::Output {
+    code.run::<avx2::Avx2>()
+}
+
+/// Eight lanes in AVX2 registers through `std::arch`; reached only through [`Avx2Cpu::run`],
+/// whose target features the operations, all `#[inline(always)]`, are compiled with.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::*;
@@ -436,9 +467,10 @@ mod avx2 {
     #[derive(Clone, Copy)]
     pub struct Avx2U32(__m256i);
 
-    // SAFETY (every `unsafe` block in this module): the instructions are AVX2, which the
-    // module's users have detected (see the module's doc); loads and stores stay within
-    // the MAX_LANES buffers and gathers within the table (the callers' indices are in range).
+    // SAFETY (every `unsafe` block in this module): the instructions are AVX2, which
+    // `Avx2Cpu` has detected before any value of these types exists; loads and stores stay
+    // within the MAX_LANES buffers, and gathers within the table (asserted in debug builds,
+    // which the tests are; the callers' indices are in range).
     macro_rules! vector_op {
         ($t:ident, $tr:ident, $f:ident, $intr:ident) => {
             impl $tr for $t {
@@ -528,6 +560,15 @@ mod avx2 {
         }
         #[inline(always)]
         fn gather(table: &[f32], index: Avx2U32) -> Self {
+            debug_assert!(
+                {
+                    let mut at = [0; MAX_LANES];
+                    index.store(&mut at);
+                    at[..8].iter().all(|&i| (i as usize) < table.len())
+                },
+                "a gather outside its table of {}",
+                table.len()
+            );
             unsafe { Avx2(_mm256_i32gather_ps::<4>(table.as_ptr(), index.0)) }
         }
         #[inline(always)]
@@ -734,27 +775,40 @@ pub(crate) mod tests {
         }
     }
 
-    /// A check to run on a lane type.
-    pub(crate) trait OnLanes {
-        fn run<L: Lanes>(&self);
-    }
-
     /// Runs `check` on one lane, arrays of 8 and 16, and AVX2 where the CPU has it.
-    pub(crate) fn on_every_lane_type(check: &impl OnLanes) {
+    pub(crate) fn on_every_lane_type(check: &impl OnLanes<Output = ()>) {
         check.run::<f32>();
         check.run::<Arr<8>>();
         check.run::<Arr<16>>();
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            unsafe { on_avx2(check) }
+        if let Some(cpu) = Avx2Cpu::detect() {
+            cpu.run(check);
         }
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn on_avx2(check: &impl OnLanes) {
-        check.run::<Avx2>();
+    /// A gather outside its table panics on every lane type, the AVX2 one by its debug
+    /// assertion: the tests run with debug assertions, and must.
+    #[test]
+    fn gathers_outside_their_table_panic() {
+        // Built without debug assertions, the AVX2 gather would read outside the table.
+        const {
+            assert!(
+                cfg!(debug_assertions),
+                "the lanes are tested with debug assertions"
+            )
+        };
+        struct Outside;
+        impl OnLanes for Outside {
+            type Output = ();
+            fn run<L: Lanes>(&self) {
+                let table = [1.0, 2.0];
+                let inside = L::gather(&table, L::U::splat(1));
+                assert_eq!(inside.values()[..L::N], [2.0; MAX_LANES][..L::N]);
+                let outside = std::panic::catch_unwind(|| L::gather(&table, L::U::splat(2)));
+                assert!(outside.is_err(), "{} lanes gathered past the table", L::N);
+            }
+        }
+        on_every_lane_type(&Outside);
     }
 
     #[test]
@@ -779,6 +833,7 @@ pub(crate) mod tests {
     fn every_lane_type_computes_the_scalar_bits() {
         struct Agrees;
         impl OnLanes for Agrees {
+            type Output = ();
             fn run<L: Lanes>(&self) {
                 agrees_with_scalar::<L>();
             }

@@ -58,11 +58,31 @@ fn arrays_baseline(scene: &Scene, spp: usize, traversal: Traversal) -> (Image, C
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::*;
-    use yat_tracer::lanes::Avx2;
+    use yat_tracer::lanes::{Avx2Cpu, Lanes, OnLanes};
 
-    #[target_feature(enable = "avx2")]
+    /// The render on the lane type `OnLanes` picks.
+    struct Render<'a> {
+        scene: &'a Scene,
+        spp: usize,
+        traversal: Traversal,
+    }
+
+    impl OnLanes for Render<'_> {
+        type Output = (Image, Counts);
+
+        #[inline(always)]
+        fn run<L: Lanes>(&self) -> Self::Output {
+            render::<L>(self.scene, self.spp, self.traversal)
+        }
+    }
+
     fn intrinsics_avx2(scene: &Scene, spp: usize, traversal: Traversal) -> (Image, Counts) {
-        render::<Avx2>(scene, spp, traversal)
+        let cpu = Avx2Cpu::detect().expect("listed only where the CPU has AVX2");
+        cpu.run(&Render {
+            scene,
+            spp,
+            traversal,
+        })
     }
 
     #[target_feature(enable = "avx2")]
@@ -81,8 +101,7 @@ mod x86 {
         if is_x86_feature_detected!("avx2") {
             out.push(Variant {
                 name: "AVX2 intrinsics, 8 lanes",
-                // SAFETY: the CPU has AVX2.
-                render: |s, spp, t| unsafe { intrinsics_avx2(s, spp, t) },
+                render: intrinsics_avx2,
             });
             out.push(Variant {
                 name: "arrays of 8, AVX2",

@@ -1085,8 +1085,9 @@ mod tests {
 
     use crate::assets::MemorySource;
     use crate::film::SampleBuffer;
-    use crate::lanes::tests::{on_every_lane_type, OnLanes};
+    use crate::lanes::tests::on_every_lane_type;
     use crate::lanes::Lanes;
+    use crate::lanes::OnLanes;
     use crate::parse::parse_scene;
     use crate::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
 
@@ -1223,6 +1224,7 @@ AttributeEnd
     fn packets_render_what_one_path_at_a_time_renders() {
         struct Renders;
         impl OnLanes for Renders {
+            type Output = ();
             fn run<L: Lanes>(&self) {
                 packets_render_the_scalar_bytes::<L>();
             }

@@ -953,7 +953,8 @@ fn fan_facing_down(n: u32) -> Geometry {
 /// [0, 1) and at its ends.
 #[test]
 fn triangle_lamps_in_lanes_give_the_bits_of_one_sample_at_a_time() {
-    use crate::lanes::tests::{on_every_lane_type, OnLanes};
+    use crate::lanes::tests::on_every_lane_type;
+    use crate::lanes::OnLanes;
     use crate::lanes::{Lanes, MAX_LANES};
 
     let lamps = vec![
@@ -976,6 +977,7 @@ fn triangle_lamps_in_lanes_give_the_bits_of_one_sample_at_a_time() {
     let (_, lights) = build(lamps, vec![]);
     struct Agrees<'a>(&'a Lights);
     impl OnLanes for Agrees<'_> {
+        type Output = ();
         fn run<L: Lanes>(&self) {
             let lights = self.0;
             let lamps = lights.triangle_lamps().expect("three plain triangle lamps");

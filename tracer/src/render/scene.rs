@@ -16,7 +16,9 @@ use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
 use crate::integrator::path::{trace_path, PathResult, PathScene, MAX_BRANCHES};
-use crate::lanes::Lanes;
+#[cfg(target_arch = "x86_64")]
+use crate::lanes::Avx2Cpu;
+use crate::lanes::{Lanes, OnLanes};
 use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
 use crate::math::Ray;
@@ -243,22 +245,14 @@ impl RenderScene {
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
         #[cfg(target_arch = "x86_64")]
-        if self.packets && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            return unsafe { self.render_unit_avx2(unit, cancel) };
+        if let Some(cpu) = Avx2Cpu::detect().filter(|_| self.packets) {
+            return cpu.run(&UnitOnLanes {
+                scene: self,
+                unit,
+                cancel,
+            });
         }
         self.render_unit_in::<f32>(unit, cancel)
-    }
-
-    /// [`Self::render_unit_in`] with 8 lanes of AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn render_unit_avx2(
-        &self,
-        unit: &WorkUnit,
-        cancel: &AtomicBool,
-    ) -> Option<(SampleBuffer, UnitStats)> {
-        self.render_unit_in::<crate::lanes::Avx2>(unit, cancel)
     }
 
     /// [`Self::render_unit_cancellable`] with the camera paths of `L::N` consecutive samples
@@ -396,6 +390,23 @@ impl RenderScene {
 /// a sample adds to a pixel with one 4-lane multiply and one add. Each lane does what adding
 /// the sums one at a time did (`sum += c * w`, the weight's lane `w = 1 * w` exactly), so the
 /// buffer has the same bits.
+/// A unit's render on the lane type [`OnLanes`] picks.
+struct UnitOnLanes<'a> {
+    scene: &'a RenderScene,
+    unit: &'a WorkUnit,
+    cancel: &'a AtomicBool,
+}
+
+impl OnLanes for UnitOnLanes<'_> {
+    type Output = Option<(SampleBuffer, UnitStats)>;
+
+    // Inlined into the lane type's target-feature function: the render loop is compiled for it.
+    #[inline(always)]
+    fn run<L: Lanes>(&self) -> Self::Output {
+        self.scene.render_unit_in::<L>(self.unit, self.cancel)
+    }
+}
+
 struct UnitSums {
     buffer: SampleBuffer,
     all: Vec<Vec4>,

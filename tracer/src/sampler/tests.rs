@@ -67,7 +67,8 @@ fn packet_draws_equal_the_pixel_draws<L: Lanes>() {
 #[test]
 fn packets_draw_each_samples_own_values() {
     struct PacketDraws;
-    impl crate::lanes::tests::OnLanes for PacketDraws {
+    impl crate::lanes::OnLanes for PacketDraws {
+        type Output = ();
         fn run<L: Lanes>(&self) {
             packet_draws_equal_the_pixel_draws::<L>();
         }
