@@ -40,7 +40,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::settings::RenderSettings;
-use crate::integrator::path::{trace_branching_path, PathScene, MAX_BRANCHES};
+use crate::integrator::{trace_branching_path, PathScene, MAX_BRANCHES};
 use crate::math::Ray;
 use crate::sampler::{mix64, PixelSampler};
 

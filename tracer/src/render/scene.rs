@@ -15,7 +15,7 @@ use crate::filter::PixelFilter;
 use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
-use crate::integrator::path::{trace_path, PathResult, PathScene, MAX_BRANCHES};
+use crate::integrator::{trace_path, PathResult, PathScene, MAX_BRANCHES};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::Avx2Cpu;
 use crate::lanes::{Lanes, OnLanes};

@@ -1,0 +1,134 @@
+//! A path's segments through participating media (LuxRender's named volumes): Beer-Lambert
+//! transmittance, free-flight sampling, and at a scattering event the light sample and the
+//! phase function's sample.
+//!
+//! The volume a ray travels in follows LuxRender's rule: after a surface, the side of it the
+//! ray leaves into (a shape's `Interior` or `Exterior`; a side with no volume is the ray's
+//! own when the ray came from it, else no volume). A ray in no volume takes, for its segment,
+//! the volume on the near side of the surface it hits. A scene without volumes takes none of
+//! these steps and draws no random numbers for them.
+
+use glam::Vec3;
+
+use super::mis::power_heuristic;
+use super::roulette::survives;
+use super::scene::PathScene;
+use super::shadow::{shadow_tmax, shadow_transmittance};
+use super::state::PrevScatter;
+use crate::math::Ray;
+use crate::medium::{Flight, MediumDesc, MediumId, Phase};
+use crate::sampler::PixelSampler;
+
+/// A path's segment through a volume: the ray, up to `length` (infinite where it hits nothing).
+pub(super) struct Segment<'a> {
+    pub(super) volume: &'a MediumDesc,
+    pub(super) id: Option<MediumId>,
+    pub(super) ray: Ray,
+    pub(super) length: f32,
+}
+
+/// What a path does along a [`Segment`].
+pub(super) enum Travel {
+    /// Through to its end, carrying this throughput.
+    Crossed(Vec3),
+    /// Scattered inside: the throughput the path goes on with, its next ray and what it leaves
+    /// the next vertex.
+    Scattered {
+        throughput: Vec3,
+        ray: Ray,
+        prev: PrevScatter,
+    },
+    /// The path ends (absorbed, out of depth, or ended by the roulette).
+    Ended,
+}
+
+/// The path's segment `segment`, reached with `throughput` after `depth` vertices: the light
+/// of a scattering vertex is added to `radiance`, the rays traced counted in `rays`.
+#[inline(always)]
+pub(super) fn travel<S: PathScene>(
+    scene: &S,
+    segment: &Segment,
+    depth: u32,
+    mut throughput: Vec3,
+    radiance: &mut Vec3,
+    sampler: &mut PixelSampler,
+    rays: &mut u32,
+) -> Travel {
+    let m = segment.volume;
+    let u = if m.scatters() { sampler.get_1d() } else { 0.0 };
+    match m.flight(segment.length, u) {
+        Flight::Pass { weight } => {
+            throughput *= weight;
+            if throughput == Vec3::ZERO {
+                Travel::Ended
+            } else {
+                Travel::Crossed(throughput)
+            }
+        }
+        Flight::Scatter { distance, weight } => {
+            throughput *= weight;
+            if depth >= scene.max_depth() {
+                return Travel::Ended;
+            }
+            let depth = depth + 1;
+            let ray = segment.ray;
+            let p = ray.at(distance);
+            let wo = -ray.dir;
+            let phase = m.phase();
+            *radiance += throughput
+                * direct_light_in_medium(scene, p, wo, &phase, segment.id, sampler, rays);
+            let wi = phase.sample(wo, sampler.get_2d());
+            let pdf = phase.pdf(wo, wi);
+            if pdf.is_nan() || pdf <= 0.0 {
+                return Travel::Ended;
+            }
+            throughput *= phase.eval(wo, wi) / pdf;
+            if !survives(
+                scene.integrator(),
+                depth,
+                true,
+                sampler.get_1d(),
+                &mut throughput,
+            ) {
+                return Travel::Ended;
+            }
+            Travel::Scattered {
+                throughput,
+                ray: Ray::new(p, wi),
+                prev: PrevScatter::plain(p, pdf, false),
+            }
+        }
+    }
+}
+
+/// One light sample at a scattering event inside a volume, weighted against phase-function
+/// sampling by the power heuristic.
+#[inline(never)]
+fn direct_light_in_medium<S: PathScene>(
+    scene: &S,
+    p: Vec3,
+    wo: Vec3,
+    phase: &Phase,
+    medium: Option<MediumId>,
+    sampler: &mut PixelSampler,
+    rays: &mut u32,
+) -> Vec3 {
+    let u_select = sampler.get_1d();
+    let u_light = sampler.get_2d();
+    let Some(ls) = scene.lights().sample(p, None, u_select, u_light) else {
+        return Vec3::ZERO;
+    };
+    if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let tr = shadow_transmittance(scene, p, ls.wi, shadow_tmax(p, p, ls.dist), medium, rays);
+    if tr == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let weight = if ls.delta {
+        1.0
+    } else {
+        power_heuristic(ls.pdf, phase.pdf(wo, ls.wi))
+    };
+    tr * phase.eval(wo, ls.wi) * ls.li * (weight / ls.pdf)
+}

@@ -1,0 +1,34 @@
+//! What the path tracer needs of the scene it traces.
+
+use super::options::IntegratorDesc;
+use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::lights::Lights;
+use crate::material::Bsdf;
+use crate::medium::{ShapeMedia, Volumes};
+
+/// What the path tracer needs from the scene. The renderer's built scene implements it, so the
+/// integrator does not depend on how the scene is built.
+pub trait PathScene {
+    /// The scene's SurfaceIntegrator settings.
+    fn integrator(&self) -> &IntegratorDesc;
+    /// Bounces per path (the settings' max depth, which the command line may override).
+    fn max_depth(&self) -> u32;
+    fn geometry(&self) -> &SceneGeometry;
+    fn lights(&self) -> &Lights;
+    /// The BSDF at a hit; `u_mix` resolves mix materials.
+    fn bsdf_at(&self, hit: &SurfaceHit, u_mix: f32) -> Bsdf;
+    /// The scene's volumes and the camera's.
+    fn volumes(&self) -> &Volumes;
+    /// The volumes on the two sides of shape `shape`.
+    fn shape_media(&self, shape: u32) -> ShapeMedia;
+    /// Whether shape `shape` is `null` (shadow rays cross it, as paths do: the geometry's
+    /// occlusion test looks through it).
+    fn is_pass_through(&self, shape: u32) -> bool;
+    /// Whether paths split at glossy vertices ([`GLOSSY_SPLIT`](super::glossy_split::GLOSSY_SPLIT)): the integrator allows it, the
+    /// scene has lamps and metals, and no volumes or material that lets rays through at some
+    /// hits only (a split sample crosses a surface only where [`Self::is_pass_through`] says so).
+    fn glossy_split(&self) -> bool;
+    /// The continuations a camera path's first broad scattering vertex sends on (see
+    /// [`MAX_BRANCHES`](super::branch::MAX_BRANCHES); 1: the path goes on alone).
+    fn first_vertex_branches(&self) -> usize;
+}

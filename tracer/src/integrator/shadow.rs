@@ -1,0 +1,84 @@
+//! Shadow rays: what reaches a light sample's point, through null surfaces and volumes.
+
+use glam::Vec3;
+
+use super::scene::PathScene;
+use super::state::MAX_PASS_THROUGH;
+use crate::math::{offset_origin, Ray};
+use crate::medium::MediumId;
+
+/// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
+/// a surface blocks the way, else the volumes' transmittance. `null` surfaces let the ray
+/// through (into the volume behind them), as LuxRender's shadow rays cross them and as paths
+/// do, so light sampling sees what BSDF sampling sees: the sky behind a `null` lamp, or a light
+/// inside a null-bounded volume. (A shadow ray stopped there would lose the light samples of
+/// what BSDF samples find behind it, while MIS weighs each as if the other could: dark.)
+pub(super) fn shadow_transmittance<S: PathScene>(
+    scene: &S,
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+    medium: Option<MediumId>,
+    rays: &mut u32,
+) -> Vec3 {
+    if scene.volumes().media.is_empty() {
+        *rays += 1;
+        let blocked = scene.geometry().occluded(&Ray::new(origin, dir), tmax);
+        return if blocked { Vec3::ZERO } else { Vec3::ONE };
+    }
+    shadow_walk(scene, origin, dir, tmax, medium, rays)
+}
+
+/// [`shadow_transmittance`] in a scene with volumes: surface by surface. Out of line: the path
+/// loop of a scene without volumes stays small.
+#[inline(never)]
+fn shadow_walk<S: PathScene>(
+    scene: &S,
+    mut origin: Vec3,
+    dir: Vec3,
+    mut tmax: f32,
+    mut medium: Option<MediumId>,
+    rays: &mut u32,
+) -> Vec3 {
+    let volumes = scene.volumes();
+    let mut tr = Vec3::ONE;
+    for _ in 0..=MAX_PASS_THROUGH {
+        *rays += 1;
+        let ray = Ray::new(origin, dir);
+        let hit = scene.geometry().intersect(&ray, tmax);
+        let sides = hit
+            .as_ref()
+            .map(|h| scene.shape_media(h.shape).met_by(dir, h.ng, medium));
+        if let (Some(h), Some(sides), None) = (&hit, sides, medium) {
+            medium = sides.toward(-dir, h.ng);
+        }
+        let length = hit.as_ref().map_or(tmax, |h| h.t);
+        if let Some(m) = medium.and_then(|m| volumes.get(m)) {
+            tr *= m.transmittance(length);
+        }
+        let (Some(h), Some(sides)) = (hit, sides) else {
+            return tr;
+        };
+        if !scene.is_pass_through(h.shape) || tr == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        medium = sides.toward(dir, h.ng);
+        let next = offset_origin(h.p, h.ng, dir);
+        tmax -= (next - origin).length();
+        origin = next;
+        if tmax <= 0.0 {
+            return tr;
+        }
+    }
+    Vec3::ZERO
+}
+
+/// The distance a shadow ray from `origin` travels to a light sampled at `dist` from `p`:
+/// stopped short of the light's own surface.
+pub(super) fn shadow_tmax(p: Vec3, origin: Vec3, dist: f32) -> f32 {
+    if dist.is_finite() {
+        (origin - p).length().mul_add(-1.0, dist) * (1.0 - 1e-3)
+    } else {
+        f32::INFINITY
+    }
+}
