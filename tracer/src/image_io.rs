@@ -69,10 +69,9 @@ impl Tiling {
 ///
 /// 8-bit files of at most 256 colours (a checkerboard, a flat-shaded or posterised texture)
 /// keep one byte per texel, an index into their colours: a quarter of `Bytes`' memory, so a
-/// texture that indirect rays look up all over stays in the core's cache (depth of field's
-/// floor, 400x400 texels of two colours: 160 KiB instead of 640). Same values as `Bytes`.
-/// Packing the indices into as few bits as the colours need (20 KiB there) measured no
-/// faster and took more instructions.
+/// texture that indirect rays look up all over stays in the core's cache (a 400x400 floor of
+/// two colours: 160 KiB instead of 640). Same values as `Bytes`. Indices packed into as few
+/// bits as the colours need are no faster (bench/RESULTS.md, "Session 16").
 #[derive(Clone, Debug)]
 enum Texels {
     Linear(Vec<[Vec3; TILE_TEXELS]>),

@@ -2,6 +2,8 @@
 
 use glam::{Affine3A, Mat4, Vec3};
 
+use crate::vec3_lanes;
+
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
     pub origin: Vec3,
@@ -79,19 +81,20 @@ pub fn luminance(c: Vec3) -> f32 {
 
 /// Offsets a ray origin along the geometric normal so it does not re-hit its own surface; the
 /// offset scales with the magnitude of the point (floating-point error grows with it).
+/// One lane of [`vec3_lanes::offset_origin`], which a packet's lanes run: the same bits.
+#[inline(always)]
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
-    if dir.dot(ng) >= 0.0 {
-        p + ng * eps
-    } else {
-        p - ng * eps
-    }
+    Vec3::from_array(vec3_lanes::offset_origin::<f32>(
+        p.to_array(),
+        ng.to_array(),
+        dir.to_array(),
+    ))
 }
 
 /// `m`'s inverse, computed in f64 and rounded back. glam's f32 `Mat4` and `Affine3A` inverses
 /// take their SSE2, NEON or scalar form by target, each with its own order of operations, so
-/// their last bits differed between x86-64 and aarch64 workers (the seed depth-of-field scene,
-/// scenes/exported); glam's f64 matrices are the same scalar code on every target. clippy.toml
+/// their last bits differ between x86-64 and aarch64 workers; glam's f64 matrices are the same
+/// scalar code on every target. clippy.toml
 /// keeps the f32 inverses out.
 pub fn inverse(m: &Mat4) -> Mat4 {
     m.as_dmat4().inverse().as_mat4()

@@ -1,4 +1,4 @@
-//! Lanes benchmark (issue #20, point 4): how much faster a path tracer runs when each
+//! Lanes benchmark: how much faster a path tracer runs when each
 //! instruction advances 8 or 16 paths, and whether that can keep an image's bits on every CPU.
 //!
 //! One path tracer (`tracer.rs`) is written once over a lane type (`lanes.rs`) and run as: one

@@ -7,16 +7,28 @@ use super::mis::power_heuristic;
 use super::scene::PathScene;
 use super::state::MAX_PASS_THROUGH;
 use crate::geometry::SurfaceHit;
+use crate::lights::Lights;
 use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
 use crate::sampler::PixelSampler;
 
 /// BSDF samples a path's first glossy vertex that may see a lamp takes for the lamps it sees
 /// directly (the path goes on with a sample of its own, which finds the environment). A lamp
-/// in a narrow lobe is a bright patch that one sample finds or misses: Mario's metal figure
-/// held some 60% of its image's error at 16 spp in those highlights, and the floor's speckles
-/// are the same highlights seen from the floor. Why 8: bench/RESULTS.md, "Glossy split".
+/// in a narrow lobe is a bright patch that one sample finds or misses: a metal figure's
+/// highlights, and the speckles they make on a floor that sees the figure. Why 8:
+/// bench/RESULTS.md, "Glossy split".
 pub const GLOSSY_SPLIT: usize = 8;
+
+/// Whether a path that may still split splits at the vertex at `hit` (reached from `wo`, its
+/// BSDF `bsdf`): its first glossy vertex that may see a lamp splits; elsewhere more samples
+/// would find the dimmer surroundings and cost what they save. Whether it splits depends on
+/// the path so far only, not on this vertex's own samples, so either way its estimate is
+/// unbiased.
+#[inline(always)]
+pub(super) fn splits_at(lights: &Lights, hit: &SurfaceHit, wo: Vec3, bsdf: &Bsdf) -> bool {
+    bsdf.glossy_cone(wo)
+        .is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone))
+}
 
 /// What a split vertex's BSDF samples see of the lights.
 pub(super) struct SplitLight {

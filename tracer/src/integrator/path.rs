@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 
-use super::glossy_split::split_bsdf_light;
+use super::glossy_split::{split_bsdf_light, splits_at};
 use super::light_draw::BsdfCounts;
 use super::media::{travel, Segment, Travel};
 use super::mirror_images::mirror_after;
@@ -153,12 +153,7 @@ pub(super) fn walk<S: PathScene>(
         }
         depth += 1;
 
-        // The first glossy vertex that may see a lamp splits (see [`GLOSSY_SPLIT`]); elsewhere
-        // more samples would find the dimmer surroundings and cost what they save. Whether it
-        // splits depends on the path so far only, not on this vertex's own samples, so either
-        // way its estimate is unbiased.
-        let split = may_split
-            && (bsdf.glossy_cone(wo)).is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone));
+        let split = may_split && splits_at(lights, &hit, wo, &bsdf);
         let broad = bsdf.gathers_from(wo);
         let branching = !split && branches > 1 && broad.is_some();
         let bsdf_counts = if split {

@@ -4,8 +4,10 @@ use glam::Vec3;
 
 use super::scene::PathScene;
 use super::state::MAX_PASS_THROUGH;
+use crate::lanes::Lanes;
 use crate::math::{offset_origin, Ray};
 use crate::medium::MediumId;
+use crate::vec3_lanes::{dot, V3};
 
 /// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
 /// a surface blocks the way, else the volumes' transmittance. `null` surfaces let the ray
@@ -75,10 +77,16 @@ fn shadow_walk<S: PathScene>(
 
 /// The distance a shadow ray from `origin` travels to a light sampled at `dist` from `p`:
 /// stopped short of the light's own surface.
+#[inline(always)]
 pub(super) fn shadow_tmax(p: Vec3, origin: Vec3, dist: f32) -> f32 {
-    if dist.is_finite() {
-        (origin - p).length().mul_add(-1.0, dist) * (1.0 - 1e-3)
-    } else {
-        f32::INFINITY
-    }
+    shadow_tmax_in_lanes::<f32>(p.to_array(), origin.to_array(), dist)
+}
+
+/// [`shadow_tmax`] in lanes (infinite for a light at infinity).
+#[inline(always)]
+pub(super) fn shadow_tmax_in_lanes<L: Lanes>(p: V3<L>, origin: V3<L>, dist: L) -> L {
+    let to_origin = [origin[0] - p[0], origin[1] - p[1], origin[2] - p[2]];
+    let short = (dist - dot(to_origin, to_origin).sqrt()) * L::splat(1.0 - 1e-3);
+    let finite = dist.abs().lt(L::splat(f32::INFINITY));
+    L::select(finite, short, L::splat(f32::INFINITY))
 }

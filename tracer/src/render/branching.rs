@@ -14,10 +14,9 @@
 //! the vertex). Half the squared difference of a pixel's two renders estimates the error of its
 //! mean, so the errors of one and of two continuations are measured, not modelled from the
 //! continuations' own: a render's two continuations are one split draw, stratified together,
-//! and do better than two independent ones (Captain Falcon: two continuations' error 0.61 of
-//! one's in the pilot, 0.62 in renders at 16 spp; modelled as independent, 0.75, for which the
-//! earlier pilot kept one continuation and Falcon's 1.15x). For three and four, the model
-//! through the two measured errors.
+//! and do better than two independent ones (modelled as independent, they would be judged too
+//! dear where they pay: bench/RESULTS.md, "Branching camera paths"). For three and four, the
+//! model through the two measured errors.
 //!
 //! Each count is taken over one fewer only where it beats it by `MIN_GAIN` with standard
 //! errors to spare (`CONFIDENCE` for two, `MODEL_CONFIDENCE` for more): a test on the mean over
@@ -28,10 +27,8 @@
 //! The pilot's camera samples are a twenty-fifth of the render's (`PILOT_SHARE`; at most
 //! `MAX_PILOT_PIXELS` pixels), half that where half its pixels already rule two continuations
 //! out: a render too short to spare a pilot of `MIN_PILOT_PIXELS` keeps one continuation; a
-//! 480x270 render of 16 spp is just long enough. Measured there (one thread, 4 seeds, MSE x
-//! time, the pilot's time included), against the earlier pilot: Captain Falcon 1.15x (two
-//! continuations in every seed), depth of field the same choices (two or three) for 1.3% more
-//! time, Cornell 1.00x (two in one seed of four), Mario 0.98x (two in one seed).
+//! 480x270 render of 16 spp is just long enough (what the pilot gains there: bench/RESULTS.md,
+//! "Branching camera paths").
 //!
 //! Only the scene and the render settings decide it: every node that builds the scene takes
 //! the same number, and the image is the same bytes wherever it is rendered.
@@ -59,17 +56,15 @@ const MAX_PILOT_PIXELS: u64 = 16384;
 const MIN_PILOT_PIXELS: u64 = 1024;
 
 /// The share of the render's camera samples the pilot's four renders may take together, as a
-/// divisor (a sample with two continuations costs some one and a half of one with one: the
-/// pilot takes some 5% of the render's time, 2.5% where it stops half way).
+/// divisor (a sample with two continuations costs about one and a half of one with one: the
+/// pilot's four renders cost some 6% of the render, half that where it stops half way).
 const PILOT_SHARE: u64 = 25;
 
 /// How much cheaper a ray before the branching vertex is than one after it, in rays per
 /// sample: the camera ray is coherent and the first light sample's shadow ray an any-hit ray,
 /// where a continuation's rays are closest hits shaded in full. Fitted to the render times of
-/// one and two continuations against their rays per sample (480x270 16 spp, one thread):
-/// depth of field 0.27, Cornell 0.34, Mario 0.41, Captain Falcon 0.48; at 0.4 the model's cost
-/// of two over one is within 2% of the time for all four (at session 20's 0.6, depth of field's
-/// was 4% high).
+/// one and two continuations against their rays per sample on the seed scenes
+/// (bench/RESULTS.md, "Branching camera paths").
 const FIRST_RAYS_DISCOUNT: f64 = 0.4;
 
 /// Splitting must promise at least this efficiency over one continuation: a scene near the
@@ -77,14 +72,13 @@ const FIRST_RAYS_DISCOUNT: f64 = 0.4;
 const MIN_GAIN: f64 = 1.05;
 
 /// Standard errors by which two continuations must beat one (by `MIN_GAIN`) to be taken: half
-/// of one, as a wrong choice costs little (two continuations measured 0.98x to 1.25x of one on
-/// the seed scenes, where the pilot's figures scatter by some 20% between seeds).
+/// of one, as a wrong choice costs little and the pilot's figures scatter between seeds
+/// (bench/RESULTS.md, "Branching camera paths").
 const CONFIDENCE: f64 = 0.5;
 
 /// Standard errors by which more than two continuations must beat one fewer (by `MIN_GAIN`),
-/// by the model: three or four where two barely pay cost more (Cornell 0.94x, 0.85x). At 1,
-/// depth of field takes three in 2 seeds of 4 (1.30x against two's 1.25x), and the seed of
-/// Cornell's that takes two stays there (0.85 standard errors for three).
+/// by the model: three or four where two barely pay cost more (bench/RESULTS.md, "Branching
+/// camera paths").
 const MODEL_CONFIDENCE: f64 = 1.0;
 
 /// Standard errors by which two continuations may fall short of one (by `MIN_GAIN`) on half

@@ -236,9 +236,9 @@ impl RenderScene {
 
     /// [`Self::render_unit`], giving up (`None`) soon after `cancel` is set: it is checked
     /// before every pixel and every [`CANCEL_CHECK_SAMPLES`] samples of a pixel, so a unit
-    /// stops within a few thousand paths' time. (Checked before every sample it cost 5% of the
-    /// render speed.)
-    /// A render server sets it when the unit's caller is gone.
+    /// stops within a few thousand paths' time (checked before every sample, it costs
+    /// measurable speed: bench/RESULTS.md, "The integrator's inlining"). A render server sets
+    /// it when the unit's caller is gone.
     pub fn render_unit_cancellable(
         &self,
         unit: &WorkUnit,

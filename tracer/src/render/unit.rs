@@ -2,8 +2,8 @@
 //! every node share. A leaf: it imports nothing from the crate.
 
 /// Side in pixels of the square blocks an adaptive unit's mask switches on and off: blocks
-/// start at multiples of it from the unit's corner. (At 8 the allocation's best gain over a
-/// uniform render, measured on the seed scenes at 160x90, was 8-24% below that at 4.)
+/// start at multiples of it from the unit's corner. (Why 4, not 8: bench/RESULTS.md, "Session
+/// 10: 4x4-pixel blocks".)
 pub const BLOCK_SIZE: u32 = 4;
 
 /// Blocks per side of a mask: 8 x 8 blocks, one bit each in a u64.

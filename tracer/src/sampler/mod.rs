@@ -18,8 +18,8 @@
 //!
 //! The camera's four dimensions (film and lens position) are one 4D Sobol point instead of two
 //! such pairs ([`PixelSampler::get_camera`]): one index permutation for all four, so that a
-//! pixel's lens positions are stratified together with its film positions (depth of field
-//! at 16 spp: 3% less squared error, the same film positions).
+//! pixel's lens positions are stratified together with its film positions (what it gains:
+//! bench/RESULTS.md, "Session 17").
 //!
 //! Where the indices are permuted depends on how the samples are used. A uniform render takes
 //! all `spp` samples of a pixel, so they are permuted over `[0, spp)`. An adaptive render
@@ -27,9 +27,8 @@
 //! own: its samples are permuted only within the dyadic blocks `[0, 16)`, `[16, 32)`,
 //! `[32, 64)`, ... (see [`PixelSampler::nested`]), each of which holds the Sobol points of an
 //! elementary net, so the first 16 x 2^k samples are the first 16 x 2^k Sobol points. (Permuted
-//! over the whole `[0, spp)`, a pixel stopped at n samples had a random subset of the points
-//! and an error falling like independent sampling's: 1.6x the squared error of a stratified
-//! prefix, measured on Captain Falcon and metal-mario-bg1.)
+//! over the whole `[0, spp)`, a pixel stopped at n samples would hold a random subset of the
+//! points, its error falling like independent sampling's.)
 
 mod packet;
 mod pixel;

@@ -92,8 +92,8 @@ impl PixelSampler {
     /// film position is the one [`Self::get_2d`] would draw; the lens position is stratified
     /// with it (16 samples take each of the 16 cells halving the four coordinates once),
     /// where a pair of its own would be independent of it.
-    // Inlined into the render loop (with the pilot a second caller, the compiler kept it and
-    // get_vertex a call away: depth of field 2.6% slower).
+    // Inlined into the render loop: a call away, it costs measurable speed (bench/RESULTS.md,
+    // "The integrator's inlining").
     #[inline(always)]
     pub fn get_camera(&mut self) -> (Vec2, Vec2) {
         let film_hash = self.next_dimension_hash();

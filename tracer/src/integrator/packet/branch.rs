@@ -1,13 +1,14 @@
 //! A packet's branching vertex: its continuations, one packet each, traced in order as the
 //! path loop's are.
 
-use super::vectors::{dot, lanes_set, offset_origin, scale, times};
+use super::vectors::lanes_set;
 use super::walk::{walk_packet, LanePrevScatter, Packet, PacketBranchPoint};
 use crate::integrator::branch::MAX_BRANCHES;
 use crate::integrator::roulette::survives_in_lanes;
 use crate::integrator::scene::PathScene;
 use crate::integrator::state::PathResult;
 use crate::lanes::{Lanes, MAX_LANES};
+use crate::vec3_lanes::{dot, offset_origin, scale, times};
 
 /// The continuations of a packet's paths at their branching vertex, one packet each, traced
 /// in order (as [`super::path`]'s `BranchVertex::branch` traces a path's).

@@ -3,15 +3,15 @@
 
 use glam::{Vec2, Vec3};
 
-use super::vectors::{
-    dot, is_zero, lanes_set, mask_of, negate, offset_origin, scale, select3, times, LaneVec3s, V3,
-};
+use super::vectors::{is_zero, lanes_set, mask_of, LaneVec3s};
 use crate::bxdf::local::cosine_hemisphere;
 use crate::integrator::mis::power_heuristic;
 use crate::integrator::scene::PathScene;
+use crate::integrator::shadow::shadow_tmax_in_lanes;
 use crate::lanes::{Lanes, MAX_LANES};
 use crate::lights::LightSamples;
 use crate::math::Ray;
+use crate::vec3_lanes::{dot, negate, offset_origin, scale, select3, times, V3};
 
 /// The Lambert vertices of a packet's live lanes: what [`Bsdf`] holds of a bare Lambert one.
 pub(super) struct LambertVertex<L: Lanes> {
@@ -123,15 +123,7 @@ impl<L: Lanes> LambertVertex<L> {
             (zero.lt(geometric) & zero.lt(shading)) | (geometric.lt(zero) & shading.lt(zero));
         let reflects = agree & zero.lt(shading);
         let origin = offset_origin(self.p, self.ng, wi);
-        let to_origin = [
-            origin[0] - self.p[0],
-            origin[1] - self.p[1],
-            origin[2] - self.p[2],
-        ];
-        // `shadow_tmax`: its multiply-add by -1 is this subtraction, exactly.
-        let short = (dist - dot(to_origin, to_origin).sqrt()) * L::splat(1.0 - 1e-3);
-        let finite = dist.abs().lt(L::splat(f32::INFINITY));
-        let tmax = L::select(finite, short, L::splat(f32::INFINITY)).values();
+        let tmax = shadow_tmax_in_lanes(self.p, origin, dist).values();
         let tested = lanes_set::<L>(lit & reflects);
         let (origin, dir) = (LaneVec3s::of(origin), LaneVec3s::of(wi));
         let mut visible = [0.0; MAX_LANES];

@@ -1,46 +1,9 @@
-//! Three coordinates in lanes, and their form in memory lane by lane.
+//! A packet's vectors in memory lane by lane, and its masks as lane sets.
 
 use glam::Vec3;
 
 use crate::lanes::{Lanes, MAX_LANES};
-
-/// Three coordinates in lanes.
-pub(super) type V3<L> = [L; 3];
-
-#[inline(always)]
-pub(super) fn dot<L: Lanes>(a: V3<L>, b: V3<L>) -> L {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline(always)]
-pub(super) fn scale<L: Lanes>(a: V3<L>, k: L) -> V3<L> {
-    [a[0] * k, a[1] * k, a[2] * k]
-}
-
-#[inline(always)]
-pub(super) fn times<L: Lanes>(a: V3<L>, b: V3<L>) -> V3<L> {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
-}
-
-#[inline(always)]
-pub(super) fn plus<L: Lanes>(a: V3<L>, b: V3<L>) -> V3<L> {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-/// `-a`, exactly (the sign of a zero too).
-#[inline(always)]
-pub(super) fn negate<L: Lanes>(a: V3<L>) -> V3<L> {
-    scale(a, L::splat(-1.0))
-}
-
-#[inline(always)]
-pub(super) fn select3<L: Lanes>(m: L::M, a: V3<L>, b: V3<L>) -> V3<L> {
-    [
-        L::select(m, a[0], b[0]),
-        L::select(m, a[1], b[1]),
-        L::select(m, a[2], b[2]),
-    ]
-}
+use crate::vec3_lanes::V3;
 
 /// Per-lane vectors as lanes hold them: a row of x, one of y, one of z, filled and read lane
 /// by lane (lanes past `L::N` are not read).
@@ -107,19 +70,4 @@ pub(super) fn lanes_set<L: Lanes>(m: L::M) -> [bool; MAX_LANES] {
         *set = one > 0.0;
     }
     set
-}
-
-/// [`crate::math::offset_origin`] in lanes.
-#[inline(always)]
-pub(super) fn offset_origin<L: Lanes>(p: V3<L>, ng: V3<L>, dir: V3<L>) -> V3<L> {
-    let a = [p[0].abs(), p[1].abs(), p[2].abs()];
-    let largest = a[0].max(a[1].max(a[2]));
-    let eps = L::splat(1e-4) * (L::splat(1.0) + largest);
-    let step = scale(ng, eps);
-    let ahead = L::splat(0.0).le(dot(dir, ng));
-    select3(
-        ahead,
-        plus(p, step),
-        [p[0] - step[0], p[1] - step[1], p[2] - step[2]],
-    )
 }

@@ -7,11 +7,10 @@
 use glam::Vec3;
 
 use super::lambert::{LambertVertex, LightDraws};
-use super::vectors::{
-    dot, lanes_set, mask_of, negate, offset_origin, plus, scale, select3, times, LaneVec3s, V3,
-};
+use super::vectors::{lanes_set, mask_of, LaneVec3s};
 use crate::geometry::SurfaceHit;
 use crate::integrator::branch::walk_to_the_end;
+use crate::integrator::glossy_split::splits_at;
 use crate::integrator::light_draw::BsdfCounts;
 use crate::integrator::mirror_images::mirror_after;
 use crate::integrator::roulette::survives_in_lanes;
@@ -23,11 +22,11 @@ use crate::material::{Bsdf, BsdfSample};
 use crate::math::Ray;
 use crate::medium::ShapeMedia;
 use crate::sampler::{PacketSampler, VertexPacket, VertexSamples};
+use crate::vec3_lanes::{dot, negate, offset_origin, plus, scale, select3, times, V3};
 
-/// A packet whose live lanes are this few hands them to [`walk`]: shading in lanes costs
-/// what it costs for all `L::N`, and below three live lanes one path at a time is the
-/// cheaper (depth of field, Cornell and Captain Falcon 2-3% sooner than with no such bound,
-/// Mario even; bench/RESULTS.md, session 28). Paths live a few vertices, so most packets end
+/// A packet whose live lanes are this few hands them to the path loop: shading in lanes costs
+/// what it costs for all `L::N`, and below three live lanes one path at a time is the cheaper
+/// (bench/RESULTS.md, "A packet's last lanes"). Paths live a few vertices, so most packets end
 /// with few lanes.
 pub(super) const FEW_LANES: usize = 2;
 
@@ -322,10 +321,7 @@ impl LaneHits {
         if lambert.is_none() {
             // A path branches at its first broad vertex, or keeps its branches past a specular
             // one: only Lambert lanes branch together.
-            let splits = packet.may_split
-                && bsdf
-                    .glossy_cone(wo)
-                    .is_some_and(|cone| lights.lamp_may_be_in(hit.p, &cone));
+            let splits = packet.may_split && splits_at(lights, hit, wo, bsdf);
             if packet.branches > 1 || splits {
                 return false;
             }
