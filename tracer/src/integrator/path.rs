@@ -168,8 +168,10 @@ pub(super) fn walk<S: PathScene>(
             wo,
             bsdf: &bsdf,
             sides,
+            depth,
+            bsdf_counts,
         };
-        let (light, image_share) = vertex.light(scene, &u, depth, bsdf_counts, &mut rays);
+        let (light, image_share) = vertex.light(scene, &u, &mut rays);
         if let Some(light) = light {
             radiance += throughput * light;
         }

@@ -23,6 +23,10 @@ pub(super) struct Vertex<'a> {
     pub(super) wo: Vec3,
     pub(super) bsdf: &'a Bsdf,
     pub(super) sides: ShapeMedia,
+    /// The path's vertices up to this one, this one counted.
+    pub(super) depth: u32,
+    /// The BSDF samples the vertex's light sample is weighed against.
+    pub(super) bsdf_counts: BsdfCounts,
 }
 
 /// Where a vertex's light sample goes ([`Vertex::choose_light`]).
@@ -34,22 +38,19 @@ pub(super) enum LightChoice {
 }
 
 impl Vertex<'_> {
-    /// The vertex's light sample (None at a specular vertex), weighed against `bsdf_counts`
-    /// BSDF samples, and the share of its light samples that went to lamp images. `depth`
-    /// counts this vertex.
+    /// The vertex's light sample (None at a specular vertex), drawn from `u`, and the share of
+    /// its light samples that went to lamp images; its rays counted in `rays`.
     #[inline(always)]
     pub(super) fn light<S: PathScene>(
         &self,
         scene: &S,
         u: &VertexSamples,
-        depth: u32,
-        bsdf_counts: BsdfCounts,
         rays: &mut u32,
     ) -> (Option<Vec3>, f32) {
         if self.bsdf.is_specular() {
             return (None, 0.0);
         }
-        let (choice, image_share) = self.choose_light(scene, u, depth, bsdf_counts, rays);
+        let (choice, image_share) = self.choose_light(scene, u, rays);
         let light = match choice {
             LightChoice::Image(light) => light,
             LightChoice::Lights(draw) => {
@@ -66,20 +67,18 @@ impl Vertex<'_> {
         &self,
         scene: &S,
         u: &VertexSamples,
-        depth: u32,
-        bsdf_counts: BsdfCounts,
         rays: &mut u32,
     ) -> (LightChoice, f32) {
         let lights = scene.lights();
         let (hit, wo, bsdf) = (self.hit, self.wo, self.bsdf);
         // A path through a mirror needs one more vertex: none past the last.
-        let (draw, image) = if lights.has_mirror_images() && depth < scene.max_depth() {
+        let (draw, image) = if lights.has_mirror_images() && self.depth < scene.max_depth() {
             split_light_sample(lights, hit.p, u)
         } else {
             (LightDraw::lights_only(u), None)
         };
         let draw = LightDraw {
-            bsdf_counts,
+            bsdf_counts: self.bsdf_counts,
             ..draw
         };
         match image {

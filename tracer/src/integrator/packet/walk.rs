@@ -346,22 +346,18 @@ impl LaneHits {
             Some(us) => us,
             None => self.by_lane.insert(u.by_lane()),
         };
+        // Only Lambert lanes stay where paths branch: any other's count is 1.
         let vertex = Vertex {
             hit,
             wo,
             bsdf,
             sides: ShapeMedia::default(),
+            depth: packet.depth + 1,
+            bsdf_counts: BsdfCounts::all(at.bsdf_count),
         };
-        let depth = packet.depth + 1;
         let mut rays = 0;
         if lambert_here {
-            let (choice, image_share) = vertex.choose_light(
-                scene,
-                &us[i],
-                depth,
-                BsdfCounts::all(at.bsdf_count),
-                &mut rays,
-            );
+            let (choice, image_share) = vertex.choose_light(scene, &us[i], &mut rays);
             self.image_share[i] = image_share;
             match choice {
                 LightChoice::Image(light) => self.lit_alone[i] = Some(light),
@@ -370,8 +366,7 @@ impl LaneHits {
                 }
             }
         } else {
-            let (light, image_share) =
-                vertex.light(scene, &us[i], depth, BsdfCounts::ONE, &mut rays);
+            let (light, image_share) = vertex.light(scene, &us[i], &mut rays);
             let sample = vertex.sample(&us[i]);
             let before_mirror = match &sample {
                 Some((bs, _)) => {
