@@ -5,6 +5,10 @@ use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers};
+use yat::shutdown::Interrupt;
+
 use crate::lit_sphere::LIT_SPHERE;
 use crate::util::*;
 
@@ -13,7 +17,8 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let reference = dir.path().join("in-process.png");
-    assert_success(&render(&scene, &reference, &["--threads", "2", "--quiet"]));
+    let in_process = Executor::InProcess { threads: Some(2) };
+    render_here(request(&scene, &reference), in_process).unwrap();
     let expected = image_bytes(&reference);
 
     let mut a = Worker::start(&["--throttle-ms", "150"]);
@@ -21,22 +26,17 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let b = Worker::start(&["--throttle-ms", "300"]);
     let out = dir.path().join("drained.png");
     let json = dir.path().join("workers.json");
-    let workers = format!("{},{}", a.address, b.address);
     let started = Instant::now();
-    // No --unit-deadline: a unit lost in the drain would cost the default 30 s.
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--quiet",
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    )
-    .spawn()
-    .unwrap();
+    // No unit deadline: a unit lost in the drain would cost the default 30 s.
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        Executor::from(DistributedConfig {
+            workers_json: Some(json.clone()),
+            ..workers_at(&[&a.address, &b.address])
+        }),
+        Observers::none(),
+        Interrupt::default(),
+    );
     let polling = Instant::now();
     // Signalled once a has returned a unit and is on another (its 2 threads pause 150 ms per
     // unit, so one in flight is on a thread, not queued).
@@ -55,7 +55,7 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
         .expect("the drained worker exits within --drain-seconds + 5 s");
     assert!(status.success(), "{status}");
     let drain = signalled.elapsed();
-    assert!(coordinator.wait().unwrap().success());
+    coordinator.join().unwrap().unwrap();
     let elapsed = started.elapsed();
     let (png, exr) = image_bytes(&out);
     assert!(exr == expected.1, "EXR differs from in-process");

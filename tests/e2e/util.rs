@@ -1,11 +1,22 @@
 //! Helpers for the end-to-end tests: the seed scenes' folder, a small scene written to a
-//! folder, `yat worker` processes on loopback ports, and `yat render` runs.
+//! folder, `yat worker` processes on loopback ports, `yat render` runs, and renders by the
+//! library in the test's own process (`yat::render::render`), for tests that need no
+//! coordinator process.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Output, Stdio};
+use std::thread::JoinHandle;
 use std::time::Duration;
+
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers, RenderRequest};
+use yat::render_report::RenderReport;
+use yat::scene::{ParsedScene, Warnings};
+use yat::shutdown::Interrupt;
+use yat_tracer::render::adaptive::AdaptiveSettings;
+use yat_tracer::render::RenderOverrides;
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
@@ -127,6 +138,56 @@ pub fn scene_bytes(dir: &Path) -> u64 {
 /// Render settings every test uses: 4 tiles x 8 passes = 32 units.
 pub const SETTINGS: [&str; 4] = ["--spp", "64", "--resolution", "128x96"];
 
+/// [`SETTINGS`] as the library takes them (and `yat render` gives them, seed 0 included).
+pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
+    spp: Some(64),
+    max_depth: None,
+    seed: Some(0),
+    resolution: Some((128, 96)),
+    latlong: yat_tracer::desc::LatLongConvention::Seed,
+};
+
+/// The request `yat render SCENE -o OUT --exr` makes with `overrides` (and `adaptive`).
+pub fn request_with(
+    scene: &Path,
+    out: &Path,
+    overrides: &RenderOverrides,
+    adaptive: Option<AdaptiveSettings>,
+) -> RenderRequest {
+    let scene = ParsedScene::load(scene, Warnings::Keep).unwrap();
+    let mut request = RenderRequest::new(scene, overrides, adaptive, Some(out.into())).unwrap();
+    request.exr = true;
+    request
+}
+
+/// [`request_with`] the test settings.
+pub fn request(scene: &Path, out: &Path) -> RenderRequest {
+    request_with(scene, out, &SETTINGS_OVERRIDES, None)
+}
+
+/// The workers at `addresses` (resolved once), with nothing else set.
+pub fn workers_at(addresses: &[&str]) -> DistributedConfig {
+    DistributedConfig {
+        workers: addresses.iter().map(|a| a.to_string()).collect(),
+        ..DistributedConfig::default()
+    }
+}
+
+/// Renders `request` on `executor` in this process, quiet and writing no interim file.
+pub fn render_here(request: RenderRequest, executor: Executor) -> anyhow::Result<RenderReport> {
+    yat::render::render(request, executor, Observers::none(), Interrupt::default())
+}
+
+/// [`yat::render::render`] on a thread of its own, as a coordinator beside the test.
+pub fn spawn_render(
+    request: RenderRequest,
+    executor: Executor,
+    observers: Observers,
+    interrupt: Interrupt,
+) -> JoinHandle<anyhow::Result<RenderReport>> {
+    std::thread::spawn(move || yat::render::render(request, executor, observers, interrupt))
+}
+
 /// A `yat worker` process on a loopback port; killed when dropped.
 pub struct Worker {
     pub address: String,
@@ -216,13 +277,9 @@ impl Worker {
         None
     }
 
-    /// Sends a signal with the `kill` command (STOP, CONT, TERM).
+    /// Sends a signal (STOP, CONT, TERM).
     pub fn signal(&self, name: &str) {
-        let status = Command::new("kill")
-            .args([&format!("-{name}"), &self.pid().to_string()])
-            .status()
-            .unwrap();
-        assert!(status.success(), "kill -{name} failed");
+        signal(self.pid(), name);
     }
 
     /// The worker's counters, over its Stats RPC.
@@ -257,6 +314,15 @@ impl Drop for Worker {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Sends process `pid` a signal (INT, TERM, STOP, CONT) with the `kill` command.
+pub fn signal(pid: u32, name: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{name}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{name} failed");
 }
 
 /// Runs `command`'s process in an address space of `bytes` (RLIMIT_AS): an allocation beyond
@@ -345,6 +411,23 @@ pub fn image_bytes(out: &Path) -> (Vec<u8>, Vec<u8>) {
         std::fs::read(out).unwrap(),
         std::fs::read(out.with_extension("exr")).unwrap(),
     )
+}
+
+/// Waits until the workers together have rendered `units` units.
+pub fn wait_for_units(workers: &[&Worker], units: u64) {
+    let started = std::time::Instant::now();
+    while workers
+        .iter()
+        .map(|w| w.stats(None).units_done)
+        .sum::<u64>()
+        < units
+    {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "render stalled"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }
 
 /// The `--workers-json` report.

@@ -10,7 +10,7 @@ use tokio::sync::mpsc;
 use yat_tracer::render::UnitStats;
 
 use super::discovery::Roster;
-use super::shared::{Event, Shared};
+use super::session_context::{Event, SessionContext};
 use crate::checkpoint::Checkpoint;
 use crate::exec::progress::Progress;
 use crate::interim::InterimClock;
@@ -23,7 +23,7 @@ const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
 pub struct RenderLoop<'a> {
     pub job: &'a RenderJob,
     pub roster: &'a Roster,
-    pub shared: &'a Arc<Shared>,
+    pub context: &'a Arc<SessionContext>,
     pub timeout: Option<Duration>,
 }
 
@@ -59,10 +59,10 @@ impl RenderLoop<'_> {
                     break Err(TimeLimitReached.into());
                 }
                 if !tokio::task::block_in_place(|| checkpoint.advance(settings, adaptive)) {
-                    self.shared.schedule.finish();
+                    self.context.schedule.finish();
                     break Ok(());
                 }
-                self.shared
+                self.context
                     .schedule
                     .start_round(checkpoint.units(settings, adaptive));
                 progress.round(self.job, &checkpoint);
@@ -70,7 +70,7 @@ impl RenderLoop<'_> {
                 continue;
             }
             tokio::select! {
-                event = events.recv() => match event.expect("the shared state holds a sender") {
+                event = events.recv() => match event.expect("the context state holds a sender") {
                     Event::Result { buffer, stats: unit_stats } => {
                         if let Err(e) = checkpoint.add(&buffer) {
                             break Err(e.into());
@@ -165,7 +165,7 @@ impl RenderLoop<'_> {
             .iter()
             .map(|n| n.report.lock().unwrap().status_row())
             .collect();
-        let stalled_after = self.shared.deadline.current() / 2;
+        let stalled_after = self.context.deadline.current() / 2;
         self.job.interim.status.set_workers(rows, stalled_after);
     }
 

@@ -22,8 +22,9 @@ pub enum Event {
     Notice(String),
 }
 
-/// What every node loop shares.
-pub struct Shared {
+/// The render as every worker's session loop sees it: the units to hand out and how long one
+/// may take, the scene to load, what a reply must fit, and where results go.
+pub struct SessionContext {
     pub schedule: Schedule,
     pub deadline: UnitDeadline,
     pub manifest: SceneManifest,
@@ -35,7 +36,7 @@ pub struct Shared {
     pub events: UnboundedSender<Event>,
 }
 
-impl Shared {
+impl SessionContext {
     pub fn notice(&self, message: String) {
         let _ = self.events.send(Event::Notice(message));
     }
