@@ -3,7 +3,7 @@
 //! and resume; the sample map shows where the samples went.
 
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use yat::render::{Executor, Observers};
@@ -26,12 +26,7 @@ const ADAPTIVE: [&str; 8] = [
 ];
 
 fn adaptive_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut command = render_command_with(scene, out, &ADAPTIVE, extra);
-    command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    command
+    piped_render_command(scene, out, &ADAPTIVE, extra)
 }
 
 fn assert_same(out: &Path, expected: &(Vec<u8>, Vec<u8>), what: &str) {

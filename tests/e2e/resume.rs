@@ -3,7 +3,7 @@
 //! of a render never stopped.
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 use yat::render::{Executor, Observers};
@@ -17,12 +17,7 @@ use crate::util::*;
 const LONG: [&str; 4] = ["--spp", "256", "--resolution", "128x96"];
 
 fn long_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut command = render_command_with(scene, out, &LONG, extra);
-    command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    command
+    piped_render_command(scene, out, &LONG, extra)
 }
 
 /// Waits until `checkpoint` holds something other than `before` (a newer save), the render

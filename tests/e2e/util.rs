@@ -388,6 +388,21 @@ pub fn render_command_with(scene: &Path, out: &Path, settings: &[&str], extra: &
     command
 }
 
+/// [`render_command_with`], its input closed and its output piped (to read or to wait on).
+pub fn piped_render_command(
+    scene: &Path,
+    out: &Path,
+    settings: &[&str],
+    extra: &[&str],
+) -> Command {
+    let mut command = render_command_with(scene, out, settings, extra);
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    command
+}
+
 pub fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     render_command(scene, out, extra)
         .output()
