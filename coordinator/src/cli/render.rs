@@ -194,8 +194,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         status,
     };
     let output_png = request.output_png.clone();
-    let report = render(request, executor, observers, interrupt.clone());
-    let report = match report {
+    let report = match render(request, executor, observers, interrupt.clone()) {
         Ok(report) => report,
         Err(e) => {
             linger(server, status_linger, &interrupt);

@@ -10,7 +10,7 @@ use tokio::sync::mpsc;
 use yat_tracer::render::UnitStats;
 
 use super::discovery::Roster;
-use super::session_context::{Event, SessionContext};
+use super::session_context::{SessionContext, SessionEvent};
 use crate::checkpoint::Checkpoint;
 use crate::exec::progress::Progress;
 use crate::interim::InterimClock;
@@ -35,7 +35,7 @@ impl RenderLoop<'_> {
     pub async fn run(
         self,
         mut checkpoint: Checkpoint,
-        mut events: mpsc::UnboundedReceiver<Event>,
+        mut events: mpsc::UnboundedReceiver<SessionEvent>,
     ) -> anyhow::Result<RenderOutcome> {
         let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
         let progress = Progress::start(self.job, &checkpoint);
@@ -71,7 +71,7 @@ impl RenderLoop<'_> {
             }
             tokio::select! {
                 event = events.recv() => match event.expect("the context state holds a sender") {
-                    Event::Result { buffer, stats: unit_stats } => {
+                    SessionEvent::Result { buffer, stats: unit_stats } => {
                         if let Err(e) = checkpoint.add(&buffer) {
                             break Err(e.into());
                         }
@@ -80,7 +80,7 @@ impl RenderLoop<'_> {
                         progress.unit_merged(unit_stats.samples);
                         progress.set_status(self.status(&checkpoint));
                     }
-                    Event::Notice(line) => progress.say(&line),
+                    SessionEvent::Notice(line) => progress.say(&line),
                 },
                 _ = tick.tick() => {
                     if self.job.interrupt.is_set() {

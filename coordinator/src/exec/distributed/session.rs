@@ -21,7 +21,7 @@ use yat_tracer::render::{WorkUnit, TILE_SIZE};
 use super::client::{WorkerClient, MIN_CHUNK_BYTES};
 use super::node::Node;
 use super::schedule::Schedule;
-use super::session_context::{Event, SessionContext};
+use super::session_context::{SessionContext, SessionEvent};
 use super::session_error::SessionError;
 use crate::sanitize::peer_text;
 
@@ -512,7 +512,7 @@ fn accept(
         }
     });
     if first {
-        let _ = context.events.send(Event::Result { buffer, stats });
+        let _ = context.events.send(SessionEvent::Result { buffer, stats });
     }
     Ok(())
 }

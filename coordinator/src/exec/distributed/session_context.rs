@@ -12,7 +12,7 @@ use super::schedule::{Schedule, UnitDeadline};
 use crate::manifest::SceneManifest;
 
 /// What node loops tell the render loop.
-pub enum Event {
+pub enum SessionEvent {
     /// A unit's result, the first one for that unit.
     Result {
         buffer: SampleBuffer,
@@ -33,11 +33,11 @@ pub struct SessionContext {
     pub frame: FilmFrame,
     /// What the scene's filter lets a sample weigh a pixel: what a reply's weight sums may be.
     pub weights: WeightBounds,
-    pub events: UnboundedSender<Event>,
+    pub events: UnboundedSender<SessionEvent>,
 }
 
 impl SessionContext {
     pub fn notice(&self, message: String) {
-        let _ = self.events.send(Event::Notice(message));
+        let _ = self.events.send(SessionEvent::Notice(message));
     }
 }
