@@ -202,15 +202,7 @@ fn workers_join_and_leave_as_the_name_resolves() {
     assert!(exr == expected.1, "EXR differs from in-process");
     assert!(png == expected.0, "PNG differs from in-process");
     let report = workers_report(&json);
-    let entry = |worker: &Worker| {
-        report["workers"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|w| w["address"] == worker.address)
-            .unwrap_or_else(|| panic!("{} not in {report:#}", worker.address))
-            .clone()
-    };
+    let entry = |worker: &Worker| worker_entry(&report, &worker.address).clone();
     let (a, b, c) = (entry(a), entry(b), entry(c));
     for w in [&a, &b, &c] {
         assert_eq!(w["dns_name"], "workers.yat.test", "{report:#}");

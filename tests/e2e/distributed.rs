@@ -38,15 +38,6 @@ fn assert_same_image(out: &Path, expected: &(Vec<u8>, Vec<u8>)) {
     );
 }
 
-fn worker_entry<'a>(report: &'a serde_json::Value, address: &str) -> &'a serde_json::Value {
-    report["workers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["address"] == address)
-        .unwrap_or_else(|| panic!("{address} not in {report:#}"))
-}
-
 fn total_units(report: &serde_json::Value) -> u64 {
     report["workers"]
         .as_array()

@@ -67,14 +67,7 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     // The units a's threads were on (each pauses 150 ms first) were finished and merged, not
     // thrown away with the session when a's queue was handed back.
     let report = workers_report(&json);
-    let merged_by_a = report["workers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["address"] == a.address)
-        .unwrap()["units"]
-        .as_u64()
-        .unwrap();
+    let merged_by_a = worker_entry(&report, &a.address)["units"].as_u64().unwrap();
     assert!(
         merged_by_a > before.units_done,
         "a had {} unit(s) in flight and {} done at SIGTERM, and {merged_by_a} merged: {report:#}",

@@ -445,6 +445,17 @@ pub fn wait_for_units(workers: &[&Worker], units: u64) {
     }
 }
 
+/// The entry of the worker at `address` in the `workers` array of `report` (the
+/// `--workers-json` report or the status page's JSON).
+pub fn worker_entry<'a>(report: &'a serde_json::Value, address: &str) -> &'a serde_json::Value {
+    report["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["address"] == address)
+        .unwrap_or_else(|| panic!("no worker {address} in {report:#}"))
+}
+
 /// The `--workers-json` report.
 pub fn workers_report(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
