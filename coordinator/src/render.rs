@@ -197,15 +197,17 @@ fn render_and_write(
         deadline: request.deadline,
     };
 
-    let outcome = match (distributed, manifest) {
-        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest),
+    let (outcome, workers) = match (distributed, manifest) {
+        (Some(config), Some(manifest)) => {
+            let (outcome, workers) = distributed::render(&config, &job, manifest)?;
+            (outcome, Some(workers))
+        }
         (_, manifest) => {
             // The in-process render reads the files itself: their copies go before it starts.
             drop(manifest);
-            in_process::render(&job, threads)
+            (in_process::render(&job, threads)?, None)
         }
     };
-    let outcome = outcome?;
     job.write_final(&outcome)?;
     if status.serving() {
         let image = outcome.film.to_display(&job.scene.desc.film);
@@ -213,9 +215,7 @@ fn render_and_write(
     }
     status.finish(Some(job.output_png.display().to_string()), None);
     let build_time = outcome.build.as_ref().map(|b| b.time).unwrap_or_default();
-    Ok(RenderReport::new(
-        &job,
-        &outcome,
-        started.elapsed() - build_time,
-    ))
+    let mut report = RenderReport::new(&job, &outcome, started.elapsed() - build_time);
+    report.workers = workers;
+    Ok(report)
 }

@@ -206,6 +206,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if !args.quiet {
+        if let Some(workers) = &report.workers {
+            workers.print();
+        }
         println!("wrote {}", output_png.display());
         report.print();
     }

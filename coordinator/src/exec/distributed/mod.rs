@@ -10,7 +10,7 @@ mod discovery;
 mod local;
 mod node;
 mod render_loop;
-mod report;
+pub mod report;
 mod schedule;
 mod session;
 mod session_context;
@@ -36,11 +36,13 @@ use schedule::{Schedule, UnitDeadline};
 use session_context::SessionContext;
 
 /// Renders `job` on the workers `config` names or starts; `manifest` holds the scene's files.
+/// Returns the workers' figures beside the outcome (and writes them to `config.workers_json`,
+/// whether the render succeeds or not).
 pub fn render(
     config: &DistributedConfig,
     job: &RenderJob,
     manifest: SceneManifest,
-) -> anyhow::Result<RenderOutcome> {
+) -> anyhow::Result<(RenderOutcome, DistributedReport)> {
     let cpu_start = process_cpu_time();
     let started = Instant::now();
     let targets = config
@@ -132,9 +134,5 @@ pub fn render(
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let outcome = outcome?;
-    if !job.quiet {
-        report.print();
-    }
-    Ok(outcome)
+    Ok((outcome?, report))
 }
