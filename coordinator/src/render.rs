@@ -107,7 +107,8 @@ impl Executor {
 
 /// What watches a render as it goes, and what it writes meanwhile.
 pub struct Observers {
-    /// No progress bar and no lines on the terminal but errors.
+    /// No progress bar and no notices on the terminal (the error a render returns is the
+    /// caller's to print).
     pub quiet: bool,
     /// Rewrite `<output>.preview.png` this often; None writes no preview.
     pub preview_every: Option<Duration>,
