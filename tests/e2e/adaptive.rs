@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use yat::render::{Executor, Observers};
 use yat::shutdown::Interrupt;
 use yat_tracer::render::adaptive::AdaptiveSettings;
+use yat_tracer::render::RenderOverrides;
 
 use crate::util::*;
 
@@ -137,22 +138,24 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
     // the uniform render's image, up to the f32 rounding of the other unit cut.
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let settings = ["--spp", "16", "--resolution", "128x96"];
+    let settings = RenderOverrides {
+        spp: Some(16),
+        ..SETTINGS_OVERRIDES
+    };
+    let two_threads = || Executor::InProcess { threads: Some(2) };
     let uniform = dir.path().join("uniform.png");
-    let output = render_command_with(&scene, &uniform, &settings, &["--threads", "2", "--quiet"])
-        .output()
-        .unwrap();
-    assert_success(&output);
-    let adaptive = dir.path().join("adaptive.png");
-    let output = render_command_with(
-        &scene,
-        &adaptive,
-        &settings,
-        &["--noise-threshold", "0.5", "--min-spp", "16", "--quiet"],
+    render_here(
+        request_with(&scene, &uniform, &settings, None),
+        two_threads(),
     )
-    .output()
     .unwrap();
-    assert_success(&output);
+    let adaptive = dir.path().join("adaptive.png");
+    let one_round = AdaptiveSettings {
+        threshold: 0.5,
+        min_spp: 16,
+    };
+    let request = request_with(&scene, &adaptive, &settings, Some(one_round));
+    render_here(request, two_threads()).unwrap();
     // min-spp = spp: one round, every pixel 16 samples, the same samples as the uniform
     // render; only the unit cut differs (one unit per tile instead of 2 passes), which changes
     // the f32 sums' rounding at most.
