@@ -1,7 +1,7 @@
 //! A worker under an orchestrator (Kubernetes, Slurm): SIGTERM mid-render drains it without
 //! costing the render anything but time, and `--threads` defaults to the CPUs it was given.
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -97,15 +97,8 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let address = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap()
-        .to_string();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let address = next_line_after(&mut stdout, "listening on ");
     let threads = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()

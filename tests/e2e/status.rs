@@ -2,7 +2,7 @@
 //! distributed render with a worker killed midway, the token, the paths it must not serve,
 //! and a real headless Chromium loading the page.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -27,13 +27,10 @@ impl Coordinator {
             .spawn()
             .expect("start yat render");
         let mut stdout = BufReader::new(child.stdout.take().unwrap());
-        let mut line = String::new();
-        stdout.read_line(&mut line).unwrap();
-        let address = line
-            .trim()
-            .strip_prefix("status page on http://")
-            .and_then(|a| a.strip_suffix('/'))
-            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
+        let page = next_line_after(&mut stdout, "status page on http://");
+        let address = page
+            .strip_suffix('/')
+            .unwrap_or_else(|| panic!("no / after the address: {page:?}"))
             .to_string();
         // The rest of stdout (the summary) is drained so the process never blocks on it.
         std::thread::spawn(move || std::io::copy(&mut stdout, &mut std::io::sink()));

@@ -233,13 +233,7 @@ impl Worker {
     pub fn spawn(mut command: Command) -> Self {
         let mut child = command.spawn().expect("start yat worker");
         let mut stdout = BufReader::new(child.stdout.take().unwrap());
-        let mut line = String::new();
-        stdout.read_line(&mut line).unwrap();
-        let address = line
-            .trim()
-            .strip_prefix("listening on ")
-            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
-            .to_string();
+        let address = next_line_after(&mut stdout, "listening on ");
         Self {
             address,
             child,
@@ -314,6 +308,16 @@ impl Drop for Worker {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// The next line of `output`, trimmed, without `prefix`; panics on a line without it.
+pub fn next_line_after(output: &mut impl BufRead, prefix: &str) -> String {
+    let mut line = String::new();
+    output.read_line(&mut line).unwrap();
+    line.trim()
+        .strip_prefix(prefix)
+        .unwrap_or_else(|| panic!("expected a line starting {prefix:?}, got {line:?}"))
+        .to_string()
 }
 
 /// Sends process `pid` a signal (INT, TERM, STOP, CONT) with the `kill` command.
