@@ -142,7 +142,6 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
         spp: Some(16),
         ..SETTINGS_OVERRIDES
     };
-    let two_threads = || Executor::InProcess { threads: Some(2) };
     let uniform = dir.path().join("uniform.png");
     render_here(
         request_with(&scene, &uniform, &settings, None),

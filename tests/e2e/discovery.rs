@@ -153,8 +153,7 @@ fn workers_join_and_leave_as_the_name_resolves() {
     let scene = write_scene(dir.path());
     let expected = {
         let out = dir.path().join("in-process.png");
-        let in_process = Executor::InProcess { threads: Some(2) };
-        render_here(request(&scene, &out), in_process).unwrap();
+        render_here(request(&scene, &out), two_threads()).unwrap();
         image_bytes(&out)
     };
     let ips = [

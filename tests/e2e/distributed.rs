@@ -16,11 +16,7 @@ use crate::util::*;
 /// The in-process render of the test scene: (PNG bytes, EXR bytes).
 fn reference(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {
     let out = dir.join("in-process.png");
-    render_here(
-        request(scene, &out),
-        Executor::InProcess { threads: Some(2) },
-    )
-    .unwrap();
+    render_here(request(scene, &out), two_threads()).unwrap();
     image_bytes(&out)
 }
 

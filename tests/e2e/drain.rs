@@ -17,8 +17,7 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let reference = dir.path().join("in-process.png");
-    let in_process = Executor::InProcess { threads: Some(2) };
-    render_here(request(&scene, &reference), in_process).unwrap();
+    render_here(request(&scene, &reference), two_threads()).unwrap();
     let expected = image_bytes(&reference);
 
     let mut a = Worker::start(&["--throttle-ms", "150"]);

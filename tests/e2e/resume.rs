@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
-use yat::render::{Executor, Observers};
+use yat::render::Observers;
 use yat::shutdown::{Interrupt, Interrupted};
 use yat_tracer::render::RenderOverrides;
 
@@ -244,7 +244,6 @@ fn a_render_its_caller_interrupts_resumes_to_the_same_image() {
         spp: Some(256),
         ..SETTINGS_OVERRIDES
     };
-    let two_threads = || Executor::InProcess { threads: Some(2) };
     let fresh = dir.path().join("fresh.png");
     render_here(request_with(&scene, &fresh, &long, None), two_threads()).unwrap();
 

@@ -173,6 +173,11 @@ pub fn workers_at(addresses: &[&str]) -> DistributedConfig {
     }
 }
 
+/// The in-process executor on two threads: the reference renders'.
+pub fn two_threads() -> Executor {
+    Executor::InProcess { threads: Some(2) }
+}
+
 /// Renders `request` on `executor` in this process, quiet and writing no interim file.
 pub fn render_here(request: RenderRequest, executor: Executor) -> anyhow::Result<RenderReport> {
     yat::render::render(request, executor, Observers::none(), Interrupt::default())
