@@ -9,7 +9,6 @@ use std::time::{Duration, Instant};
 use yat::render::{Executor, Observers};
 use yat::shutdown::Interrupt;
 use yat_tracer::render::adaptive::AdaptiveSettings;
-use yat_tracer::render::RenderOverrides;
 
 use crate::util::*;
 
@@ -138,10 +137,7 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
     // the uniform render's image, up to the f32 rounding of the other unit cut.
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let settings = RenderOverrides {
-        spp: Some(16),
-        ..SETTINGS_OVERRIDES
-    };
+    let settings = settings_with_spp(16);
     let uniform = dir.path().join("uniform.png");
     render_here(
         request_with(&scene, &uniform, &settings, None),

@@ -151,11 +151,7 @@ fn wait_for(worker: &Worker, units: u64) {
 fn workers_join_and_leave_as_the_name_resolves() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = {
-        let out = dir.path().join("in-process.png");
-        render_here(request(&scene, &out), two_threads()).unwrap();
-        image_bytes(&out)
-    };
+    let expected = reference_image(dir.path(), &scene);
     let ips = [
         Ipv4Addr::new(127, 0, 0, 2),
         Ipv4Addr::new(127, 0, 0, 3),

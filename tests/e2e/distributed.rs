@@ -13,13 +13,6 @@ use yat_proto::flags::ClientTlsFlags;
 
 use crate::util::*;
 
-/// The in-process render of the test scene: (PNG bytes, EXR bytes).
-fn reference(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {
-    let out = dir.join("in-process.png");
-    render_here(request(scene, &out), two_threads()).unwrap();
-    image_bytes(&out)
-}
-
 fn assert_same_image(out: &Path, expected: &(Vec<u8>, Vec<u8>)) {
     let (png, exr) = image_bytes(out);
     assert!(
@@ -67,7 +60,7 @@ fn error_of(render: anyhow::Result<yat::render_report::RenderReport>) -> String 
 fn two_workers_and_local_workers_match_the_in_process_render() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let a = Worker::start(&[]);
     let b = Worker::start(&[]);
     let out = dir.path().join("two.png");
@@ -106,7 +99,7 @@ fn two_workers_and_local_workers_match_the_in_process_render() {
 fn a_killed_worker_costs_only_time() {
     let dir = tempfile::tempdir().unwrap();
     let (scene, [mut a, b]) = two_slow_workers(dir.path(), "100");
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let a_address = a.address.clone();
     let out = dir.path().join("killed.png");
     let json = dir.path().join("killed.json");
@@ -147,7 +140,7 @@ fn a_killed_worker_costs_only_time() {
 fn a_frozen_worker_costs_only_time() {
     let dir = tempfile::tempdir().unwrap();
     let (scene, [a, b]) = two_slow_workers(dir.path(), "100");
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let out = dir.path().join("frozen.png");
     let json = dir.path().join("frozen.json");
     let config = DistributedConfig {
@@ -185,7 +178,7 @@ fn free_address() -> String {
 fn a_late_worker_receives_units() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let late_address = free_address();
     let a = Worker::start(&["--throttle-ms", "250"]);
     let out = dir.path().join("late.png");
@@ -306,7 +299,7 @@ fn write_tls_files(dir: &Path) -> [std::path::PathBuf; 3] {
 fn tls_workers_render_for_a_coordinator_that_trusts_their_ca() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let [ca, cert, key] = write_tls_files(dir.path());
     let worker = Worker::start(&[
         "--tls-cert",

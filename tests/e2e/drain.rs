@@ -16,9 +16,7 @@ use crate::util::*;
 fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let reference = dir.path().join("in-process.png");
-    render_here(request(&scene, &reference), two_threads()).unwrap();
-    let expected = image_bytes(&reference);
+    let expected = reference_image(dir.path(), &scene);
 
     let mut a = Worker::start(&["--throttle-ms", "150"]);
     // b is the slower: a's units are its own, not end-game copies of b's, when it is signalled.

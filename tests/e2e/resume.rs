@@ -8,7 +8,6 @@ use std::time::{Duration, Instant};
 
 use yat::render::Observers;
 use yat::shutdown::{Interrupt, Interrupted};
-use yat_tracer::render::RenderOverrides;
 
 use crate::util::*;
 
@@ -240,10 +239,7 @@ fn a_checkpoint_of_another_render_is_not_used() {
 fn a_render_its_caller_interrupts_resumes_to_the_same_image() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let long = RenderOverrides {
-        spp: Some(256),
-        ..SETTINGS_OVERRIDES
-    };
+    let long = settings_with_spp(256);
     let fresh = dir.path().join("fresh.png");
     render_here(request_with(&scene, &fresh, &long, None), two_threads()).unwrap();
 

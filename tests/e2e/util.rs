@@ -147,6 +147,14 @@ pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
     latlong: yat_tracer::desc::LatLongConvention::Seed,
 };
 
+/// [`SETTINGS_OVERRIDES`] with `spp` samples per pixel.
+pub fn settings_with_spp(spp: u32) -> RenderOverrides {
+    RenderOverrides {
+        spp: Some(spp),
+        ..SETTINGS_OVERRIDES
+    }
+}
+
 /// The request `yat render SCENE -o OUT --exr` makes with `overrides` (and `adaptive`).
 pub fn request_with(
     scene: &Path,
@@ -181,6 +189,14 @@ pub fn two_threads() -> Executor {
 /// Renders `request` on `executor` in this process, quiet and writing no interim file.
 pub fn render_here(request: RenderRequest, executor: Executor) -> anyhow::Result<RenderReport> {
     yat::render::render(request, executor, Observers::none(), Interrupt::default())
+}
+
+/// The in-process render of `scene` with the test settings, into `dir`/in-process.png: (PNG
+/// bytes, EXR bytes), what every other render of it must match.
+pub fn reference_image(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {
+    let out = dir.join("in-process.png");
+    render_here(request(scene, &out), two_threads()).unwrap();
+    image_bytes(&out)
 }
 
 /// [`yat::render::render`] on a thread of its own, as a coordinator beside the test.
