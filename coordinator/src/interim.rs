@@ -60,14 +60,14 @@ impl Default for InterimClock {
 
 /// Which interim outputs to write now.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Due {
+pub struct DueOutputs {
     pub preview: bool,
     pub checkpoint: bool,
     /// A new image for the status page (the board says when).
     pub status_image: bool,
 }
 
-impl Due {
+impl DueOutputs {
     pub fn any(self) -> bool {
         self.preview || self.checkpoint || self.status_image
     }
@@ -75,7 +75,7 @@ impl Due {
 
 impl InterimOutputs {
     /// The outputs whose period has passed; their clocks restart now.
-    pub fn due(&self, clock: &mut InterimClock) -> Due {
+    pub fn due(&self, clock: &mut InterimClock) -> DueOutputs {
         let restart = |last: &mut Instant, every: Option<Duration>| {
             let due = every.is_some_and(|every| last.elapsed() >= every);
             if due {
@@ -83,7 +83,7 @@ impl InterimOutputs {
             }
             due
         };
-        Due {
+        DueOutputs {
             preview: restart(&mut clock.preview, self.preview.as_ref().map(|p| p.every)),
             checkpoint: restart(
                 &mut clock.checkpoint,
@@ -96,7 +96,12 @@ impl InterimOutputs {
     /// The part of writing the due outputs that reads the render so far, and is quick: tone
     /// mapping the preview (once, for the file and the status page), writing the checkpoint's
     /// bytes. Render threads wait for it.
-    pub fn stage(&self, due: Due, checkpoint: &Checkpoint, desc: &FilmDesc) -> StagedOutputs {
+    pub fn stage(
+        &self,
+        due: DueOutputs,
+        checkpoint: &Checkpoint,
+        desc: &FilmDesc,
+    ) -> StagedOutputs {
         let preview_file = self.preview.as_ref().filter(|_| due.preview);
         let started = Instant::now();
         let image = (preview_file.is_some() || due.status_image)
@@ -181,7 +186,7 @@ mod tests {
             status: StatusBoard::unserved(),
         };
         let mut clock = InterimClock::default();
-        assert_eq!(outputs.due(&mut clock), Due::default());
+        assert_eq!(outputs.due(&mut clock), DueOutputs::default());
         std::thread::sleep(Duration::from_millis(250));
         let due = outputs.due(&mut clock);
         assert!(due.preview && !due.checkpoint && due.any());

@@ -29,7 +29,7 @@ pub const V3_NAME: &str = "x86-64-v3";
 
 /// What a starting `yat` does about its instruction set.
 #[derive(Debug, PartialEq, Eq)]
-pub enum Start {
+pub enum IsaChoice {
     /// Run this binary.
     Stay,
     /// Replace the process with this x86-64-v3 build.
@@ -48,27 +48,27 @@ pub fn choose(
     cpu_has_v3: bool,
     isa_env: Option<&OsStr>,
     is_executable: impl Fn(&Path) -> bool,
-) -> Start {
+) -> IsaChoice {
     if built_for_v3 {
         return if cpu_has_v3 {
-            Start::Stay
+            IsaChoice::Stay
         } else {
-            Start::Unsupported
+            IsaChoice::Unsupported
         };
     }
     if !cpu_has_v3 || isa_env.is_some_and(|v| v == "baseline" || v == V3_NAME) {
-        return Start::Stay;
+        return IsaChoice::Stay;
     }
     let Some(name) = exe.file_name() else {
-        return Start::Stay;
+        return IsaChoice::Stay;
     };
     let mut sibling_name = name.to_os_string();
     sibling_name.push(V3_SUFFIX);
     let sibling = exe.with_file_name(sibling_name);
     if is_executable(&sibling) {
-        Start::HandOver(sibling)
+        IsaChoice::HandOver(sibling)
     } else {
-        Start::Stay
+        IsaChoice::Stay
     }
 }
 
@@ -87,14 +87,14 @@ pub fn start() -> Result<(), String> {
         isa_env.as_deref(),
         is_executable,
     ) {
-        Start::Stay => Ok(()),
-        Start::Unsupported => Err(format!(
+        IsaChoice::Stay => Ok(()),
+        IsaChoice::Unsupported => Err(format!(
             "{} was built for x86-64-v3 (AVX2, FMA, BMI2) and this CPU lacks some of it: run \
              the baseline build ({} without the suffix)",
             exe.display(),
             V3_SUFFIX
         )),
-        Start::HandOver(sibling) => {
+        IsaChoice::HandOver(sibling) => {
             hand_over(&sibling);
             Ok(())
         }
@@ -179,7 +179,7 @@ pub fn is_executable(path: &Path) -> bool {
 mod tests {
     use super::*;
 
-    fn start(built_for_v3: bool, cpu_has_v3: bool, env: Option<&str>, sibling: bool) -> Start {
+    fn start(built_for_v3: bool, cpu_has_v3: bool, env: Option<&str>, sibling: bool) -> IsaChoice {
         choose(
             Path::new("/opt/yat/bin/yat"),
             built_for_v3,
@@ -194,29 +194,29 @@ mod tests {
         let sibling = PathBuf::from("/opt/yat/bin/yat-x86-64-v3");
         assert_eq!(
             start(false, true, None, true),
-            Start::HandOver(sibling.clone())
+            IsaChoice::HandOver(sibling.clone())
         );
         assert_eq!(
             start(false, true, Some("auto"), true),
-            Start::HandOver(sibling)
+            IsaChoice::HandOver(sibling)
         );
-        assert_eq!(start(false, false, None, true), Start::Stay);
-        assert_eq!(start(false, true, None, false), Start::Stay);
-        assert_eq!(start(false, true, Some("baseline"), true), Start::Stay);
+        assert_eq!(start(false, false, None, true), IsaChoice::Stay);
+        assert_eq!(start(false, true, None, false), IsaChoice::Stay);
+        assert_eq!(start(false, true, Some("baseline"), true), IsaChoice::Stay);
         // Handed over already (a baseline binary under the sibling's name): no second exec.
-        assert_eq!(start(false, true, Some(V3_NAME), true), Start::Stay);
+        assert_eq!(start(false, true, Some(V3_NAME), true), IsaChoice::Stay);
     }
 
     #[test]
     fn a_v3_build_runs_only_where_the_cpu_has_v3() {
-        assert_eq!(start(true, true, None, false), Start::Stay);
-        assert_eq!(start(true, true, Some("baseline"), true), Start::Stay);
-        assert_eq!(start(true, false, None, true), Start::Unsupported);
+        assert_eq!(start(true, true, None, false), IsaChoice::Stay);
+        assert_eq!(start(true, true, Some("baseline"), true), IsaChoice::Stay);
+        assert_eq!(start(true, false, None, true), IsaChoice::Unsupported);
     }
 
     #[test]
     fn a_path_without_a_file_name_stays() {
         let start = choose(Path::new("/"), false, true, None, |_| true);
-        assert_eq!(start, Start::Stay);
+        assert_eq!(start, IsaChoice::Stay);
     }
 }

@@ -1,5 +1,6 @@
-//! A render job: the scene, the settings that decide the image, and the outputs (the final
-//! image, the interim preview and checkpoint); and what rendering it yields, whoever renders it.
+//! A render job as the executors see it (made by [`crate::render::render`]): the scene, the
+//! settings that decide the image, and the outputs (the final image, the interim preview and
+//! checkpoint); and what rendering it yields, whoever renders it.
 
 use std::path::{Component, Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -30,8 +31,8 @@ pub struct RenderJob {
     pub quiet: bool,
     /// The preview and the checkpoint, written as the render goes.
     pub interim: InterimOutputs,
-    /// Set by Ctrl-C or SIGTERM: the render stops, saving what it can (the checkpoint, the
-    /// preview) and saying what is lost.
+    /// Once set (by Ctrl-C, SIGTERM or the caller), the render stops, saving what it can (the
+    /// checkpoint, the preview) and saying what is lost.
     pub interrupt: Interrupt,
     /// `--time-limit`: when an adaptive render stops at a round boundary.
     pub deadline: Option<Instant>,
@@ -204,7 +205,7 @@ impl RenderJob {
             return None;
         }
         // The best image so far, every merged unit in it: the preview, when previews are on.
-        let preview = crate::interim::Due {
+        let preview = crate::interim::DueOutputs {
             preview: true,
             checkpoint: false,
             status_image: self.interim.status.serving(),

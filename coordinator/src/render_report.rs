@@ -2,6 +2,7 @@
 
 use std::time::Duration;
 
+use crate::exec::distributed::report::DistributedReport;
 use crate::job::{RenderJob, RenderOutcome};
 
 #[derive(serde::Serialize)]
@@ -29,6 +30,10 @@ pub struct RenderReport {
     /// The build of the coordinator's process ([`crate::isa::build_name`]), which renders an
     /// in-process render.
     pub instruction_set: &'static str,
+    /// A distributed render's figures of the workers and the coordinator (`--workers-json`
+    /// writes them, the stats JSON leaves them out).
+    #[serde(skip)]
+    pub workers: Option<DistributedReport>,
 }
 
 impl RenderReport {
@@ -55,6 +60,7 @@ impl RenderReport {
             peak_memory_bytes: peak_memory_bytes(),
             adaptive_rounds: outcome.round.as_ref().map(|r| r.index + 1),
             instruction_set: crate::isa::build_name(),
+            workers: None,
         }
     }
 

@@ -1,6 +1,6 @@
-//! Interrupt handling: Ctrl-C (SIGINT) and SIGTERM, as a flag a render polls ([`Interrupt`]),
-//! the error of a render they stopped ([`Interrupted`]), or a future a server awaits
-//! ([`signalled`]).
+//! Stopping a render or a server: a flag the caller of a render owns and the render polls
+//! ([`Interrupt`], which `yat render` wires to Ctrl-C (SIGINT) and SIGTERM), the error of a
+//! render it stopped ([`Interrupted`]), and a future a server awaits ([`signalled`]).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -8,13 +8,13 @@ use std::sync::Arc;
 use anyhow::Context;
 use tokio::signal::unix::SignalKind;
 
-/// Ctrl-C and SIGTERM as a flag the render loops poll: the first signal stops the render,
-/// saving what it merged where it can and saying what is lost; a second one ends the process
-/// at once.
+/// A flag the render loops poll: once set, the render stops, saving what it merged where it
+/// can and saying what is lost. The caller owns it: [`Interrupt::install`] sets it on Ctrl-C and
+/// SIGTERM, [`Interrupt::cancel`] from code; a default one is set by nothing else.
 #[derive(Clone, Default)]
 pub struct Interrupt {
     set: Arc<AtomicBool>,
-    /// The number of the signal that set it.
+    /// The number of the signal that set it; 0 when [`Interrupt::cancel`] did.
     signal: Arc<AtomicUsize>,
 }
 
@@ -22,6 +22,8 @@ pub struct Interrupt {
 pub const INTERRUPTED_EXIT_CODE: u8 = 130;
 
 impl Interrupt {
+    /// An interrupt Ctrl-C and SIGTERM set: the first signal stops the render, a second one
+    /// ends the process at once.
     pub fn install() -> anyhow::Result<Self> {
         let interrupt = Self::default();
         for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
@@ -32,12 +34,18 @@ impl Interrupt {
                 interrupt.set.clone(),
             )
             .context("cannot watch for Ctrl-C")?;
-            signal_hook::flag::register(signal, interrupt.set.clone())
-                .context("cannot watch for Ctrl-C")?;
+            // The signal's number before the flag, so whoever sees the flag sees its cause.
             signal_hook::flag::register_usize(signal, interrupt.signal.clone(), signal as usize)
+                .context("cannot watch for Ctrl-C")?;
+            signal_hook::flag::register(signal, interrupt.set.clone())
                 .context("cannot watch for Ctrl-C")?;
         }
         Ok(interrupt)
+    }
+
+    /// Stops the render as a signal would, the caller its cause.
+    pub fn cancel(&self) {
+        self.set.store(true, Ordering::Relaxed);
     }
 
     pub fn is_set(&self) -> bool {
@@ -47,18 +55,19 @@ impl Interrupt {
     /// The signal that set the flag, as a user knows it.
     pub fn cause(&self) -> &'static str {
         match self.signal.load(Ordering::Relaxed) as i32 {
+            0 => "its caller",
             signal_hook::consts::SIGTERM => "SIGTERM",
             _ => "Ctrl-C (SIGINT)",
         }
     }
 }
 
-/// The error of a render stopped by Ctrl-C or SIGTERM; `main` exits with
-/// [`INTERRUPTED_EXIT_CODE`] on it.
+/// The error of a render its [`Interrupt`] stopped; `main` exits with [`INTERRUPTED_EXIT_CODE`]
+/// on it.
 #[derive(Debug, thiserror::Error)]
 #[error("interrupted by {cause}; {kept}")]
 pub struct Interrupted {
-    /// The signal, as [`Interrupt::cause`] names it.
+    /// The signal or the caller, as [`Interrupt::cause`] names it.
     pub cause: &'static str,
     /// What became of the samples merged before it.
     pub kept: String,

@@ -3,12 +3,17 @@
 //! and resume; the sample map shows where the samples went.
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
+
+use yat::render::{Executor, Observers};
+use yat::shutdown::Interrupt;
+use yat_tracer::render::adaptive::AdaptiveSettings;
 
 use crate::util::*;
 
-/// Up to 64 samples per pixel in five rounds (4, 4, 8, 16, 32 samples) of at most 4 units.
+/// Up to 64 samples per pixel in five rounds (4, 4, 8, 16, 32 samples) of at most 4 units
+/// (the --spp and --resolution of [`SETTINGS`]).
 const ADAPTIVE: [&str; 8] = [
     "--spp",
     "64",
@@ -21,26 +26,13 @@ const ADAPTIVE: [&str; 8] = [
 ];
 
 fn adaptive_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut command = render_command_with(scene, out, &ADAPTIVE, extra);
-    command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    command
+    piped_render_command(scene, out, &ADAPTIVE, extra)
 }
 
 fn assert_same(out: &Path, expected: &(Vec<u8>, Vec<u8>), what: &str) {
     let (png, exr) = image_bytes(out);
     assert!(exr == expected.1, "{what}: the EXR differs from in-process");
     assert!(png == expected.0, "{what}: the PNG differs from in-process");
-}
-
-fn signal(child: &Child, name: &str) {
-    let status = Command::new("kill")
-        .args([&format!("-{name}"), &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success(), "kill -{name} failed");
 }
 
 #[test]
@@ -85,25 +77,24 @@ fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
     assert_success(&output);
     assert_same(&out, &expected, "2 local workers");
 
-    // Two workers, one killed half way: its units go to the other.
+    // Two workers, one killed half way: its units go to the other. The coordinator is the
+    // library's render in this process.
     let mut a = Worker::start(&["--throttle-ms", "40"]);
     let b = Worker::start(&["--throttle-ms", "40"]);
-    let workers = format!("{},{}", a.address, b.address);
     let out = dir.path().join("killed.png");
-    let render = adaptive_render(&scene, &out, &["--workers", &workers])
-        .spawn()
-        .unwrap();
-    let started = Instant::now();
-    while a.stats(None).units_done + b.stats(None).units_done < 6 {
-        assert!(
-            started.elapsed() < Duration::from_secs(60),
-            "render stalled"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let adaptive = AdaptiveSettings {
+        threshold: 0.15,
+        min_spp: 4,
+    };
+    let coordinator = spawn_render(
+        request_with(&scene, &out, &SETTINGS_OVERRIDES, Some(adaptive)),
+        Executor::from(workers_at(&[&a.address, &b.address])),
+        Observers::none(),
+        Interrupt::default(),
+    );
+    wait_for_units(&[&a, &b], 6);
     a.kill();
-    let output = render.wait_with_output().unwrap();
-    assert_success(&output);
+    coordinator.join().unwrap().unwrap();
     assert_same(&out, &expected, "a worker killed half way");
 
     // Stopped by Ctrl-C once a checkpoint is saved, then resumed in-process. The first part
@@ -126,7 +117,7 @@ fn adaptive_images_are_the_same_bytes_wherever_and_however_rendered() {
     }
     // Into a later round, where the checkpoint holds decisions.
     std::thread::sleep(Duration::from_millis(300));
-    signal(&render, "INT");
+    signal(render.id(), "INT");
     let stopped = render.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&stopped.stderr);
     assert_eq!(stopped.status.code(), Some(130), "{stderr}");
@@ -146,22 +137,20 @@ fn an_adaptive_render_of_one_round_matches_the_uniform_render() {
     // the uniform render's image, up to the f32 rounding of the other unit cut.
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let settings = ["--spp", "16", "--resolution", "128x96"];
+    let settings = settings_with_spp(16);
     let uniform = dir.path().join("uniform.png");
-    let output = render_command_with(&scene, &uniform, &settings, &["--threads", "2", "--quiet"])
-        .output()
-        .unwrap();
-    assert_success(&output);
-    let adaptive = dir.path().join("adaptive.png");
-    let output = render_command_with(
-        &scene,
-        &adaptive,
-        &settings,
-        &["--noise-threshold", "0.5", "--min-spp", "16", "--quiet"],
+    render_here(
+        request_with(&scene, &uniform, &settings, None),
+        two_threads(),
     )
-    .output()
     .unwrap();
-    assert_success(&output);
+    let adaptive = dir.path().join("adaptive.png");
+    let one_round = AdaptiveSettings {
+        threshold: 0.5,
+        min_spp: 16,
+    };
+    let request = request_with(&scene, &adaptive, &settings, Some(one_round));
+    render_here(request, two_threads()).unwrap();
     // min-spp = spp: one round, every pixel 16 samples, the same samples as the uniform
     // render; only the unit cut differs (one unit per tile instead of 2 passes), which changes
     // the f32 sums' rounding at most.

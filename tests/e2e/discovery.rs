@@ -1,7 +1,8 @@
 //! DNS discovery end to end: a real DNS server in this process (hickory's in-memory authority
 //! for `yat.test.` on UDP and TCP loopback), real `yat worker` processes on 127.0.0.2-4 (one
-//! port, several loopback addresses, as a headless Service's pods share one), and the real
-//! coordinator following the name while its answer changes mid-render.
+//! port, several loopback addresses, as a headless Service's pods share one), and the
+//! coordinator (the library's render in this process) following the name while its answer
+//! changes mid-render.
 
 use std::collections::BTreeMap;
 use std::net::{Ipv4Addr, SocketAddr, TcpListener};
@@ -14,6 +15,9 @@ use hickory_server::proto::rr::rdata::{A, SOA};
 use hickory_server::proto::rr::{LowerName, Name, RData, Record, RecordSet, RecordType, RrKey};
 use hickory_server::store::in_memory::InMemoryAuthority;
 use hickory_server::ServerFuture;
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers};
+use yat::shutdown::Interrupt;
 
 use crate::util::*;
 
@@ -147,11 +151,7 @@ fn wait_for(worker: &Worker, units: u64) {
 fn workers_join_and_leave_as_the_name_resolves() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = {
-        let out = dir.path().join("in-process.png");
-        assert_success(&render(&scene, &out, &["--threads", "2", "--quiet"]));
-        image_bytes(&out)
-    };
+    let expected = reference_image(dir.path(), &scene);
     let ips = [
         Ipv4Addr::new(127, 0, 0, 2),
         Ipv4Addr::new(127, 0, 0, 3),
@@ -166,23 +166,18 @@ fn workers_join_and_leave_as_the_name_resolves() {
 
     let out = dir.path().join("dns.png");
     let json = dir.path().join("dns.json");
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &format!("workers.yat.test:{port}"),
-            "--resolve-every",
-            "0.5",
-            "--workers-json",
-            json.to_str().unwrap(),
-            "--checkpoint-every",
-            "0",
-        ],
-    )
-    .env("YAT_DNS_SERVER", dns.address.to_string())
-    .spawn()
-    .unwrap();
+    let by_name = DistributedConfig {
+        resolve_every: Duration::from_millis(500),
+        dns_server: Some(dns.address),
+        workers_json: Some(json.clone()),
+        ..workers_at(&[&format!("workers.yat.test:{port}")])
+    };
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        Executor::from(by_name),
+        Observers::none(),
+        Interrupt::default(),
+    );
 
     wait_for(a, 3);
     dns.set_workers(&ips[..2]);
@@ -190,8 +185,7 @@ fn workers_join_and_leave_as_the_name_resolves() {
     // A leaves the answer while it holds units; C joins.
     dns.set_workers(&ips[1..]);
     let removed = Instant::now();
-    let status = coordinator.wait().unwrap();
-    assert!(status.success(), "coordinator failed: {status}");
+    coordinator.join().unwrap().unwrap();
     // A unit presumed lost waits 30 s (the deadline floor): A finished what it held at once.
     assert!(
         removed.elapsed() < Duration::from_secs(25),
@@ -203,15 +197,7 @@ fn workers_join_and_leave_as_the_name_resolves() {
     assert!(exr == expected.1, "EXR differs from in-process");
     assert!(png == expected.0, "PNG differs from in-process");
     let report = workers_report(&json);
-    let entry = |worker: &Worker| {
-        report["workers"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|w| w["address"] == worker.address)
-            .unwrap_or_else(|| panic!("{} not in {report:#}", worker.address))
-            .clone()
-    };
+    let entry = |worker: &Worker| worker_entry(&report, &worker.address).clone();
     let (a, b, c) = (entry(a), entry(b), entry(c));
     for w in [&a, &b, &c] {
         assert_eq!(w["dns_name"], "workers.yat.test", "{report:#}");

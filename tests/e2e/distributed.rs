@@ -1,18 +1,17 @@
-//! Distributed rendering end to end: the real `yat` binary as coordinator and workers, real
-//! sockets on loopback. Every image must be bit-identical to the in-process render, whatever
-//! the workers do.
+//! Distributed rendering end to end: real `yat worker` processes on loopback sockets, the
+//! coordinator the library's render in this process (`yat render` where the test needs its
+//! process: its output, its local workers). Every image must be bit-identical to the in-process
+//! render, whatever the workers do.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use crate::util::*;
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers};
+use yat::shutdown::Interrupt;
+use yat_proto::flags::ClientTlsFlags;
 
-/// The in-process render of the test scene: (PNG bytes, EXR bytes).
-fn reference(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {
-    let out = dir.join("in-process.png");
-    assert_success(&render(scene, &out, &["--threads", "2", "--quiet"]));
-    image_bytes(&out)
-}
+use crate::util::*;
 
 fn assert_same_image(out: &Path, expected: &(Vec<u8>, Vec<u8>)) {
     let (png, exr) = image_bytes(out);
@@ -28,15 +27,6 @@ fn assert_same_image(out: &Path, expected: &(Vec<u8>, Vec<u8>)) {
     );
 }
 
-fn worker_entry<'a>(report: &'a serde_json::Value, address: &str) -> &'a serde_json::Value {
-    report["workers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["address"] == address)
-        .unwrap_or_else(|| panic!("{address} not in {report:#}"))
-}
-
 fn total_units(report: &serde_json::Value) -> u64 {
     report["workers"]
         .as_array()
@@ -46,44 +36,37 @@ fn total_units(report: &serde_json::Value) -> u64 {
         .sum()
 }
 
-/// Waits until the workers together have rendered `units` units.
-fn wait_for_units(workers: &[&Worker], units: u64) {
-    let started = Instant::now();
-    while workers
-        .iter()
-        .map(|w| w.stats(None).units_done)
-        .sum::<u64>()
-        < units
-    {
-        assert!(
-            started.elapsed() < Duration::from_secs(30),
-            "render stalled"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+/// Two workers that pause `throttle_ms` before each unit, and the test scene in `dir`.
+fn two_slow_workers(dir: &Path, throttle_ms: &str) -> (std::path::PathBuf, [Worker; 2]) {
+    let throttle = ["--throttle-ms", throttle_ms];
+    let scene = write_scene(dir);
+    (scene, [Worker::start(&throttle), Worker::start(&throttle)])
+}
+
+/// `config` with its figures written to `json`.
+fn reporting_to(json: &Path, config: DistributedConfig) -> Executor {
+    Executor::from(DistributedConfig {
+        workers_json: Some(json.into()),
+        ..config
+    })
+}
+
+/// The error text of a render that failed, as `yat render` prints it.
+fn error_of(render: anyhow::Result<yat::render_report::RenderReport>) -> String {
+    format!("{:?}", render.err().expect("the render fails"))
 }
 
 #[test]
 fn two_workers_and_local_workers_match_the_in_process_render() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let a = Worker::start(&[]);
     let b = Worker::start(&[]);
     let out = dir.path().join("two.png");
     let json = dir.path().join("two.json");
-    let workers = format!("{},{}", a.address, b.address);
-    let output = render(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    );
-    assert_success(&output);
+    let on_both = workers_at(&[&a.address, &b.address]);
+    render_here(request(&scene, &out), reporting_to(&json, on_both)).unwrap();
     assert_same_image(&out, &expected);
     let report = workers_report(&json);
     assert_eq!(report["units"], 32);
@@ -99,47 +82,45 @@ fn two_workers_and_local_workers_match_the_in_process_render() {
         report["result_bytes_per_unit_pixel"],
         16.0 * 13200.0 / 12288.0
     );
+
+    // Local workers are `yat worker` processes of the coordinator's own binary.
+    let out = dir.path().join("local.png");
+    let output = render(&scene, &out, &["--local-workers", "2"]);
+    assert_success(&output);
+    assert_same_image(&out, &expected);
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(
-        stdout.contains("samples/s") && stdout.contains(&a.address),
-        "{stdout}"
+        stdout.contains("samples/s") && stdout.contains("127.0.0.1:"),
+        "the workers' figures are printed: {stdout}"
     );
-
-    let out = dir.path().join("local.png");
-    assert_success(&render(&scene, &out, &["--local-workers", "2"]));
-    assert_same_image(&out, &expected);
 }
 
 #[test]
 fn a_killed_worker_costs_only_time() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
-    let mut a = Worker::start(&["--throttle-ms", "100"]);
-    let b = Worker::start(&["--throttle-ms", "100"]);
-    let (a_address, workers) = (a.address.clone(), format!("{},{}", a.address, b.address));
+    let (scene, [mut a, b]) = two_slow_workers(dir.path(), "100");
+    let expected = reference_image(dir.path(), &scene);
+    let a_address = a.address.clone();
     let out = dir.path().join("killed.png");
     let json = dir.path().join("killed.json");
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    )
-    .args(["--preview-every", "0.1"])
-    .spawn()
-    .unwrap();
+    let observers = Observers {
+        preview_every: Some(Duration::from_millis(100)),
+        ..Observers::none()
+    };
+    let on_both = workers_at(&[&a.address, &b.address]);
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        reporting_to(&json, on_both),
+        observers,
+        Interrupt::default(),
+    );
     wait_for_units(&[&a, &b], 12);
     assert!(
         out.with_extension("preview.png").exists(),
         "a preview is written during the render"
     );
     a.kill();
-    assert!(coordinator.wait().unwrap().success());
+    coordinator.join().unwrap().unwrap();
     assert_same_image(&out, &expected);
     assert!(
         !out.with_extension("preview.png").exists(),
@@ -158,31 +139,25 @@ fn a_killed_worker_costs_only_time() {
 #[test]
 fn a_frozen_worker_costs_only_time() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
-    let a = Worker::start(&["--throttle-ms", "100"]);
-    let b = Worker::start(&["--throttle-ms", "100"]);
-    let workers = format!("{},{}", a.address, b.address);
+    let (scene, [a, b]) = two_slow_workers(dir.path(), "100");
+    let expected = reference_image(dir.path(), &scene);
     let out = dir.path().join("frozen.png");
     let json = dir.path().join("frozen.json");
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    )
-    .env("YAT_UNIT_DEADLINE", "2")
-    .spawn()
-    .unwrap();
+    let config = DistributedConfig {
+        unit_deadline: Some(Duration::from_secs(2)),
+        ..workers_at(&[&a.address, &b.address])
+    };
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        reporting_to(&json, config),
+        Observers::none(),
+        Interrupt::default(),
+    );
     wait_for_units(&[&a, &b], 8);
     b.signal("STOP");
-    let status = coordinator.wait().unwrap();
+    let rendered = coordinator.join().unwrap();
     b.signal("CONT");
-    assert!(status.success());
+    rendered.unwrap();
     assert_same_image(&out, &expected);
     let report = workers_report(&json);
     assert_eq!(total_units(&report), 32);
@@ -193,34 +168,30 @@ fn a_frozen_worker_costs_only_time() {
     );
 }
 
+/// A loopback address nothing listens on (yet).
+fn free_address() -> String {
+    let probe = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    probe.local_addr().unwrap().to_string()
+}
+
 #[test]
 fn a_late_worker_receives_units() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
-    let late_address = {
-        let probe = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
-        probe.local_addr().unwrap().to_string()
-    };
+    let expected = reference_image(dir.path(), &scene);
+    let late_address = free_address();
     let a = Worker::start(&["--throttle-ms", "250"]);
-    let workers = format!("{},{late_address}", a.address);
     let out = dir.path().join("late.png");
     let json = dir.path().join("late.json");
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    )
-    .spawn()
-    .unwrap();
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        reporting_to(&json, workers_at(&[&a.address, &late_address])),
+        Observers::none(),
+        Interrupt::default(),
+    );
     wait_for_units(&[&a], 2);
     let late = Worker::start_on(&late_address, &["--throttle-ms", "250"]);
-    assert!(coordinator.wait().unwrap().success());
+    coordinator.join().unwrap().unwrap();
     assert_same_image(&out, &expected);
     let report = workers_report(&json);
     assert_eq!(total_units(&report), 32);
@@ -236,24 +207,22 @@ fn a_wrong_or_missing_token_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let worker = Worker::start(&["--token", "correct horse"]);
+    let with_token = |token: Option<&str>| DistributedConfig {
+        token: token.map(String::from),
+        ..workers_at(&[&worker.address])
+    };
     for token in [Some("battery staple"), None] {
-        let mut args = vec!["--workers", worker.address.as_str(), "--timeout", "20"];
-        if let Some(token) = token {
-            args.extend(["--token", token]);
-        }
-        let output = render(&scene, &dir.path().join("refused.png"), &args);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{stderr}");
-        assert!(stderr.contains("authentication"), "{stderr}");
+        let refused = DistributedConfig {
+            timeout: Some(Duration::from_secs(20)),
+            ..with_token(token)
+        };
+        let out = dir.path().join("refused.png");
+        let error = error_of(render_here(request(&scene, &out), Executor::from(refused)));
+        assert!(error.contains("authentication"), "{error}");
     }
     let out = dir.path().join("accepted.png");
-    let workers = worker.address.as_str();
-    let output = render(
-        &scene,
-        &out,
-        &["--workers", workers, "--token", "correct horse"],
-    );
-    assert_success(&output);
+    let accepted = with_token(Some("correct horse"));
+    render_here(request(&scene, &out), Executor::from(accepted)).unwrap();
 }
 
 #[test]
@@ -263,17 +232,9 @@ fn a_second_render_sends_no_scene_bytes() {
     let worker = Worker::start(&[]);
     let sent = |name: &str| {
         let json = dir.path().join(format!("{name}.json"));
-        let output = render(
-            &scene,
-            &dir.path().join(format!("{name}.png")),
-            &[
-                "--workers",
-                &worker.address,
-                "--workers-json",
-                json.to_str().unwrap(),
-            ],
-        );
-        assert_success(&output);
+        let out = dir.path().join(format!("{name}.png"));
+        let on_worker = reporting_to(&json, workers_at(&[&worker.address]));
+        render_here(request(&scene, &out), on_worker).unwrap();
         worker_entry(&workers_report(&json), &worker.address)["blob_bytes_sent"]
             .as_u64()
             .unwrap()
@@ -298,20 +259,16 @@ fn a_second_render_sends_no_scene_bytes() {
 fn with_no_worker_the_render_stops_after_its_timeout() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let nobody = {
-        let probe = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
-        probe.local_addr().unwrap().to_string()
-    };
+    let nobody = free_address();
     let started = Instant::now();
-    let output = render(
-        &scene,
-        &dir.path().join("never.png"),
-        &["--workers", &nobody, "--timeout", "1.5"],
-    );
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success());
-    assert!(stderr.contains("no worker connected"), "{stderr}");
-    assert!(stderr.contains(&nobody), "names the worker: {stderr}");
+    let config = DistributedConfig {
+        timeout: Some(Duration::from_millis(1500)),
+        ..workers_at(&[&nobody])
+    };
+    let out = dir.path().join("never.png");
+    let error = error_of(render_here(request(&scene, &out), Executor::from(config)));
+    assert!(error.contains("no worker connected"), "{error}");
+    assert!(error.contains(&nobody), "names the worker: {error}");
     let took = started.elapsed();
     assert!(
         took >= Duration::from_millis(1500) && took < Duration::from_secs(10),
@@ -342,7 +299,7 @@ fn write_tls_files(dir: &Path) -> [std::path::PathBuf; 3] {
 fn tls_workers_render_for_a_coordinator_that_trusts_their_ca() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let expected = reference(dir.path(), &scene);
+    let expected = reference_image(dir.path(), &scene);
     let [ca, cert, key] = write_tls_files(dir.path());
     let worker = Worker::start(&[
         "--tls-cert",
@@ -351,23 +308,28 @@ fn tls_workers_render_for_a_coordinator_that_trusts_their_ca() {
         key.to_str().unwrap(),
     ]);
     let out = dir.path().join("tls.png");
-    let tls = [
-        "--workers",
-        &worker.address,
-        "--tls-ca",
-        ca.to_str().unwrap(),
-        "--tls-domain",
-        "localhost",
-    ];
-    assert_success(&render(&scene, &out, &tls));
+    let tls = ClientTlsFlags {
+        tls_ca: Some(ca),
+        tls_domain: Some("localhost".into()),
+        ..ClientTlsFlags::default()
+    };
+    let trusting = DistributedConfig {
+        tls: tls.config().unwrap(),
+        tls_domain_given: true,
+        ..workers_at(&[&worker.address])
+    };
+    render_here(request(&scene, &out), Executor::from(trusting)).unwrap();
     assert_same_image(&out, &expected);
 
-    let plain = render(
-        &scene,
-        &dir.path().join("plain.png"),
-        &["--workers", &worker.address, "--timeout", "2"],
+    let plain = DistributedConfig {
+        timeout: Some(Duration::from_secs(2)),
+        ..workers_at(&[&worker.address])
+    };
+    let out = dir.path().join("plain.png");
+    assert!(
+        render_here(request(&scene, &out), Executor::from(plain)).is_err(),
+        "a plaintext client is not served"
     );
-    assert!(!plain.status.success(), "a plaintext client is not served");
 }
 
 /// The processes whose parent is `pid`.

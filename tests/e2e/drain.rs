@@ -1,9 +1,13 @@
 //! A worker under an orchestrator (Kubernetes, Slurm): SIGTERM mid-render drains it without
 //! costing the render anything but time, and `--threads` defaults to the CPUs it was given.
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers};
+use yat::shutdown::Interrupt;
 
 use crate::lit_sphere::LIT_SPHERE;
 use crate::util::*;
@@ -12,31 +16,24 @@ use crate::util::*;
 fn a_worker_terminated_mid_render_drains_and_exits_0() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
-    let reference = dir.path().join("in-process.png");
-    assert_success(&render(&scene, &reference, &["--threads", "2", "--quiet"]));
-    let expected = image_bytes(&reference);
+    let expected = reference_image(dir.path(), &scene);
 
     let mut a = Worker::start(&["--throttle-ms", "150"]);
     // b is the slower: a's units are its own, not end-game copies of b's, when it is signalled.
     let b = Worker::start(&["--throttle-ms", "300"]);
     let out = dir.path().join("drained.png");
     let json = dir.path().join("workers.json");
-    let workers = format!("{},{}", a.address, b.address);
     let started = Instant::now();
-    // No --unit-deadline: a unit lost in the drain would cost the default 30 s.
-    let mut coordinator = render_command(
-        &scene,
-        &out,
-        &[
-            "--workers",
-            &workers,
-            "--quiet",
-            "--workers-json",
-            json.to_str().unwrap(),
-        ],
-    )
-    .spawn()
-    .unwrap();
+    // No unit deadline: a unit lost in the drain would cost the default 30 s.
+    let coordinator = spawn_render(
+        request(&scene, &out),
+        Executor::from(DistributedConfig {
+            workers_json: Some(json.clone()),
+            ..workers_at(&[&a.address, &b.address])
+        }),
+        Observers::none(),
+        Interrupt::default(),
+    );
     let polling = Instant::now();
     // Signalled once a has returned a unit and is on another (its 2 threads pause 150 ms per
     // unit, so one in flight is on a thread, not queued).
@@ -55,7 +52,7 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
         .expect("the drained worker exits within --drain-seconds + 5 s");
     assert!(status.success(), "{status}");
     let drain = signalled.elapsed();
-    assert!(coordinator.wait().unwrap().success());
+    coordinator.join().unwrap().unwrap();
     let elapsed = started.elapsed();
     let (png, exr) = image_bytes(&out);
     assert!(exr == expected.1, "EXR differs from in-process");
@@ -67,14 +64,7 @@ fn a_worker_terminated_mid_render_drains_and_exits_0() {
     // The units a's threads were on (each pauses 150 ms first) were finished and merged, not
     // thrown away with the session when a's queue was handed back.
     let report = workers_report(&json);
-    let merged_by_a = report["workers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["address"] == a.address)
-        .unwrap()["units"]
-        .as_u64()
-        .unwrap();
+    let merged_by_a = worker_entry(&report, &a.address)["units"].as_u64().unwrap();
     assert!(
         merged_by_a > before.units_done,
         "a had {} unit(s) in flight and {} done at SIGTERM, and {merged_by_a} merged: {report:#}",
@@ -104,15 +94,8 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let address = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap()
-        .to_string();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let address = next_line_after(&mut stdout, "listening on ");
     let threads = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()

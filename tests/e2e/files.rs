@@ -138,17 +138,20 @@ fn a_film_filename_cannot_leave_the_current_folder() {
         "../../escape".to_string(),
         format!("{}", elsewhere.display()),
     ];
-    for filename in &cases {
-        let text = hostile::scene("Shape \"sphere\"").replace(
-            "\"string filename\" [\"hostile\"]",
-            &format!("\"string filename\" [\"{filename}\"]"),
-        );
+    // `yat render scene.lxs -q` in `work`, scene.lxs holding `text`.
+    let render_in_work = |text: String| {
         std::fs::write(work.join("scene.lxs"), text).unwrap();
-        let output = Command::new(YAT)
+        Command::new(YAT)
             .current_dir(&work)
             .args(["render", "scene.lxs", "-q"])
             .output()
-            .unwrap();
+            .unwrap()
+    };
+    for filename in &cases {
+        let output = render_in_work(hostile::scene("Shape \"sphere\"").replace(
+            "\"string filename\" [\"hostile\"]",
+            &format!("\"string filename\" [\"{filename}\"]"),
+        ));
         assert_success(&output);
         let err = stderr_of(&output);
         let name = Path::new(filename).file_name().unwrap().to_str().unwrap();
@@ -161,13 +164,7 @@ fn a_film_filename_cannot_leave_the_current_folder() {
     assert!(!root.path().join("a/escape.png").exists());
     assert!(!elsewhere.with_extension("png").exists());
 
-    let text = hostile::scene("").replace("[\"hostile\"]", "[\"..\"]");
-    std::fs::write(work.join("scene.lxs"), text).unwrap();
-    let output = Command::new(YAT)
-        .current_dir(&work)
-        .args(["render", "scene.lxs", "-q"])
-        .output()
-        .unwrap();
+    let output = render_in_work(hostile::scene("").replace("[\"hostile\"]", "[\"..\"]"));
     assert!(!output.status.success());
     assert!(
         stderr_of(&output).contains("names no file"),

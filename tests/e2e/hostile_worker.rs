@@ -378,13 +378,7 @@ impl Bench {
             "{misbehaviour:?}: {requests} requests to the fake"
         );
         let report = workers_report(&out.with_extension("json"));
-        let fake = report["workers"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|w| w["address"] == self.fake.address.as_str())
-            .unwrap()
-            .clone();
+        let fake = worker_entry(&report, &self.fake.address).clone();
         assert_eq!(fake["units"], 0, "{misbehaviour:?}: {report:#}");
         let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
         (fake, stderr)

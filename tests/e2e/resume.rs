@@ -1,9 +1,13 @@
-//! End-to-end: a render stopped by a crash (SIGKILL) or by Ctrl-C (SIGINT), in-process or on
-//! workers, resumes from its checkpoint to exactly the image of a render never stopped.
+//! End-to-end: a render stopped by a crash (SIGKILL), by Ctrl-C (SIGINT) or by the caller of the
+//! library's render, in-process or on workers, resumes from its checkpoint to exactly the image
+//! of a render never stopped.
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
+
+use yat::render::Observers;
+use yat::shutdown::{Interrupt, Interrupted};
 
 use crate::util::*;
 
@@ -12,12 +16,7 @@ use crate::util::*;
 const LONG: [&str; 4] = ["--spp", "256", "--resolution", "128x96"];
 
 fn long_render(scene: &Path, out: &Path, extra: &[&str]) -> Command {
-    let mut command = render_command_with(scene, out, &LONG, extra);
-    command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    command
+    piped_render_command(scene, out, &LONG, extra)
 }
 
 /// Waits until `checkpoint` holds something other than `before` (a newer save), the render
@@ -42,14 +41,6 @@ fn wait_until(render: &mut Child, what: &str, done: impl Fn() -> bool) {
         );
         std::thread::sleep(Duration::from_millis(10));
     }
-}
-
-fn signal(child: &Child, name: &str) {
-    let status = Command::new("kill")
-        .args([&format!("-{name}"), &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success(), "kill -{name} failed");
 }
 
 #[test]
@@ -94,7 +85,7 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
     .spawn()
     .unwrap();
     wait_for_new_checkpoint(&mut render, &checkpoint, Some(&after_crash));
-    signal(&render, "INT");
+    signal(render.id(), "INT");
     let interrupted = render.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&interrupted.stderr);
     assert_eq!(interrupted.status.code(), Some(130), "{stderr}");
@@ -168,7 +159,7 @@ fn sigterm_with_checkpoints_off_says_the_merged_samples_are_lost() {
     .unwrap();
     // An in-process render writes its preview after merging a unit.
     wait_until(&mut render, "merged a unit", || preview.exists());
-    signal(&render, "TERM");
+    signal(render.id(), "TERM");
     let stopped = render.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&stopped.stderr);
     assert_eq!(stopped.status.code(), Some(130), "{stderr}");
@@ -240,4 +231,65 @@ fn a_checkpoint_of_another_render_is_not_used() {
         std::fs::read(out.with_extension("exr")).unwrap(),
         std::fs::read(reference.with_extension("exr")).unwrap()
     );
+}
+
+/// The library's render stopped by its caller (the interrupt it was given) saves its
+/// checkpoint, and the same request resumes from it to the image of a render never stopped.
+#[test]
+fn a_render_its_caller_interrupts_resumes_to_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let long = settings_with_spp(256);
+    let fresh = dir.path().join("fresh.png");
+    render_here(request_with(&scene, &fresh, &long, None), two_threads()).unwrap();
+
+    let out = dir.path().join("stopped.png");
+    let checkpoint = out.with_extension("resume");
+    let checkpointing = || Observers {
+        checkpoint_every: Some(Duration::from_millis(50)),
+        ..Observers::none()
+    };
+    let interrupt = Interrupt::default();
+    let render = spawn_render(
+        request_with(&scene, &out, &long, None),
+        two_threads(),
+        checkpointing(),
+        interrupt.clone(),
+    );
+    let started = Instant::now();
+    while !checkpoint.exists() {
+        assert!(
+            !render.is_finished(),
+            "the render ended before a checkpoint"
+        );
+        assert!(started.elapsed() < Duration::from_secs(60), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    interrupt.cancel();
+    let error = render.join().unwrap().err().expect("the render stops");
+    let stopped = error
+        .downcast_ref::<Interrupted>()
+        .unwrap_or_else(|| panic!("{error:?}"));
+    assert_eq!(stopped.cause, "its caller");
+    assert!(stopped.kept.contains("kept in"), "{}", stopped.kept);
+    assert!(!out.exists(), "no final image from a stopped render");
+
+    let report = yat::render::render(
+        request_with(&scene, &out, &long, None),
+        two_threads(),
+        checkpointing(),
+        Interrupt::default(),
+    )
+    .unwrap();
+    assert!(
+        report.samples < 256 * 128 * 96,
+        "rendered only what the checkpoint lacked: {} samples",
+        report.samples
+    );
+    assert_eq!(
+        std::fs::read(out.with_extension("exr")).unwrap(),
+        std::fs::read(fresh.with_extension("exr")).unwrap(),
+        "resumed image differs from the uninterrupted one"
+    );
+    assert!(!checkpoint.exists(), "the checkpoint is removed at the end");
 }

@@ -2,7 +2,7 @@
 //! distributed render with a worker killed midway, the token, the paths it must not serve,
 //! and a real headless Chromium loading the page.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -27,13 +27,10 @@ impl Coordinator {
             .spawn()
             .expect("start yat render");
         let mut stdout = BufReader::new(child.stdout.take().unwrap());
-        let mut line = String::new();
-        stdout.read_line(&mut line).unwrap();
-        let address = line
-            .trim()
-            .strip_prefix("status page on http://")
-            .and_then(|a| a.strip_suffix('/'))
-            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
+        let page = next_line_after(&mut stdout, "status page on http://");
+        let address = page
+            .strip_suffix('/')
+            .unwrap_or_else(|| panic!("no / after the address: {page:?}"))
             .to_string();
         // The rest of stdout (the summary) is drained so the process never blocks on it.
         std::thread::spawn(move || std::io::copy(&mut stdout, &mut std::io::sink()));
@@ -74,11 +71,7 @@ impl Coordinator {
 
     /// Ctrl-C ends the lingering page; the render had succeeded.
     fn stop(mut self) {
-        let status = Command::new("kill")
-            .args(["-INT", &self.child.id().to_string()])
-            .status()
-            .unwrap();
-        assert!(status.success());
+        signal(self.child.id(), "INT");
         let exit = self.child.wait().unwrap();
         assert!(exit.success(), "{exit}");
     }
@@ -204,15 +197,6 @@ fn metric(samples: &[(String, f64)], series: &str) -> f64 {
         .1
 }
 
-fn worker<'a>(status: &'a serde_json::Value, address: &str) -> &'a serde_json::Value {
-    status["workers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|w| w["address"] == address)
-        .unwrap_or_else(|| panic!("no worker {address} in {status:#}"))
-}
-
 fn status_command(scene: &Path, out: &Path, settings: &[&str], extra: &[&str]) -> Command {
     let mut command = render_command_with(scene, out, settings, extra);
     command.args([
@@ -269,7 +253,7 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
     assert!(early["progress"]["eta_seconds"].as_f64().unwrap() > 0.0);
     assert!(early["progress"]["samples_per_second"].as_f64().unwrap() > 0.0);
     assert_eq!(early["progress"]["round"], serde_json::Value::Null);
-    let a_row = worker(&early, &a_address);
+    let a_row = worker_entry(&early, &a_address);
     assert_eq!(a_row["threads"], 1);
     assert!(a_row["bytes_sent"].as_u64().unwrap() >= scene_bytes(dir.path()));
     assert!(a_row["bytes_received"].as_u64().unwrap() > 0);
@@ -281,22 +265,25 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
 
     a.kill();
     let gone = coordinator.poll_until("the killed worker gone", &mut monotone, |s| {
-        worker(s, &a_address)["state"] == "gone"
+        worker_entry(s, &a_address)["state"] == "gone"
     });
-    assert!(worker(&gone, &a_address)["reason"].is_string(), "{gone:#}");
+    assert!(
+        worker_entry(&gone, &a_address)["reason"].is_string(),
+        "{gone:#}"
+    );
     let done = coordinator.poll_until("the end", &mut monotone, |s| s["state"] != "rendering");
     assert_eq!(done["state"], "finished", "{done:#}");
     let progress = &done["progress"];
     assert_eq!(progress["units_done"], 32);
     assert_eq!(progress["ratio"], 1.0);
     assert_eq!(progress["eta_seconds"], serde_json::Value::Null);
-    let killed = worker(&done, &a_address);
+    let killed = worker_entry(&done, &a_address);
     assert_eq!(killed["state"], "gone", "{done:#}");
     assert!(killed["failures"].as_u64().unwrap() >= 1, "{done:#}");
     let requeued = killed["units_requeued"].as_u64().unwrap();
     assert!(requeued >= 1, "{done:#}");
     assert!(progress["units_requeued"].as_u64().unwrap() >= requeued);
-    assert_eq!(worker(&done, &b.address)["state"], "done", "{done:#}");
+    assert_eq!(worker_entry(&done, &b.address)["state"], "done", "{done:#}");
     let merged: u64 = done["workers"]
         .as_array()
         .unwrap()
@@ -359,7 +346,7 @@ fn the_status_page_follows_a_distributed_render_with_a_worker_killed() {
             &samples,
             &format!("yat_worker_units_total{{worker=\"{}\"}}", b.address)
         ),
-        worker(&done, &b.address)["units"].as_f64().unwrap()
+        worker_entry(&done, &b.address)["units"].as_f64().unwrap()
     );
 
     // /image.png: the final image, pixel for pixel the PNG written.

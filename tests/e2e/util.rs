@@ -1,11 +1,22 @@
 //! Helpers for the end-to-end tests: the seed scenes' folder, a small scene written to a
-//! folder, `yat worker` processes on loopback ports, and `yat render` runs.
+//! folder, `yat worker` processes on loopback ports, `yat render` runs, and renders by the
+//! library in the test's own process (`yat::render::render`), for tests that need no
+//! coordinator process.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Output, Stdio};
+use std::thread::JoinHandle;
 use std::time::Duration;
+
+use yat::exec::distributed::config::DistributedConfig;
+use yat::render::{Executor, Observers, RenderRequest};
+use yat::render_report::RenderReport;
+use yat::scene::{ParsedScene, Warnings};
+use yat::shutdown::Interrupt;
+use yat_tracer::render::adaptive::AdaptiveSettings;
+use yat_tracer::render::RenderOverrides;
 
 pub const YAT: &str = env!("CARGO_BIN_EXE_yat");
 
@@ -127,6 +138,77 @@ pub fn scene_bytes(dir: &Path) -> u64 {
 /// Render settings every test uses: 4 tiles x 8 passes = 32 units.
 pub const SETTINGS: [&str; 4] = ["--spp", "64", "--resolution", "128x96"];
 
+/// [`SETTINGS`] as the library takes them (and `yat render` gives them, seed 0 included).
+pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
+    spp: Some(64),
+    max_depth: None,
+    seed: Some(0),
+    resolution: Some((128, 96)),
+    latlong: yat_tracer::desc::LatLongConvention::Seed,
+};
+
+/// [`SETTINGS_OVERRIDES`] with `spp` samples per pixel.
+pub fn settings_with_spp(spp: u32) -> RenderOverrides {
+    RenderOverrides {
+        spp: Some(spp),
+        ..SETTINGS_OVERRIDES
+    }
+}
+
+/// The request `yat render SCENE -o OUT --exr` makes with `overrides` (and `adaptive`).
+pub fn request_with(
+    scene: &Path,
+    out: &Path,
+    overrides: &RenderOverrides,
+    adaptive: Option<AdaptiveSettings>,
+) -> RenderRequest {
+    let scene = ParsedScene::load(scene, Warnings::Keep).unwrap();
+    let mut request = RenderRequest::new(scene, overrides, adaptive, Some(out.into())).unwrap();
+    request.exr = true;
+    request
+}
+
+/// [`request_with`] the test settings.
+pub fn request(scene: &Path, out: &Path) -> RenderRequest {
+    request_with(scene, out, &SETTINGS_OVERRIDES, None)
+}
+
+/// The workers at `addresses` (resolved once), with nothing else set.
+pub fn workers_at(addresses: &[&str]) -> DistributedConfig {
+    DistributedConfig {
+        workers: addresses.iter().map(|a| a.to_string()).collect(),
+        ..DistributedConfig::default()
+    }
+}
+
+/// The in-process executor on two threads: the reference renders'.
+pub fn two_threads() -> Executor {
+    Executor::InProcess { threads: Some(2) }
+}
+
+/// Renders `request` on `executor` in this process, quiet and writing no interim file.
+pub fn render_here(request: RenderRequest, executor: Executor) -> anyhow::Result<RenderReport> {
+    yat::render::render(request, executor, Observers::none(), Interrupt::default())
+}
+
+/// The in-process render of `scene` with the test settings, into `dir`/in-process.png: (PNG
+/// bytes, EXR bytes), what every other render of it must match.
+pub fn reference_image(dir: &Path, scene: &Path) -> (Vec<u8>, Vec<u8>) {
+    let out = dir.join("in-process.png");
+    render_here(request(scene, &out), two_threads()).unwrap();
+    image_bytes(&out)
+}
+
+/// [`yat::render::render`] on a thread of its own, as a coordinator beside the test.
+pub fn spawn_render(
+    request: RenderRequest,
+    executor: Executor,
+    observers: Observers,
+    interrupt: Interrupt,
+) -> JoinHandle<anyhow::Result<RenderReport>> {
+    std::thread::spawn(move || yat::render::render(request, executor, observers, interrupt))
+}
+
 /// A `yat worker` process on a loopback port; killed when dropped.
 pub struct Worker {
     pub address: String,
@@ -172,13 +254,7 @@ impl Worker {
     pub fn spawn(mut command: Command) -> Self {
         let mut child = command.spawn().expect("start yat worker");
         let mut stdout = BufReader::new(child.stdout.take().unwrap());
-        let mut line = String::new();
-        stdout.read_line(&mut line).unwrap();
-        let address = line
-            .trim()
-            .strip_prefix("listening on ")
-            .unwrap_or_else(|| panic!("unexpected first line {line:?}"))
-            .to_string();
+        let address = next_line_after(&mut stdout, "listening on ");
         Self {
             address,
             child,
@@ -216,13 +292,9 @@ impl Worker {
         None
     }
 
-    /// Sends a signal with the `kill` command (STOP, CONT, TERM).
+    /// Sends a signal (STOP, CONT, TERM).
     pub fn signal(&self, name: &str) {
-        let status = Command::new("kill")
-            .args([&format!("-{name}"), &self.pid().to_string()])
-            .status()
-            .unwrap();
-        assert!(status.success(), "kill -{name} failed");
+        signal(self.pid(), name);
     }
 
     /// The worker's counters, over its Stats RPC.
@@ -257,6 +329,25 @@ impl Drop for Worker {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// The next line of `output`, trimmed, without `prefix`; panics on a line without it.
+pub fn next_line_after(output: &mut impl BufRead, prefix: &str) -> String {
+    let mut line = String::new();
+    output.read_line(&mut line).unwrap();
+    line.trim()
+        .strip_prefix(prefix)
+        .unwrap_or_else(|| panic!("expected a line starting {prefix:?}, got {line:?}"))
+        .to_string()
+}
+
+/// Sends process `pid` a signal (INT, TERM, STOP, CONT) with the `kill` command.
+pub fn signal(pid: u32, name: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{name}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{name} failed");
 }
 
 /// Runs `command`'s process in an address space of `bytes` (RLIMIT_AS): an allocation beyond
@@ -322,6 +413,21 @@ pub fn render_command_with(scene: &Path, out: &Path, settings: &[&str], extra: &
     command
 }
 
+/// [`render_command_with`], its input closed and its output piped (to read or to wait on).
+pub fn piped_render_command(
+    scene: &Path,
+    out: &Path,
+    settings: &[&str],
+    extra: &[&str],
+) -> Command {
+    let mut command = render_command_with(scene, out, settings, extra);
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    command
+}
+
 pub fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     render_command(scene, out, extra)
         .output()
@@ -345,6 +451,34 @@ pub fn image_bytes(out: &Path) -> (Vec<u8>, Vec<u8>) {
         std::fs::read(out).unwrap(),
         std::fs::read(out.with_extension("exr")).unwrap(),
     )
+}
+
+/// Waits until the workers together have rendered `units` units.
+pub fn wait_for_units(workers: &[&Worker], units: u64) {
+    let started = std::time::Instant::now();
+    while workers
+        .iter()
+        .map(|w| w.stats(None).units_done)
+        .sum::<u64>()
+        < units
+    {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "render stalled"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// The entry of the worker at `address` in the `workers` array of `report` (the
+/// `--workers-json` report or the status page's JSON).
+pub fn worker_entry<'a>(report: &'a serde_json::Value, address: &str) -> &'a serde_json::Value {
+    report["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|w| w["address"] == address)
+        .unwrap_or_else(|| panic!("no worker {address} in {report:#}"))
 }
 
 /// The `--workers-json` report.

@@ -1,6 +1,7 @@
-//! `yat render`: load the scene, make the render job from the flags, hand it to the in-process
-//! executor or the distributed one, then write the image the scene's Film names and report;
-//! with `--status-addr`, serve the status page meanwhile (and for `--status-linger` after).
+//! `yat render`: load the scene, turn the flags into a render request, an executor and its
+//! observers, call [`crate::render::render`], then write and print what its report says; with
+//! `--status-addr`, serve the status page meanwhile (and for `--status-linger` after), and
+//! Ctrl-C and SIGTERM stop the render through its interrupt.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -10,18 +11,13 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use yat_tracer::render::adaptive::{AdaptiveSettings, DEFAULT_MIN_SPP};
 use yat_tracer::render::settings::MAX_SIDE;
-use yat_tracer::render::{RenderOverrides, RenderSettings};
+use yat_tracer::render::RenderOverrides;
 
 use super::budget::BudgetArgs;
 use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
-use crate::checkpoint::{CheckpointFile, RenderIdentity};
-use crate::exec::{distributed, in_process};
-use crate::interim::{InterimOutputs, PreviewFile};
-use crate::job::{check_output_path, film_output_path, RenderJob};
-use crate::manifest::SceneManifest;
-use crate::render_report::RenderReport;
+use crate::render::{render, Executor, Observers, RenderRequest};
 use crate::scene::{ParsedScene, Warnings};
 use crate::shutdown::Interrupt;
 use crate::status::server::StatusServer;
@@ -143,42 +139,32 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         resolution: args.resolution,
         latlong: args.latlong.into(),
     };
-    let settings = RenderSettings::resolve(&scene.desc, &overrides);
-    settings
-        .check()
-        .with_context(|| format!("cannot render {}", args.scene.display()))?;
     let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
         threshold,
         min_spp: args.min_spp,
     });
-    if let Some(a) = &adaptive {
-        a.check()
-            .with_context(|| format!("cannot render {}", args.scene.display()))?;
-    }
-    scene.check_film(&settings, adaptive.is_some())?;
-    let output_png = match &args.output {
-        Some(output) => output.clone(),
-        None => {
-            let (output, warning) = film_output_path(&scene.desc.film.filename)?;
-            if let Some(warning) = warning {
-                eprintln!("warning: {warning}");
-            }
-            output
-        }
-    };
-    check_output_path(&output_png)?;
-    let checkpoint_every = seconds("checkpoint-every", args.checkpoint_every)?;
-    let preview_every = seconds("preview-every", args.preview_every)?;
+    let mut request = RenderRequest::new(scene, &overrides, adaptive, args.output.clone())?;
+    let every = |name, value| seconds(name, value).map(|every| (!every.is_zero()).then_some(every));
+    let checkpoint_every = every("checkpoint-every", args.checkpoint_every)?;
+    let preview_every = every("preview-every", args.preview_every)?;
     let status_linger = seconds("status-linger", args.status_linger)?;
-    let deadline = args
+    request.deadline = args
         .time_limit
         .map(|t| seconds("time-limit", t).map(|limit| started + limit))
         .transpose()?;
-    let workers = args.distributed.config()?;
+    request.exr = args.exr;
+    request.sample_map = args.sample_map.clone();
+    let executor = match args.distributed.config()? {
+        Some(config) => config.into(),
+        None => Executor::InProcess {
+            threads: args.threads,
+        },
+    };
+    let settings = &request.settings;
     let status = Arc::new(StatusBoard::new(
         SceneInfo {
             path: args.scene.display().to_string(),
-            name: scene.main_name.clone(),
+            name: request.scene.main_name.clone(),
         },
         SettingsInfo {
             width: settings.width,
@@ -186,12 +172,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             spp: settings.spp,
             max_depth: settings.max_depth,
             seed: settings.seed,
-            executor: if workers.is_some() {
-                "distributed"
-            } else {
-                "in-process"
-            }
-            .into(),
+            executor: executor.name().into(),
             threads: None,
         },
         args.status_addr.is_some(),
@@ -205,78 +186,33 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
-    // The files by content: what workers receive, and what names the render for its checkpoint.
-    let manifest = if workers.is_some() || !checkpoint_every.is_zero() {
-        Some(SceneManifest::read(&scene)?)
-    } else {
-        None
-    };
-    let checkpoint = manifest
-        .as_ref()
-        .filter(|_| !checkpoint_every.is_zero())
-        .map(|m| {
-            let identity = RenderIdentity::of(&m.load_request(&settings), adaptive.as_ref());
-            CheckpointFile::beside(&output_png, identity, checkpoint_every)
-        });
     let interrupt = Interrupt::install()?;
-    let job = RenderJob {
-        scene,
-        settings,
-        adaptive,
-        sample_map: args.sample_map.clone(),
-        interim: InterimOutputs {
-            preview: (!preview_every.is_zero())
-                .then(|| PreviewFile::beside(&output_png, preview_every)),
-            checkpoint,
-            status: status.clone(),
-        },
-        output_png,
-        exr: args.exr,
+    let observers = Observers {
         quiet: args.quiet,
-        interrupt,
-        deadline,
+        preview_every,
+        checkpoint_every,
+        status,
     };
-
-    let outcome = match (workers, manifest) {
-        (Some(config), Some(manifest)) => distributed::render(&config, &job, manifest),
-        (_, manifest) => {
-            // The in-process render reads the files itself: their copies go before it starts.
-            drop(manifest);
-            in_process::render(&job, args.threads)
-        }
-    };
-    let outcome = outcome.and_then(|outcome| {
-        job.write_final(&outcome)?;
-        Ok(outcome)
-    });
-    let outcome = match outcome {
-        Ok(outcome) => {
-            if server.is_some() {
-                let image = outcome.film.to_display(&job.scene.desc.film);
-                status.publish_image(image, Duration::ZERO);
-            }
-            status.finish(Some(job.output_png.display().to_string()), None);
-            outcome
-        }
+    let output_png = request.output_png.clone();
+    let report = match render(request, executor, observers, interrupt.clone()) {
+        Ok(report) => report,
         Err(e) => {
-            status.finish(None, Some(format!("{e:#}")));
-            linger(server, status_linger, &job.interrupt);
+            linger(server, status_linger, &interrupt);
             return Err(e);
         }
     };
-    let build_time = outcome.build.as_ref().map(|b| b.time).unwrap_or_default();
-    let render_time = started.elapsed() - job.scene.parse_time - build_time;
-
-    let report = RenderReport::new(&job, &outcome, render_time);
     if let Some(path) = &args.stats_json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if !args.quiet {
-        println!("wrote {}", job.output_png.display());
+        if let Some(workers) = &report.workers {
+            workers.print();
+        }
+        println!("wrote {}", output_png.display());
         report.print();
     }
-    linger(server, status_linger, &job.interrupt);
+    linger(server, status_linger, &interrupt);
     Ok(())
 }
 

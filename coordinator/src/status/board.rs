@@ -22,8 +22,8 @@ pub const MAX_EVENTS: usize = 50;
 /// A new image is made at most this often (tone mapping the film costs the render a moment).
 pub const IMAGE_EVERY: Duration = Duration::from_secs(1);
 /// And at most once per this many times what the last one cost to make (tone mapping and PNG
-/// encoding), so the page takes at most ~1% of a core however large the film: a 512x512
-/// image costs ~10 ms (once a second), a 4K one ~0.2 s (once every 20 s).
+/// encoding), so the page takes at most ~1% of a core however large the film (docs/status.md,
+/// "What it costs the render").
 pub const IMAGE_COST_FACTOR: u32 = 100;
 /// New images are made only while someone fetched one within this time: an unwatched page
 /// costs nothing.

@@ -9,6 +9,14 @@ use super::snapshot::{RenderState, Snapshot, WorkerRow, WorkerState};
 
 pub const CONTENT_TYPE: &str = "text/plain; version=0.0.4; charset=utf-8";
 
+/// A family with one sample per worker: name, type, help, the value of the worker's row.
+type WorkerFamily = (
+    &'static str,
+    &'static str,
+    &'static str,
+    fn(&WorkerRow) -> f64,
+);
+
 /// The exposition of `snap`.
 pub fn render(snap: &Snapshot) -> String {
     let mut out = String::new();
@@ -20,67 +28,72 @@ pub fn render(snap: &Snapshot) -> String {
             let _ = writeln!(out, "{name}{labels} {value}");
         }
     };
-    let one = |v: f64| vec![(String::new(), v)];
-    family(
-        "yat_up",
-        "gauge",
-        "1 while the render runs, 0 once it has ended.",
-        &one(f64::from(u8::from(snap.state == RenderState::Rendering))),
-    );
-    family(
-        "yat_render_failed",
-        "gauge",
-        "1 if the render ended in an error.",
-        &one(f64::from(u8::from(snap.state == RenderState::Failed))),
-    );
-    family(
-        "yat_samples_total",
-        "counter",
-        "Camera samples merged into the image (a resumed checkpoint's included).",
-        &one(p.samples_done as f64),
-    );
-    family(
-        "yat_samples_planned",
-        "gauge",
-        "Camera samples of the whole render.",
-        &one(p.samples_total as f64),
-    );
-    family(
-        "yat_units_done_total",
-        "counter",
-        "Work units merged.",
-        &one(p.units_done as f64),
-    );
-    family(
-        "yat_units_planned",
-        "gauge",
-        "Work units of the whole render.",
-        &one(p.units_total as f64),
-    );
-    family(
-        "yat_units_requeued_total",
-        "counter",
-        "Work units a worker lost or gave back, sent again.",
-        &one(p.units_requeued as f64),
-    );
-    family(
-        "yat_progress_ratio",
-        "gauge",
-        "Samples merged over samples planned, 0 to 1.",
-        &one(p.ratio),
-    );
-    family(
-        "yat_samples_per_second",
-        "gauge",
-        "Samples this run merged per second so far.",
-        &one(p.samples_per_second),
-    );
-    family(
-        "yat_elapsed_seconds",
-        "gauge",
-        "Seconds since the render started.",
-        &one(p.elapsed_seconds),
-    );
+    // The render's families, one sample each: name, type, help, value.
+    let totals = [
+        (
+            "yat_up",
+            "gauge",
+            "1 while the render runs, 0 once it has ended.",
+            f64::from(u8::from(snap.state == RenderState::Rendering)),
+        ),
+        (
+            "yat_render_failed",
+            "gauge",
+            "1 if the render ended in an error.",
+            f64::from(u8::from(snap.state == RenderState::Failed)),
+        ),
+        (
+            "yat_samples_total",
+            "counter",
+            "Camera samples merged into the image (a resumed checkpoint's included).",
+            p.samples_done as f64,
+        ),
+        (
+            "yat_samples_planned",
+            "gauge",
+            "Camera samples of the whole render.",
+            p.samples_total as f64,
+        ),
+        (
+            "yat_units_done_total",
+            "counter",
+            "Work units merged.",
+            p.units_done as f64,
+        ),
+        (
+            "yat_units_planned",
+            "gauge",
+            "Work units of the whole render.",
+            p.units_total as f64,
+        ),
+        (
+            "yat_units_requeued_total",
+            "counter",
+            "Work units a worker lost or gave back, sent again.",
+            p.units_requeued as f64,
+        ),
+        (
+            "yat_progress_ratio",
+            "gauge",
+            "Samples merged over samples planned, 0 to 1.",
+            p.ratio,
+        ),
+        (
+            "yat_samples_per_second",
+            "gauge",
+            "Samples this run merged per second so far.",
+            p.samples_per_second,
+        ),
+        (
+            "yat_elapsed_seconds",
+            "gauge",
+            "Seconds since the render started.",
+            p.elapsed_seconds,
+        ),
+    ];
+    for (name, kind, help, value) in totals {
+        family(name, kind, help, &[(String::new(), value)]);
+    }
     let per_worker = |value: fn(&WorkerRow) -> f64| -> Vec<(String, f64)> {
         snap.workers
             .iter()
@@ -120,48 +133,53 @@ pub fn render(snap: &Snapshot) -> String {
         "1 for the worker's state: connecting, connected, stalled, gone or done.",
         &states,
     );
-    family(
-        "yat_worker_threads",
-        "gauge",
-        "Render threads the worker reported.",
-        &per_worker(|w| f64::from(w.threads)),
-    );
-    family(
-        "yat_worker_samples_total",
-        "counter",
-        "Camera samples of the worker's units that were merged.",
-        &per_worker(|w| w.samples as f64),
-    );
-    family(
-        "yat_worker_units_total",
-        "counter",
-        "Work units of the worker that were merged.",
-        &per_worker(|w| w.units as f64),
-    );
-    family(
-        "yat_worker_failures_total",
-        "counter",
-        "Sessions the worker lost and bad replies it sent.",
-        &per_worker(|w| w.failures as f64),
-    );
-    family(
-        "yat_worker_units_requeued_total",
-        "counter",
-        "Work units the worker held that went back to the queue.",
-        &per_worker(|w| w.units_requeued as f64),
-    );
-    family(
-        "yat_worker_sent_bytes_total",
-        "counter",
-        "Bytes of every request sent to the worker, scene files included.",
-        &per_worker(|w| w.bytes_sent as f64),
-    );
-    family(
-        "yat_worker_received_bytes_total",
-        "counter",
-        "Bytes of every reply received from the worker.",
-        &per_worker(|w| w.bytes_received as f64),
-    );
+    let worker_families: [WorkerFamily; 7] = [
+        (
+            "yat_worker_threads",
+            "gauge",
+            "Render threads the worker reported.",
+            |w| f64::from(w.threads),
+        ),
+        (
+            "yat_worker_samples_total",
+            "counter",
+            "Camera samples of the worker's units that were merged.",
+            |w| w.samples as f64,
+        ),
+        (
+            "yat_worker_units_total",
+            "counter",
+            "Work units of the worker that were merged.",
+            |w| w.units as f64,
+        ),
+        (
+            "yat_worker_failures_total",
+            "counter",
+            "Sessions the worker lost and bad replies it sent.",
+            |w| w.failures as f64,
+        ),
+        (
+            "yat_worker_units_requeued_total",
+            "counter",
+            "Work units the worker held that went back to the queue.",
+            |w| w.units_requeued as f64,
+        ),
+        (
+            "yat_worker_sent_bytes_total",
+            "counter",
+            "Bytes of every request sent to the worker, scene files included.",
+            |w| w.bytes_sent as f64,
+        ),
+        (
+            "yat_worker_received_bytes_total",
+            "counter",
+            "Bytes of every reply received from the worker.",
+            |w| w.bytes_received as f64,
+        ),
+    ];
+    for (name, kind, help, value) in worker_families {
+        family(name, kind, help, &per_worker(value));
+    }
     out
 }
 

@@ -6,6 +6,8 @@ use std::time::Duration;
 
 use tonic::transport::ClientTlsConfig;
 
+/// The default: no worker, names resolved once, no token, TLS, timeout or report file.
+#[derive(Default)]
 pub struct DistributedConfig {
     /// Workers to render on, HOST:PORT each: an IP literal is one worker, a DNS name is a
     /// worker at every address it resolves to.

@@ -26,7 +26,7 @@ use tonic::transport::ClientTlsConfig;
 use super::client::ClientConfig;
 use super::node::Node;
 use super::session::run_node;
-use super::shared::Shared;
+use super::session_context::SessionContext;
 
 /// A name's resolution (every attempt and name server included) is abandoned after this long.
 const RESOLVE_DEADLINE: Duration = Duration::from_secs(5);
@@ -189,7 +189,7 @@ impl ClientTemplate {
 }
 
 /// A worker of the render and the task serving it.
-struct Member {
+struct ServedWorker {
     node: Arc<Node>,
     /// The `--workers` entry (name and port) it was found under; `None` for a listed address
     /// or a local worker.
@@ -202,26 +202,29 @@ struct Member {
 }
 
 /// Starts serving `node` in a task of its own; the sender asks it to leave.
-fn spawn_session(node: &Arc<Node>, shared: &Arc<Shared>) -> (JoinHandle<()>, watch::Sender<bool>) {
+fn spawn_session(
+    node: &Arc<Node>,
+    context: &Arc<SessionContext>,
+) -> (JoinHandle<()>, watch::Sender<bool>) {
     let (leave, asked) = watch::channel(false);
-    let task = tokio::spawn(run_node(node.clone(), shared.clone(), asked));
+    let task = tokio::spawn(run_node(node.clone(), context.clone(), asked));
     (task, leave)
 }
 
 /// The workers of a render, each served by its own session loop (`run_node`). It only grows:
 /// a worker removed from DNS stays listed (as gone) for the final report.
 pub struct Roster {
-    shared: Arc<Shared>,
-    members: Mutex<Vec<Member>>,
+    context: Arc<SessionContext>,
+    workers: Mutex<Vec<ServedWorker>>,
     /// The resolution task, while names are followed.
     follower: Mutex<Option<JoinHandle<()>>>,
 }
 
 impl Roster {
-    pub fn new(shared: Arc<Shared>) -> Self {
+    pub fn new(context: Arc<SessionContext>) -> Self {
         Self {
-            shared,
-            members: Mutex::new(Vec::new()),
+            context,
+            workers: Mutex::new(Vec::new()),
             follower: Mutex::new(None),
         }
     }
@@ -229,8 +232,8 @@ impl Roster {
     /// Adds a listed or local worker and starts serving it (inside the runtime).
     pub fn add(&self, node: Node) {
         let node = Arc::new(node);
-        let (task, leave) = spawn_session(&node, &self.shared);
-        self.members.lock().unwrap().push(Member {
+        let (task, leave) = spawn_session(&node, &self.context);
+        self.workers.lock().unwrap().push(ServedWorker {
             node,
             entry: None,
             address: None,
@@ -242,14 +245,14 @@ impl Roster {
 
     /// Every worker the render has had, removed ones included.
     pub fn nodes(&self) -> Vec<Arc<Node>> {
-        let members = self.members.lock().unwrap();
-        members.iter().map(|m| m.node.clone()).collect()
+        let workers = self.workers.lock().unwrap();
+        workers.iter().map(|m| m.node.clone()).collect()
     }
 
     /// Workers currently in the render (not removed from DNS).
     pub fn current_count(&self) -> usize {
-        let members = self.members.lock().unwrap();
-        members.iter().filter(|m| !m.removed).count()
+        let workers = self.workers.lock().unwrap();
+        workers.iter().filter(|m| !m.removed).count()
     }
 
     /// Whether a followed name may still bring workers: the render should wait for them
@@ -263,8 +266,8 @@ impl Roster {
         if let Some(follower) = self.follower.lock().unwrap().take() {
             follower.abort();
         }
-        for member in self.members.lock().unwrap().iter_mut() {
-            if let Some(task) = member.task.take() {
+        for served in self.workers.lock().unwrap().iter_mut() {
+            if let Some(task) = served.task.take() {
                 task.abort();
             }
         }
@@ -279,25 +282,25 @@ impl Roster {
         answer: &BTreeSet<SocketAddr>,
     ) -> (usize, usize) {
         let entry = format!("{host}:{port}");
-        let ours = |m: &Member| m.entry.as_deref() == Some(entry.as_str());
-        let mut members = self.members.lock().unwrap();
+        let ours = |m: &ServedWorker| m.entry.as_deref() == Some(entry.as_str());
+        let mut workers = self.workers.lock().unwrap();
         let mut removed = 0;
-        for member in members.iter_mut().filter(|m| ours(m)) {
-            let in_answer = member.address.is_some_and(|a| answer.contains(&a));
-            if !in_answer && !member.removed {
-                member.removed = true;
-                member.leave.send_replace(true);
+        for served in workers.iter_mut().filter(|m| ours(m)) {
+            let in_answer = served.address.is_some_and(|a| answer.contains(&a));
+            if !in_answer && !served.removed {
+                served.removed = true;
+                served.leave.send_replace(true);
                 // Past the deadline, aborting the session gives what it still holds back to the
                 // queue.
-                if let Some(task) = member.task.take() {
-                    let grace = self.shared.deadline.current();
+                if let Some(task) = served.task.take() {
+                    let grace = self.context.deadline.current();
                     let session = task.abort_handle();
                     tokio::spawn(async move {
                         tokio::time::sleep(grace).await;
                         session.abort();
                     });
                 }
-                member.node.update(|r| {
+                served.node.update(|r| {
                     r.connected = false;
                     r.gone = Some(REMOVED_FROM_DNS.to_string());
                 });
@@ -305,7 +308,7 @@ impl Roster {
             }
         }
         // An address already in the render (listed, or under another entry) is one worker.
-        let elsewhere: HashSet<String> = members
+        let elsewhere: HashSet<String> = workers
             .iter()
             .filter(|m| !ours(m) && !m.removed)
             .map(|m| m.node.address().to_string())
@@ -315,17 +318,17 @@ impl Roster {
             if elsewhere.contains(&address.to_string()) {
                 continue;
             }
-            let existing = members
+            let existing = workers
                 .iter_mut()
                 .find(|m| ours(m) && m.address == Some(address));
             let node = match existing {
-                Some(member) if member.removed => {
-                    member.removed = false;
-                    member.node.update(|r| r.gone = None);
+                Some(served) if served.removed => {
+                    served.removed = false;
+                    served.node.update(|r| r.gone = None);
                     // A new session; the old one, if still finishing its units, ends by itself.
-                    let (task, leave) = spawn_session(&member.node, &self.shared);
-                    member.task = Some(task);
-                    member.leave = leave;
+                    let (task, leave) = spawn_session(&served.node, &self.context);
+                    served.task = Some(task);
+                    served.leave = leave;
                     joined += 1;
                     continue;
                 }
@@ -333,8 +336,8 @@ impl Roster {
                 None => Arc::new(Node::new(client.for_address(host, address), None)),
             };
             node.update(|r| r.dns_name = Some(host.to_string()));
-            let (task, leave) = spawn_session(&node, &self.shared);
-            members.push(Member {
+            let (task, leave) = spawn_session(&node, &self.context);
+            workers.push(ServedWorker {
                 node,
                 entry: Some(entry.clone()),
                 address: Some(address),
@@ -440,12 +443,12 @@ impl Discovery {
     /// has. A failure keeps the last good answer and is said once.
     async fn round(&mut self, index: usize, roster: &Roster) -> Result<usize, ResolveFailure> {
         let name = &mut self.names[index];
-        let shared = &roster.shared;
+        let context = &roster.context;
         let (answer, left_out) = match self.resolver.resolve(&name.host, name.port).await {
             Ok(answer) => answer,
             Err(e) => {
                 if !std::mem::replace(&mut name.failing, true) {
-                    shared.notice(format!(
+                    context.notice(format!(
                         "cannot resolve {} ({e}); keeping its last answer",
                         name.host
                     ));
@@ -454,23 +457,23 @@ impl Discovery {
             }
         };
         if std::mem::take(&mut name.failing) {
-            shared.notice(format!("{} resolves again", name.host));
+            context.notice(format!("{} resolves again", name.host));
         }
         if left_out > 0 && !std::mem::replace(&mut name.capped, true) {
-            shared.notice(format!(
+            context.notice(format!(
                 "{} resolves to {} addresses; using the first {MAX_ADDRESSES_PER_NAME}",
                 name.host,
                 MAX_ADDRESSES_PER_NAME + left_out
             ));
         }
         if answer.is_empty() && !std::mem::replace(&mut name.empty, true) {
-            shared.notice(format!("{} resolves to no address (yet)", name.host));
+            context.notice(format!("{} resolves to no address (yet)", name.host));
         }
         name.empty = answer.is_empty();
         let (joined, removed) =
             roster.follow_answer(&self.client, (&name.host, name.port), &answer);
         if joined + removed > 0 {
-            shared.notice(format!(
+            context.notice(format!(
                 "{} resolves to {} address(es): {joined} joined, {removed} removed",
                 name.host,
                 answer.len()
@@ -548,7 +551,7 @@ mod tests {
         use super::super::schedule::{Schedule, UnitDeadline};
         use crate::manifest::SceneManifest;
         use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter};
-        Roster::new(Arc::new(Shared {
+        Roster::new(Arc::new(SessionContext {
             schedule: Schedule::new(Vec::new(), |_| false, true),
             deadline: UnitDeadline::new(None),
             manifest: SceneManifest {
@@ -590,7 +593,7 @@ mod tests {
         assert_eq!(gone(0).as_deref(), Some(REMOVED_FROM_DNS));
         assert_eq!((roster.nodes().len(), roster.current_count()), (2, 1));
         assert!(
-            roster.members.lock().unwrap()[0].task.is_none(),
+            roster.workers.lock().unwrap()[0].task.is_none(),
             "its session is stopped"
         );
         assert_eq!(

@@ -10,11 +10,11 @@ mod discovery;
 mod local;
 mod node;
 mod render_loop;
-mod report;
+pub mod report;
 mod schedule;
 mod session;
+mod session_context;
 mod session_error;
-mod shared;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -33,14 +33,16 @@ use node::Node;
 use render_loop::RenderLoop;
 use report::{process_cpu_time, DistributedReport};
 use schedule::{Schedule, UnitDeadline};
-use shared::Shared;
+use session_context::SessionContext;
 
 /// Renders `job` on the workers `config` names or starts; `manifest` holds the scene's files.
+/// Returns the workers' figures beside the outcome (and writes them to `config.workers_json`,
+/// whether the render succeeds or not).
 pub fn render(
     config: &DistributedConfig,
     job: &RenderJob,
     manifest: SceneManifest,
-) -> anyhow::Result<RenderOutcome> {
+) -> anyhow::Result<(RenderOutcome, DistributedReport)> {
     let cpu_start = process_cpu_time();
     let started = Instant::now();
     let targets = config
@@ -81,7 +83,7 @@ pub fn render(
     let start = job.resume();
     let units = start.units(&job.settings, job.adaptive.as_ref());
     let (events, event_rx) = mpsc::unbounded_channel();
-    let shared = Arc::new(Shared {
+    let context = Arc::new(SessionContext {
         // An adaptive render's round is never known to be the last before it is merged.
         schedule: Schedule::new(units, |u| start.is_done(u), job.adaptive.is_none()),
         deadline: UnitDeadline::new(config.unit_deadline),
@@ -91,7 +93,7 @@ pub fn render(
         manifest,
         events,
     });
-    let roster = Arc::new(Roster::new(shared.clone()));
+    let roster = Arc::new(Roster::new(context.clone()));
     let client = ClientTemplate {
         token: config.token.clone(),
         tls: config.tls.clone(),
@@ -108,7 +110,7 @@ pub fn render(
         let render_loop = RenderLoop {
             job,
             roster: &roster,
-            shared: &shared,
+            context: &context,
             timeout: config.timeout,
         };
         render_loop.run(start, event_rx).await
@@ -119,7 +121,7 @@ pub fn render(
     let mut report = DistributedReport::new(
         started.elapsed(),
         process_cpu_time().saturating_sub(cpu_start),
-        shared.schedule.len(),
+        context.schedule.len(),
         outcome.as_ref().map_or(0, |o| o.stats.samples),
         roster
             .nodes()
@@ -127,14 +129,10 @@ pub fn render(
             .map(|n| n.report.lock().unwrap().clone())
             .collect(),
     );
-    report.units_copied = shared.schedule.copies();
+    report.units_copied = context.schedule.copies();
     if let Some(path) = &config.workers_json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let outcome = outcome?;
-    if !job.quiet {
-        report.print();
-    }
-    Ok(outcome)
+    Ok((outcome?, report))
 }

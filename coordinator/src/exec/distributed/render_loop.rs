@@ -10,7 +10,7 @@ use tokio::sync::mpsc;
 use yat_tracer::render::UnitStats;
 
 use super::discovery::Roster;
-use super::shared::{Event, Shared};
+use super::session_context::{SessionContext, SessionEvent};
 use crate::checkpoint::Checkpoint;
 use crate::exec::progress::Progress;
 use crate::interim::InterimClock;
@@ -23,7 +23,7 @@ const WAITING_NOTICE_EVERY: Duration = Duration::from_secs(5);
 pub struct RenderLoop<'a> {
     pub job: &'a RenderJob,
     pub roster: &'a Roster,
-    pub shared: &'a Arc<Shared>,
+    pub context: &'a Arc<SessionContext>,
     pub timeout: Option<Duration>,
 }
 
@@ -35,7 +35,7 @@ impl RenderLoop<'_> {
     pub async fn run(
         self,
         mut checkpoint: Checkpoint,
-        mut events: mpsc::UnboundedReceiver<Event>,
+        mut events: mpsc::UnboundedReceiver<SessionEvent>,
     ) -> anyhow::Result<RenderOutcome> {
         let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
         let progress = Progress::start(self.job, &checkpoint);
@@ -59,10 +59,10 @@ impl RenderLoop<'_> {
                     break Err(TimeLimitReached.into());
                 }
                 if !tokio::task::block_in_place(|| checkpoint.advance(settings, adaptive)) {
-                    self.shared.schedule.finish();
+                    self.context.schedule.finish();
                     break Ok(());
                 }
-                self.shared
+                self.context
                     .schedule
                     .start_round(checkpoint.units(settings, adaptive));
                 progress.round(self.job, &checkpoint);
@@ -70,8 +70,8 @@ impl RenderLoop<'_> {
                 continue;
             }
             tokio::select! {
-                event = events.recv() => match event.expect("the shared state holds a sender") {
-                    Event::Result { buffer, stats: unit_stats } => {
+                event = events.recv() => match event.expect("the context state holds a sender") {
+                    SessionEvent::Result { buffer, stats: unit_stats } => {
                         if let Err(e) = checkpoint.add(&buffer) {
                             break Err(e.into());
                         }
@@ -80,7 +80,7 @@ impl RenderLoop<'_> {
                         progress.unit_merged(unit_stats.samples);
                         progress.set_status(self.status(&checkpoint));
                     }
-                    Event::Notice(line) => progress.say(&line),
+                    SessionEvent::Notice(line) => progress.say(&line),
                 },
                 _ = tick.tick() => {
                     if self.job.interrupt.is_set() {
@@ -165,7 +165,7 @@ impl RenderLoop<'_> {
             .iter()
             .map(|n| n.report.lock().unwrap().status_row())
             .collect();
-        let stalled_after = self.shared.deadline.current() / 2;
+        let stalled_after = self.context.deadline.current() / 2;
         self.job.interim.status.set_workers(rows, stalled_after);
     }
 

@@ -21,8 +21,8 @@ use yat_tracer::render::{WorkUnit, TILE_SIZE};
 use super::client::{WorkerClient, MIN_CHUNK_BYTES};
 use super::node::Node;
 use super::schedule::Schedule;
+use super::session_context::{SessionContext, SessionEvent};
 use super::session_error::SessionError;
-use super::shared::{Event, Shared};
 use crate::sanitize::peer_text;
 
 const MIN_BACKOFF: Duration = Duration::from_millis(250);
@@ -136,21 +136,25 @@ pub fn check_handshake(address: &str, reply: &pb::HandshakeReply) -> Result<Work
 /// good, or `leave` turns true (then the units in flight are finished first). The backoff
 /// between sessions and the count of bad replies are reset only by an accepted result, so a
 /// worker that fails fast is not retried fast, and one that never does better is retired.
-pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Receiver<bool>) {
+pub async fn run_node(
+    node: Arc<Node>,
+    context: Arc<SessionContext>,
+    mut leave: watch::Receiver<bool>,
+) {
     let mut backoff = MIN_BACKOFF;
     let mut bad_in_a_row = 0;
-    let mut changed = shared.schedule.watch();
-    while !shared.schedule.is_finished() && !*leave.borrow() {
+    let mut changed = context.schedule.watch();
+    while !context.schedule.is_finished() && !*leave.borrow() {
         if let Some(status) = node.local.as_ref().and_then(|l| l.exit_status()) {
             retire(
                 &node,
-                &shared,
+                &context,
                 format!("the local worker exited ({status})"),
             );
             return;
         }
         let mut accepted = 0;
-        let outcome = session(&node, &shared, &mut accepted, &mut leave).await;
+        let outcome = session(&node, &context, &mut accepted, &mut leave).await;
         let was_rendering = std::mem::take(&mut node.report.lock().unwrap().connected);
         if accepted > 0 {
             backoff = MIN_BACKOFF;
@@ -162,11 +166,11 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Re
                 return;
             }
             Err(SessionError::Permanent(reason)) => {
-                retire(&node, &shared, reason);
+                retire(&node, &context, reason);
                 return;
             }
             Err(SessionError::Draining(what)) => {
-                shared.notice(format!(
+                context.notice(format!(
                     "worker {} draining ({what}); its units go back to the queue",
                     node.address()
                 ));
@@ -182,17 +186,17 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Re
                     let reason = format!(
                         "retired after {bad_in_a_row} bad replies in a row, the last: {error}"
                     );
-                    retire(&node, &shared, reason);
+                    retire(&node, &context, reason);
                     return;
                 }
-                shared.notice(format!(
+                context.notice(format!(
                     "worker {} answered badly ({error}); its units go back to the queue",
                     node.address()
                 ));
             }
             Err(SessionError::Transient(error)) => {
                 if was_rendering {
-                    shared.notice(format!(
+                    context.notice(format!(
                         "worker {} lost ({error}); its units go back to the queue",
                         node.address()
                     ));
@@ -205,7 +209,7 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Re
             _ = tokio::time::sleep(backoff) => {}
             // Only the end cuts the wait short: a requeue (this worker's own units going back
             // included) must not, or a worker failing fast would be retried at once.
-            _ = changed.wait_for(|_| shared.schedule.is_finished()) => {}
+            _ = changed.wait_for(|_| context.schedule.is_finished()) => {}
             // Asked to leave (or the roster is gone): nothing is held between sessions.
             _ = leave.wait_for(|&leaving| leaving) => return,
         }
@@ -214,15 +218,15 @@ pub async fn run_node(node: Arc<Node>, shared: Arc<Shared>, mut leave: watch::Re
 }
 
 /// This worker will not be used again in this render, for `reason`.
-fn retire(node: &Node, shared: &Shared, reason: String) {
-    shared.notice(format!("worker {} refused: {reason}", node.address()));
+fn retire(node: &Node, context: &SessionContext, reason: String) {
+    context.notice(format!("worker {} refused: {reason}", node.address()));
     node.update(|r| r.gone = Some(reason));
 }
 
 /// One session; `accepted` counts the results it accepted.
 async fn session(
     node: &Node,
-    shared: &Shared,
+    context: &SessionContext,
     accepted: &mut usize,
     leave: &mut watch::Receiver<bool>,
 ) -> Result<(), SessionError> {
@@ -244,8 +248,8 @@ async fn session(
         r.threads = worker.threads;
     });
 
-    upload_missing_blobs(&mut client, node, shared, &worker).await?;
-    let load = shared.load_request.clone();
+    upload_missing_blobs(&mut client, node, context, &worker).await?;
+    let load = context.load_request.clone();
     let sent = load.encoded_len() as u64;
     let loaded = client.load_scene(load).await?;
     if loaded.scene_id.is_empty() || loaded.scene_id.len() > MAX_SCENE_ID_BYTES {
@@ -259,7 +263,7 @@ async fn session(
         r.bytes_received += loaded.encoded_len() as u64;
         r.connected = true;
     });
-    shared.notice(format!(
+    context.notice(format!(
         "worker {address} ({}, {}, {} threads{}) ready{}",
         worker.hostname,
         worker.software,
@@ -279,7 +283,7 @@ async fn session(
     let first_in_flight = (worker.threads as usize).min(MAX_UNITS_BEFORE_A_RESULT);
     let units = UnitLoop {
         node,
-        shared,
+        context,
         scene_id: &loaded.scene_id,
         first_in_flight,
         max_in_flight: in_flight,
@@ -291,10 +295,10 @@ async fn session(
 async fn upload_missing_blobs(
     client: &mut WorkerClient,
     node: &Node,
-    shared: &Shared,
+    context: &SessionContext,
     worker: &WorkerInfo,
 ) -> Result<(), SessionError> {
-    let blobs = &shared.manifest.blobs;
+    let blobs = &context.manifest.blobs;
     let query = pb::HasBlobsRequest {
         sha256: blobs.keys().cloned().collect(),
     };
@@ -382,7 +386,7 @@ async fn render_one(
 /// it may hold.
 struct UnitLoop<'a> {
     node: &'a Node,
-    shared: &'a Shared,
+    context: &'a SessionContext,
     scene_id: &'a str,
     first_in_flight: usize,
     max_in_flight: usize,
@@ -401,12 +405,12 @@ impl UnitLoop<'_> {
     ) -> Result<(), SessionError> {
         let UnitLoop {
             node,
-            shared,
+            context,
             scene_id,
             first_in_flight,
             max_in_flight,
         } = self;
-        let schedule = &shared.schedule;
+        let schedule = &context.schedule;
         let mut changed = schedule.watch();
         let mut held = HeldUnits {
             schedule,
@@ -441,7 +445,7 @@ impl UnitLoop<'_> {
                     client.clone(),
                     request,
                     unit,
-                    shared.deadline.current(),
+                    context.deadline.current(),
                 ));
             }
             if calls.is_empty() {
@@ -475,7 +479,7 @@ impl UnitLoop<'_> {
                         outcome => outcome?,
                     };
                     // Kept in `held` until accepted: an error returns it to the queue.
-                    accept(node, shared, unit, outcome)?;
+                    accept(node, context, unit, outcome)?;
                     held.units.remove(&unit);
                     *accepted += 1;
                 }
@@ -489,15 +493,15 @@ impl UnitLoop<'_> {
 /// Checks a reply and hands its buffer to the render loop if it is the unit's first result.
 fn accept(
     node: &Node,
-    shared: &Shared,
+    context: &SessionContext,
     unit: WorkUnit,
     (reply, took): (pb::RenderUnitReply, Duration),
 ) -> Result<(), SessionError> {
     let received = reply.encoded_len() as u64;
-    let (buffer, stats) = result_from_wire(unit, &shared.frame, &shared.weights, &reply)
+    let (buffer, stats) = result_from_wire(unit, &context.frame, &context.weights, &reply)
         .map_err(|e| SessionError::BadReply(e.to_string()))?;
-    shared.deadline.observe(took);
-    let first = shared.schedule.complete(&unit);
+    context.deadline.observe(took);
+    let first = context.schedule.complete(&unit);
     node.update(|r| {
         r.bytes_received += received;
         if first {
@@ -508,7 +512,7 @@ fn accept(
         }
     });
     if first {
-        let _ = shared.events.send(Event::Result { buffer, stats });
+        let _ = context.events.send(SessionEvent::Result { buffer, stats });
     }
     Ok(())
 }

@@ -12,7 +12,7 @@ use super::schedule::{Schedule, UnitDeadline};
 use crate::manifest::SceneManifest;
 
 /// What node loops tell the render loop.
-pub enum Event {
+pub enum SessionEvent {
     /// A unit's result, the first one for that unit.
     Result {
         buffer: SampleBuffer,
@@ -22,8 +22,9 @@ pub enum Event {
     Notice(String),
 }
 
-/// What every node loop shares.
-pub struct Shared {
+/// The render as every worker's session loop sees it: the units to hand out and how long one
+/// may take, the scene to load, what a reply must fit, and where results go.
+pub struct SessionContext {
     pub schedule: Schedule,
     pub deadline: UnitDeadline,
     pub manifest: SceneManifest,
@@ -32,11 +33,11 @@ pub struct Shared {
     pub frame: FilmFrame,
     /// What the scene's filter lets a sample weigh a pixel: what a reply's weight sums may be.
     pub weights: WeightBounds,
-    pub events: UnboundedSender<Event>,
+    pub events: UnboundedSender<SessionEvent>,
 }
 
-impl Shared {
+impl SessionContext {
     pub fn notice(&self, message: String) {
-        let _ = self.events.send(Event::Notice(message));
+        let _ = self.events.send(SessionEvent::Notice(message));
     }
 }

@@ -1,0 +1,222 @@
+//! A render as one library call: [`render`] takes what to render ([`RenderRequest`]), who
+//! renders it ([`Executor`]), who watches it ([`Observers`]) and the caller's [`Interrupt`], and
+//! writes the image and returns its figures ([`RenderReport`]). `yat render` turns its flags
+//! into these; the end-to-end tests and any other front end call it the same way.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use yat_tracer::render::adaptive::AdaptiveSettings;
+use yat_tracer::render::{RenderOverrides, RenderSettings};
+
+use crate::checkpoint::{CheckpointFile, RenderIdentity};
+use crate::exec::distributed::config::DistributedConfig;
+use crate::exec::{distributed, in_process};
+use crate::interim::{InterimOutputs, PreviewFile};
+use crate::job::{check_output_path, film_output_path, RenderJob};
+use crate::manifest::SceneManifest;
+use crate::render_report::RenderReport;
+use crate::scene::ParsedScene;
+use crate::shutdown::Interrupt;
+use crate::status::StatusBoard;
+
+/// What to render and where the image goes: the scene, the settings that decide its bytes, the
+/// files written at the end.
+pub struct RenderRequest {
+    pub scene: ParsedScene,
+    pub settings: RenderSettings,
+    /// Adaptive sampling (settings.spp is then the most any pixel gets); None renders every
+    /// pixel with spp samples.
+    pub adaptive: Option<AdaptiveSettings>,
+    /// The PNG; the preview, the checkpoint and the EXR go beside it.
+    pub output_png: PathBuf,
+    /// Also write linear radiance as OpenEXR next to the PNG.
+    pub exr: bool,
+    /// Where to write the sample map of an adaptive render, at the end.
+    pub sample_map: Option<PathBuf>,
+    /// When an adaptive render stops at a round boundary.
+    pub deadline: Option<Instant>,
+}
+
+impl RenderRequest {
+    /// A render of `scene` with the settings `overrides` resolve from it, checked (and the
+    /// film checked against the scene's memory budget), into `output_png`, or, when None, the
+    /// PNG the scene's Film names in the current folder (with a warning on stderr when the
+    /// scene names a folder). No EXR, sample map or deadline: set those fields after.
+    pub fn new(
+        scene: ParsedScene,
+        overrides: &RenderOverrides,
+        adaptive: Option<AdaptiveSettings>,
+        output_png: Option<PathBuf>,
+    ) -> anyhow::Result<Self> {
+        let settings = RenderSettings::resolve(&scene.desc, overrides);
+        let cannot_render = || format!("cannot render {}", scene.path.display());
+        settings.check().with_context(cannot_render)?;
+        if let Some(a) = &adaptive {
+            a.check().with_context(cannot_render)?;
+        }
+        scene.check_film(&settings, adaptive.is_some())?;
+        let output_png = match output_png {
+            Some(output) => output,
+            None => {
+                let (output, warning) = film_output_path(&scene.desc.film.filename)?;
+                if let Some(warning) = warning {
+                    eprintln!("warning: {warning}");
+                }
+                output
+            }
+        };
+        check_output_path(&output_png)?;
+        Ok(Self {
+            scene,
+            settings,
+            adaptive,
+            output_png,
+            exr: false,
+            sample_map: None,
+            deadline: None,
+        })
+    }
+}
+
+/// Who renders: this process's threads, or workers over gRPC.
+pub enum Executor {
+    /// On this many threads [default: the CPUs this process may use].
+    InProcess { threads: Option<usize> },
+    /// Boxed: a configuration is much larger than a thread count.
+    Distributed(Box<DistributedConfig>),
+}
+
+impl From<DistributedConfig> for Executor {
+    fn from(config: DistributedConfig) -> Self {
+        Self::Distributed(Box::new(config))
+    }
+}
+
+impl Executor {
+    /// As the status page names it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::InProcess { .. } => "in-process",
+            Self::Distributed(_) => "distributed",
+        }
+    }
+}
+
+/// What watches a render as it goes, and what it writes meanwhile.
+pub struct Observers {
+    /// No progress bar and no notices on the terminal (the error a render returns is the
+    /// caller's to print).
+    pub quiet: bool,
+    /// Rewrite `<output>.preview.png` this often; None writes no preview.
+    pub preview_every: Option<Duration>,
+    /// Save the render so far to `<output>.resume` this often (and when it stops short), so
+    /// that the same request resumes it; None saves no checkpoint.
+    pub checkpoint_every: Option<Duration>,
+    /// The status page's board: progress, workers, events, the image when it is served.
+    pub status: Arc<StatusBoard>,
+}
+
+impl Observers {
+    /// Nothing on the terminal, no interim files, a board nobody serves.
+    pub fn none() -> Self {
+        Self {
+            quiet: true,
+            preview_every: None,
+            checkpoint_every: None,
+            status: StatusBoard::unserved(),
+        }
+    }
+}
+
+/// Renders `request` on `executor`, resuming from its checkpoint when one of the same render is
+/// beside the output, writing the interim outputs `observers` ask for, and stopping, its
+/// checkpoint saved, once `interrupt` is set (the error is then
+/// [`crate::shutdown::Interrupted`]). Writes the final image and removes the interim files; the
+/// report says what the render cost. The status board is told how the render ended either way.
+pub fn render(
+    request: RenderRequest,
+    executor: Executor,
+    observers: Observers,
+    interrupt: Interrupt,
+) -> anyhow::Result<RenderReport> {
+    let status = observers.status.clone();
+    let report = render_and_write(request, executor, observers, interrupt);
+    if let Err(e) = &report {
+        status.finish(None, Some(format!("{e:#}")));
+    }
+    report
+}
+
+/// [`render`] but for telling the board of a failure.
+fn render_and_write(
+    request: RenderRequest,
+    executor: Executor,
+    observers: Observers,
+    interrupt: Interrupt,
+) -> anyhow::Result<RenderReport> {
+    let started = Instant::now();
+    let (distributed, threads) = match executor {
+        Executor::Distributed(config) => (Some(config), None),
+        Executor::InProcess { threads } => (None, threads),
+    };
+    // The files by content: what workers receive, and what names the render for its checkpoint.
+    let manifest = if distributed.is_some() || observers.checkpoint_every.is_some() {
+        Some(SceneManifest::read(&request.scene)?)
+    } else {
+        None
+    };
+    let checkpoint = manifest
+        .as_ref()
+        .zip(observers.checkpoint_every)
+        .map(|(m, every)| {
+            let identity = RenderIdentity::of(
+                &m.load_request(&request.settings),
+                request.adaptive.as_ref(),
+            );
+            CheckpointFile::beside(&request.output_png, identity, every)
+        });
+    let status = observers.status;
+    let job = RenderJob {
+        interim: InterimOutputs {
+            preview: observers
+                .preview_every
+                .map(|every| PreviewFile::beside(&request.output_png, every)),
+            checkpoint,
+            status: status.clone(),
+        },
+        scene: request.scene,
+        settings: request.settings,
+        adaptive: request.adaptive,
+        sample_map: request.sample_map,
+        output_png: request.output_png,
+        exr: request.exr,
+        quiet: observers.quiet,
+        interrupt,
+        deadline: request.deadline,
+    };
+
+    let (outcome, workers) = match (distributed, manifest) {
+        (Some(config), Some(manifest)) => {
+            let (outcome, workers) = distributed::render(&config, &job, manifest)?;
+            (outcome, Some(workers))
+        }
+        (_, manifest) => {
+            // The in-process render reads the files itself: their copies go before it starts.
+            drop(manifest);
+            (in_process::render(&job, threads)?, None)
+        }
+    };
+    job.write_final(&outcome)?;
+    if status.serving() {
+        let image = outcome.film.to_display(&job.scene.desc.film);
+        status.publish_image(image, Duration::ZERO);
+    }
+    status.finish(Some(job.output_png.display().to_string()), None);
+    let build_time = outcome.build.as_ref().map(|b| b.time).unwrap_or_default();
+    let mut report = RenderReport::new(&job, &outcome, started.elapsed() - build_time);
+    report.workers = workers;
+    Ok(report)
+}
