@@ -16,6 +16,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -23,6 +24,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, Emission};
+use super::error::LightError;
+use super::kind::{LatLongConvention, LightKind};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -41,11 +44,11 @@ pub struct DistantLight {
 
 impl DistantLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let to = params.vec3("to", DEFAULT_TO)?;
         if params.float("theta", DEFAULT_THETA)? != 0.0 {
@@ -63,15 +66,6 @@ impl DistantLight {
         })
     }
 
-    /// The light to sample (with `to_light` normalised), if it emits.
-    pub fn light(&self) -> Option<DistantLight> {
-        let to_light = self.to_light.normalize_or_zero();
-        (emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
-            to_light,
-            radiance: self.radiance,
-        })
-    }
-
     pub fn sample(&self) -> DeltaSample {
         DeltaSample {
             wi: self.to_light,
@@ -83,5 +77,28 @@ impl DistantLight {
     /// The flux through a disk of the scene's size.
     pub fn power(&self, scene_radius: f32) -> f32 {
         PI * scene_radius * scene_radius * luminance(self.radiance)
+    }
+}
+
+impl LightKind for DistantLight {
+    type Sampler = DistantLight;
+
+    fn name(&self) -> &'static str {
+        "distant"
+    }
+
+    /// The light to sample (with `to_light` normalised), if it emits.
+    fn light(
+        &self,
+        _source: &dyn AssetSource,
+        _latlong: LatLongConvention,
+    ) -> Result<Option<DistantLight>, LightError> {
+        Ok({
+            let to_light = self.to_light.normalize_or_zero();
+            (emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
+                to_light,
+                radiance: self.radiance,
+            })
+        })
     }
 }

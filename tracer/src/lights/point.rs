@@ -17,6 +17,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -24,6 +25,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
+use super::error::LightError;
+use super::kind::{LatLongConvention, LightKind};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -42,11 +45,11 @@ pub struct PointLight {
 
 impl PointLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let gain = normalised_gain(
             e.gain,
@@ -59,11 +62,6 @@ impl PointLight {
             position: from + ctx.ctm().transform_point3(Vec3::ZERO),
             intensity: e.l * gain,
         })
-    }
-
-    /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<PointLight> {
-        emits(self.intensity).then(|| self.clone())
     }
 
     pub fn sample(&self, from: Vec3) -> Option<DeltaSample> {
@@ -81,5 +79,24 @@ impl PointLight {
 
     pub fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
+    }
+}
+
+impl LightKind for PointLight {
+    type Sampler = PointLight;
+
+    fn name(&self) -> &'static str {
+        "point"
+    }
+
+    /// The light to sample, if it emits.
+    fn light(
+        &self,
+        _source: &dyn AssetSource,
+        _latlong: LatLongConvention,
+    ) -> Result<Option<PointLight>, LightError> {
+        Ok({
+            emits(self.intensity).then(|| self.clone())
+        })
     }
 }

@@ -19,6 +19,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -26,6 +27,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
+use super::error::LightError;
+use super::kind::{LatLongConvention, LightKind};
 use super::point::PointLight;
 use super::sample::DeltaSample;
 
@@ -55,11 +58,11 @@ pub struct SpotLight {
 
 impl SpotLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let to = params.vec3("to", DEFAULT_TO)?;
         let cone_angle = params.float("coneangle", DEFAULT_CONE_ANGLE)?;
@@ -87,17 +90,31 @@ impl SpotLight {
             cone_delta_angle,
         })
     }
+}
+
+impl LightKind for SpotLight {
+    type Sampler = SpotCone;
+
+    fn name(&self) -> &'static str {
+        "spot"
+    }
 
     /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<SpotCone> {
-        emits(self.intensity).then(|| {
-            SpotCone::new(
-                self.position,
-                self.direction,
-                self.intensity,
-                self.cone_angle,
-                self.cone_delta_angle,
-            )
+    fn light(
+        &self,
+        _source: &dyn AssetSource,
+        _latlong: LatLongConvention,
+    ) -> Result<Option<SpotCone>, LightError> {
+        Ok({
+            emits(self.intensity).then(|| {
+                SpotCone::new(
+                    self.position,
+                    self.direction,
+                    self.intensity,
+                    self.cone_angle,
+                    self.cone_delta_angle,
+                )
+            })
         })
     }
 }

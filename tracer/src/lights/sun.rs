@@ -28,6 +28,7 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3};
 
+use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::{luminance, Frame};
 use crate::parse::context::ParseContext;
@@ -35,7 +36,9 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::spectra::emission_rgb;
 
-use super::emission::emits;
+use super::emission::{self, emits};
+use super::error::LightError;
+use super::kind::{LatLongConvention, LightKind};
 
 /// `sundir` (LuxRender 1.x's sun default points down: a sun with no direction is set).
 pub const DEFAULT_SUNDIR: Vec3 = Vec3::new(0.0, 0.0, -1.0);
@@ -59,11 +62,11 @@ pub struct SunLight {
 
 impl SunLight {
     pub(crate) fn read(
-        gain: f32,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
         let sundir = params.vec3("sundir", DEFAULT_SUNDIR)?;
         let turbidity = params.float("turbidity", DEFAULT_TURBIDITY)?;
         let relsize = params.float("relsize", DEFAULT_RELSIZE)?;
@@ -109,23 +112,37 @@ impl SunLight {
         let sin = f64::from(self.relsize) * SUN_RADIUS_KM / SUN_DISTANCE_KM;
         sin.min(1.0).powi(2) as f32
     }
+}
+
+impl LightKind for SunLight {
+    type Sampler = SunDisc;
+
+    fn name(&self) -> &'static str {
+        "sun"
+    }
 
     /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<SunDisc> {
-        let to_sun = self.to_sun.normalize_or_zero();
-        let sin2 = self.sin2_max();
-        let radiance = self.radiance();
-        (emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
-            // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
-            let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-            SunDisc {
-                frame: Frame::from_normal(to_sun),
-                to_sun,
-                radiance,
-                sin2_max: sin2,
-                one_minus_cos,
-                pdf: 1.0 / (TAU * one_minus_cos),
-            }
+    fn light(
+        &self,
+        _source: &dyn AssetSource,
+        _latlong: LatLongConvention,
+    ) -> Result<Option<SunDisc>, LightError> {
+        Ok({
+            let to_sun = self.to_sun.normalize_or_zero();
+            let sin2 = self.sin2_max();
+            let radiance = self.radiance();
+            (emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
+                // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
+                let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+                SunDisc {
+                    frame: Frame::from_normal(to_sun),
+                    to_sun,
+                    radiance,
+                    sin2_max: sin2,
+                    one_minus_cos,
+                    pdf: 1.0 / (TAU * one_minus_cos),
+                }
+            })
         })
     }
 }

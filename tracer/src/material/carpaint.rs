@@ -28,6 +28,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::coated::{Coat, CoatLobe};
 use crate::bxdf::coating::Coating;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
@@ -236,16 +237,27 @@ impl CarPaint {
             depth,
         }
     }
+}
+
+impl MaterialKind for CarPaint {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd];
+        params.extend(&self.ks);
+        params.extend(&self.r);
+        params.extend(&self.m);
+        params.extend([&self.ka, &self.depth]);
+        texture_ids(&params)
+    }
 
     /// The base under the flakes.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         Bxdf::Diffuse(DiffuseReflection {
             r: eval.color(self.kd),
             roughness: OrenNayar::new(0.0),
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
+    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
         let off = CoatLobe {
             weight: Vec3::ZERO,
             r0: Vec3::ZERO,
@@ -272,15 +284,6 @@ impl CarPaint {
             eval.float(self.depth),
             None,
         );
-        Coating::two_sided(coat, true)
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd];
-        params.extend(&self.ks);
-        params.extend(&self.r);
-        params.extend(&self.m);
-        params.extend([&self.ka, &self.depth]);
-        texture_ids(&params)
+        Some(Coating::two_sided(coat, true))
     }
 }

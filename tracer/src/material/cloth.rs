@@ -30,6 +30,7 @@
 use glam::{Vec2, Vec3};
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::cloth::{Cloth as ClothLobe, Highlight, Scattering, Yarn, YarnKind, ALBEDO_STEPS};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -401,17 +402,19 @@ impl Cloth {
             ),
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Cloth {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         let highlight = self.preset.highlight(eval.at.uv, self.repeat);
         let [kd, ks] = match highlight.yarn.kind {
             YarnKind::Warp => self.warp,
             YarnKind::Weft => self.weft,
         };
         Bxdf::Cloth(ClothLobe::new(eval.color(kd), eval.color(ks), highlight))
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
     }
 }

@@ -19,6 +19,7 @@
 //! A non-positive index is treated as no interface (index 1).
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::dielectric::{Dielectric, Surface};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -115,8 +116,20 @@ impl Glass {
             index_from_volumes: glass2,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Glass {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[
+            &self.kr,
+            &self.kt,
+            &self.index,
+            &self.uroughness,
+            &self.vroughness,
+        ])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         let eta = eval.float(self.index);
         let surface = if self.architectural {
             Surface::Thin
@@ -133,15 +146,5 @@ impl Glass {
             eta: if eta > 0.0 { eta } else { 1.0 },
             surface,
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[
-            &self.kr,
-            &self.kt,
-            &self.index,
-            &self.uroughness,
-            &self.vroughness,
-        ])
     }
 }

@@ -24,6 +24,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::coated::Coat;
 use crate::bxdf::coating::Coating;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
@@ -151,22 +152,28 @@ impl Glossy {
         ctx.unsupported_unless(params, "sigma", 0.0);
         Ok(Self { kd, coat })
     }
+}
+
+impl MaterialKind for Glossy {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd];
+        params.extend(self.coat.textures());
+        texture_ids(&params)
+    }
 
     /// The base under the coat.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         Bxdf::Diffuse(DiffuseReflection {
             r: eval.color(self.kd),
             roughness: OrenNayar::new(0.0),
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
-        Coating::two_sided(self.coat.coat(eval), true)
+    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
+        Some(Coating::two_sided(self.coat.coat(eval), true))
     }
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd];
-        params.extend(self.coat.textures());
-        texture_ids(&params)
+    fn multibounce(&self) -> bool {
+        self.coat.multibounce
     }
 }

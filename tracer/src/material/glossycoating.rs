@@ -16,7 +16,10 @@
 //! glossycoating) keeps its lobes but loses that inner coat: one coat per surface.
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
+use super::matte::Matte;
 use super::glossy::{CoatParams, DEFAULT_ROUGHNESS};
+use crate::bxdf::Bxdf;
 use crate::bxdf::coating::Coating;
 use crate::diag::SourcePos;
 use crate::param::{MaterialId, TextureId};
@@ -50,11 +53,26 @@ impl GlossyCoating {
     }
 
     /// The coat over a base whose lobe is `diffuse` (Lambert) or not.
-    pub fn coating(&self, eval: &TextureEval, diffuse: bool) -> Coating {
+    pub fn coat_over(&self, eval: &TextureEval, diffuse: bool) -> Coating {
         Coating::two_sided(self.coat.coat(eval), diffuse)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for GlossyCoating {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&self.coat.textures())
+    }
+
+    fn materials(&self) -> Vec<MaterialId> {
+        vec![self.base]
+    }
+
+    /// Resolved with its base by [`super::Materials`]; alone it shows the default matte.
+    fn bxdf(&self, _eval: &TextureEval, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
+    }
+
+    fn multibounce(&self) -> bool {
+        self.coat.multibounce
     }
 }

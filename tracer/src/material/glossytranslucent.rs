@@ -22,6 +22,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use super::glossy::{CoatParams, DEFAULT_KS, DEFAULT_ROUGHNESS};
 use crate::bxdf::coating::Coating;
 use crate::bxdf::diffuse::{DiffuseTranslucent, OrenNayar};
@@ -79,9 +80,20 @@ impl GlossyTranslucent {
             back,
         })
     }
+}
+
+impl MaterialKind for GlossyTranslucent {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd, &self.kt];
+        params.extend(self.front.textures());
+        if let Some(b) = &self.back {
+            params.extend(b.textures());
+        }
+        texture_ids(&params)
+    }
 
     /// The diffuse sheet under the coats.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         let r = eval.color(self.kd);
         Bxdf::Translucent(DiffuseTranslucent {
             r,
@@ -90,21 +102,16 @@ impl GlossyTranslucent {
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
+    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
         let front = self.front.coat(eval);
-        Coating {
+        Some(Coating {
             front,
             back: self.back.as_ref().map_or(front, |b| b.coat(eval)),
             diffuse_base: true,
-        }
+        })
     }
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd, &self.kt];
-        params.extend(self.front.textures());
-        if let Some(b) = &self.back {
-            params.extend(b.textures());
-        }
-        texture_ids(&params)
+    fn multibounce(&self) -> bool {
+        self.front.multibounce || self.back.as_ref().is_some_and(|b| b.multibounce)
     }
 }

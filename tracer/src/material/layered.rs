@@ -19,6 +19,9 @@
 //! translucent layers, which this does not.
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
+use super::matte::Matte;
+use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::parse::context::ParseContext;
@@ -72,13 +75,21 @@ impl Layered {
         };
         (None, u)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Layered {
+    fn textures(&self) -> Vec<TextureId> {
         let opacities: Vec<&Tex> = self.layers.iter().map(|(_, t)| t).collect();
         texture_ids(&opacities)
     }
 
-    pub fn materials(&self) -> Vec<MaterialId> {
+    fn materials(&self) -> Vec<MaterialId> {
         self.layers.iter().map(|(id, _)| *id).collect()
+    }
+
+    /// Resolved to one of its layers by [`super::Materials`]; alone it shows the default
+    /// matte.
+    fn bxdf(&self, _eval: &TextureEval, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
     }
 }

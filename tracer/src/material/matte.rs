@@ -15,6 +15,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -57,13 +58,6 @@ impl Matte {
         })
     }
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
-        Bxdf::Diffuse(DiffuseReflection {
-            r: eval.color(self.kd),
-            roughness: OrenNayar::new(eval.float(self.sigma)),
-        })
-    }
-
     /// What a hit on an undefined material (an out-of-range id, or a mix cycle) shows: the
     /// default matte, without evaluating anything.
     pub fn default_bxdf() -> Bxdf {
@@ -72,8 +66,17 @@ impl Matte {
             roughness: OrenNayar::new(DEFAULT_SIGMA),
         })
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Matte {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[&self.kd, &self.sigma])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+        Bxdf::Diffuse(DiffuseReflection {
+            r: eval.color(self.kd),
+            roughness: OrenNayar::new(eval.float(self.sigma)),
+        })
     }
 }

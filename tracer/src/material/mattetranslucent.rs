@@ -14,8 +14,10 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::diffuse::{DiffuseTranslucent, OrenNayar};
 use crate::bxdf::Bxdf;
+use crate::diag::SourcePos;
 use crate::param::{Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -35,7 +37,11 @@ pub struct MatteTranslucent {
 }
 
 impl MatteTranslucent {
-    pub fn read(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        _pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, true)?,
             kt: ctx.color_param(params, "Kt", DEFAULT_KT, true)?,
@@ -43,8 +49,14 @@ impl MatteTranslucent {
             energy_conserving: params.bool("energyconserving", false)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for MatteTranslucent {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr, &self.kt, &self.sigma])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         let r = eval.color(self.kr);
         let kt = eval.color(self.kt);
         let t = if self.energy_conserving {
@@ -57,9 +69,5 @@ impl MatteTranslucent {
             t,
             roughness: OrenNayar::new(eval.float(self.sigma)),
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr, &self.kt, &self.sigma])
     }
 }

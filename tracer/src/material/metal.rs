@@ -19,6 +19,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use super::nk;
 use crate::assets::AssetKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
@@ -77,8 +78,20 @@ impl Metal {
             vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Metal {
+    fn textures(&self) -> Vec<TextureId> {
+        let fresnel = match &self.fresnel {
+            Fresnel::Reflectance(x) | Fresnel::Index(x) => Some(x),
+            Fresnel::Conductor { .. } => None,
+        };
+        let mut params: Vec<&Tex> = fresnel.into_iter().collect();
+        params.extend([&self.uroughness, &self.vroughness]);
+        texture_ids(&params)
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         let fresnel = match self.fresnel {
             Fresnel::Conductor { eta, k } => ConductorFresnel::Complex { eta, k },
             Fresnel::Index(index) => ConductorFresnel::Complex {
@@ -91,16 +104,6 @@ impl Metal {
             fresnel,
             distrib: eval.roughness(self.uroughness, self.vroughness),
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        let fresnel = match &self.fresnel {
-            Fresnel::Reflectance(x) | Fresnel::Index(x) => Some(x),
-            Fresnel::Conductor { .. } => None,
-        };
-        let mut params: Vec<&Tex> = fresnel.into_iter().collect();
-        params.extend([&self.uroughness, &self.vroughness]);
-        texture_ids(&params)
     }
 }
 

@@ -10,6 +10,7 @@
 //! | `film` | float | 0; thin-film interference is not supported (a warning otherwise) |
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -36,15 +37,17 @@ impl Mirror {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Mirror {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
         Bxdf::Conductor(Conductor {
             fresnel: ConductorFresnel::Constant(eval.color(self.kr)),
             distrib: None,
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr])
     }
 }

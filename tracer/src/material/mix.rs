@@ -16,6 +16,9 @@
 //! is [`Materials`](super::Materials)' (it needs the other materials).
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
+use super::matte::Matte;
+use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::{MaterialId, Tex, TextureId};
 use crate::parse::context::ParseContext;
@@ -71,13 +74,21 @@ impl Mix {
         u = u.clamp(0.0, 1.0 - f32::EPSILON);
         (next, u)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Mix {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[&self.amount])
     }
 
     /// The materials it mixes.
-    pub fn materials(&self) -> Vec<MaterialId> {
+    fn materials(&self) -> Vec<MaterialId> {
         vec![self.a, self.b]
+    }
+
+    /// Resolved to one of its materials by [`super::Materials`]; alone it shows the default
+    /// matte.
+    fn bxdf(&self, _eval: &TextureEval, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
     }
 }

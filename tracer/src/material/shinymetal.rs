@@ -24,6 +24,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -64,9 +65,15 @@ impl ShinyMetal {
             vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
         })
     }
+}
+
+impl MaterialKind for ShinyMetal {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr, &self.ks, &self.uroughness, &self.vroughness])
+    }
 
     /// The lobe chosen by `u` in [0, 1): the mirror or the glossy metal.
-    pub fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
         let (kr, ks) = (eval.color(self.kr), eval.color(self.ks));
         let (sr, ss) = (kr.max_element(), ks.max_element());
         if sr + ss <= 0.0 {
@@ -92,9 +99,5 @@ impl ShinyMetal {
                 distrib: eval.roughness(self.uroughness, self.vroughness),
             })
         }
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr, &self.ks, &self.uroughness, &self.vroughness])
     }
 }

@@ -13,6 +13,7 @@
 //! | `thickness` | float texture, the layer's optical depth, clamped to [0, 1] | 0.1 ([`DEFAULT_THICKNESS`]) |
 
 use super::eval::{texture_ids, TextureEval};
+use super::kind::MaterialKind;
 use crate::bxdf::velvet::Velvet as VelvetLobe;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
@@ -50,17 +51,10 @@ impl Velvet {
             thickness: ctx.float_param(params, "thickness", DEFAULT_THICKNESS)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
-        let p = self.p.map(|t| eval.float(t).clamp(-MAX_P, MAX_P));
-        Bxdf::Velvet(VelvetLobe::new(
-            eval.color(self.kd),
-            p,
-            eval.float(self.thickness).clamp(0.0, 1.0),
-        ))
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Velvet {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[
             &self.kd,
             &self.p[0],
@@ -68,5 +62,14 @@ impl Velvet {
             &self.p[2],
             &self.thickness,
         ])
+    }
+
+    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+        let p = self.p.map(|t| eval.float(t).clamp(-MAX_P, MAX_P));
+        Bxdf::Velvet(VelvetLobe::new(
+            eval.color(self.kd),
+            p,
+            eval.float(self.thickness).clamp(0.0, 1.0),
+        ))
     }
 }
