@@ -49,7 +49,7 @@ impl Bsdf {
 
     /// True when the material is `null`: the ray continues straight through.
     pub fn is_pass_through(&self) -> bool {
-        matches!(self.bxdf, Bxdf::PassThrough)
+        matches!(self.bxdf, Bxdf::PassThrough(_))
     }
 
     /// A bare Lambert BSDF's shading frame, geometric normal and value (the same for every

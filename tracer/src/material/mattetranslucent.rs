@@ -15,7 +15,8 @@ use glam::Vec3;
 
 use super::eval::{texture_ids, TextureEval};
 use super::kind::MaterialKind;
-use crate::bxdf::diffuse::{DiffuseTranslucent, OrenNayar};
+use crate::bxdf::diffuse::OrenNayar;
+use crate::bxdf::translucent::DiffuseTranslucent;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::{Tex, TextureId};

@@ -10,6 +10,7 @@
 
 use super::eval::TextureEval;
 use super::kind::MaterialKind;
+use crate::bxdf::pass_through::PassThrough;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
 use crate::param::TextureId;
@@ -36,6 +37,6 @@ impl MaterialKind for Null {
     }
 
     fn bxdf(&self, _eval: &TextureEval, _u: f32) -> Bxdf {
-        Bxdf::PassThrough
+        Bxdf::PassThrough(PassThrough)
     }
 }

@@ -20,6 +20,8 @@ use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::image_io::RgbImage;
 
 pub const DEFAULT_TEX: f32 = 0.0;
 pub const DEFAULT_AMOUNT: f32 = 0.0;
@@ -58,8 +60,23 @@ impl Band {
             amount: ctx.tex(amount, false, Vec3::splat(DEFAULT_AMOUNT)),
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Band {
+    fn name(&self) -> &'static str {
+        "band"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        self.textures.iter().copied().chain([self.amount]).collect()
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
         let a = textures.eval(self.amount, at).x;
         let (first, last) = (self.offsets[0], self.offsets[self.offsets.len() - 1]);
         if a.is_nan() || a < first {

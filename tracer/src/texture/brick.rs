@@ -31,6 +31,8 @@ use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::image_io::RgbImage;
 
 pub const DEFAULT_BOND: &str = "running";
 pub const DEFAULT_BRICKTEX: f32 = 1.0;
@@ -154,20 +156,6 @@ impl Brick {
         }
     }
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
-        match self.brick_at(self.mapping.map(at)) {
-            Some(index) => {
-                let brick = TexturePoint {
-                    p: index,
-                    p_world: index,
-                    ..*at
-                };
-                textures.eval(self.brick, at) * textures.eval(self.modulation, &brick)
-            }
-            None => textures.eval(self.mortar, at),
-        }
-    }
-
     fn inside(b: Vec3, mortar: Vec3) -> bool {
         b.z > mortar.z && b.y > mortar.y && b.x > mortar.x
     }
@@ -243,5 +231,34 @@ impl Brick {
             }
         }
         (by > mortar.z && bx > mortar.x).then_some(Vec3::new(ix, iy, 0.0))
+    }
+}
+
+impl TextureType for Brick {
+    fn name(&self) -> &'static str {
+        "brick"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        vec![self.brick, self.mortar, self.modulation]
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
+        match self.brick_at(self.mapping.map(at)) {
+            Some(index) => {
+                let brick = TexturePoint {
+                    p: index,
+                    p_world: index,
+                    ..*at
+                };
+                textures.eval(self.brick, at) * textures.eval(self.modulation, &brick)
+            }
+            None => textures.eval(self.mortar, at),
+        }
     }
 }

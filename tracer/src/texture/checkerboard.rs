@@ -16,7 +16,9 @@
 use glam::Vec3;
 
 use super::common::{Declared, TextureEval, TexturePoint};
+use super::kind::TextureType;
 use super::mapping::{Mapping2D, Mapping3D};
+use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 use crate::param::Tex;
 use crate::parse::context::ParseContext;
@@ -42,6 +44,7 @@ pub struct Checkerboard3D {
 }
 
 /// What `"checkerboard"` reads as, by its dimension.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Checkerboard {
     D2(Checkerboard2D),
     D3(Checkerboard3D),
@@ -90,5 +93,37 @@ impl Checkerboard3D {
         let p = self.mapping.map(at).floor();
         let first = (p.x + p.y + p.z).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
+    }
+}
+
+impl TextureType for Checkerboard {
+    fn name(&self) -> &'static str {
+        "checkerboard"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        match self {
+            Checkerboard::D2(t) => vec![t.tex1, t.tex2],
+            Checkerboard::D3(t) => vec![t.tex1, t.tex2],
+        }
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        match self {
+            Checkerboard::D2(t) => Some(&t.mapping),
+            Checkerboard::D3(_) => None,
+        }
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
+        match self {
+            Checkerboard::D2(t) => t.eval(at, textures),
+            Checkerboard::D3(t) => t.eval(at, textures),
+        }
     }
 }

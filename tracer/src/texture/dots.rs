@@ -21,6 +21,8 @@ use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::image_io::RgbImage;
 
 pub const DEFAULT_INSIDE: f32 = 1.0;
 pub const DEFAULT_OUTSIDE: f32 = 0.0;
@@ -61,8 +63,27 @@ impl Dots {
         let (ds, dt) = (s - centre_s, t - centre_t);
         ds * ds + dt * dt < RADIUS * RADIUS
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Dots {
+    fn name(&self) -> &'static str {
+        "dots"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        vec![self.outside, self.inside]
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        Some(&self.mapping)
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
         let st = self.mapping.map(at);
         let tex = if Self::inside(st.x, st.y) {
             self.inside

@@ -17,6 +17,9 @@ use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::image_io::RgbImage;
+use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 0.0;
 pub const DEFAULT_TEX2: f32 = 1.0;
@@ -34,6 +37,7 @@ impl Mix {
     pub fn read(
         decl: &Declared,
         params: &ParamList,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         let amount = params.tex_float("amount", DEFAULT_AMOUNT)?;
@@ -43,8 +47,23 @@ impl Mix {
             amount: ctx.tex(amount, false, Vec3::splat(DEFAULT_AMOUNT)),
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Mix {
+    fn name(&self) -> &'static str {
+        "mix"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        vec![self.tex1, self.tex2, self.amount]
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
         let t = textures.eval(self.amount, at).x;
         textures.eval(self.tex1, at) * (1.0 - t) + textures.eval(self.tex2, at) * t
     }

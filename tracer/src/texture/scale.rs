@@ -19,6 +19,9 @@ use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::image_io::RgbImage;
+use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 1.0;
 pub const DEFAULT_TEX2: f32 = 1.0;
@@ -33,6 +36,7 @@ impl Scale {
     pub fn read(
         decl: &Declared,
         params: &ParamList,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         Ok(Scale {
@@ -40,8 +44,23 @@ impl Scale {
             tex2: decl.tex(ctx, params, "tex2", DEFAULT_TEX2)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Scale {
+    fn name(&self) -> &'static str {
+        "scale"
+    }
+
+    fn references(&self) -> Vec<Tex> {
+        vec![self.tex1, self.tex2]
+    }
+
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        _image: Option<&RgbImage>,
+    ) -> Vec3 {
         textures.eval(self.tex1, at) * textures.eval(self.tex2, at)
     }
 }

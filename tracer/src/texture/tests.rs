@@ -192,7 +192,7 @@ fn checkerboards_alternate() {
         TextureDesc {
             name: "check2d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard2D(Checkerboard2D {
+            kind: TextureKind::Checkerboard(Checkerboard::D2(Checkerboard2D {
                 tex1: Tex::color(Vec3::ONE),
                 tex2: Tex::color(Vec3::ZERO),
                 mapping: Mapping2D::Uv {
@@ -201,16 +201,16 @@ fn checkerboards_alternate() {
                     udelta: 0.0,
                     vdelta: 0.0,
                 },
-            }),
+            })),
         },
         TextureDesc {
             name: "check3d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard3D(Checkerboard3D {
+            kind: TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
                 tex1: Tex::color(Vec3::ONE),
                 tex2: Tex::color(Vec3::ZERO),
                 mapping: Mapping3D::global(Mat4::from_scale(Vec3::splat(2.0))),
-            }),
+            })),
         },
     ];
     let textures = Textures::new(&descs, &MemorySource::new()).unwrap();

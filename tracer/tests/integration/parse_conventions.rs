@@ -11,7 +11,7 @@ use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
-use yat_tracer::texture::{Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
+use yat_tracer::texture::{Checkerboard, Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
 
 fn source(files: &[(&str, &[u8])]) -> MemorySource {
     let mut s = MemorySource::new();
@@ -467,12 +467,12 @@ fn textures_map_to_descriptions() {
     assert!(!d.textures[1].is_color && d.textures[0].is_color);
     assert_eq!(
         *t(2),
-        TextureKind::Checkerboard3D(Checkerboard3D {
+        TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
             tex1: Tex::float(1.0),
             tex2: Tex::Texture(TextureId(1)),
             // 3D mappings take the CTM uninverted, as LuxRender 1.x does.
             mapping: Mapping3D::global(Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)))
-        })
+        }))
     );
     assert_eq!(
         *t(3),

@@ -12,7 +12,7 @@ use yat_tracer::lights::InfiniteLight;
 use yat_tracer::material::Matte;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
 use yat_tracer::sampler::PixelSampler;
-use yat_tracer::texture::Checkerboard2D;
+use yat_tracer::texture::{Checkerboard, Checkerboard2D};
 
 use crate::scene::empty_scene as scene;
 
@@ -380,7 +380,7 @@ fn planar_mapping_follows_the_object_space() {
     desc.textures.push(TextureDesc {
         name: "checks".into(),
         is_color: true,
-        kind: TextureKind::Checkerboard2D(Checkerboard2D {
+        kind: TextureKind::Checkerboard(Checkerboard::D2(Checkerboard2D {
             tex1: Tex::float(1.0),
             tex2: Tex::float(0.0),
             mapping: Mapping2D::Planar {
@@ -390,7 +390,7 @@ fn planar_mapping_follows_the_object_space() {
                 udelta: 0.0,
                 vdelta: 0.0,
             },
-        }),
+        })),
     });
     desc.materials.push(MaterialDesc::Matte(Matte {
         kd: Tex::Texture(TextureId(0)),

@@ -1,0 +1,40 @@
+//! What every texture type says of itself, for the dispatch [`super`]'s type list generates: its
+//! name, what it references, the file it reads and its value at a point. A leaf of the
+//! texture family, so the texture files never import `texture/mod.rs`.
+
+use glam::Vec3;
+
+use super::common::{TextureEval, TexturePoint};
+use super::mapping::Mapping2D;
+use crate::image_io::RgbImage;
+use crate::param::Tex;
+
+pub trait TextureType {
+    /// The LuxRender type name.
+    fn name(&self) -> &'static str;
+
+    /// The textures (or constants) this texture reads, in parameter order; a texture that
+    /// reads others must list them (they are checked to be defined before it).
+    fn references(&self) -> Vec<Tex> {
+        Vec::new()
+    }
+
+    /// The image file this texture reads, and the gamma it is decoded with.
+    fn file(&self) -> Option<(&str, f32)> {
+        None
+    }
+
+    /// The 2D mapping this texture looks itself up with, if it has one.
+    fn mapping(&self) -> Option<&Mapping2D> {
+        None
+    }
+
+    /// The value at `at`: `textures` evaluates the textures it references, `image` is its
+    /// [`TextureType::file`] decoded (None for a texture that reads none).
+    fn eval(
+        &self,
+        at: &TexturePoint,
+        textures: &impl TextureEval,
+        image: Option<&RgbImage>,
+    ) -> Vec3;
+}
