@@ -8,7 +8,9 @@ use std::path::Path;
 use yat_tracer::desc::{Mapping2D, Tex, TextureKind};
 use yat_tracer::texture::blender::noise_basis::{Metric, NoiseBasis};
 use yat_tracer::texture::blender::{musgrave, Blender, BlenderKind};
-use yat_tracer::texture::{Bond, Coordinates, Fbm, Mapping3D, NormalMap, Op, Wrinkled};
+use yat_tracer::texture::{
+    Bond, Coordinates, Fbm, Mapping3D, NormalMap, Op, TextureType, Wrinkled,
+};
 
 use crate::props::{matrix, quoted, tex_value, v3, Props};
 
