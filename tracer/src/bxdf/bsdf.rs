@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::coating::Coating;
+use super::coat_over_base::Coating;
 use super::sample::LocalSample;
 use super::Bxdf;
 use crate::math::{Cone, Frame};

@@ -7,13 +7,13 @@
 //! implements), [`local`] (local-frame helpers), [`fresnel`], [`microfacet`]
 //! (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the lobes
 //! [`pass_through`], [`diffuse`], [`translucent`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`],
-//! [`cloth`], the glossy [`coated`] layer and [`coating`] (a coat over any lobe), and [`bsdf`]
+//! [`cloth`], the glossy [`coat`] layer and [`coat_over_base`] (a coat over any base lobe), and [`bsdf`]
 //! (world frame). A new lobe is its file (its struct and [`Lobe`] impl) plus one line in the
 //! lobe list below.
 
 pub mod bsdf;
-pub mod coated;
-pub mod coating;
+pub mod coat;
+pub mod coat_over_base;
 pub mod fresnel;
 pub mod ggx_albedo;
 pub mod lobe;

@@ -18,7 +18,7 @@
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
-//! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_cones` (which lamps a cone
+//! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_spheres` (which lamps a cone
 //! of directions may reach), `triangle_lamps` (a few plain triangle lamps sampled in lanes).
 //! A new kind is one new file (its description, its reader, its [`LightKind`] impl) plus one
 //! line in the kind list below, which generates the rest; a light of a new sort (not a point,
@@ -30,7 +30,7 @@ mod emission;
 mod error;
 mod facing;
 mod kind;
-mod lamp_cones;
+mod lamp_spheres;
 mod mirrored;
 mod sample;
 mod triangle_lamps;
@@ -66,7 +66,7 @@ pub use triangle_lamps::{LightSamples, TriangleLamps};
 use area::AreaLight;
 use distribution::Distribution1D;
 use infinite::Environment;
-use lamp_cones::LampCones;
+use lamp_spheres::LampSpheres;
 use mirrored::MirrorImages;
 use spot::SpotCone;
 use sun::SunDisc;
@@ -255,7 +255,7 @@ pub struct Lights {
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
     images: MirrorImages,
     /// The area lights' bounding spheres, for [`Self::lamp_may_be_in`].
-    lamp_cones: LampCones,
+    lamp_spheres: LampSpheres,
     /// The lights as tables for packets, when they are a few plain triangle lamps.
     triangle_lamps: Option<TriangleLamps>,
 }
@@ -336,7 +336,7 @@ impl Lights {
             _ => None,
         });
         Ok(Self {
-            lamp_cones: LampCones::new(&lamp_boxes),
+            lamp_spheres: LampSpheres::new(&lamp_boxes),
             triangle_lamps: TriangleLamps::new(lamps, &selection),
             lights,
             selection,
@@ -466,12 +466,12 @@ impl Lights {
 
     /// Whether an area light may lie in `cone` seen from `p` (true may be wrong, false is not).
     pub fn lamp_may_be_in(&self, p: Vec3, cone: &Cone) -> bool {
-        self.lamp_cones.may_reach(p, cone)
+        self.lamp_spheres.may_reach(p, cone)
     }
 
     /// Whether a ray from `p` along `dir` may reach an area light (false is never wrong).
     pub fn lamp_may_be_along(&self, p: Vec3, dir: Vec3) -> bool {
-        self.lamp_cones.may_reach_along(p, dir)
+        self.lamp_spheres.may_reach_along(p, dir)
     }
 
     /// Whether the scene has lamp images (most have none).

@@ -29,12 +29,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
 use super::kind::MaterialKind;
 use crate::bxdf::cloth::{Cloth as ClothLobe, Highlight, Scattering, Yarn, YarnKind, ALBEDO_STEPS};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -372,8 +372,8 @@ impl Preset {
 pub struct Cloth {
     pub preset: &'static Preset,
     /// Diffuse and highlight colours of the warp, then of the weft.
-    pub warp: [Tex; 2],
-    pub weft: [Tex; 2],
+    pub warp: [ConstOrTexture; 2],
+    pub weft: [ConstOrTexture; 2],
     pub repeat: Vec2,
 }
 
@@ -409,7 +409,7 @@ impl MaterialKind for Cloth {
         texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
     }
 
-    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let highlight = self.preset.highlight(eval.at.uv, self.repeat);
         let [kd, ks] = match highlight.yarn.kind {
             YarnKind::Warp => self.warp,

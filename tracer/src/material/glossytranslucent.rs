@@ -16,20 +16,20 @@
 //! | `backface_Ks`, `backface_index`, `backface_Ka`, `backface_d`, `backface_uroughness`, `backface_vroughness`, `backface_multibounce` | the back coat when `onesided` is false | Ks 0 ([`DEFAULT_BACKFACE_KS`]), roughness 0 ([`DEFAULT_BACKFACE_ROUGHNESS`]), the rest as glossy |
 //!
 //! Light crossing the sheet passes the coat of the face it enters and the coat of the face it
-//! leaves (see [`coating`](crate::bxdf::coating)); what Kd reflects is not transmitted, as in
+//! leaves (see [`coat_over_base`](crate::bxdf::coat_over_base)); what Kd reflects is not transmitted, as in
 //! LuxRender's Kt (1 - Kd).
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
 use super::kind::MaterialKind;
 use super::glossy::{CoatParams, DEFAULT_KS, DEFAULT_ROUGHNESS};
-use crate::bxdf::coating::Coating;
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::diffuse::OrenNayar;
 use crate::bxdf::translucent::DiffuseTranslucent;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -41,8 +41,8 @@ pub const DEFAULT_BACKFACE_ROUGHNESS: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct GlossyTranslucent {
-    pub kd: Tex,
-    pub kt: Tex,
+    pub kd: ConstOrTexture,
+    pub kt: ConstOrTexture,
     pub front: CoatParams,
     /// None: the back face has the front's coat (`onesided`).
     pub back: Option<CoatParams>,
@@ -94,7 +94,7 @@ impl MaterialKind for GlossyTranslucent {
     }
 
     /// The diffuse sheet under the coats.
-    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let r = eval.color(self.kd);
         Bxdf::Translucent(DiffuseTranslucent {
             r,
@@ -103,7 +103,7 @@ impl MaterialKind for GlossyTranslucent {
         })
     }
 
-    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
+    fn coating(&self, eval: &HitTextures) -> Option<Coating> {
         let front = self.front.coat(eval);
         Some(Coating {
             front,

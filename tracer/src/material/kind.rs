@@ -2,10 +2,10 @@
 //! the textures and materials it references and the lobe and coat it makes at a hit. A leaf of
 //! the material family, so the material files never import `material/mod.rs`.
 
-use super::eval::TextureEval;
-use crate::bxdf::coating::Coating;
+use super::eval::HitTextures;
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::Bxdf;
-use crate::param::{MaterialId, TextureId};
+use crate::refs::{MaterialId, TextureId};
 
 pub trait MaterialKind {
     /// The textures the material reads directly, in parameter order.
@@ -19,10 +19,10 @@ pub trait MaterialKind {
 
     /// The lobe at a hit, under [`MaterialKind::coating`]; `u` in [0, 1) chooses between
     /// lobes where a material has several.
-    fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf;
+    fn bxdf(&self, eval: &HitTextures, u: f32) -> Bxdf;
 
     /// The coat over [`MaterialKind::bxdf`], for the materials that have one.
-    fn coating(&self, _eval: &TextureEval) -> Option<Coating> {
+    fn coating(&self, _eval: &HitTextures) -> Option<Coating> {
         None
     }
 

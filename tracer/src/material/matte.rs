@@ -14,12 +14,12 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
 use super::kind::MaterialKind;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -31,17 +31,17 @@ pub const DEFAULT_SIGMA: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Matte {
-    pub kd: Tex,
+    pub kd: ConstOrTexture,
     /// Oren-Nayar sigma in degrees.
-    pub sigma: Tex,
+    pub sigma: ConstOrTexture,
 }
 
 impl Default for Matte {
     /// LuxRender's default material.
     fn default() -> Self {
         Self {
-            kd: Tex::color(Vec3::splat(DEFAULT_KD)),
-            sigma: Tex::float(DEFAULT_SIGMA),
+            kd: ConstOrTexture::color(Vec3::splat(DEFAULT_KD)),
+            sigma: ConstOrTexture::float(DEFAULT_SIGMA),
         }
     }
 }
@@ -73,7 +73,7 @@ impl MaterialKind for Matte {
         texture_ids(&[&self.kd, &self.sigma])
     }
 
-    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::Diffuse(DiffuseReflection {
             r: eval.color(self.kd),
             roughness: OrenNayar::new(eval.float(self.sigma)),

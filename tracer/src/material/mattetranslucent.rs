@@ -13,13 +13,13 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
 use super::kind::MaterialKind;
 use crate::bxdf::diffuse::OrenNayar;
 use crate::bxdf::translucent::DiffuseTranslucent;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -31,9 +31,9 @@ pub const DEFAULT_SIGMA: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MatteTranslucent {
-    pub kr: Tex,
-    pub kt: Tex,
-    pub sigma: Tex,
+    pub kr: ConstOrTexture,
+    pub kt: ConstOrTexture,
+    pub sigma: ConstOrTexture,
     pub energy_conserving: bool,
 }
 
@@ -57,7 +57,7 @@ impl MaterialKind for MatteTranslucent {
         texture_ids(&[&self.kr, &self.kt, &self.sigma])
     }
 
-    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let r = eval.color(self.kr);
         let kt = eval.color(self.kt);
         let t = if self.energy_conserving {

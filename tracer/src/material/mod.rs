@@ -33,17 +33,17 @@ pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
 pub use bump::Bump;
 pub use kind::MaterialKind;
 
-use crate::bxdf::coating::Coating;
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::{ggx_albedo, Bxdf};
 use crate::diag::SourcePos;
 use crate::geometry::SurfaceHit;
 use crate::math::Frame;
-use crate::param::{MaterialId, Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::texture::{TexturePoint, Textures};
-use eval::TextureEval;
+use crate::refs::{ConstOrTexture, MaterialId, TextureId};
+use crate::texture::{LookupPoint, Textures};
+use eval::HitTextures;
 
 /// Generates the material family from its kind list (see [`materials!`]'s invocation below):
 /// each kind's module and re-export, the [`MaterialDesc`] variant, the name table from
@@ -109,7 +109,7 @@ macro_rules! materials {
             /// The lobe of a leaf material at a hit, under its coat if it has one (`mix`,
             /// `layered` and glossycoating resolved by [`Materials`] first; an unresolved one
             /// shows the default matte). `u` in [0, 1) chooses shinymetal's lobe.
-            fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
+            fn bxdf(&self, eval: &HitTextures, u: f32) -> Bxdf {
                 match self {
                     $(Self::$kind(m) => m.bxdf(eval, u),)+
                     Self::Bumped(m, _) => m.bxdf(eval, u),
@@ -117,7 +117,7 @@ macro_rules! materials {
             }
 
             /// The coat over [`MaterialDesc::bxdf`], for the materials that have one.
-            fn coating(&self, eval: &TextureEval) -> Option<Coating> {
+            fn coating(&self, eval: &HitTextures) -> Option<Coating> {
                 match self {
                     $(Self::$kind(m) => m.coating(eval),)+
                     Self::Bumped(m, _) => m.coating(eval),
@@ -178,7 +178,7 @@ impl MaterialDesc {
             }
             return Ok(Self::Matte(Matte {
                 kd,
-                sigma: Tex::float(matte::DEFAULT_SIGMA),
+                sigma: ConstOrTexture::float(matte::DEFAULT_SIGMA),
             }));
         };
         if matches!(material, Self::Mix(_) | Self::Null(_)) {
@@ -210,7 +210,7 @@ impl Materials {
     fn resolve(
         &self,
         id: MaterialId,
-        eval: &TextureEval,
+        eval: &HitTextures,
         u_mix: f32,
     ) -> Option<(&MaterialDesc, f32, Option<&Bump>)> {
         let mut material = self.materials.get(id.0 as usize)?;
@@ -250,7 +250,7 @@ impl Materials {
     fn scattering(
         &self,
         id: MaterialId,
-        eval: &TextureEval,
+        eval: &HitTextures,
         u_mix: f32,
     ) -> (Bxdf, Option<Coating>, Option<&Bump>) {
         let Some((leaf, u, bump)) = self.resolve(id, eval, u_mix) else {
@@ -288,9 +288,9 @@ impl Materials {
         textures: &Textures,
         u_mix: f32,
     ) -> Bsdf {
-        let eval = TextureEval {
+        let eval = HitTextures {
             textures,
-            at: TexturePoint {
+            at: LookupPoint {
                 p: world_to_object.transform_point3(hit.p),
                 p_world: hit.p,
                 uv: hit.uv,

@@ -8,12 +8,12 @@
 //! It has no parameters.
 
 
-use super::eval::TextureEval;
+use super::eval::HitTextures;
 use super::kind::MaterialKind;
 use crate::bxdf::pass_through::PassThrough;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::TextureId;
+use crate::refs::TextureId;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -36,7 +36,7 @@ impl MaterialKind for Null {
         Vec::new()
     }
 
-    fn bxdf(&self, _eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, _eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::PassThrough(PassThrough)
     }
 }

@@ -15,12 +15,12 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
 use super::kind::MaterialKind;
 use crate::bxdf::scatter::Scatter as ScatterLobe;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -30,8 +30,8 @@ pub const DEFAULT_G: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scatter {
-    pub kd: Tex,
-    pub g: Tex,
+    pub kd: ConstOrTexture,
+    pub g: ConstOrTexture,
 }
 
 impl Scatter {
@@ -52,7 +52,7 @@ impl MaterialKind for Scatter {
         texture_ids(&[&self.kd, &self.g])
     }
 
-    fn bxdf(&self, eval: &TextureEval, _u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         // The asymmetry may be negative: read it unclamped, then bound it to [-1, 1].
         let g = eval
             .textures

@@ -10,7 +10,7 @@ use glam::{Affine3A, Vec2, Vec3};
 use super::*;
 use crate::desc::MaterialDesc;
 use crate::geometry::SurfaceHit;
-use crate::param::{Fresnel, MaterialId, Tex};
+use crate::refs::{ConstOrTexture, Fresnel, MaterialId};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 use glossy::CoatParams;
@@ -40,12 +40,12 @@ fn bsdf_of(material: MaterialDesc) -> Bsdf {
     )
 }
 
-fn c(v: f32) -> Tex {
-    Tex::float(v)
+fn c(v: f32) -> ConstOrTexture {
+    ConstOrTexture::float(v)
 }
 
-fn rgb(r: f32, g: f32, b: f32) -> Tex {
-    Tex::color(Vec3::new(r, g, b))
+fn rgb(r: f32, g: f32, b: f32) -> ConstOrTexture {
+    ConstOrTexture::color(Vec3::new(r, g, b))
 }
 
 fn matte(kd: f32, sigma: f32) -> MaterialDesc {
@@ -133,7 +133,7 @@ fn velvet(kd: f32, p: [f32; 3], thickness: f32) -> MaterialDesc {
 fn scatter(kd: f32, g: Vec3) -> MaterialDesc {
     MaterialDesc::Scatter(Scatter {
         kd: c(kd),
-        g: Tex::color(g),
+        g: ConstOrTexture::color(g),
     })
 }
 

@@ -13,8 +13,8 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
-use crate::param::Tex;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -34,8 +34,8 @@ pub enum Op {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Arithmetic {
     pub op: Op,
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
 }
 
 impl Arithmetic {
@@ -83,14 +83,14 @@ impl TextureType for Arithmetic {
         }
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.tex1, self.tex2]
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let (a, b) = (textures.eval(self.tex1, at), textures.eval(self.tex2, at));

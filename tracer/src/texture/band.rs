@@ -14,9 +14,9 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -30,8 +30,8 @@ pub const DEFAULT_AMOUNT: f32 = 0.0;
 pub struct Band {
     /// Ascending, at least one, as many as `textures`.
     pub offsets: Vec<f32>,
-    pub textures: Vec<Tex>,
-    pub amount: Tex,
+    pub textures: Vec<ConstOrTexture>,
+    pub amount: ConstOrTexture,
 }
 
 impl Band {
@@ -67,14 +67,14 @@ impl TextureType for Band {
         "band"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         self.textures.iter().copied().chain([self.amount]).collect()
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let a = textures.eval(self.amount, at).x;

@@ -15,7 +15,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
@@ -73,8 +73,8 @@ impl TextureType for Bilerp {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let st = self.mapping.map(at);

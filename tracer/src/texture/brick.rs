@@ -24,10 +24,10 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -60,9 +60,9 @@ pub enum Bond {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Brick {
     pub bond: Bond,
-    pub brick: Tex,
-    pub mortar: Tex,
-    pub modulation: Tex,
+    pub brick: ConstOrTexture,
+    pub mortar: ConstOrTexture,
+    pub modulation: ConstOrTexture,
     /// Brick size along x, y, z (width, depth, height) after the bond's adjustments.
     pub size: Vec3,
     pub mortar_size: f32,
@@ -239,19 +239,19 @@ impl TextureType for Brick {
         "brick"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.brick, self.mortar, self.modulation]
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         match self.brick_at(self.mapping.map(at)) {
             Some(index) => {
-                let brick = TexturePoint {
+                let brick = LookupPoint {
                     p: index,
                     p_world: index,
                     ..*at

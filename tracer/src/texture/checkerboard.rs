@@ -15,12 +15,12 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::kind::TextureType;
 use super::mapping::{Mapping2D, Mapping3D};
 use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -31,15 +31,15 @@ pub const DEFAULT_TEX2: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard2D {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     pub mapping: Mapping2D,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard3D {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     pub mapping: Mapping3D,
 }
 
@@ -81,7 +81,7 @@ impl Checkerboard {
 }
 
 impl Checkerboard2D {
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+    pub fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at).floor();
         let first = (st.x + st.y).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
@@ -89,7 +89,7 @@ impl Checkerboard2D {
 }
 
 impl Checkerboard3D {
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+    pub fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let p = self.mapping.map(at).floor();
         let first = (p.x + p.y + p.z).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
@@ -101,7 +101,7 @@ impl TextureType for Checkerboard {
         "checkerboard"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         match self {
             Checkerboard::D2(t) => vec![t.tex1, t.tex2],
             Checkerboard::D3(t) => vec![t.tex1, t.tex2],
@@ -117,8 +117,8 @@ impl TextureType for Checkerboard {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         match self {

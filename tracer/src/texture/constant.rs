@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
@@ -49,8 +49,8 @@ impl TextureType for Constant {
 
     fn eval(
         &self,
-        _at: &TexturePoint,
-        _textures: &impl TextureEval,
+        _at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         self.value

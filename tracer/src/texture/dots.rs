@@ -13,11 +13,11 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use super::noise::noise2;
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -31,8 +31,8 @@ pub const RADIUS: f32 = 0.35;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dots {
-    pub inside: Tex,
-    pub outside: Tex,
+    pub inside: ConstOrTexture,
+    pub outside: ConstOrTexture,
     pub mapping: Mapping2D,
 }
 
@@ -70,7 +70,7 @@ impl TextureType for Dots {
         "dots"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.outside, self.inside]
     }
 
@@ -80,8 +80,8 @@ impl TextureType for Dots {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let st = self.mapping.map(at);

@@ -14,7 +14,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use super::noise::{fbm, MAX_OCTAVES};
 use crate::diag::SourcePos;
@@ -72,8 +72,8 @@ impl TextureType for Fbm {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let o = &self.0;

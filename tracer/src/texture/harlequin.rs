@@ -10,7 +10,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::kind::TextureType;
 use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
@@ -63,8 +63,8 @@ impl TextureType for Harlequin {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         Self::colour(at.prim % PALETTE_SIZE)

@@ -24,7 +24,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::image_io::{Edge, RgbImage};
@@ -102,7 +102,7 @@ impl ImageMap {
     }
 
     /// The texel value at a surface point, `image` being this texture's decoded file.
-    pub fn texel(&self, at: &TexturePoint, image: &RgbImage) -> Vec3 {
+    pub fn texel(&self, at: &LookupPoint, image: &RgbImage) -> Vec3 {
         lookup(image, self.mapping.map(at), self.wrap, self.gain)
     }
 }
@@ -136,8 +136,8 @@ impl TextureType for ImageMap {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         image: Option<&RgbImage>,
     ) -> Vec3 {
         self.texel(at, image.expect("decoded in Textures::new"))

@@ -4,10 +4,10 @@
 
 use glam::Vec3;
 
-use super::common::{TextureEval, TexturePoint};
+use super::common::{LookupPoint, ReferencedTextures};
 use super::mapping::Mapping2D;
 use crate::image_io::RgbImage;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 
 pub trait TextureType {
     /// The LuxRender type name.
@@ -15,7 +15,7 @@ pub trait TextureType {
 
     /// The textures (or constants) this texture reads, in parameter order; a texture that
     /// reads others must list them (they are checked to be defined before it).
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         Vec::new()
     }
 
@@ -33,8 +33,8 @@ pub trait TextureType {
     /// [`TextureType::file`] decoded (None for a texture that reads none).
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         image: Option<&RgbImage>,
     ) -> Vec3;
 }

@@ -18,7 +18,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::fbm::Octaves;
 use super::noise::fbm;
 use crate::diag::SourcePos;
@@ -75,8 +75,8 @@ impl TextureType for Marble {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let o = &self.octaves;

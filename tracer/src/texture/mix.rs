@@ -12,8 +12,8 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
-use crate::param::Tex;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -27,10 +27,10 @@ pub const DEFAULT_AMOUNT: f32 = 0.5;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mix {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     /// Weight of `tex2` (a float texture: its first channel).
-    pub amount: Tex,
+    pub amount: ConstOrTexture,
 }
 
 impl Mix {
@@ -54,14 +54,14 @@ impl TextureType for Mix {
         "mix"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.tex1, self.tex2, self.amount]
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let t = textures.eval(self.amount, at).x;

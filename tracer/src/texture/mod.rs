@@ -19,7 +19,7 @@
 //!
 //! A new texture type is a new file here (struct, defaults, `read`, its [`TextureType`] impl)
 //! plus one line in the type list below, which generates the rest. A texture that evaluates
-//! other textures does so through the `&impl TextureEval` its `eval` is given.
+//! other textures does so through the `&impl ReferencedTextures` its `eval` is given.
 
 pub mod blackbody;
 pub mod common;
@@ -44,15 +44,15 @@ use glam::Vec3;
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::image_io::{self, RgbImage};
-use crate::param::{Fresnel, Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::{ConstOrTexture, Fresnel, TextureId};
 
 pub use arithmetic::Op;
 pub use brick::Bond;
 pub use checkerboard::{Checkerboard2D, Checkerboard3D};
-pub use common::{Declared, TextureEval, TexturePoint};
+pub use common::{Declared, LookupPoint, ReferencedTextures};
 pub use fbm::Octaves;
 pub use imagemap::Wrap;
 pub use kind::TextureType;
@@ -104,7 +104,7 @@ macro_rules! textures {
             }
 
             /// The textures (or constants) this texture reads, in parameter order.
-            pub fn references(&self) -> Vec<Tex> {
+            pub fn references(&self) -> Vec<ConstOrTexture> {
                 match self {
                     $(Self::$kind(t) => t.references(),)+
                 }
@@ -127,8 +127,8 @@ macro_rules! textures {
             /// The value at `at` (see [`TextureType::eval`]).
             fn eval(
                 &self,
-                at: &TexturePoint,
-                textures: &impl TextureEval,
+                at: &LookupPoint,
+                textures: &impl ReferencedTextures,
                 image: Option<&RgbImage>,
             ) -> Vec3 {
                 match self {
@@ -275,7 +275,7 @@ impl Textures {
         let mut textures = Vec::with_capacity(descs.len());
         for (index, desc) in descs.iter().enumerate() {
             for tex in desc.kind.references() {
-                if let Tex::Texture(TextureId(used)) = tex {
+                if let ConstOrTexture::Texture(TextureId(used)) = tex {
                     if used as usize >= index {
                         return Err(TextureError::ForwardReference {
                             texture: desc.name.clone(),
@@ -309,17 +309,17 @@ impl Textures {
     }
 
     /// The value of a parameter at a surface point. An id that names no texture gives black.
-    pub fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3 {
+    pub fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3 {
         match tex {
-            Tex::Const(c) => c,
-            Tex::Texture(TextureId(id)) => match self.textures.get(id as usize) {
+            ConstOrTexture::Const(c) => c,
+            ConstOrTexture::Texture(TextureId(id)) => match self.textures.get(id as usize) {
                 Some(texture) => self.eval_texture(texture, at),
                 None => Vec3::ZERO,
             },
         }
     }
 
-    fn eval_texture(&self, texture: &Texture, at: &TexturePoint) -> Vec3 {
+    fn eval_texture(&self, texture: &Texture, at: &LookupPoint) -> Vec3 {
         let image = texture.image.map(|image| &self.images[image]);
         let value = texture.kind.eval(at, self, image);
         if texture.is_color {
@@ -331,8 +331,8 @@ impl Textures {
 
     /// The tangent-space normal (x along u, y along v, z along the normal; not normalised) of
     /// `tex` at `at` when it is a normal map, else `None`.
-    pub fn normal_map(&self, tex: Tex, at: &TexturePoint) -> Option<Vec3> {
-        let Tex::Texture(TextureId(id)) = tex else {
+    pub fn normal_map(&self, tex: ConstOrTexture, at: &LookupPoint) -> Option<Vec3> {
+        let ConstOrTexture::Texture(TextureId(id)) = tex else {
             return None;
         };
         let texture = self.textures.get(id as usize)?;
@@ -352,9 +352,9 @@ impl Textures {
     /// such. What a light colour
     /// given as a texture reads (LuxRender accepts a texture wherever a colour goes). None
     /// for a texture that varies over a surface or reads a file.
-    pub fn uniform_value(descs: &[TextureDesc], tex: Tex) -> Option<Vec3> {
-        fn uniform(descs: &[TextureDesc], tex: Tex) -> bool {
-            let Tex::Texture(TextureId(id)) = tex else {
+    pub fn uniform_value(descs: &[TextureDesc], tex: ConstOrTexture) -> Option<Vec3> {
+        fn uniform(descs: &[TextureDesc], tex: ConstOrTexture) -> bool {
+            let ConstOrTexture::Texture(TextureId(id)) = tex else {
                 return true;
             };
             descs.get(id as usize).is_some_and(|d| {
@@ -366,8 +366,8 @@ impl Textures {
                         | TextureKind::Arithmetic(_)
                 ) && d.kind.references().into_iter().all(|r| match r {
                     // Only earlier textures: rules out cycles.
-                    Tex::Texture(TextureId(used)) => used < id && uniform(descs, r),
-                    Tex::Const(_) => true,
+                    ConstOrTexture::Texture(TextureId(used)) => used < id && uniform(descs, r),
+                    ConstOrTexture::Const(_) => true,
                 })
             })
         }
@@ -386,13 +386,13 @@ impl Textures {
                 .collect(),
             images: Vec::new(),
         };
-        let origin = TexturePoint::new(Vec3::ZERO, glam::Vec2::ZERO);
+        let origin = LookupPoint::new(Vec3::ZERO, glam::Vec2::ZERO);
         Some(textures.eval(tex, &origin))
     }
 }
 
-impl TextureEval for Textures {
-    fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3 {
+impl ReferencedTextures for Textures {
+    fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3 {
         Textures::eval(self, tex, at)
     }
 }

@@ -14,7 +14,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::imagemap::ImageMap;
 use super::kind::TextureType;
 use super::mapping::Mapping2D;
@@ -44,7 +44,7 @@ impl NormalMap {
 
     /// The tangent-space normal at a surface point (not normalised; `image` is the decoded
     /// file).
-    pub fn normal(&self, at: &TexturePoint, image: &RgbImage) -> Vec3 {
+    pub fn normal(&self, at: &LookupPoint, image: &RgbImage) -> Vec3 {
         self.0.texel(at, image) * 2.0 - Vec3::ONE
     }
 }
@@ -65,8 +65,8 @@ impl TextureType for NormalMap {
     /// A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
     fn eval(
         &self,
-        _at: &TexturePoint,
-        _textures: &impl TextureEval,
+        _at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         Vec3::ZERO

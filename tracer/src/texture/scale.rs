@@ -14,8 +14,8 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
-use crate::param::Tex;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -28,8 +28,8 @@ pub const DEFAULT_TEX2: f32 = 1.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scale {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
 }
 
 impl Scale {
@@ -51,14 +51,14 @@ impl TextureType for Scale {
         "scale"
     }
 
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.tex1, self.tex2]
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         textures.eval(self.tex1, at) * textures.eval(self.tex2, at)

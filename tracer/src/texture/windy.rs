@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use super::noise::fbm;
 use crate::diag::SourcePos;
@@ -52,8 +52,8 @@ impl TextureType for Windy {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let p = self.mapping.map(at);

@@ -15,7 +15,7 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::fbm::Octaves;
 use super::noise::turbulence;
 use crate::diag::SourcePos;
@@ -46,8 +46,8 @@ impl TextureType for Wrinkled {
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        _textures: &impl TextureEval,
+        at: &LookupPoint,
+        _textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let o = &self.0;

@@ -25,11 +25,11 @@ mod tests;
 use glam::Vec3;
 
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::texture::common::{Declared, TextureEval, TexturePoint};
+use crate::texture::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::texture::kind::TextureType;
 use crate::image_io::RgbImage;
 pub use common::{Base, Pattern};
@@ -152,14 +152,14 @@ impl TextureType for Blender {
     }
 
     /// The textures it blends.
-    fn references(&self) -> Vec<Tex> {
+    fn references(&self) -> Vec<ConstOrTexture> {
         vec![self.base.tex1, self.base.tex2]
     }
 
     fn eval(
         &self,
-        at: &TexturePoint,
-        textures: &impl TextureEval,
+        at: &LookupPoint,
+        textures: &impl ReferencedTextures,
         _image: Option<&RgbImage>,
     ) -> Vec3 {
         let f = self.base.weight(self.pattern(self.base.mapping.map(at)));
