@@ -298,9 +298,7 @@ impl Cloth {
 }
 
 impl Lobe for Cloth {
-    fn gathers_broadly(&self) -> bool {
-        true
-    }
+    const GATHERS_BROADLY: bool = true;
 
     /// What it reflects at most, for lobe selection under a coat.
     fn albedo_hint(&self, _cos_o: f32) -> Vec3 {

@@ -66,9 +66,7 @@ impl DiffuseReflection {
 }
 
 impl Lobe for DiffuseReflection {
-    fn gathers_broadly(&self) -> bool {
-        true
-    }
+    const GATHERS_BROADLY: bool = true;
 
     fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
         self.r

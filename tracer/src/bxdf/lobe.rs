@@ -19,9 +19,7 @@ pub trait Lobe {
     /// Whether the lobe reflects only (light reaches the surface from the side it is seen
     /// from) and spreads over the hemisphere much as the cosine does (see
     /// [`super::Bxdf::gathers_broadly`]).
-    fn gathers_broadly(&self) -> bool {
-        false
-    }
+    const GATHERS_BROADLY: bool = false;
 
     /// For a narrow glossy lobe, the half angle around the mirror direction that holds most of
     /// it (see [`super::Bxdf::glossy_spread`]).

@@ -57,7 +57,7 @@ macro_rules! lobes {
             /// cost.
             pub fn gathers_broadly(&self) -> bool {
                 match self {
-                    $(Bxdf::$variant(l) => l.gathers_broadly(),)+
+                    $(Bxdf::$variant(_) => <$module::$lobe as Lobe>::GATHERS_BROADLY,)+
                 }
             }
 
@@ -88,23 +88,25 @@ macro_rules! lobes {
                     }
             }
 
-            pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-                let (wo, wi) = if self.mirrors_back_face(wo) {
+            /// `wo` and `wi` as the lobe handles them: mirrored together when `wo` is below a
+            /// two-sided lobe.
+            fn facing_up(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+                if self.mirrors_back_face(wo) {
                     (flip_z(wo), flip_z(wi))
                 } else {
                     (wo, wi)
-                };
+                }
+            }
+
+            pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+                let (wo, wi) = self.facing_up(wo, wi);
                 match self {
                     $(Bxdf::$variant(l) => l.f(wo, wi),)+
                 }
             }
 
             pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-                let (wo, wi) = if self.mirrors_back_face(wo) {
-                    (flip_z(wo), flip_z(wi))
-                } else {
-                    (wo, wi)
-                };
+                let (wo, wi) = self.facing_up(wo, wi);
                 match self {
                     $(Bxdf::$variant(l) => l.pdf(wo, wi),)+
                 }

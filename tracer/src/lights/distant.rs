@@ -16,7 +16,6 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -25,7 +24,7 @@ use crate::parse::params::ParamList;
 
 use super::emission::{emits, Emission};
 use super::error::LightError;
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LightKind, MapSource};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -88,17 +87,11 @@ impl LightKind for DistantLight {
     }
 
     /// The light to sample (with `to_light` normalised), if it emits.
-    fn light(
-        &self,
-        _source: &dyn AssetSource,
-        _latlong: LatLongConvention,
-    ) -> Result<Option<DistantLight>, LightError> {
-        Ok({
-            let to_light = self.to_light.normalize_or_zero();
-            (emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
-                to_light,
-                radiance: self.radiance,
-            })
-        })
+    fn light(&self, _maps: &MapSource) -> Result<Option<DistantLight>, LightError> {
+        let to_light = self.to_light.normalize_or_zero();
+        Ok((emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
+            to_light,
+            radiance: self.radiance,
+        }))
     }
 }

@@ -31,7 +31,7 @@ use crate::parse::params::ParamList;
 use super::distribution::Distribution2D;
 use super::emission::{emits, Emission};
 use super::error::LightError;
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LatLongConvention, LightKind, MapSource};
 use super::facing::{FacingTables, FACING_BINS, MAX_FACING_CELLS};
 
 /// `mapping`: the only one modelled.
@@ -97,16 +97,12 @@ impl LightKind for InfiniteLight {
     }
 
     /// The light to sample, if it emits: its map read from `source` and decoded.
-    fn light(
-        &self,
-        source: &dyn AssetSource,
-        latlong: LatLongConvention,
-    ) -> Result<Option<Environment>, LightError> {
+    fn light(&self, maps: &MapSource) -> Result<Option<Environment>, LightError> {
         if !emits(self.radiance) {
             return Ok(None);
         }
         let image = match &self.map {
-            Some(map) => Some(load_map(source, &map.filename, map.gamma)?),
+            Some(map) => Some(load_map(maps.files, &map.filename, map.gamma)?),
             None => None,
         };
         if Environment::is_singular(&self.light_to_world) {
@@ -116,7 +112,7 @@ impl LightKind for InfiniteLight {
             self.radiance,
             image,
             &self.light_to_world,
-            latlong,
+            maps.latlong,
         )))
     }
 }

@@ -15,6 +15,13 @@ pub enum LatLongConvention {
     LuxRender,
 }
 
+/// Where the lights' maps come from: the scene's files, and the LatLong convention they are
+/// indexed by.
+pub struct MapSource<'a> {
+    pub files: &'a dyn AssetSource,
+    pub latlong: LatLongConvention,
+}
+
 pub trait LightKind {
     /// What the light becomes in the sampler (the list line says which [`super::Lights`]
     /// member holds it).
@@ -28,11 +35,6 @@ pub trait LightKind {
         Vec::new()
     }
 
-    /// The light ready to sample, its maps read from `source` and indexed by `latlong`; None
-    /// when it emits nothing.
-    fn light(
-        &self,
-        source: &dyn AssetSource,
-        latlong: LatLongConvention,
-    ) -> Result<Option<Self::Sampler>, LightError>;
+    /// The light ready to sample, its maps read from `maps`; None when it emits nothing.
+    fn light(&self, maps: &MapSource) -> Result<Option<Self::Sampler>, LightError>;
 }

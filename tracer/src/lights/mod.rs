@@ -56,7 +56,7 @@ use crate::texture::Textures;
 pub use area::AreaLightParams;
 pub use error::LightError;
 pub use infinite::{map_cost, EnvMapDesc};
-pub use kind::{LatLongConvention, LightKind};
+pub use kind::{LatLongConvention, LightKind, MapSource};
 pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
 pub use sample::LightSample;
 pub use sky::SkyModel;
@@ -88,17 +88,13 @@ macro_rules! lights {
         }
 
         impl LightDesc {
-            /// The light of LuxRender type `ty`; None for a type this renderer does not know.
-            fn read_kind(
-                ty: &str,
-                params: &ParamList,
-                pos: &SourcePos,
-                ctx: &mut dyn ParseContext,
-            ) -> Result<Option<Self>, ParseError> {
-                Ok(Some(match ty {
-                    $($($name => Self::$variant($kind::$read(params, pos, ctx)?),)+)+
-                    _ => return Ok(None),
-                }))
+            /// The reader of LuxRender light type `ty`; None for a type this renderer does not
+            /// know.
+            fn reader(ty: &str) -> Option<Reader<Self>> {
+                Some(match ty {
+                    $($($name => |params, pos, ctx| Ok(Self::$variant($kind::$read(params, pos, ctx)?)),)+)+
+                    _ => return None,
+                })
             }
 
             /// The LuxRender type name.
@@ -116,13 +112,9 @@ macro_rules! lights {
             }
 
             /// The light ready to sample (see [`LightKind::light`]).
-            fn light(
-                &self,
-                source: &dyn AssetSource,
-                latlong: LatLongConvention,
-            ) -> Result<Option<Light>, LightError> {
+            fn light(&self, maps: &MapSource) -> Result<Option<Light>, LightError> {
                 Ok(match self {
-                    $(Self::$variant(l) => l.light(source, latlong)?.map($sampler),)+
+                    $(Self::$variant(l) => l.light(maps)?.map($sampler),)+
                 })
             }
         }
@@ -141,6 +133,9 @@ lights! {
         => |l| Light::Infinite(AtInfinity::Sky(l)),
 }
 
+/// Reads a light of type `T` from a statement's parameters.
+type Reader<T> = fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<T, ParseError>;
+
 /// Reads `LightSource "ty"` through the name table: the lights it makes (`sunsky` and
 /// `sunsky2` make a sun and a sky from the same parameters, as LuxRender does), none for an
 /// unknown type (a warning).
@@ -150,19 +145,18 @@ pub(crate) fn read(
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
 ) -> Result<Vec<LightDesc>, ParseError> {
-    let sky: fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<SkyLight, ParseError> =
-        match ty {
-            "sunsky" => SkyLight::read_preetham,
-            "sunsky2" => SkyLight::read_hosek,
-            _ => {
-                let Some(light) = LightDesc::read_kind(ty, params, pos, ctx)? else {
-                    ignore_all(params);
-                    ctx.warn(pos, format!("unknown LightSource \"{ty}\" skipped"));
-                    return Ok(Vec::new());
-                };
-                return Ok(vec![light]);
-            }
-        };
+    let sky: Reader<SkyLight> = match ty {
+        "sunsky" => SkyLight::read_preetham,
+        "sunsky2" => SkyLight::read_hosek,
+        _ => {
+            let Some(read) = LightDesc::reader(ty) else {
+                ignore_all(params);
+                ctx.warn(pos, format!("unknown LightSource \"{ty}\" skipped"));
+                return Ok(Vec::new());
+            };
+            return Ok(vec![read(params, pos, ctx)?]);
+        }
+    };
     Ok(vec![
         LightDesc::Sun(SunLight::read(params, pos, ctx)?),
         LightDesc::Sky(sky(params, pos, ctx)?),
@@ -298,8 +292,12 @@ impl Lights {
             }
         }
 
+        let maps = MapSource {
+            files: source,
+            latlong,
+        };
         for desc in descs {
-            lights.extend(desc.light(source, latlong)?);
+            lights.extend(desc.light(&maps)?);
         }
 
         let scene_radius = geometry

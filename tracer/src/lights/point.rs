@@ -17,7 +17,6 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -26,7 +25,7 @@ use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
 use super::error::LightError;
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LightKind, MapSource};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -90,13 +89,7 @@ impl LightKind for PointLight {
     }
 
     /// The light to sample, if it emits.
-    fn light(
-        &self,
-        _source: &dyn AssetSource,
-        _latlong: LatLongConvention,
-    ) -> Result<Option<PointLight>, LightError> {
-        Ok({
-            emits(self.intensity).then(|| self.clone())
-        })
+    fn light(&self, _maps: &MapSource) -> Result<Option<PointLight>, LightError> {
+        Ok(emits(self.intensity).then(|| self.clone()))
     }
 }

@@ -19,7 +19,6 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::luminance;
 use crate::parse::context::ParseContext;
@@ -28,7 +27,7 @@ use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
 use super::error::LightError;
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LightKind, MapSource};
 use super::point::PointLight;
 use super::sample::DeltaSample;
 
@@ -100,22 +99,16 @@ impl LightKind for SpotLight {
     }
 
     /// The light to sample, if it emits.
-    fn light(
-        &self,
-        _source: &dyn AssetSource,
-        _latlong: LatLongConvention,
-    ) -> Result<Option<SpotCone>, LightError> {
-        Ok({
-            emits(self.intensity).then(|| {
-                SpotCone::new(
-                    self.position,
-                    self.direction,
-                    self.intensity,
-                    self.cone_angle,
-                    self.cone_delta_angle,
-                )
-            })
-        })
+    fn light(&self, _maps: &MapSource) -> Result<Option<SpotCone>, LightError> {
+        Ok(emits(self.intensity).then(|| {
+            SpotCone::new(
+                self.position,
+                self.direction,
+                self.intensity,
+                self.cone_angle,
+                self.cone_delta_angle,
+            )
+        }))
     }
 }
 

@@ -28,7 +28,6 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3};
 
-use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::math::{luminance, Frame};
 use crate::parse::context::ParseContext;
@@ -38,7 +37,7 @@ use crate::spectra::emission_rgb;
 
 use super::emission::{self, emits};
 use super::error::LightError;
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LightKind, MapSource};
 
 /// `sundir` (LuxRender 1.x's sun default points down: a sun with no direction is set).
 pub const DEFAULT_SUNDIR: Vec3 = Vec3::new(0.0, 0.0, -1.0);
@@ -122,28 +121,22 @@ impl LightKind for SunLight {
     }
 
     /// The light to sample, if it emits.
-    fn light(
-        &self,
-        _source: &dyn AssetSource,
-        _latlong: LatLongConvention,
-    ) -> Result<Option<SunDisc>, LightError> {
-        Ok({
-            let to_sun = self.to_sun.normalize_or_zero();
-            let sin2 = self.sin2_max();
-            let radiance = self.radiance();
-            (emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
-                // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
-                let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-                SunDisc {
-                    frame: Frame::from_normal(to_sun),
-                    to_sun,
-                    radiance,
-                    sin2_max: sin2,
-                    one_minus_cos,
-                    pdf: 1.0 / (TAU * one_minus_cos),
-                }
-            })
-        })
+    fn light(&self, _maps: &MapSource) -> Result<Option<SunDisc>, LightError> {
+        let to_sun = self.to_sun.normalize_or_zero();
+        let sin2 = self.sin2_max();
+        let radiance = self.radiance();
+        Ok((emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
+            // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
+            let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+            SunDisc {
+                frame: Frame::from_normal(to_sun),
+                to_sun,
+                radiance,
+                sin2_max: sin2,
+                one_minus_cos,
+                pdf: 1.0 / (TAU * one_minus_cos),
+            }
+        }))
     }
 }
 

@@ -64,21 +64,16 @@ macro_rules! materials {
         }
 
         impl MaterialDesc {
-            /// The material of LuxRender type `ty`, without its bump map; None for a type this
-            /// renderer does not know.
-            fn read_kind(
-                ty: &str,
-                params: &ParamList,
-                pos: &SourcePos,
-                ctx: &mut dyn ParseContext,
-            ) -> Result<Option<Self>, ParseError> {
-                Ok(Some(match ty {
+            /// The reader of LuxRender material type `ty` (the material without its bump map);
+            /// None for a type this renderer does not know.
+            fn reader(ty: &str) -> Option<MaterialReader> {
+                Some(match ty {
                     $(
-                        $name => Self::$kind($kind::$read(params, pos, ctx)?),
-                        $($alias => Self::$kind($kind::$read_alias(params, pos, ctx)?),)*
+                        $name => |params, pos, ctx| Ok(Self::$kind($kind::$read(params, pos, ctx)?)),
+                        $($alias => |params, pos, ctx| Ok(Self::$kind($kind::$read_alias(params, pos, ctx)?)),)*
                     )+
-                    _ => return Ok(None),
-                }))
+                    _ => return None,
+                })
             }
 
             /// The kind's LuxRender name: the first of the names read into it.
@@ -155,6 +150,10 @@ materials! {
     cloth::Cloth { "cloth" => read },
 }
 
+/// Reads a material kind from a statement's parameters.
+type MaterialReader =
+    fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<MaterialDesc, ParseError>;
+
 /// What a ray that no layer of a `layered` material catches meets.
 static PASS_THROUGH: MaterialDesc = MaterialDesc::Null(Null);
 
@@ -167,7 +166,7 @@ impl MaterialDesc {
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        let Some(material) = Self::read_kind(ty, params, pos, ctx)? else {
+        let Some(read) = Self::reader(ty) else {
             ctx.warn(
                 pos,
                 format!("material \"{ty}\" is not supported; using matte (with its Kd when given)"),
@@ -181,6 +180,7 @@ impl MaterialDesc {
                 sigma: ConstOrTexture::float(matte::DEFAULT_SIGMA),
             }));
         };
+        let material = read(params, pos, ctx)?;
         if matches!(material, Self::Mix(_) | Self::Null(_)) {
             return Ok(material);
         }

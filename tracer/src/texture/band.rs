@@ -21,7 +21,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_TEX: f32 = 0.0;
 pub const DEFAULT_AMOUNT: f32 = 0.0;
@@ -71,12 +70,7 @@ impl TextureType for Band {
         self.textures.iter().copied().chain([self.amount]).collect()
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let a = textures.eval(self.amount, at).x;
         let (first, last) = (self.offsets[0], self.offsets[self.offsets.len() - 1]);
         if a.is_nan() || a < first {

@@ -22,7 +22,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_V00: f32 = 0.0;
 pub const DEFAULT_V01: f32 = 1.0;
@@ -71,12 +70,7 @@ impl TextureType for Bilerp {
         Some(&self.mapping)
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         let (s, t) = (st.x - st.x.floor(), st.y - st.y.floor());
         (1.0 - s) * (1.0 - t) * self.v00

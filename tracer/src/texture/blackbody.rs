@@ -12,22 +12,14 @@
 //! It reads as a [`Constant`] texture (the colour is computed once, at parse time, by
 //! [`blackbody_rgb`]).
 
-use super::common::Declared;
 use super::constant::Constant;
-use crate::diag::SourcePos;
-use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::spectra::blackbody_rgb;
 
 pub const DEFAULT_TEMPERATURE: f32 = 6500.0;
 
-pub fn read(
-    _decl: &Declared,
-    params: &ParamList,
-    _pos: &SourcePos,
-    _ctx: &mut dyn ParseContext,
-) -> Result<Constant, ParseError> {
+pub fn read(params: &ParamList) -> Result<Constant, ParseError> {
     Ok(Constant {
         value: blackbody_rgb(params.float("temperature", DEFAULT_TEMPERATURE)?),
     })

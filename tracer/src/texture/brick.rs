@@ -32,7 +32,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_BOND: &str = "running";
 pub const DEFAULT_BRICKTEX: f32 = 1.0;
@@ -243,12 +242,7 @@ impl TextureType for Brick {
         vec![self.brick, self.mortar, self.modulation]
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         match self.brick_at(self.mapping.map(at)) {
             Some(index) => {
                 let brick = LookupPoint {

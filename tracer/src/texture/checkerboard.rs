@@ -18,7 +18,6 @@ use glam::Vec3;
 use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::kind::TextureType;
 use super::mapping::{Mapping2D, Mapping3D};
-use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
@@ -115,12 +114,7 @@ impl TextureType for Checkerboard {
         }
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         match self {
             Checkerboard::D2(t) => t.eval(at, textures),
             Checkerboard::D3(t) => t.eval(at, textures),

@@ -4,6 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::image_io::RgbImage;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -43,6 +44,10 @@ impl LookupPoint {
 pub trait ReferencedTextures {
     /// The value of `tex` at `at` (a constant is itself; an id naming no texture is black).
     fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3;
+
+    /// The decoded file of the texture being evaluated (one whose
+    /// [`TextureType::file`](super::kind::TextureType::file) names one).
+    fn image(&self) -> &RgbImage;
 }
 
 /// The `Texture "name" "float"|"color" "type"` header a texture reader is given with the

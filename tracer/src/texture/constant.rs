@@ -15,7 +15,6 @@ use super::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 
@@ -47,12 +46,7 @@ impl TextureType for Constant {
         "constant"
     }
 
-    fn eval(
-        &self,
-        _at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, _at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         self.value
     }
 }

@@ -22,7 +22,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_INSIDE: f32 = 1.0;
 pub const DEFAULT_OUTSIDE: f32 = 0.0;
@@ -78,12 +77,7 @@ impl TextureType for Dots {
         Some(&self.mapping)
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         let tex = if Self::inside(st.x, st.y) {
             self.inside

@@ -10,23 +10,15 @@
 //!
 //! Read as a [`Constant`].
 
-use super::common::Declared;
 use glam::Vec3;
 
 use super::constant::Constant;
-use crate::diag::SourcePos;
-use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 pub const DEFAULT_ENERGY: f32 = 1.0;
 
-pub fn read(
-    _decl: &Declared,
-    params: &ParamList,
-    _pos: &SourcePos,
-    _ctx: &mut dyn ParseContext,
-) -> Result<Constant, ParseError> {
+pub fn read(params: &ParamList) -> Result<Constant, ParseError> {
     Ok(Constant {
         value: Vec3::splat(params.float("energy", DEFAULT_ENERGY)?),
     })

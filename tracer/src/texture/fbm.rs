@@ -22,7 +22,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_OCTAVES: i32 = 8;
 pub const DEFAULT_ROUGHNESS: f32 = 0.5;
@@ -70,12 +69,7 @@ impl TextureType for Fbm {
         "fbm"
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let o = &self.0;
         Vec3::splat(fbm(o.mapping.map(at), o.roughness, o.octaves))
     }

@@ -13,10 +13,7 @@
 //! energy x exp(-(lambda - wavelength)^2 / (2 width^2)), reduced to RGB by
 //! [`spectrum_rgb`] (a flat spectrum keeps its value); read as a [`Constant`].
 
-use super::common::Declared;
 use super::constant::Constant;
-use crate::diag::SourcePos;
-use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::spectra::spectrum_rgb;
@@ -25,12 +22,7 @@ pub const DEFAULT_WAVELENGTH: f32 = 550.0;
 pub const DEFAULT_WIDTH: f32 = 50.0;
 pub const DEFAULT_ENERGY: f32 = 1.0;
 
-pub fn read(
-    _decl: &Declared,
-    params: &ParamList,
-    _pos: &SourcePos,
-    _ctx: &mut dyn ParseContext,
-) -> Result<Constant, ParseError> {
+pub fn read(params: &ParamList) -> Result<Constant, ParseError> {
     let mean = f64::from(params.float("wavelength", DEFAULT_WAVELENGTH)?);
     let width = f64::from(params.float("width", DEFAULT_WIDTH)?)
         .abs()

@@ -12,7 +12,6 @@ use glam::Vec3;
 
 use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -61,12 +60,7 @@ impl TextureType for Harlequin {
         "harlequin"
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         Self::colour(at.prim % PALETTE_SIZE)
     }
 }

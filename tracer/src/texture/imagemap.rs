@@ -134,12 +134,7 @@ impl TextureType for ImageMap {
         Some(&self.mapping)
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        image: Option<&RgbImage>,
-    ) -> Vec3 {
-        self.texel(at, image.expect("decoded in Textures::new"))
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
+        self.texel(at, textures.image())
     }
 }

@@ -6,7 +6,6 @@ use glam::Vec3;
 
 use super::common::{LookupPoint, ReferencedTextures};
 use super::mapping::Mapping2D;
-use crate::image_io::RgbImage;
 use crate::refs::ConstOrTexture;
 
 pub trait TextureType {
@@ -29,12 +28,7 @@ pub trait TextureType {
         None
     }
 
-    /// The value at `at`: `textures` evaluates the textures it references, `image` is its
-    /// [`TextureType::file`] decoded (None for a texture that reads none).
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        image: Option<&RgbImage>,
-    ) -> Vec3;
+    /// The value at `at`; `textures` evaluates the textures it references and gives its
+    /// [`TextureType::file`] decoded.
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3;
 }

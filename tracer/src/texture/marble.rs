@@ -26,7 +26,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 pub const DEFAULT_SCALE: f32 = 1.0;
 pub const DEFAULT_VARIATION: f32 = 0.2;
@@ -73,12 +72,7 @@ impl TextureType for Marble {
         "marble"
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let o = &self.octaves;
         let p = o.mapping.map(at) * self.scale;
         let marble = p.y + self.variation * fbm(p, o.roughness, o.octaves);

@@ -18,7 +18,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 0.0;
@@ -58,12 +57,7 @@ impl TextureType for Mix {
         vec![self.tex1, self.tex2, self.amount]
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let t = textures.eval(self.amount, at).x;
         textures.eval(self.tex1, at) * (1.0 - t) + textures.eval(self.tex2, at) * t
     }

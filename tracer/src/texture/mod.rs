@@ -71,7 +71,7 @@ pub struct TextureDesc {
 /// LuxRender's texture types to the readers, and every dispatch `match`, each arm a call of
 /// the type's [`TextureType`] method.
 macro_rules! textures {
-    ($($module:ident::$kind:ident { $($name:literal => $read:path),* },)+) => {
+    ($($module:ident::$kind:ident { $($name:literal => $read:expr),* },)+) => {
         $(pub mod $module;)+
         $(pub use $module::$kind;)+
 
@@ -81,18 +81,12 @@ macro_rules! textures {
         }
 
         impl TextureKind {
-            /// The texture of a LuxRender type the table names; None for another.
-            fn read_named(
-                class: &str,
-                decl: &Declared,
-                params: &ParamList,
-                pos: &SourcePos,
-                ctx: &mut dyn ParseContext,
-            ) -> Result<Option<Self>, ParseError> {
-                Ok(Some(match class {
-                    $($($name => Self::$kind($read(decl, params, pos, ctx)?),)*)+
-                    _ => return Ok(None),
-                }))
+            /// The reader of a LuxRender type the table names; None for another.
+            fn reader(class: &str) -> Option<TextureReader> {
+                Some(match class {
+                    $($($name => |decl, params, pos, ctx| Ok(Self::$kind(($read)(decl, params, pos, ctx)?)),)*)+
+                    _ => return None,
+                })
             }
 
             /// The LuxRender type name (a texture read as a constant, as blackbody is, says
@@ -125,19 +119,18 @@ macro_rules! textures {
             }
 
             /// The value at `at` (see [`TextureType::eval`]).
-            fn eval(
-                &self,
-                at: &LookupPoint,
-                textures: &impl ReferencedTextures,
-                image: Option<&RgbImage>,
-            ) -> Vec3 {
+            fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
                 match self {
-                    $(Self::$kind(t) => TextureType::eval(t, at, textures, image),)+
+                    $(Self::$kind(t) => t.eval(at, textures),)+
                 }
             }
         }
     };
 }
+
+/// Reads a texture type from a statement's header and parameters.
+type TextureReader =
+    fn(&Declared, &ParamList, &SourcePos, &mut dyn ParseContext) -> Result<TextureKind, ParseError>;
 
 // The types: `module::Type { "luxrender type" => reader, ... },`; the blender_* types are read
 // by [`Blender::read`], which knows their names.
@@ -146,9 +139,9 @@ textures! {
     checkerboard::Checkerboard { "checkerboard" => Checkerboard::read },
     constant::Constant {
         "constant" => Constant::read,
-        "blackbody" => blackbody::read,
-        "gaussian" => gaussian::read,
-        "equalenergy" => equalenergy::read,
+        "blackbody" => |_, params, _, _| blackbody::read(params),
+        "gaussian" => |_, params, _, _| gaussian::read(params),
+        "equalenergy" => |_, params, _, _| equalenergy::read(params),
         "lampspectrum" => lampspectrum::read,
         "tabulateddata" => tabulateddata::read_file,
         "irregulardata" => tabulateddata::read_inline
@@ -232,8 +225,8 @@ impl TextureKind {
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Option<Self>, ParseError> {
-        if let Some(texture) = Self::read_named(class, decl, params, pos, ctx)? {
-            return Ok(Some(texture));
+        if let Some(read) = Self::reader(class) {
+            return Ok(Some(read(decl, params, pos, ctx)?));
         }
         Ok(Blender::read(class, decl, params, pos, ctx)?.map(Self::Blender))
     }
@@ -320,8 +313,13 @@ impl Textures {
     }
 
     fn eval_texture(&self, texture: &Texture, at: &LookupPoint) -> Vec3 {
-        let image = texture.image.map(|image| &self.images[image]);
-        let value = texture.kind.eval(at, self, image);
+        let value = texture.kind.eval(
+            at,
+            &Evaluating {
+                textures: self,
+                texture,
+            },
+        );
         if texture.is_color {
             value
         } else {
@@ -391,8 +389,19 @@ impl Textures {
     }
 }
 
-impl ReferencedTextures for Textures {
+/// What a texture sees of the scene's textures while it is evaluated: the others, and its own
+/// decoded file.
+struct Evaluating<'a> {
+    textures: &'a Textures,
+    texture: &'a Texture,
+}
+
+impl ReferencedTextures for Evaluating<'_> {
     fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3 {
-        Textures::eval(self, tex, at)
+        self.textures.eval(tex, at)
+    }
+
+    fn image(&self) -> &RgbImage {
+        self.textures.image(self.texture)
     }
 }

@@ -63,12 +63,7 @@ impl TextureType for NormalMap {
     }
 
     /// A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
-    fn eval(
-        &self,
-        _at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, _at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         Vec3::ZERO
     }
 }

@@ -20,7 +20,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 1.0;
@@ -55,12 +54,7 @@ impl TextureType for Scale {
         vec![self.tex1, self.tex2]
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         textures.eval(self.tex1, at) * textures.eval(self.tex2, at)
     }
 }

@@ -18,7 +18,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Uv {
@@ -47,12 +46,7 @@ impl TextureType for Uv {
         Some(&self.mapping)
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         Vec3::new(st.x - st.x.floor(), st.y - st.y.floor(), 0.0)
     }

@@ -19,7 +19,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 /// LuxRender's fixed wind and wave constants.
 const WIND_FREQUENCY: f32 = 0.1;
@@ -50,12 +49,7 @@ impl TextureType for Windy {
         "windy"
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let p = self.mapping.map(at);
         let wind = fbm(WIND_FREQUENCY * p, OMEGA, WIND_OCTAVES);
         let waves = fbm(p, OMEGA, WAVE_OCTAVES);

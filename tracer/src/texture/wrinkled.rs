@@ -23,7 +23,6 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use super::kind::TextureType;
-use crate::image_io::RgbImage;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Wrinkled(pub Octaves);
@@ -44,12 +43,7 @@ impl TextureType for Wrinkled {
         "wrinkled"
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        _textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let o = &self.0;
         Vec3::splat(turbulence(o.mapping.map(at), o.roughness, o.octaves))
     }

@@ -30,7 +30,6 @@ use std::f32::consts::{PI, TAU};
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
-use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::image_io::{ImageCost, RgbImage};
 use crate::parse::context::ParseContext;
@@ -40,7 +39,7 @@ use crate::parse::params::ParamList;
 use super::emission::{self, emits};
 use super::error::LightError;
 use super::infinite::{map_cost, Environment};
-use super::kind::{LatLongConvention, LightKind};
+use super::kind::{LatLongConvention, LightKind, MapSource};
 
 pub use hosek::Hosek;
 pub use preetham::Preetham;
@@ -213,11 +212,7 @@ impl LightKind for SkyLight {
         }
     }
 
-    fn light(
-        &self,
-        _source: &dyn AssetSource,
-        _latlong: LatLongConvention,
-    ) -> Result<Option<Environment>, LightError> {
+    fn light(&self, _maps: &MapSource) -> Result<Option<Environment>, LightError> {
         Ok(self.tabulated())
     }
 }

@@ -31,7 +31,6 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::texture::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::texture::kind::TextureType;
-use crate::image_io::RgbImage;
 pub use common::{Base, Pattern};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -156,12 +155,7 @@ impl TextureType for Blender {
         vec![self.base.tex1, self.base.tex2]
     }
 
-    fn eval(
-        &self,
-        at: &LookupPoint,
-        textures: &impl ReferencedTextures,
-        _image: Option<&RgbImage>,
-    ) -> Vec3 {
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let f = self.base.weight(self.pattern(self.base.mapping.map(at)));
         let (a, b) = (
             textures.eval(self.base.tex1, at),
