@@ -108,8 +108,8 @@ impl Bsdf {
 
     /// f(wo, wi) for the non-specular lobes; wo and wi are unit world directions away from
     /// the surface.
-    // Inlined into the path loop, as `pdf` is: with the sampler's code written over lanes the
-    // loop grew and the compiler left it out of line (depth of field 1.4% slower).
+    // Inlined into the path loop, as `pdf` is: the loop is large enough that the compiler
+    // leaves it out of line otherwise (bench/RESULTS.md, "Figures moved out of the code").
     #[inline(always)]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (wo_local, wi_local) = (self.frame.to_local(wo), self.frame.to_local(wi));

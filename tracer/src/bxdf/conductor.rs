@@ -9,8 +9,8 @@ use super::lobe::Lobe;
 use super::sample::LocalSample;
 
 /// The widest microfacet alpha [`Lobe::glossy_spread`] counts as glossy. A wider lobe sees a
-/// lamp as light sampling does, and more BSDF samples add little (bench/RESULTS.md, "Lobes:
-/// where a glossy split pays").
+/// lamp as light sampling does, and more BSDF samples add little (bench/RESULTS.md, "Figures
+/// moved out of the code").
 pub const GLOSSY_ALPHA: f32 = 0.1;
 
 /// Where a conductor's reflectance comes from.
