@@ -10,6 +10,8 @@
 
 pub mod campaign;
 pub mod mutate;
+#[cfg(test)]
+mod parser_regressions;
 pub mod parser_target;
 pub mod stand_ins;
 pub mod wire_target;

@@ -52,7 +52,7 @@ const MAX_TESSELLATED_SHAPES: usize = 64;
 const TESSELLATION_SEGMENTS: u32 = 12;
 
 /// The settings every input is built and rendered with: small and fast.
-fn render_settings() -> RenderSettings {
+pub(crate) fn render_settings() -> RenderSettings {
     RenderSettings {
         width: 8,
         height: 8,
@@ -63,7 +63,7 @@ fn render_settings() -> RenderSettings {
     }
 }
 
-const UNIT: WorkUnit = WorkUnit {
+pub(crate) const UNIT: WorkUnit = WorkUnit {
     index: 0,
     x0: 0,
     y0: 0,

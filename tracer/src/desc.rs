@@ -20,7 +20,7 @@ pub use crate::lights::{EnvMapDesc, LatLongConvention, LightDesc};
 pub use crate::material::MaterialDesc;
 pub use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 pub use crate::mesh::TriangleMesh;
-pub use crate::param::{Fresnel, MaterialId, Tex, TextureId};
+pub use crate::refs::{ConstOrTexture, Fresnel, MaterialId, TextureId};
 pub use crate::sampler::SamplerDesc;
 pub use crate::shape::{AreaLightDesc, Geometry, ShapeDesc};
 pub use crate::texture::{Mapping2D, TextureDesc, TextureKind, Wrap};

@@ -27,10 +27,10 @@ use crate::diag::SourcePos;
 use crate::medium::common::ShapeMedia;
 use crate::mesh::quadric::Quadric;
 use crate::mesh::{heightfield, inline, subdiv, TriangleMesh};
-use crate::param::{MaterialId, Tex};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::{ConstOrTexture, MaterialId};
 
 /// Radius of spheres, disks and cylinders when the file does not say.
 pub const DEFAULT_RADIUS: f32 = 1.0;
@@ -78,7 +78,7 @@ pub enum Geometry {
 /// efficacy / (area x pi x mean luminance of `L`) when that is positive (lights/area.rs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLightDesc {
-    pub l: Tex,
+    pub l: ConstOrTexture,
     pub gain: f32,
     pub power: f32,
     pub efficacy: f32,

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeSet;
 
-use yat_tracer::desc::{Mapping2D, MaterialId, SceneDesc, Tex, TextureId, TextureKind};
+use yat_tracer::desc::{ConstOrTexture, Mapping2D, MaterialId, SceneDesc, TextureId, TextureKind};
 
 use crate::error::ExportError;
 
@@ -12,8 +12,8 @@ fn is_baked(mapping: &Mapping2D) -> bool {
     !matches!(mapping, Mapping2D::Uv { .. })
 }
 
-fn push_tex(t: &Tex, out: &mut Vec<TextureId>) {
-    if let Tex::Texture(id) = t {
+fn push_tex(t: &ConstOrTexture, out: &mut Vec<TextureId>) {
+    if let ConstOrTexture::Texture(id) = t {
         out.push(*id);
     }
 }

@@ -2,7 +2,7 @@
 //! the emission of an area light when the material is an emitter's.
 
 use glam::Vec3;
-use yat_tracer::desc::{AreaLightDesc, Fresnel, MaterialDesc, Tex};
+use yat_tracer::desc::{AreaLightDesc, ConstOrTexture, Fresnel, MaterialDesc};
 use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{Glass, Glossy, Matte, MatteTranslucent, Metal, Mirror, Mix};
 
@@ -21,7 +21,7 @@ pub fn write_material(
     let mut set = |key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
     match m {
         MaterialDesc::Matte(Matte { kd, sigma }) => {
-            let rough = *sigma != Tex::float(0.0);
+            let rough = *sigma != ConstOrTexture::float(0.0);
             set("type", quoted(if rough { "roughmatte" } else { "matte" }));
             set("kd", tex_value(kd, true));
             if rough {
@@ -62,7 +62,8 @@ pub fn write_material(
             vroughness,
             ..
         }) => {
-            let rough = *uroughness != Tex::float(0.0) || *vroughness != Tex::float(0.0);
+            let rough = *uroughness != ConstOrTexture::float(0.0)
+                || *vroughness != ConstOrTexture::float(0.0);
             let kind = match (architectural, rough) {
                 (true, _) => "archglass",
                 (false, true) => "roughglass",

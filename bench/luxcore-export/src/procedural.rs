@@ -5,10 +5,12 @@
 
 use std::path::Path;
 
-use yat_tracer::desc::{Mapping2D, Tex, TextureKind};
+use yat_tracer::desc::{ConstOrTexture, Mapping2D, TextureKind};
 use yat_tracer::texture::blender::noise_basis::{Metric, NoiseBasis};
 use yat_tracer::texture::blender::{musgrave, Blender, BlenderKind};
-use yat_tracer::texture::{Bond, Coordinates, Fbm, Mapping3D, NormalMap, Op, Wrinkled};
+use yat_tracer::texture::{
+    Bond, Coordinates, Fbm, Mapping3D, NormalMap, Op, TextureType, Wrinkled,
+};
 
 use crate::props::{matrix, quoted, tex_value, v3, Props};
 
@@ -183,7 +185,7 @@ pub fn write_procedural(
     scene_dir: &Path,
     notes: &mut Vec<String>,
 ) -> bool {
-    let tv = |t: &Tex| tex_value(t, color);
+    let tv = |t: &ConstOrTexture| tex_value(t, color);
     let set = |p: &mut Props, key: &str, value: String| p.set(format!("{prefix}.{key}"), value);
     match kind {
         TextureKind::Fbm(Fbm(o)) | TextureKind::Wrinkled(Wrinkled(o)) => {
@@ -229,8 +231,10 @@ pub fn write_procedural(
             // constant modulation is folded into it.
             set(p, "brickmodbias", "-1".to_string());
             let brick = match (&t.brick, &t.modulation) {
-                (_, Tex::Const(m)) if *m == glam::Vec3::ONE => t.brick,
-                (Tex::Const(b), Tex::Const(m)) => Tex::Const(*b * *m),
+                (_, ConstOrTexture::Const(m)) if *m == glam::Vec3::ONE => t.brick,
+                (ConstOrTexture::Const(b), ConstOrTexture::Const(m)) => {
+                    ConstOrTexture::Const(*b * *m)
+                }
                 _ => {
                     notes.push(format!(
                         "{prefix}: brickmodtex cannot be evaluated per brick in LuxCore; left out"
@@ -268,8 +272,8 @@ pub fn write_procedural(
             for (i, (o, v)) in t.offsets.iter().zip(&t.textures).enumerate() {
                 set(p, &format!("offset{i}"), o.to_string());
                 let value = match v {
-                    Tex::Const(c) => v3(*c),
-                    Tex::Texture(_) => {
+                    ConstOrTexture::Const(c) => v3(*c),
+                    ConstOrTexture::Texture(_) => {
                         notes.push(format!("{prefix}: band value {} is a texture; LuxCore takes colours (white used)", i + 1));
                         "1 1 1".into()
                     }

@@ -4,7 +4,7 @@
 use std::fmt::{Display, Write as _};
 
 use glam::{Mat4, Vec3};
-use yat_tracer::desc::{MaterialId, Tex, TextureId};
+use yat_tracer::desc::{ConstOrTexture, MaterialId, TextureId};
 
 /// SDL text: one `key = value` line per property.
 #[derive(Default)]
@@ -47,10 +47,10 @@ pub fn mat_name(id: MaterialId) -> String {
 }
 
 /// A material or texture parameter: a constant inline, a texture by name.
-pub fn tex_value(t: &Tex, color: bool) -> String {
+pub fn tex_value(t: &ConstOrTexture, color: bool) -> String {
     match t {
-        Tex::Const(c) if color => v3(*c),
-        Tex::Const(c) => c.x.to_string(),
-        Tex::Texture(id) => quoted(&tex_name(*id)),
+        ConstOrTexture::Const(c) if color => v3(*c),
+        ConstOrTexture::Const(c) => c.x.to_string(),
+        ConstOrTexture::Texture(id) => quoted(&tex_name(*id)),
     }
 }

@@ -9,7 +9,7 @@ use glam::{Mat3, Vec2, Vec3};
 use yat_tracer::desc::{Geometry, MaterialDesc, SceneDesc, ShapeDesc, TriangleMesh};
 use yat_tracer::material::Null;
 use yat_tracer::mesh::tessellate::{plane_quad, tessellate};
-use yat_tracer::texture::TexturePoint;
+use yat_tracer::texture::LookupPoint;
 
 use crate::bake::material_bake;
 use crate::error::ExportError;
@@ -132,7 +132,7 @@ fn export_shape(
     let uvs: Option<Vec<Vec2>> = match material_bake(desc, shape.material)? {
         Some(mapping) => Some(
             (0..mesh.positions.len())
-                .map(|i| mapping.map(&TexturePoint::new(mesh.positions[i], object_uv(i))))
+                .map(|i| mapping.map(&LookupPoint::new(mesh.positions[i], object_uv(i))))
                 .collect(),
         ),
         None => mesh

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use glam::Vec2;
 use yat_tracer::desc::{Mapping2D, SceneDesc, TextureId, TextureKind, Wrap};
-use yat_tracer::texture::{Checkerboard2D, Checkerboard3D, Constant, ImageMap, Mix, Scale};
+use yat_tracer::texture::{
+    Checkerboard, Checkerboard2D, Checkerboard3D, Constant, ImageMap, Mix, Scale,
+};
 
 use crate::error::ExportError;
 use crate::procedural::{write_mapping3d, write_procedural};
@@ -69,21 +71,21 @@ pub fn write_textures(
                 }
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard2D(Checkerboard2D {
+            TextureKind::Checkerboard(Checkerboard::D2(Checkerboard2D {
                 tex1,
                 tex2,
                 mapping,
-            }) => {
+            })) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard2d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));
                 write_mapping(p, &prefix, mapping);
             }
-            TextureKind::Checkerboard3D(Checkerboard3D {
+            TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
                 tex1,
                 tex2,
                 mapping,
-            }) => {
+            })) => {
                 p.set(format!("{prefix}.type"), quoted("checkerboard3d"));
                 p.set(format!("{prefix}.texture1"), tex_value(tex1, color));
                 p.set(format!("{prefix}.texture2"), tex_value(tex2, color));

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::coating::Coating;
+use super::coat_over_base::Coating;
 use super::sample::LocalSample;
 use super::Bxdf;
 use crate::math::{Cone, Frame};
@@ -49,7 +49,7 @@ impl Bsdf {
 
     /// True when the material is `null`: the ray continues straight through.
     pub fn is_pass_through(&self) -> bool {
-        matches!(self.bxdf, Bxdf::PassThrough)
+        matches!(self.bxdf, Bxdf::PassThrough(_))
     }
 
     /// A bare Lambert BSDF's shading frame, geometric normal and value (the same for every
@@ -108,8 +108,8 @@ impl Bsdf {
 
     /// f(wo, wi) for the non-specular lobes; wo and wi are unit world directions away from
     /// the surface.
-    // Inlined into the path loop, as `pdf` is: with the sampler's code written over lanes the
-    // loop grew and the compiler left it out of line (depth of field 1.4% slower).
+    // Inlined into the path loop, as `pdf` is: the loop is large enough that the compiler
+    // leaves it out of line otherwise (bench/RESULTS.md, "Figures moved out of the code").
     #[inline(always)]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (wo_local, wi_local) = (self.frame.to_local(wo), self.frame.to_local(wi));

@@ -27,6 +27,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, PI};
 use glam::{Vec2, Vec3};
 
 use super::local::same_hemisphere;
+use super::lobe::Lobe;
 use super::sample::{cosine_pdf, LocalSample};
 
 /// Whether a yarn runs along v (warp) or along u (weft, the same geometry turned a quarter).
@@ -294,9 +295,18 @@ impl Cloth {
         let cap = |w: Vec3| self.room / h.albedo_bound(w.z);
         h.glint.min(cap(wo)).min(cap(wi)) * h.normalization
     }
+}
+
+impl Lobe for Cloth {
+    const GATHERS_BROADLY: bool = true;
+
+    /// What it reflects at most, for lobe selection under a coat.
+    fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
+        (self.kd + self.ks * self.room).min(Vec3::ONE)
+    }
 
     /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if !same_hemisphere(wo, wi) || wi.z == 0.0 || wo.z == 0.0 {
             return Vec3::ZERO;
         }
@@ -309,16 +319,11 @@ impl Cloth {
         (self.kd + self.ks * highlight) * FRAC_1_PI
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         cosine_pdf(wo, wi)
     }
 
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
-    }
-
-    /// What it reflects at most, for lobe selection under a coat.
-    pub fn albedo_hint(&self) -> Vec3 {
-        (self.kd + self.ks * self.room).min(Vec3::ONE)
     }
 }

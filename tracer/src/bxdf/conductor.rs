@@ -5,7 +5,13 @@ use glam::{Vec2, Vec3};
 use super::fresnel;
 use super::local::{reflect, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
+use super::lobe::Lobe;
 use super::sample::LocalSample;
+
+/// The widest microfacet alpha [`Lobe::glossy_spread`] counts as glossy. A wider lobe sees a
+/// lamp as light sampling does, and more BSDF samples add little (bench/RESULTS.md, "Figures
+/// moved out of the code").
+pub const GLOSSY_ALPHA: f32 = 0.1;
 
 /// Where a conductor's reflectance comes from.
 #[derive(Clone, Copy, Debug)]
@@ -40,13 +46,26 @@ impl Conductor {
     pub fn fresnel_at(&self, cos: f32) -> Vec3 {
         self.fresnel.eval(cos)
     }
+}
 
-    pub fn is_specular(&self) -> bool {
+impl Lobe for Conductor {
+    fn glossy_spread(&self) -> Option<f32> {
+        match self.distrib {
+            Some(d) if d.max_alpha() < GLOSSY_ALPHA => Some(d.reflection_spread()),
+            _ => None,
+        }
+    }
+
+    fn albedo_hint(&self, cos_o: f32) -> Vec3 {
+        self.fresnel_at(cos_o)
+    }
+
+    fn is_specular(&self) -> bool {
         self.distrib.is_none()
     }
 
     /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let Some(distrib) = self.distrib else {
             return Vec3::ZERO;
         };
@@ -62,7 +81,7 @@ impl Conductor {
         self.fresnel.eval(wo.dot(wm)) * (distrib.d(wm) * distrib.g(wo, wi) / (4.0 * cos_i * cos_o))
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let Some(distrib) = self.distrib else {
             return 0.0;
         };
@@ -77,7 +96,7 @@ impl Conductor {
         distrib.d_visible(wo, wm) / (4.0 * wo.dot(wm).abs())
     }
 
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         if wo.z == 0.0 {
             return None;
         }

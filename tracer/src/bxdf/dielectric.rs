@@ -12,6 +12,7 @@ use glam::{Vec2, Vec3};
 use super::fresnel;
 use super::local::{reflect, refract, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
+use super::lobe::Lobe;
 use super::sample::LocalSample;
 
 #[derive(Clone, Copy, Debug)]
@@ -33,9 +34,6 @@ pub struct Dielectric {
 }
 
 impl Dielectric {
-    pub fn is_specular(&self) -> bool {
-        !matches!(self.surface, Surface::Rough(_)) || self.eta == 1.0
-    }
 
     /// Probability of choosing reflection given Fresnel reflectance `r`: in proportion to the
     /// reflected and transmitted energy, so a black tint is never sampled.
@@ -46,28 +44,6 @@ impl Dielectric {
             pr / (pr + pt)
         } else {
             0.0
-        }
-    }
-
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        match self.surface {
-            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).0,
-            _ => Vec3::ZERO,
-        }
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self.surface {
-            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).1,
-            _ => 0.0,
-        }
-    }
-
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
-        match self.surface {
-            Surface::Rough(distrib) if self.eta != 1.0 => self.sample_rough(distrib, wo, u_lobe, u),
-            Surface::Thin => self.sample_thin(wo, u_lobe),
-            _ => self.sample_smooth(wo, u_lobe),
         }
     }
 
@@ -195,5 +171,40 @@ impl Dielectric {
         };
         let (f, pdf) = self.rough_f_pdf(distrib, wo, wi);
         LocalSample::non_specular(wi, f, pdf)
+    }
+}
+
+impl Lobe for Dielectric {
+    /// Glass tells its sides apart: which one a ray leaves by decides the refraction.
+    const TWO_SIDED: bool = false;
+
+    fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
+        self.kr.max(self.kt)
+    }
+
+    fn is_specular(&self) -> bool {
+        !matches!(self.surface, Surface::Rough(_)) || self.eta == 1.0
+    }
+
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).0,
+            _ => Vec3::ZERO,
+        }
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.rough_f_pdf(distrib, wo, wi).1,
+            _ => 0.0,
+        }
+    }
+
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        match self.surface {
+            Surface::Rough(distrib) if self.eta != 1.0 => self.sample_rough(distrib, wo, u_lobe, u),
+            Surface::Thin => self.sample_thin(wo, u_lobe),
+            _ => self.sample_smooth(wo, u_lobe),
+        }
     }
 }

@@ -1,11 +1,12 @@
-//! Diffuse lobes: Lambert or Oren-Nayar reflection (matte), and diffuse reflection plus
-//! diffuse transmission (mattetranslucent). Both are two-sided.
+//! The diffuse lobe of matte: Lambert or Oren-Nayar reflection, two-sided; the Oren-Nayar
+//! terms it shares with [`super::translucent`].
 
 use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::local::{cosine_hemisphere_pdf, flip_z, same_hemisphere, sample_cosine_hemisphere};
+use super::local::same_hemisphere;
+use super::lobe::Lobe;
 use super::sample::{cosine_pdf, LocalSample};
 
 /// The Oren-Nayar roughness terms (pbrt's qualitative model); A = 1, B = 0 is Lambert.
@@ -27,7 +28,7 @@ impl OrenNayar {
     }
 
     /// The factor multiplying R/pi for two directions in the same (upper) hemisphere.
-    fn factor(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub fn factor(&self, wo: Vec3, wi: Vec3) -> f32 {
         if self.b == 0.0 {
             return self.a;
         }
@@ -57,77 +58,33 @@ pub struct DiffuseReflection {
 }
 
 impl DiffuseReflection {
+    /// The lobe's value for every pair of directions it reflects, where that is one value
+    /// (Lambert: no Oren-Nayar slope term).
+    pub fn lambert_value(&self) -> Option<Vec3> {
+        (self.roughness.b == 0.0).then(|| self.r * (FRAC_1_PI * self.roughness.a))
+    }
+}
+
+impl Lobe for DiffuseReflection {
+    const GATHERS_BROADLY: bool = true;
+
+    fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
+        self.r
+    }
+
     /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if !same_hemisphere(wo, wi) {
             return Vec3::ZERO;
         }
         self.r * (FRAC_1_PI * self.roughness.factor(wo, wi))
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         cosine_pdf(wo, wi)
     }
 
-    /// The lobe's value for every pair of directions it reflects, where that is one value
-    /// (Lambert: no Oren-Nayar slope term).
-    pub fn lambert_value(&self) -> Option<Vec3> {
-        (self.roughness.b == 0.0).then(|| self.r * (FRAC_1_PI * self.roughness.a))
-    }
-
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
-    }
-}
-
-/// mattetranslucent: diffuse reflection `r` on the side of `wo`, diffuse transmission `t` to
-/// the other side, each with the same Oren-Nayar roughness.
-#[derive(Clone, Copy, Debug)]
-pub struct DiffuseTranslucent {
-    pub r: Vec3,
-    pub t: Vec3,
-    pub roughness: OrenNayar,
-}
-
-impl DiffuseTranslucent {
-    /// Probability of sampling the reflection lobe, by albedo.
-    fn reflect_probability(&self) -> f32 {
-        let (r, t) = (self.r.element_sum(), self.t.element_sum());
-        if r + t > 0.0 {
-            r / (r + t)
-        } else {
-            0.5
-        }
-    }
-
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if wi.z == 0.0 {
-            return Vec3::ZERO;
-        }
-        if same_hemisphere(wo, wi) {
-            self.r * (FRAC_1_PI * self.roughness.factor(wo, wi))
-        } else {
-            self.t * (FRAC_1_PI * self.roughness.factor(wo, flip_z(wi)))
-        }
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let p_r = self.reflect_probability();
-        let lobe = if same_hemisphere(wo, wi) {
-            p_r
-        } else {
-            1.0 - p_r
-        };
-        lobe * cosine_hemisphere_pdf(wi.z.abs())
-    }
-
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
-        let up = sample_cosine_hemisphere(u);
-        let wi = if u_lobe < self.reflect_probability() {
-            up
-        } else {
-            flip_z(up)
-        };
-        LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
     }
 }

@@ -3,175 +3,143 @@
 //! them per hit from their evaluated parameters; [`bsdf::Bsdf`] places one in the world (it
 //! imports this enum; nothing here imports it).
 //!
-//! Files: [`sample`] (the shared [`LocalSample`]), [`local`] (local-frame helpers), [`fresnel`],
-//! [`microfacet`] (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the
-//! lobes [`diffuse`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`], the glossy
-//! [`coated`] layer and [`coating`] (a coat over any lobe), and [`bsdf`] (world frame).
+//! Files: [`sample`] (the shared [`LocalSample`]), [`lobe`] (the [`Lobe`] trait every lobe
+//! implements), [`local`] (local-frame helpers), [`fresnel`], [`microfacet`]
+//! (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the lobes
+//! [`pass_through`], [`diffuse`], [`translucent`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`],
+//! [`cloth`], the glossy [`coat`] layer and [`coat_over_base`] (a coat over any base lobe), and [`bsdf`]
+//! (world frame). A new lobe is its file (its struct and [`Lobe`] impl) plus one line in the
+//! lobe list below.
 
 pub mod bsdf;
-pub mod cloth;
-pub mod coated;
-pub mod coating;
-pub mod conductor;
-pub mod dielectric;
-pub mod diffuse;
+pub mod coat;
+pub mod coat_over_base;
 pub mod fresnel;
 pub mod ggx_albedo;
+pub mod lobe;
 pub mod local;
 pub mod microfacet;
 pub mod sample;
-pub mod scatter;
-pub mod velvet;
 
 use glam::{Vec2, Vec3};
 
+pub use conductor::GLOSSY_ALPHA;
+pub use lobe::Lobe;
 pub use sample::LocalSample;
 
-use cloth::Cloth;
-use conductor::Conductor;
-use dielectric::Dielectric;
-use diffuse::{DiffuseReflection, DiffuseTranslucent};
 use local::flip_z;
-use scatter::Scatter;
-use velvet::Velvet;
 
-/// The widest microfacet alpha [`Bxdf::glossy_spread`] counts as glossy. A wider lobe sees a
-/// lamp as light sampling does, and more BSDF samples add little: our materials scene's copper
-/// (alpha 0.2) split lowered its error 0.5% for 6.7% more work; its gold (0.05) 10% for 4.7%.
-pub const GLOSSY_ALPHA: f32 = 0.1;
+/// Generates the lobe family from its list (see [`lobes!`]'s invocation below): each lobe's
+/// module, the [`Bxdf`] variant and every dispatch `match`, each arm a call of the lobe's
+/// [`Lobe`] method (a plain match: no heap, no virtual calls).
+macro_rules! lobes {
+    ($($(#[$doc:meta])* $variant:ident($module:ident::$lobe:ident),)+) => {
+        $(pub mod $module;)+
 
-#[derive(Clone, Copy, Debug)]
-pub enum Bxdf {
-    /// `null`: not a surface at all.
-    PassThrough,
-    Diffuse(DiffuseReflection),
-    Translucent(DiffuseTranslucent),
-    Conductor(Conductor),
-    Dielectric(Dielectric),
-    Velvet(Velvet),
-    Scatter(Scatter),
-    Cloth(Cloth),
+        #[derive(Clone, Copy, Debug)]
+        pub enum Bxdf {
+            $($(#[$doc])* $variant($module::$lobe),)+
+        }
+
+        impl Bxdf {
+            /// Whether the lobe is a delta distribution (light samples never find it).
+            pub fn is_specular(&self) -> bool {
+                match self {
+                    $(Bxdf::$variant(l) => l.is_specular(),)+
+                }
+            }
+
+            /// Whether the lobe reflects only (light reaches the surface from the side it is
+            /// seen from) and spreads over the hemisphere much as the cosine does: the surfaces
+            /// whose light samples of an environment map are drawn for the side they face. A
+            /// metal's lobe is narrower: most of those samples would find it dark, each after a
+            /// shadow ray, where half of the map's own samples fall behind the surface at no
+            /// cost.
+            pub fn gathers_broadly(&self) -> bool {
+                match self {
+                    $(Bxdf::$variant(_) => <$module::$lobe as Lobe>::GATHERS_BROADLY,)+
+                }
+            }
+
+            /// For a rough metal whose lobe is narrow (alpha below [`GLOSSY_ALPHA`]), the half
+            /// angle around the mirror direction that holds most of its lobe: a lamp it
+            /// reflects is a bright, sharp-edged patch of the lobe, which one BSDF sample finds
+            /// or misses.
+            pub fn glossy_spread(&self) -> Option<f32> {
+                match self {
+                    $(Bxdf::$variant(l) => l.glossy_spread(),)+
+                }
+            }
+
+            /// Roughly what the lobe reflects and transmits of the light arriving at `cos_o`:
+            /// what a coat over it weighs it by when choosing which to sample.
+            pub fn albedo_hint(&self, cos_o: f32) -> Vec3 {
+                match self {
+                    $(Bxdf::$variant(l) => l.albedo_hint(cos_o),)+
+                }
+            }
+
+            /// Whether a query from `wo` is mirrored to the upper hemisphere (see
+            /// [`Lobe::TWO_SIDED`]).
+            fn mirrors_back_face(&self, wo: Vec3) -> bool {
+                wo.z < 0.0
+                    && match self {
+                        $(Bxdf::$variant(_) => <$module::$lobe as Lobe>::TWO_SIDED,)+
+                    }
+            }
+
+            /// `wo` and `wi` as the lobe handles them: mirrored together when `wo` is below a
+            /// two-sided lobe.
+            fn facing_up(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+                if self.mirrors_back_face(wo) {
+                    (flip_z(wo), flip_z(wi))
+                } else {
+                    (wo, wi)
+                }
+            }
+
+            pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+                let (wo, wi) = self.facing_up(wo, wi);
+                match self {
+                    $(Bxdf::$variant(l) => l.f(wo, wi),)+
+                }
+            }
+
+            pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+                let (wo, wi) = self.facing_up(wo, wi);
+                match self {
+                    $(Bxdf::$variant(l) => l.pdf(wo, wi),)+
+                }
+            }
+
+            pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+                let mirrored = self.mirrors_back_face(wo);
+                let wo = if mirrored { flip_z(wo) } else { wo };
+                let sample = match self {
+                    $(Bxdf::$variant(l) => l.sample(wo, u_lobe, u),)+
+                }?;
+                Some(if mirrored {
+                    LocalSample {
+                        wi: flip_z(sample.wi),
+                        ..sample
+                    }
+                } else {
+                    sample
+                })
+            }
+        }
+    };
 }
 
-impl Bxdf {
-    pub fn is_specular(&self) -> bool {
-        match self {
-            Bxdf::PassThrough => true,
-            Bxdf::Conductor(c) => c.is_specular(),
-            Bxdf::Dielectric(d) => d.is_specular(),
-            Bxdf::Diffuse(_)
-            | Bxdf::Translucent(_)
-            | Bxdf::Velvet(_)
-            | Bxdf::Scatter(_)
-            | Bxdf::Cloth(_) => false,
-        }
-    }
-
-    /// Whether the lobe reflects only (light reaches the surface from the side it is seen
-    /// from) and spreads over the hemisphere much as the cosine does: the surfaces whose light
-    /// samples of an environment map are drawn for the side they face. A metal's lobe is
-    /// narrower: most of those samples would find it dark, each after a shadow ray, where half
-    /// of the map's own samples fall behind the surface at no cost.
-    pub fn gathers_broadly(&self) -> bool {
-        match self {
-            Bxdf::Diffuse(_) | Bxdf::Velvet(_) | Bxdf::Cloth(_) => true,
-            Bxdf::PassThrough
-            | Bxdf::Conductor(_)
-            | Bxdf::Translucent(_)
-            | Bxdf::Dielectric(_)
-            | Bxdf::Scatter(_) => false,
-        }
-    }
-
-    /// For a rough metal whose lobe is narrow (alpha below [`GLOSSY_ALPHA`]), the half angle
-    /// around the mirror direction that holds most of its lobe: a lamp it reflects is a
-    /// bright, sharp-edged patch of the lobe, which one BSDF sample finds or misses.
-    pub fn glossy_spread(&self) -> Option<f32> {
-        match self {
-            Bxdf::Conductor(Conductor {
-                distrib: Some(d), ..
-            }) if d.max_alpha() < GLOSSY_ALPHA => Some(d.reflection_spread()),
-            _ => None,
-        }
-    }
-
-    /// Roughly what the lobe reflects and transmits of the light arriving at `cos_o`: what a
-    /// coat over it weighs it by when choosing which to sample.
-    pub fn albedo_hint(&self, cos_o: f32) -> Vec3 {
-        match self {
-            Bxdf::PassThrough => Vec3::ZERO,
-            Bxdf::Diffuse(d) => d.r,
-            Bxdf::Translucent(t) => t.r + t.t,
-            Bxdf::Conductor(c) => c.fresnel_at(cos_o),
-            Bxdf::Dielectric(d) => d.kr.max(d.kt),
-            Bxdf::Velvet(v) => v.albedo_hint(),
-            Bxdf::Scatter(s) => s.albedo_hint(),
-            Bxdf::Cloth(c) => c.albedo_hint(),
-        }
-    }
-
-    /// Every variant but glass looks the same from both sides: a query from below is mirrored
-    /// to the upper hemisphere, so those variants only handle wo.z >= 0.
-    fn mirrors_back_face(&self, wo: Vec3) -> bool {
-        wo.z < 0.0 && !matches!(self, Bxdf::Dielectric(_))
-    }
-
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        let (wo, wi) = if self.mirrors_back_face(wo) {
-            (flip_z(wo), flip_z(wi))
-        } else {
-            (wo, wi)
-        };
-        match self {
-            Bxdf::PassThrough => Vec3::ZERO,
-            Bxdf::Diffuse(d) => d.f(wo, wi),
-            Bxdf::Translucent(t) => t.f(wo, wi),
-            Bxdf::Conductor(c) => c.f(wo, wi),
-            Bxdf::Dielectric(d) => d.f(wo, wi),
-            Bxdf::Velvet(v) => v.f(wo, wi),
-            Bxdf::Scatter(s) => s.f(wo, wi),
-            Bxdf::Cloth(c) => c.f(wo, wi),
-        }
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let (wo, wi) = if self.mirrors_back_face(wo) {
-            (flip_z(wo), flip_z(wi))
-        } else {
-            (wo, wi)
-        };
-        match self {
-            Bxdf::PassThrough => 0.0,
-            Bxdf::Diffuse(d) => d.pdf(wo, wi),
-            Bxdf::Translucent(t) => t.pdf(wo, wi),
-            Bxdf::Conductor(c) => c.pdf(wo, wi),
-            Bxdf::Dielectric(d) => d.pdf(wo, wi),
-            Bxdf::Velvet(v) => v.pdf(wo, wi),
-            Bxdf::Scatter(s) => s.pdf(wo, wi),
-            Bxdf::Cloth(c) => c.pdf(wo, wi),
-        }
-    }
-
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
-        let mirrored = self.mirrors_back_face(wo);
-        let wo = if mirrored { flip_z(wo) } else { wo };
-        let sample = match self {
-            Bxdf::PassThrough => None,
-            Bxdf::Diffuse(d) => d.sample(wo, u),
-            Bxdf::Translucent(t) => t.sample(wo, u_lobe, u),
-            Bxdf::Conductor(c) => c.sample(wo, u),
-            Bxdf::Dielectric(d) => d.sample(wo, u_lobe, u),
-            Bxdf::Velvet(v) => v.sample(wo, u),
-            Bxdf::Scatter(s) => s.sample(wo, u),
-            Bxdf::Cloth(c) => c.sample(wo, u),
-        }?;
-        Some(if mirrored {
-            LocalSample {
-                wi: flip_z(sample.wi),
-                ..sample
-            }
-        } else {
-            sample
-        })
-    }
+// The lobes: `Variant(module::Lobe),`.
+lobes! {
+    /// `null`: not a surface at all.
+    PassThrough(pass_through::PassThrough),
+    Diffuse(diffuse::DiffuseReflection),
+    Translucent(translucent::DiffuseTranslucent),
+    Conductor(conductor::Conductor),
+    Dielectric(dielectric::Dielectric),
+    Velvet(velvet::Velvet),
+    Scatter(scatter::Scatter),
+    Cloth(cloth::Cloth),
 }

@@ -9,6 +9,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::lobe::Lobe;
 use super::sample::LocalSample;
 use crate::medium::phase::Phase;
 
@@ -29,8 +30,14 @@ impl Scatter {
             phase: Phase::new(g),
         }
     }
+}
 
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+impl Lobe for Scatter {
+    fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
+        self.r
+    }
+
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let cos_i = wi.z.abs();
         if cos_i < MIN_COS {
             return Vec3::ZERO;
@@ -39,16 +46,12 @@ impl Scatter {
         self.r * self.phase.eval(wo, wi) / cos_i
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         self.phase.pdf(wo, wi)
     }
 
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         let wi = self.phase.sample(wo, u);
         LocalSample::non_specular(wi, self.f(wo, wi), self.pdf(wo, wi))
-    }
-
-    pub fn albedo_hint(&self) -> Vec3 {
-        self.r
     }
 }

@@ -18,6 +18,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::local::same_hemisphere;
+use super::lobe::Lobe;
 use super::sample::{cosine_pdf, LocalSample};
 
 /// Midpoints used to integrate the clamped phase polynomial over the cosine.
@@ -57,9 +58,18 @@ impl Velvet {
             thickness: thickness.max(0.0),
         }
     }
+}
+
+impl Lobe for Velvet {
+    const GATHERS_BROADLY: bool = true;
+
+    /// What it reflects at most, for lobe selection under a coat.
+    fn albedo_hint(&self, _cos_o: f32) -> Vec3 {
+        self.r
+    }
 
     /// `wo` is in the upper hemisphere (the BSDF mirrors back-face queries).
-    pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if !same_hemisphere(wo, wi) {
             return Vec3::ZERO;
         }
@@ -73,16 +83,11 @@ impl Velvet {
         self.r * (phase * scattered / (cos_i + cos_o))
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         cosine_pdf(wo, wi)
     }
 
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         LocalSample::cosine(wo, u, |wi| self.f(wo, wi))
-    }
-
-    /// What it reflects at most, for lobe selection under a coat.
-    pub fn albedo_hint(&self) -> Vec3 {
-        self.r
     }
 }

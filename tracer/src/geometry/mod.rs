@@ -156,10 +156,9 @@ impl SceneGeometry {
             (WideBvh::default(), Vec::new())
         } else {
             let mut core_time = Duration::ZERO;
-            // obvhs's slow preset (pre-splitting, wider PLOC search, more reinsertion) traces
-            // CaptainFalcon 13% faster and the 2M-triangle heavy scene 10% faster than the
-            // medium one, for +1.5 us of build per triangle on 2 cores (heavy: 2.3 -> 5.4 s):
-            // paid back within seconds of rendering at 1080p.
+            // obvhs's slow preset (pre-splitting, wider PLOC search, more reinsertion): its
+            // faster traversal pays back its longer build within seconds of rendering at 1080p
+            // (bench/RESULTS.md, "Figures moved out of the code").
             let cwbvh = build_cwbvh(&aabbs, BvhBuildParams::slow_build(), &mut core_time);
             let order = &cwbvh.primitive_indices;
             let prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();

@@ -28,8 +28,8 @@ pub(crate) fn scene_desc(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> Scen
     desc.integrator.max_depth = 4;
     desc.integrator.rr_strategy = RussianRoulette::None;
     desc.materials = vec![MaterialDesc::Matte(Matte {
-        kd: Tex::float(0.5),
-        sigma: Tex::float(0.0),
+        kd: ConstOrTexture::float(0.5),
+        sigma: ConstOrTexture::float(0.0),
     })];
     desc.shapes = shapes;
     desc.lights = lights;

@@ -35,12 +35,12 @@ use glam::{Affine3A, Mat4, Vec2, Vec3, Vec3A};
 use crate::diag::SourcePos;
 use crate::geometry::{AnalyticShape, ShapeSurface, SurfaceSample, TriangleSurface};
 use crate::math::{luminance, Frame};
-use crate::param::{Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::shape::AreaLightDesc;
-use crate::texture::{TexturePoint, Textures};
+use crate::texture::{LookupPoint, Textures};
 
 use super::distribution::Distribution1D;
 use super::emission::{emits, normalised_gain, surface_color, DEFAULT_GAIN, DEFAULT_L};
@@ -55,7 +55,7 @@ pub const DEFAULT_EFFICACY: f32 = 17.0;
 /// world-space area of each shape is.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLightParams {
-    pub l: Tex,
+    pub l: ConstOrTexture,
     pub gain: f32,
     pub power: f32,
     pub efficacy: f32,
@@ -99,7 +99,7 @@ impl AreaLightDesc {
     /// Constant radiance `radiance`, without power normalisation.
     pub fn constant(radiance: Vec3) -> Self {
         Self {
-            l: Tex::Const(radiance),
+            l: ConstOrTexture::Const(radiance),
             gain: 1.0,
             power: 0.0,
             efficacy: 0.0,
@@ -121,8 +121,8 @@ impl AreaLightDesc {
     /// The radiance of a constant `L`; None for a texture.
     pub fn radiance(&self) -> Option<Vec3> {
         match self.l {
-            Tex::Const(l) => Some(l * self.scale(luminance(l))),
-            Tex::Texture(_) => None,
+            ConstOrTexture::Const(l) => Some(l * self.scale(luminance(l))),
+            ConstOrTexture::Texture(_) => None,
         }
     }
 }
@@ -142,14 +142,14 @@ struct EmissionTexture {
 impl EmissionTexture {
     /// The radiance at world point `p` with surface coordinates `uv`.
     fn at(&self, p: Vec3, uv: Vec2) -> Vec3 {
-        let at = TexturePoint {
+        let at = LookupPoint {
             p: self.world_to_object.transform_point3(p),
             p_world: p,
             uv,
             prim: 0,
         };
         self.textures
-            .eval(Tex::Texture(self.l), &at)
+            .eval(ConstOrTexture::Texture(self.l), &at)
             .max(Vec3::ZERO)
             * self.scale
     }
@@ -162,8 +162,10 @@ impl EmissionTexture {
         for j in 0..n {
             for i in 0..n {
                 let uv = (Vec2::new(i as f32, j as f32) + 0.5) / n as f32;
-                let at = TexturePoint::new(uv.extend(0.0), uv);
-                sum += textures.eval(Tex::Texture(l), &at).max(Vec3::ZERO);
+                let at = LookupPoint::new(uv.extend(0.0), uv);
+                sum += textures
+                    .eval(ConstOrTexture::Texture(l), &at)
+                    .max(Vec3::ZERO);
             }
         }
         sum / (n * n) as f32
@@ -205,7 +207,7 @@ enum Emitter {
 }
 
 /// The surface a light point was sampled on.
-enum On<'a> {
+enum SampledSurface<'a> {
     Triangle(&'a TriangleSurface),
     Quadric(&'a AnalyticShape),
 }
@@ -230,8 +232,8 @@ impl AreaLight {
         textures: &Arc<Textures>,
     ) -> Option<Self> {
         let (radiance, texture) = match desc.l {
-            Tex::Const(l) => (l * desc.scale(luminance(l)), None),
-            Tex::Texture(l) => {
+            ConstOrTexture::Const(l) => (l * desc.scale(luminance(l)), None),
+            ConstOrTexture::Texture(l) => {
                 let mean = EmissionTexture::mean(textures, l);
                 let scale = desc.scale(luminance(mean));
                 let texture = EmissionTexture {
@@ -343,20 +345,20 @@ impl AreaLight {
                     pdf_area: 1.0 / area,
                     ..s
                 };
-                (s, On::Triangle(&triangles[i]))
+                (s, SampledSurface::Triangle(&triangles[i]))
             }
-            Emitter::Quadric(shape) => (shape.sample(u), On::Quadric(shape)),
+            Emitter::Quadric(shape) => (shape.sample(u), SampledSurface::Quadric(shape)),
             Emitter::Sphere {
                 centre,
                 radius,
                 shape,
             } => {
                 if from.distance_squared(*centre) <= radius * radius * ON_SPHERE {
-                    (shape.sample(u), On::Quadric(shape))
+                    (shape.sample(u), SampledSurface::Quadric(shape))
                 } else {
                     let (wi, dist, pdf) =
                         sample_sphere_cone(from, *centre, *radius, shape.orientation(), u)?;
-                    let li = self.li(from, wi, dist, On::Quadric(shape));
+                    let li = self.li(from, wi, dist, SampledSurface::Quadric(shape));
                     return Some(EmitterSample { wi, dist, pdf, li });
                 }
             }
@@ -378,14 +380,14 @@ impl AreaLight {
     /// The radiance of the light point `from + dist wi` of surface `on`, at the uv a ray from
     /// `from` would hit there (interpolated on the triangle, or the quadric's own
     /// parametrisation of the point).
-    fn li(&self, from: Vec3, wi: Vec3, dist: f32, on: On) -> Vec3 {
+    fn li(&self, from: Vec3, wi: Vec3, dist: f32, on: SampledSurface) -> Vec3 {
         let Some(texture) = &self.texture else {
             return self.radiance;
         };
         let p = from + wi * dist;
         let uv = match on {
-            On::Triangle(triangle) => triangle.uv_at(p),
-            On::Quadric(shape) => {
+            SampledSurface::Triangle(triangle) => triangle.uv_at(p),
+            SampledSurface::Quadric(shape) => {
                 let hit = shape.hit_at(Vec3A::from(from), Vec3A::from(wi), dist);
                 shape.hit(hit, 0).uv
             }
@@ -496,7 +498,7 @@ mod tests {
     fn area_gain_follows_power_and_efficacy() {
         let l = Vec3::new(1.0, 0.5, 0.25);
         let e = AreaLightParams {
-            l: Tex::Const(l),
+            l: ConstOrTexture::Const(l),
             gain: 2.0,
             power: 100.0,
             efficacy: 17.0,

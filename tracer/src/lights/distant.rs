@@ -23,6 +23,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, Emission};
+use super::error::LightError;
+use super::kind::{LightKind, MapSource};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -41,11 +43,11 @@ pub struct DistantLight {
 
 impl DistantLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let to = params.vec3("to", DEFAULT_TO)?;
         if params.float("theta", DEFAULT_THETA)? != 0.0 {
@@ -63,15 +65,6 @@ impl DistantLight {
         })
     }
 
-    /// The light to sample (with `to_light` normalised), if it emits.
-    pub fn light(&self) -> Option<DistantLight> {
-        let to_light = self.to_light.normalize_or_zero();
-        (emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
-            to_light,
-            radiance: self.radiance,
-        })
-    }
-
     pub fn sample(&self) -> DeltaSample {
         DeltaSample {
             wi: self.to_light,
@@ -83,5 +76,22 @@ impl DistantLight {
     /// The flux through a disk of the scene's size.
     pub fn power(&self, scene_radius: f32) -> f32 {
         PI * scene_radius * scene_radius * luminance(self.radiance)
+    }
+}
+
+impl LightKind for DistantLight {
+    type Sampler = DistantLight;
+
+    fn name(&self) -> &'static str {
+        "distant"
+    }
+
+    /// The light to sample (with `to_light` normalised), if it emits.
+    fn light(&self, _maps: &MapSource) -> Result<Option<DistantLight>, LightError> {
+        let to_light = self.to_light.normalize_or_zero();
+        Ok((emits(self.radiance) && to_light != Vec3::ZERO).then_some(DistantLight {
+            to_light,
+            radiance: self.radiance,
+        }))
     }
 }

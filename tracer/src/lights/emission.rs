@@ -11,10 +11,10 @@
 
 use glam::Vec3;
 
-use crate::param::Tex;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
-use crate::parse::params::{ParamList, TexValue};
+use crate::parse::params::{ConstOrTextureName, ParamList};
+use crate::refs::ConstOrTexture;
 
 /// `L`: the emitted colour.
 pub const DEFAULT_L: Vec3 = Vec3::ONE;
@@ -45,12 +45,12 @@ pub(crate) fn surface_color(
     name: &str,
     default: Vec3,
     ctx: &mut dyn ParseContext,
-) -> Result<Tex, ParseError> {
+) -> Result<ConstOrTexture, ParseError> {
     let value = params.tex_color(name, default)?;
     Ok(match ctx.tex(value, true, default) {
-        Tex::Texture(id) => ctx
-            .uniform_texture(Tex::Texture(id))
-            .map_or(Tex::Texture(id), Tex::Const),
+        ConstOrTexture::Texture(id) => ctx
+            .uniform_texture(ConstOrTexture::Texture(id))
+            .map_or(ConstOrTexture::Texture(id), ConstOrTexture::Const),
         constant => constant,
     })
 }
@@ -64,11 +64,11 @@ pub(crate) fn light_color(
 ) -> Result<Vec3, ParseError> {
     let value = params.tex_color(name, default)?;
     let (texture, pos) = match &value {
-        TexValue::Const(c) => return Ok(*c),
-        TexValue::Named { name, pos } => (name.clone(), pos.clone()),
+        ConstOrTextureName::Const(c) => return Ok(*c),
+        ConstOrTextureName::Named { name, pos } => (name.clone(), pos.clone()),
     };
     Ok(match ctx.tex(value, true, default) {
-        Tex::Const(c) => c,
+        ConstOrTexture::Const(c) => c,
         tex => ctx.uniform_texture(tex).unwrap_or_else(|| {
             ctx.warn(
                 &pos,

@@ -31,21 +31,13 @@ use crate::parse::params::ParamList;
 use super::distribution::Distribution2D;
 use super::emission::{emits, Emission};
 use super::error::LightError;
+use super::kind::{LatLongConvention, LightKind, MapSource};
 use super::facing::{FacingTables, FACING_BINS, MAX_FACING_CELLS};
 
 /// `mapping`: the only one modelled.
 pub const DEFAULT_MAPPING: &str = "latlong";
 /// `gamma` of the map.
 pub const DEFAULT_GAMMA: f32 = 1.0;
-
-/// How a LatLong map is indexed (docs/architecture.md): the seed tracer's u = (pi + phi) / 2pi, or
-/// LuxRender's s = phi / 2pi with phi in [0, 2pi). Both use t = theta / pi.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum LatLongConvention {
-    #[default]
-    Seed,
-    LuxRender,
-}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvMapDesc {
@@ -65,11 +57,11 @@ pub struct InfiniteLight {
 
 impl InfiniteLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let mapping = params.string_or("mapping", DEFAULT_MAPPING)?;
         if mapping != DEFAULT_MAPPING {
             ctx.warn(
@@ -91,18 +83,26 @@ impl InfiniteLight {
             light_to_world: ctx.ctm(),
         })
     }
+}
+
+impl LightKind for InfiniteLight {
+    type Sampler = Environment;
+
+    fn files(&self) -> Vec<&str> {
+        self.map.iter().map(|m| m.filename.as_str()).collect()
+    }
+
+    fn name(&self) -> &'static str {
+        "infinite"
+    }
 
     /// The light to sample, if it emits: its map read from `source` and decoded.
-    pub fn light(
-        &self,
-        source: &dyn AssetSource,
-        latlong: LatLongConvention,
-    ) -> Result<Option<Environment>, LightError> {
+    fn light(&self, maps: &MapSource) -> Result<Option<Environment>, LightError> {
         if !emits(self.radiance) {
             return Ok(None);
         }
         let image = match &self.map {
-            Some(map) => Some(load_map(source, &map.filename, map.gamma)?),
+            Some(map) => Some(load_map(maps.files, &map.filename, map.gamma)?),
             None => None,
         };
         if Environment::is_singular(&self.light_to_world) {
@@ -112,7 +112,7 @@ impl InfiniteLight {
             self.radiance,
             image,
             &self.light_to_world,
-            latlong,
+            maps.latlong,
         )))
     }
 }

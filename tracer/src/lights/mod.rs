@@ -18,24 +18,21 @@
 //! with its statement, parameters and defaults, reading and sampling; the leaves they share:
 //! `emission` (`L`, `gain`, LuxRender's power/efficacy normalisation), `sample` (the sample
 //! types), `error`, `distribution` (sampling tables), `facing` (a map's tables for the side a
-//! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_cones` (which lamps a cone
+//! surface faces); `mirrored` (lamp images in flat mirrors), `lamp_spheres` (which lamps a cone
 //! of directions may reach), `triangle_lamps` (a few plain triangle lamps sampled in lanes).
-//! A new kind is one new file, one line in `read` and one line in each `match` below.
+//! A new kind is one new file (its description, its reader, its [`LightKind`] impl) plus one
+//! line in the kind list below, which generates the rest; a light of a new sort (not a point,
+//! a spot, a direction, a map or a cone at infinity) also needs its [`Light`] member.
 
 mod area;
-mod distant;
 mod distribution;
 mod emission;
 mod error;
 mod facing;
-mod infinite;
-mod lamp_cones;
+mod kind;
+mod lamp_spheres;
 mod mirrored;
-mod point;
 mod sample;
-mod sky;
-mod spot;
-mod sun;
 mod triangle_lamps;
 
 #[cfg(test)]
@@ -57,100 +54,113 @@ use crate::shape::ShapeDesc;
 use crate::texture::Textures;
 
 pub use area::AreaLightParams;
-pub use distant::DistantLight;
 pub use error::LightError;
-pub use infinite::{map_cost, EnvMapDesc, InfiniteLight, LatLongConvention};
+pub use infinite::{map_cost, EnvMapDesc};
+pub use kind::{LatLongConvention, LightKind, MapSource};
 pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
-pub use point::PointLight;
 pub use sample::LightSample;
-pub use sky::{SkyLight, SkyModel};
-pub use spot::SpotLight;
-pub use sun::{sun_rgb, SunLight};
+pub use sky::SkyModel;
+pub use sun::sun_rgb;
 pub use triangle_lamps::{LightSamples, TriangleLamps};
 
 use area::AreaLight;
 use distribution::Distribution1D;
-use emission::Emission;
 use infinite::Environment;
-use lamp_cones::LampCones;
+use lamp_spheres::LampSpheres;
 use mirrored::MirrorImages;
 use spot::SpotCone;
 use sun::SunDisc;
 
-/// A `LightSource` statement as described: plain data with LuxRender's defaults applied.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LightDesc {
-    Point(PointLight),
-    Spot(SpotLight),
-    Distant(DistantLight),
-    Infinite(InfiniteLight),
-    Sun(SunLight),
-    Sky(SkyLight),
+/// Generates the light family from its kind list (see [`lights!`]'s invocation below): each
+/// kind's module and re-export, the [`LightDesc`] variant, the name table from LuxRender's
+/// light types to the kind's readers, and the dispatch `match`es, each arm a call of the
+/// kind's [`LightKind`] method; a kind's line ends with the [`Light`] member its sampler
+/// becomes.
+macro_rules! lights {
+    ($($module:ident::$kind:ident as $variant:ident { $($name:literal => $read:ident),+ } => $sampler:expr,)+) => {
+        $(mod $module;)+
+        $(pub use $module::$kind;)+
+
+        /// A `LightSource` statement as described: plain data with LuxRender's defaults applied.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum LightDesc {
+            $($variant($kind),)+
+        }
+
+        impl LightDesc {
+            /// The reader of LuxRender light type `ty`; None for a type this renderer does not
+            /// know.
+            fn reader(ty: &str) -> Option<Reader<Self>> {
+                Some(match ty {
+                    $($($name => |params, pos, ctx| Ok(Self::$variant($kind::$read(params, pos, ctx)?)),)+)+
+                    _ => return None,
+                })
+            }
+
+            /// The LuxRender type name.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Self::$variant(l) => l.name(),)+
+                }
+            }
+
+            /// The files the light references (as written; the scene lists them in its assets).
+            pub fn files(&self) -> Vec<&str> {
+                match self {
+                    $(Self::$variant(l) => l.files(),)+
+                }
+            }
+
+            /// The light ready to sample (see [`LightKind::light`]).
+            fn light(&self, maps: &MapSource) -> Result<Option<Light>, LightError> {
+                Ok(match self {
+                    $(Self::$variant(l) => l.light(maps)?.map($sampler),)+
+                })
+            }
+        }
+    };
 }
 
-impl LightDesc {
-    /// The LuxRender type name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            LightDesc::Point(_) => "point",
-            LightDesc::Spot(_) => "spot",
-            LightDesc::Distant(_) => "distant",
-            LightDesc::Infinite(_) => "infinite",
-            LightDesc::Sun(_) => "sun",
-            LightDesc::Sky(l) => l.name(),
-        }
-    }
-
-    /// The files the light references (as written; the scene lists them in its assets).
-    pub fn files(&self) -> Vec<&str> {
-        match self {
-            LightDesc::Infinite(l) => l.map.iter().map(|m| m.filename.as_str()).collect(),
-            _ => Vec::new(),
-        }
-    }
+// The kinds: `module::Kind as Variant { "luxrender type" => reader, ... } => sampler member,`.
+lights! {
+    point::PointLight as Point { "point" => read, "goniometric" => read } => Light::Point,
+    spot::SpotLight as Spot { "spot" => read } => Light::Spot,
+    distant::DistantLight as Distant { "distant" => read } => Light::Distant,
+    infinite::InfiniteLight as Infinite { "infinite" => read, "infinitesample" => read }
+        => |l| Light::Infinite(AtInfinity::Map(l)),
+    sun::SunLight as Sun { "sun" => read } => |l| Light::Infinite(AtInfinity::Sun(l)),
+    sky::SkyLight as Sky { "sky" => read_preetham, "sky2" => read_hosek }
+        => |l| Light::Infinite(AtInfinity::Sky(l)),
 }
 
-/// Reads `LightSource "ty"`: the lights it makes (`sunsky` and `sunsky2` make a sun and a
-/// sky from the same parameters, as LuxRender does), none for an unknown type (a warning).
+/// Reads a light of type `T` from a statement's parameters.
+type Reader<T> = fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<T, ParseError>;
+
+/// Reads `LightSource "ty"` through the name table: the lights it makes (`sunsky` and
+/// `sunsky2` make a sun and a sky from the same parameters, as LuxRender does), none for an
+/// unknown type (a warning).
 pub(crate) fn read(
     ty: &str,
     params: &ParamList,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
 ) -> Result<Vec<LightDesc>, ParseError> {
-    let sky = |hosek, ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
-        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
-        Ok(LightDesc::Sky(SkyLight::read(
-            hosek, gain, params, pos, ctx,
-        )?))
-    };
-    let sun = |ctx: &mut dyn ParseContext| -> Result<LightDesc, ParseError> {
-        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
-        Ok(LightDesc::Sun(SunLight::read(gain, params, pos, ctx)?))
-    };
-    Ok(match ty {
-        "sun" => vec![sun(ctx)?],
-        "sky" => vec![sky(false, ctx)?],
-        "sky2" => vec![sky(true, ctx)?],
-        "sunsky" => vec![sun(ctx)?, sky(false, ctx)?],
-        "sunsky2" => vec![sun(ctx)?, sky(true, ctx)?],
+    let sky: Reader<SkyLight> = match ty {
+        "sunsky" => SkyLight::read_preetham,
+        "sunsky2" => SkyLight::read_hosek,
         _ => {
-            let e = Emission::read(params, ctx)?;
-            vec![match ty {
-                "point" | "goniometric" => LightDesc::Point(PointLight::read(e, params, pos, ctx)?),
-                "spot" => LightDesc::Spot(SpotLight::read(e, params, pos, ctx)?),
-                "distant" => LightDesc::Distant(DistantLight::read(e, params, pos, ctx)?),
-                "infinite" | "infinitesample" => {
-                    LightDesc::Infinite(InfiniteLight::read(e, params, pos, ctx)?)
-                }
-                other => {
-                    ignore_all(params);
-                    ctx.warn(pos, format!("unknown LightSource \"{other}\" skipped"));
-                    return Ok(Vec::new());
-                }
-            }]
+            let Some(read) = LightDesc::reader(ty) else {
+                ignore_all(params);
+                ctx.warn(pos, format!("unknown LightSource \"{ty}\" skipped"));
+                return Ok(Vec::new());
+            };
+            return Ok(vec![read(params, pos, ctx)?]);
         }
-    })
+    };
+    Ok(vec![
+        LightDesc::Sun(SunLight::read(params, pos, ctx)?),
+        LightDesc::Sky(sky(params, pos, ctx)?),
+    ])
 }
 
 fn ignore_all(params: &ParamList) {
@@ -239,7 +249,7 @@ pub struct Lights {
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
     images: MirrorImages,
     /// The area lights' bounding spheres, for [`Self::lamp_may_be_in`].
-    lamp_cones: LampCones,
+    lamp_spheres: LampSpheres,
     /// The lights as tables for packets, when they are a few plain triangle lamps.
     triangle_lamps: Option<TriangleLamps>,
 }
@@ -282,18 +292,12 @@ impl Lights {
             }
         }
 
+        let maps = MapSource {
+            files: source,
+            latlong,
+        };
         for desc in descs {
-            let light = match desc {
-                LightDesc::Point(l) => l.light().map(Light::Point),
-                LightDesc::Spot(l) => l.light().map(Light::Spot),
-                LightDesc::Distant(l) => l.light().map(Light::Distant),
-                LightDesc::Infinite(l) => l
-                    .light(source, latlong)?
-                    .map(|l| Light::Infinite(AtInfinity::Map(l))),
-                LightDesc::Sun(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sun(l))),
-                LightDesc::Sky(l) => l.light().map(|l| Light::Infinite(AtInfinity::Sky(l))),
-            };
-            lights.extend(light);
+            lights.extend(desc.light(&maps)?);
         }
 
         let scene_radius = geometry
@@ -330,7 +334,7 @@ impl Lights {
             _ => None,
         });
         Ok(Self {
-            lamp_cones: LampCones::new(&lamp_boxes),
+            lamp_spheres: LampSpheres::new(&lamp_boxes),
             triangle_lamps: TriangleLamps::new(lamps, &selection),
             lights,
             selection,
@@ -460,12 +464,12 @@ impl Lights {
 
     /// Whether an area light may lie in `cone` seen from `p` (true may be wrong, false is not).
     pub fn lamp_may_be_in(&self, p: Vec3, cone: &Cone) -> bool {
-        self.lamp_cones.may_reach(p, cone)
+        self.lamp_spheres.may_reach(p, cone)
     }
 
     /// Whether a ray from `p` along `dir` may reach an area light (false is never wrong).
     pub fn lamp_may_be_along(&self, p: Vec3, dir: Vec3) -> bool {
-        self.lamp_cones.may_reach_along(p, dir)
+        self.lamp_spheres.may_reach_along(p, dir)
     }
 
     /// Whether the scene has lamp images (most have none).

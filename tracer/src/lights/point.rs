@@ -24,6 +24,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
+use super::error::LightError;
+use super::kind::{LightKind, MapSource};
 use super::sample::DeltaSample;
 
 /// `from`.
@@ -42,11 +44,11 @@ pub struct PointLight {
 
 impl PointLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let gain = normalised_gain(
             e.gain,
@@ -59,11 +61,6 @@ impl PointLight {
             position: from + ctx.ctm().transform_point3(Vec3::ZERO),
             intensity: e.l * gain,
         })
-    }
-
-    /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<PointLight> {
-        emits(self.intensity).then(|| self.clone())
     }
 
     pub fn sample(&self, from: Vec3) -> Option<DeltaSample> {
@@ -81,5 +78,18 @@ impl PointLight {
 
     pub fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
+    }
+}
+
+impl LightKind for PointLight {
+    type Sampler = PointLight;
+
+    fn name(&self) -> &'static str {
+        "point"
+    }
+
+    /// The light to sample, if it emits.
+    fn light(&self, _maps: &MapSource) -> Result<Option<PointLight>, LightError> {
+        Ok(emits(self.intensity).then(|| self.clone()))
     }
 }

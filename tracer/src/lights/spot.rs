@@ -26,6 +26,8 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
 use super::emission::{emits, normalised_gain, Emission};
+use super::error::LightError;
+use super::kind::{LightKind, MapSource};
 use super::point::PointLight;
 use super::sample::DeltaSample;
 
@@ -55,11 +57,11 @@ pub struct SpotLight {
 
 impl SpotLight {
     pub(crate) fn read(
-        e: Emission,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let e = Emission::read(params, ctx)?;
         let from = params.vec3("from", DEFAULT_FROM)?;
         let to = params.vec3("to", DEFAULT_TO)?;
         let cone_angle = params.float("coneangle", DEFAULT_CONE_ANGLE)?;
@@ -87,10 +89,18 @@ impl SpotLight {
             cone_delta_angle,
         })
     }
+}
+
+impl LightKind for SpotLight {
+    type Sampler = SpotCone;
+
+    fn name(&self) -> &'static str {
+        "spot"
+    }
 
     /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<SpotCone> {
-        emits(self.intensity).then(|| {
+    fn light(&self, _maps: &MapSource) -> Result<Option<SpotCone>, LightError> {
+        Ok(emits(self.intensity).then(|| {
             SpotCone::new(
                 self.position,
                 self.direction,
@@ -98,7 +108,7 @@ impl SpotLight {
                 self.cone_angle,
                 self.cone_delta_angle,
             )
-        })
+        }))
     }
 }
 

@@ -35,7 +35,9 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::spectra::emission_rgb;
 
-use super::emission::emits;
+use super::emission::{self, emits};
+use super::error::LightError;
+use super::kind::{LightKind, MapSource};
 
 /// `sundir` (LuxRender 1.x's sun default points down: a sun with no direction is set).
 pub const DEFAULT_SUNDIR: Vec3 = Vec3::new(0.0, 0.0, -1.0);
@@ -59,11 +61,11 @@ pub struct SunLight {
 
 impl SunLight {
     pub(crate) fn read(
-        gain: f32,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
         let sundir = params.vec3("sundir", DEFAULT_SUNDIR)?;
         let turbidity = params.float("turbidity", DEFAULT_TURBIDITY)?;
         let relsize = params.float("relsize", DEFAULT_RELSIZE)?;
@@ -109,13 +111,21 @@ impl SunLight {
         let sin = f64::from(self.relsize) * SUN_RADIUS_KM / SUN_DISTANCE_KM;
         sin.min(1.0).powi(2) as f32
     }
+}
+
+impl LightKind for SunLight {
+    type Sampler = SunDisc;
+
+    fn name(&self) -> &'static str {
+        "sun"
+    }
 
     /// The light to sample, if it emits.
-    pub fn light(&self) -> Option<SunDisc> {
+    fn light(&self, _maps: &MapSource) -> Result<Option<SunDisc>, LightError> {
         let to_sun = self.to_sun.normalize_or_zero();
         let sin2 = self.sin2_max();
         let radiance = self.radiance();
-        (emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
+        Ok((emits(radiance) && to_sun != Vec3::ZERO && sin2 > 0.0).then(|| {
             // 1 - cos theta_max without the cancellation of 1 - sqrt(1 - sin^2) near 1.
             let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
             SunDisc {
@@ -126,7 +136,7 @@ impl SunLight {
                 one_minus_cos,
                 pdf: 1.0 / (TAU * one_minus_cos),
             }
-        })
+        }))
     }
 }
 

@@ -28,13 +28,13 @@
 
 use glam::{Affine3A, Vec2, Vec3};
 
-use super::eval::TextureEval;
+use super::eval::HitTextures;
 use crate::geometry::SurfaceHit;
-use crate::param::{Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::texture::TexturePoint;
+use crate::refs::{ConstOrTexture, TextureId};
+use crate::texture::LookupPoint;
 
 /// LuxRender's finite-difference step, in world units.
 pub const DEFAULT_SAMPLE_DISTANCE: f32 = 0.001;
@@ -60,18 +60,18 @@ impl Bump {
             DEFAULT_SAMPLE_DISTANCE
         };
         Ok(match ctx.float_param(params, "bumpmap", 0.0)? {
-            Tex::Texture(map) => Some(Self {
+            ConstOrTexture::Texture(map) => Some(Self {
                 map,
                 sample_distance,
             }),
-            Tex::Const(_) => None,
+            ConstOrTexture::Const(_) => None,
         })
     }
 
     /// The bumped shading normal at `hit` (unit, in the hemisphere of `hit.ns`; `hit.ns` when
     /// the result would be degenerate). `world_to_object` moves the object-space texture point
     /// along with the world one.
-    pub fn normal(&self, hit: &SurfaceHit, eval: &TextureEval, world_to_object: &Affine3A) -> Vec3 {
+    pub fn normal(&self, hit: &SurfaceHit, eval: &HitTextures, world_to_object: &Affine3A) -> Vec3 {
         let n = hit.ns;
         let dpdu = hit.dpdu;
         // A usable v tangent: LuxRender's coordinate system when the uvs give none.
@@ -80,7 +80,10 @@ impl Bump {
         } else {
             n.cross(dpdu)
         };
-        let bumped = match eval.textures.normal_map(Tex::Texture(self.map), &eval.at) {
+        let bumped = match eval
+            .textures
+            .normal_map(ConstOrTexture::Texture(self.map), &eval.at)
+        {
             Some(tangent_space) => {
                 let t = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
                 let b = n.cross(t);
@@ -88,12 +91,13 @@ impl Bump {
                 tangent_space.x * t + tangent_space.y * b + tangent_space.z * n
             }
             None => {
-                let height = |at: &TexturePoint| eval.float_at(Tex::Texture(self.map), at);
+                let height =
+                    |at: &LookupPoint| eval.float_at(ConstOrTexture::Texture(self.map), at);
                 let base = height(&eval.at);
                 let moved = |tangent: Vec3, duv: Vec2| {
                     let step = self.sample_distance / tangent.length();
                     let offset = step * tangent;
-                    let at = TexturePoint {
+                    let at = LookupPoint {
                         p: eval.at.p + world_to_object.transform_vector3(offset),
                         p_world: eval.at.p_world + offset,
                         uv: eval.at.uv + step * duv,
@@ -128,8 +132,8 @@ mod tests {
     use crate::assets::MemorySource;
     use crate::desc::MaterialDesc;
     use crate::material::Materials;
-    use crate::param::MaterialId;
     use crate::parse::parse_scene;
+    use crate::refs::MaterialId;
     use crate::texture::Textures;
 
     /// The scene's textures and its first material's bump map.
@@ -168,9 +172,9 @@ mod tests {
     }
 
     fn normal_at(textures: &Textures, bump: &Bump, hit: &SurfaceHit) -> Vec3 {
-        let eval = TextureEval {
+        let eval = HitTextures {
             textures,
-            at: TexturePoint {
+            at: LookupPoint {
                 p: hit.p,
                 p_world: hit.p,
                 uv: hit.uv,
@@ -247,11 +251,11 @@ mod tests {
         );
         assert!(close(n, Vec3::new(0.0, 0.6, 0.8)), "{n}");
         // Read as a plain float texture a normal map is 0 (no height).
-        let eval = TextureEval {
+        let eval = HitTextures {
             textures: &textures,
-            at: TexturePoint::new(Vec3::ZERO, Vec2::splat(0.5)),
+            at: LookupPoint::new(Vec3::ZERO, Vec2::splat(0.5)),
         };
-        assert_eq!(eval.float(Tex::Texture(bump.map)), 0.0);
+        assert_eq!(eval.float(ConstOrTexture::Texture(bump.map)), 0.0);
     }
 
     #[test]

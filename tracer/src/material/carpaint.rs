@@ -22,19 +22,20 @@
 //! With a `name`, the preset's values replace Kd, Ks1-3, R1-3 and M1-3 (as in LuxRender, which
 //! then ignores those parameters). LuxRender's lobes use Schlick's distribution with
 //! r = M^2, which is GGX with alpha = M. Where the three weights sum to more than 1 they are
-//! scaled down (the [`crate::bxdf::coated::Coat`] rule), so custom layers cannot create
+//! scaled down (the [`crate::bxdf::coat::Coat`] rule), so custom layers cannot create
 //! energy; the presets' weights are far below that.
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
-use crate::bxdf::coated::{Coat, CoatLobe};
-use crate::bxdf::coating::Coating;
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use crate::bxdf::coat::{Coat, CoatLobe};
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::microfacet::TrowbridgeReitz;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -151,12 +152,12 @@ pub fn preset(name: &str) -> Option<&'static Preset> {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CarPaint {
-    pub kd: Tex,
-    pub ks: [Tex; 3],
-    pub r: [Tex; 3],
-    pub m: [Tex; 3],
-    pub ka: Tex,
-    pub depth: Tex,
+    pub kd: ConstOrTexture,
+    pub ks: [ConstOrTexture; 3],
+    pub r: [ConstOrTexture; 3],
+    pub m: [ConstOrTexture; 3],
+    pub ka: ConstOrTexture,
+    pub depth: ConstOrTexture,
 }
 
 impl CarPaint {
@@ -192,10 +193,10 @@ impl CarPaint {
             return Ok(Self::from_preset(p, ka, depth));
         }
         let d = &PRESETS[0];
-        let mut color = |n: &str, c: [f32; 3]| -> Result<Tex, ParseError> {
+        let mut color = |n: &str, c: [f32; 3]| -> Result<ConstOrTexture, ParseError> {
             ctx.color_param(params, n, 0.0, true).map(|t| match t {
                 // color_param's default is a splat; the preset's is a colour.
-                Tex::Const(_) if params.find(n).is_none() => Tex::color(Vec3::from_array(c)),
+                ConstOrTexture::Const(_) if params.find(n).is_none() => ConstOrTexture::color(Vec3::from_array(c)),
                 t => t,
             })
         };
@@ -225,27 +226,38 @@ impl CarPaint {
     }
 
     /// Preset `p` with clear-layer absorption `ka` and thickness `depth`.
-    pub fn from_preset(p: &Preset, ka: Tex, depth: Tex) -> Self {
-        let color = |c: [f32; 3]| Tex::color(Vec3::from_array(c));
+    pub fn from_preset(p: &Preset, ka: ConstOrTexture, depth: ConstOrTexture) -> Self {
+        let color = |c: [f32; 3]| ConstOrTexture::color(Vec3::from_array(c));
         Self {
             kd: color(p.kd),
             ks: p.ks.map(color),
-            r: p.r.map(Tex::float),
-            m: p.m.map(Tex::float),
+            r: p.r.map(ConstOrTexture::float),
+            m: p.m.map(ConstOrTexture::float),
             ka,
             depth,
         }
     }
+}
+
+impl MaterialKind for CarPaint {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd];
+        params.extend(&self.ks);
+        params.extend(&self.r);
+        params.extend(&self.m);
+        params.extend([&self.ka, &self.depth]);
+        texture_ids(&params)
+    }
 
     /// The base under the flakes.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::Diffuse(DiffuseReflection {
             r: eval.color(self.kd),
             roughness: OrenNayar::new(0.0),
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
+    fn coating(&self, eval: &HitTextures) -> Option<Coating> {
         let off = CoatLobe {
             weight: Vec3::ZERO,
             r0: Vec3::ZERO,
@@ -272,15 +284,6 @@ impl CarPaint {
             eval.float(self.depth),
             None,
         );
-        Coating::two_sided(coat, true)
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd];
-        params.extend(&self.ks);
-        params.extend(&self.r);
-        params.extend(&self.m);
-        params.extend([&self.ka, &self.depth]);
-        texture_ids(&params)
+        Some(Coating::two_sided(coat, true))
     }
 }

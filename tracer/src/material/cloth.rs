@@ -29,11 +29,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::cloth::{Cloth as ClothLobe, Highlight, Scattering, Yarn, YarnKind, ALBEDO_STEPS};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -371,8 +372,8 @@ impl Preset {
 pub struct Cloth {
     pub preset: &'static Preset,
     /// Diffuse and highlight colours of the warp, then of the weft.
-    pub warp: [Tex; 2],
-    pub weft: [Tex; 2],
+    pub warp: [ConstOrTexture; 2],
+    pub weft: [ConstOrTexture; 2],
     pub repeat: Vec2,
 }
 
@@ -401,17 +402,19 @@ impl Cloth {
             ),
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Cloth {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let highlight = self.preset.highlight(eval.at.uv, self.repeat);
         let [kd, ks] = match highlight.yarn.kind {
             YarnKind::Warp => self.warp,
             YarnKind::Weft => self.weft,
         };
         Bxdf::Cloth(ClothLobe::new(eval.color(kd), eval.color(ks), highlight))
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.warp[0], &self.warp[1], &self.weft[0], &self.weft[1]])
     }
 }

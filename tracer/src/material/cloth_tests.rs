@@ -8,6 +8,7 @@ use glam::{Vec2, Vec3};
 use super::cloth::{Preset, DEFAULT_REPEAT, PRESETS};
 use crate::bxdf::cloth::{Cloth as ClothLobe, ALBEDO_STEPS};
 use crate::bxdf::local::sample_cosine_hemisphere;
+use crate::bxdf::Lobe;
 use crate::sampler::PixelSampler;
 
 fn repeat() -> Vec2 {
@@ -86,7 +87,7 @@ fn preset_normalisations_and_albedo_bounds_match_their_measurement() {
 /// Directional albedo by `n` samples of the lobe's own sampling (mean of f cos / pdf).
 fn sampled_albedo(lobe: &ClothLobe, wo: Vec3, seed: u64, n: u32) -> Vec3 {
     let sum: Vec3 = (0..n)
-        .filter_map(|i| lobe.sample(wo, PixelSampler::new(3, 0, i, n, seed).get_2d()))
+        .filter_map(|i| lobe.sample(wo, 0.0, PixelSampler::new(3, 0, i, n, seed).get_2d()))
         .map(|s| s.f * s.wi.z / s.pdf)
         .sum();
     sum / n as f32

@@ -5,13 +5,13 @@
 use glam::Vec3;
 
 use crate::bxdf::microfacet::TrowbridgeReitz;
-use crate::param::{Tex, TextureId};
-use crate::texture::{TexturePoint, Textures};
+use crate::refs::{ConstOrTexture, TextureId};
+use crate::texture::{LookupPoint, Textures};
 
 /// The scene's textures and the point they are evaluated at.
-pub struct TextureEval<'a> {
+pub struct HitTextures<'a> {
     pub textures: &'a Textures,
-    pub at: TexturePoint,
+    pub at: LookupPoint,
 }
 
 /// Reflectances are clamped to [0, 1] (as LuxRender does) so no texture can create energy;
@@ -20,35 +20,35 @@ fn unit(c: Vec3) -> Vec3 {
     c.max(Vec3::ZERO).min(Vec3::ONE)
 }
 
-impl TextureEval<'_> {
+impl HitTextures<'_> {
     /// A colour parameter, clamped to [0, 1].
-    pub fn color(&self, t: Tex) -> Vec3 {
+    pub fn color(&self, t: ConstOrTexture) -> Vec3 {
         unit(self.textures.eval(t, &self.at))
     }
 
     /// A float parameter.
-    pub fn float(&self, t: Tex) -> f32 {
+    pub fn float(&self, t: ConstOrTexture) -> f32 {
         self.float_at(t, &self.at)
     }
 
     /// A float parameter at another point (a bump map's finite differences).
-    pub fn float_at(&self, t: Tex, at: &TexturePoint) -> f32 {
+    pub fn float_at(&self, t: ConstOrTexture, at: &LookupPoint) -> f32 {
         self.textures.eval(t, at).x
     }
 
     /// The microfacet distribution for (u, v) roughness; None is a perfectly smooth surface.
-    pub fn roughness(&self, u: Tex, v: Tex) -> Option<TrowbridgeReitz> {
+    pub fn roughness(&self, u: ConstOrTexture, v: ConstOrTexture) -> Option<TrowbridgeReitz> {
         TrowbridgeReitz::from_roughness(self.float(u), self.float(v))
     }
 }
 
 /// The textures among `params`, in order (what a material references).
-pub fn texture_ids(params: &[&Tex]) -> Vec<TextureId> {
+pub fn texture_ids(params: &[&ConstOrTexture]) -> Vec<TextureId> {
     params
         .iter()
         .filter_map(|t| match t {
-            Tex::Texture(id) => Some(*id),
-            Tex::Const(_) => None,
+            ConstOrTexture::Texture(id) => Some(*id),
+            ConstOrTexture::Const(_) => None,
         })
         .collect()
 }

@@ -18,11 +18,12 @@
 //!
 //! A non-positive index is treated as no interface (index 1).
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::dielectric::{Dielectric, Surface};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -39,12 +40,12 @@ pub const DEFAULT_ROUGHGLASS_ROUGHNESS: f32 = 0.001;
 /// glass and roughglass: zero roughness is the smooth specular glass.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Glass {
-    pub kr: Tex,
-    pub kt: Tex,
-    pub index: Tex,
+    pub kr: ConstOrTexture,
+    pub kt: ConstOrTexture,
+    pub index: ConstOrTexture,
     pub architectural: bool,
-    pub uroughness: Tex,
-    pub vroughness: Tex,
+    pub uroughness: ConstOrTexture,
+    pub vroughness: ConstOrTexture,
     /// glass2: `index` is replaced, per shape, by its volumes' (see the table above).
     pub index_from_volumes: bool,
 }
@@ -97,7 +98,7 @@ impl Glass {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
             kt: ctx.color_param(params, "Kt", DEFAULT_KT, false)?,
             index: if glass2 {
-                Tex::float(GLASS2_INDEX_WITHOUT_VOLUMES)
+                ConstOrTexture::float(GLASS2_INDEX_WITHOUT_VOLUMES)
             } else {
                 ctx.float_param(params, "index", DEFAULT_INDEX)?
             },
@@ -105,18 +106,30 @@ impl Glass {
             uroughness: if rough > 0.0 {
                 ctx.float_param(params, "uroughness", rough)?
             } else {
-                Tex::float(0.0)
+                ConstOrTexture::float(0.0)
             },
             vroughness: if rough > 0.0 {
                 ctx.float_param(params, "vroughness", rough)?
             } else {
-                Tex::float(0.0)
+                ConstOrTexture::float(0.0)
             },
             index_from_volumes: glass2,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Glass {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[
+            &self.kr,
+            &self.kt,
+            &self.index,
+            &self.uroughness,
+            &self.vroughness,
+        ])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let eta = eval.float(self.index);
         let surface = if self.architectural {
             Surface::Thin
@@ -133,15 +146,5 @@ impl Glass {
             eta: if eta > 0.0 { eta } else { 1.0 },
             surface,
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[
-            &self.kr,
-            &self.kt,
-            &self.index,
-            &self.uroughness,
-            &self.vroughness,
-        ])
     }
 }

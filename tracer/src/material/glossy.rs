@@ -1,6 +1,6 @@
 //! `Material "glossy"` and `"glossy2"` (LuxRender's Glossy2): a Lambert base under a glossy
-//! coat (the [`coated`](crate::bxdf::coated) layer, put together by
-//! [`coating`](crate::bxdf::coating)). The coat's parameters are also glossycoating's and
+//! coat (the [`coat`](crate::bxdf::coat) layer, put together by
+//! [`coat_over_base`](crate::bxdf::coat_over_base)). The coat's parameters are also glossycoating's and
 //! glossytranslucent's ([`CoatParams`]).
 //!
 //! ```text
@@ -23,14 +23,15 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
-use crate::bxdf::coated::Coat;
-use crate::bxdf::coating::Coating;
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use crate::bxdf::coat::Coat;
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::microfacet::TrowbridgeReitz;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -48,11 +49,11 @@ pub const DEFAULT_ROUGHNESS: f32 = 0.1;
 /// ((i-1)/(i+1))^2 when index > 0), absorption Ka with depth d, anisotropic roughness.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CoatParams {
-    pub ks: Tex,
-    pub ka: Tex,
-    pub depth: Tex,
-    pub uroughness: Tex,
-    pub vroughness: Tex,
+    pub ks: ConstOrTexture,
+    pub ka: ConstOrTexture,
+    pub depth: ConstOrTexture,
+    pub uroughness: ConstOrTexture,
+    pub vroughness: ConstOrTexture,
     pub multibounce: bool,
 }
 
@@ -72,15 +73,15 @@ impl CoatParams {
         let ks = ctx.color_param(params, &name("Ks"), ks_default, false)?;
         let index = ctx.float_param(params, &name("index"), DEFAULT_INDEX)?;
         let ks = match index {
-            Tex::Const(i) if i.x > 0.0 => {
+            ConstOrTexture::Const(i) if i.x > 0.0 => {
                 let f = ((i.x - 1.0) / (i.x + 1.0)).powi(2);
                 match ks {
-                    Tex::Const(c) => Tex::Const(c * f),
-                    Tex::Texture(id) => Tex::Texture(ctx.scaled_texture(id, f)),
+                    ConstOrTexture::Const(c) => ConstOrTexture::Const(c * f),
+                    ConstOrTexture::Texture(id) => ConstOrTexture::Texture(ctx.scaled_texture(id, f)),
                 }
             }
-            Tex::Const(_) => ks,
-            Tex::Texture(_) => {
+            ConstOrTexture::Const(_) => ks,
+            ConstOrTexture::Texture(_) => {
                 ctx.warn(
                     pos,
                     format!(
@@ -93,7 +94,7 @@ impl CoatParams {
             }
         };
         let ks = match ks {
-            Tex::Const(c) => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
+            ConstOrTexture::Const(c) => ConstOrTexture::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
             t => t,
         };
         Ok(Self {
@@ -107,7 +108,7 @@ impl CoatParams {
     }
 
     /// The coat at a hit.
-    pub fn coat(&self, eval: &TextureEval) -> Coat {
+    pub fn coat(&self, eval: &HitTextures) -> Coat {
         // Each roughness texture is read once: the lobe and the multibounce term share it.
         let (u, v) = (eval.float(self.uroughness), eval.float(self.vroughness));
         let distrib = TrowbridgeReitz::from_roughness(u, v);
@@ -122,7 +123,7 @@ impl CoatParams {
         )
     }
 
-    pub fn textures(&self) -> Vec<&Tex> {
+    pub fn textures(&self) -> Vec<&ConstOrTexture> {
         vec![
             &self.ks,
             &self.ka,
@@ -136,7 +137,7 @@ impl CoatParams {
 /// A Lambert base Kd under a [`CoatParams`] coat.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Glossy {
-    pub kd: Tex,
+    pub kd: ConstOrTexture,
     pub coat: CoatParams,
 }
 
@@ -151,22 +152,28 @@ impl Glossy {
         ctx.unsupported_unless(params, "sigma", 0.0);
         Ok(Self { kd, coat })
     }
+}
+
+impl MaterialKind for Glossy {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd];
+        params.extend(self.coat.textures());
+        texture_ids(&params)
+    }
 
     /// The base under the coat.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::Diffuse(DiffuseReflection {
             r: eval.color(self.kd),
             roughness: OrenNayar::new(0.0),
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
-        Coating::two_sided(self.coat.coat(eval), true)
+    fn coating(&self, eval: &HitTextures) -> Option<Coating> {
+        Some(Coating::two_sided(self.coat.coat(eval), true))
     }
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd];
-        params.extend(self.coat.textures());
-        texture_ids(&params)
+    fn multibounce(&self) -> bool {
+        self.coat.multibounce
     }
 }

@@ -1,5 +1,5 @@
 //! `Material "glossycoating"`: the Glossy2 coat over any other material (the
-//! [`coating`](crate::bxdf::coating) composition).
+//! [`coat_over_base`](crate::bxdf::coat_over_base) composition).
 //!
 //! ```text
 //! MakeNamedMaterial "lacquered" "string type" ["glossycoating"] "string basematerial" ["wood"]
@@ -15,11 +15,14 @@
 //! it). A base that has a coat of its own (glossy, carpaint, glossytranslucent, another
 //! glossycoating) keeps its lobes but loses that inner coat: one coat per surface.
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use super::matte::Matte;
 use super::glossy::{CoatParams, DEFAULT_ROUGHNESS};
-use crate::bxdf::coating::Coating;
+use crate::bxdf::Bxdf;
+use crate::bxdf::coat_over_base::Coating;
 use crate::diag::SourcePos;
-use crate::param::{MaterialId, TextureId};
+use crate::refs::{MaterialId, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -50,11 +53,26 @@ impl GlossyCoating {
     }
 
     /// The coat over a base whose lobe is `diffuse` (Lambert) or not.
-    pub fn coating(&self, eval: &TextureEval, diffuse: bool) -> Coating {
+    pub fn coat_over(&self, eval: &HitTextures, diffuse: bool) -> Coating {
         Coating::two_sided(self.coat.coat(eval), diffuse)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for GlossyCoating {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&self.coat.textures())
+    }
+
+    fn materials(&self) -> Vec<MaterialId> {
+        vec![self.base]
+    }
+
+    /// Resolved with its base by [`super::Materials`]; alone it shows the default matte.
+    fn bxdf(&self, _eval: &HitTextures, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
+    }
+
+    fn multibounce(&self) -> bool {
+        self.coat.multibounce
     }
 }

@@ -16,18 +16,20 @@
 //! | `backface_Ks`, `backface_index`, `backface_Ka`, `backface_d`, `backface_uroughness`, `backface_vroughness`, `backface_multibounce` | the back coat when `onesided` is false | Ks 0 ([`DEFAULT_BACKFACE_KS`]), roughness 0 ([`DEFAULT_BACKFACE_ROUGHNESS`]), the rest as glossy |
 //!
 //! Light crossing the sheet passes the coat of the face it enters and the coat of the face it
-//! leaves (see [`coating`](crate::bxdf::coating)); what Kd reflects is not transmitted, as in
+//! leaves (see [`coat_over_base`](crate::bxdf::coat_over_base)); what Kd reflects is not transmitted, as in
 //! LuxRender's Kt (1 - Kd).
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use super::glossy::{CoatParams, DEFAULT_KS, DEFAULT_ROUGHNESS};
-use crate::bxdf::coating::Coating;
-use crate::bxdf::diffuse::{DiffuseTranslucent, OrenNayar};
+use crate::bxdf::coat_over_base::Coating;
+use crate::bxdf::diffuse::OrenNayar;
+use crate::bxdf::translucent::DiffuseTranslucent;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -39,8 +41,8 @@ pub const DEFAULT_BACKFACE_ROUGHNESS: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct GlossyTranslucent {
-    pub kd: Tex,
-    pub kt: Tex,
+    pub kd: ConstOrTexture,
+    pub kt: ConstOrTexture,
     pub front: CoatParams,
     /// None: the back face has the front's coat (`onesided`).
     pub back: Option<CoatParams>,
@@ -79,9 +81,20 @@ impl GlossyTranslucent {
             back,
         })
     }
+}
+
+impl MaterialKind for GlossyTranslucent {
+    fn textures(&self) -> Vec<TextureId> {
+        let mut params = vec![&self.kd, &self.kt];
+        params.extend(self.front.textures());
+        if let Some(b) = &self.back {
+            params.extend(b.textures());
+        }
+        texture_ids(&params)
+    }
 
     /// The diffuse sheet under the coats.
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let r = eval.color(self.kd);
         Bxdf::Translucent(DiffuseTranslucent {
             r,
@@ -90,21 +103,16 @@ impl GlossyTranslucent {
         })
     }
 
-    pub fn coating(&self, eval: &TextureEval) -> Coating {
+    fn coating(&self, eval: &HitTextures) -> Option<Coating> {
         let front = self.front.coat(eval);
-        Coating {
+        Some(Coating {
             front,
             back: self.back.as_ref().map_or(front, |b| b.coat(eval)),
             diffuse_base: true,
-        }
+        })
     }
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        let mut params = vec![&self.kd, &self.kt];
-        params.extend(self.front.textures());
-        if let Some(b) = &self.back {
-            params.extend(b.textures());
-        }
-        texture_ids(&params)
+    fn multibounce(&self) -> bool {
+        self.front.multibounce || self.back.as_ref().is_some_and(|b| b.multibounce)
     }
 }

@@ -18,9 +18,12 @@
 //! base); LuxRender, which calls it experimental, also walks light back and forth between
 //! translucent layers, which this does not.
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use super::matte::Matte;
+use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{MaterialId, Tex, TextureId};
+use crate::refs::{MaterialId, ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -32,7 +35,7 @@ pub const DEFAULT_OPACITY: f32 = 1.0;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layered {
     /// The layers present, top first, with their opacities.
-    pub layers: Vec<(MaterialId, Tex)>,
+    pub layers: Vec<(MaterialId, ConstOrTexture)>,
 }
 
 impl Layered {
@@ -53,7 +56,7 @@ impl Layered {
 
     /// One level of the resolution: the layer `u` falls in, or None when it passes every layer,
     /// and `u` rescaled to [0, 1) within the chosen layer (see [`super::mix::Mix::choose`]).
-    pub fn choose(&self, eval: &TextureEval, u: f32) -> (Option<MaterialId>, f32) {
+    pub fn choose(&self, eval: &HitTextures, u: f32) -> (Option<MaterialId>, f32) {
         // The probability mass not yet taken by the layers above.
         let (mut start, mut left) = (0.0f32, 1.0f32);
         for &(id, opacity) in &self.layers {
@@ -72,13 +75,21 @@ impl Layered {
         };
         (None, u)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
-        let opacities: Vec<&Tex> = self.layers.iter().map(|(_, t)| t).collect();
+impl MaterialKind for Layered {
+    fn textures(&self) -> Vec<TextureId> {
+        let opacities: Vec<&ConstOrTexture> = self.layers.iter().map(|(_, t)| t).collect();
         texture_ids(&opacities)
     }
 
-    pub fn materials(&self) -> Vec<MaterialId> {
+    fn materials(&self) -> Vec<MaterialId> {
         self.layers.iter().map(|(id, _)| *id).collect()
+    }
+
+    /// Resolved to one of its layers by [`super::Materials`]; alone it shows the default
+    /// matte.
+    fn bxdf(&self, _eval: &HitTextures, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
     }
 }

@@ -14,11 +14,12 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::diffuse::{DiffuseReflection, OrenNayar};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -30,17 +31,17 @@ pub const DEFAULT_SIGMA: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Matte {
-    pub kd: Tex,
+    pub kd: ConstOrTexture,
     /// Oren-Nayar sigma in degrees.
-    pub sigma: Tex,
+    pub sigma: ConstOrTexture,
 }
 
 impl Default for Matte {
     /// LuxRender's default material.
     fn default() -> Self {
         Self {
-            kd: Tex::color(Vec3::splat(DEFAULT_KD)),
-            sigma: Tex::float(DEFAULT_SIGMA),
+            kd: ConstOrTexture::color(Vec3::splat(DEFAULT_KD)),
+            sigma: ConstOrTexture::float(DEFAULT_SIGMA),
         }
     }
 }
@@ -57,13 +58,6 @@ impl Matte {
         })
     }
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
-        Bxdf::Diffuse(DiffuseReflection {
-            r: eval.color(self.kd),
-            roughness: OrenNayar::new(eval.float(self.sigma)),
-        })
-    }
-
     /// What a hit on an undefined material (an out-of-range id, or a mix cycle) shows: the
     /// default matte, without evaluating anything.
     pub fn default_bxdf() -> Bxdf {
@@ -72,8 +66,17 @@ impl Matte {
             roughness: OrenNayar::new(DEFAULT_SIGMA),
         })
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Matte {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[&self.kd, &self.sigma])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
+        Bxdf::Diffuse(DiffuseReflection {
+            r: eval.color(self.kd),
+            roughness: OrenNayar::new(eval.float(self.sigma)),
+        })
     }
 }

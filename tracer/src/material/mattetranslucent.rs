@@ -13,10 +13,13 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
-use crate::bxdf::diffuse::{DiffuseTranslucent, OrenNayar};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use crate::bxdf::diffuse::OrenNayar;
+use crate::bxdf::translucent::DiffuseTranslucent;
 use crate::bxdf::Bxdf;
-use crate::param::{Tex, TextureId};
+use crate::diag::SourcePos;
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -28,14 +31,18 @@ pub const DEFAULT_SIGMA: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MatteTranslucent {
-    pub kr: Tex,
-    pub kt: Tex,
-    pub sigma: Tex,
+    pub kr: ConstOrTexture,
+    pub kt: ConstOrTexture,
+    pub sigma: ConstOrTexture,
     pub energy_conserving: bool,
 }
 
 impl MatteTranslucent {
-    pub fn read(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Self, ParseError> {
+    pub fn read(
+        params: &ParamList,
+        _pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         Ok(Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, true)?,
             kt: ctx.color_param(params, "Kt", DEFAULT_KT, true)?,
@@ -43,8 +50,14 @@ impl MatteTranslucent {
             energy_conserving: params.bool("energyconserving", false)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for MatteTranslucent {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr, &self.kt, &self.sigma])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let r = eval.color(self.kr);
         let kt = eval.color(self.kt);
         let t = if self.energy_conserving {
@@ -57,9 +70,5 @@ impl MatteTranslucent {
             t,
             roughness: OrenNayar::new(eval.float(self.sigma)),
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr, &self.kt, &self.sigma])
     }
 }

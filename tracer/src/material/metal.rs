@@ -18,16 +18,17 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use super::nk;
 use crate::assets::AssetKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Fresnel, Tex, TextureId};
-use crate::parse::context::{ParseContext, TexBinding};
+use crate::refs::{Fresnel, ConstOrTexture, TextureId};
+use crate::parse::context::{ParseContext, BoundTexture};
 use crate::parse::error::ParseError;
-use crate::parse::params::{ParamList, ParamType, TexValue};
+use crate::parse::params::{ParamList, ParamType, ConstOrTextureName};
 
 pub const DEFAULT_PRESET: &str = "aluminium";
 /// LuxRender's metal2 default Fresnel term: index 5, no absorption.
@@ -38,8 +39,8 @@ pub const DEFAULT_ROUGHNESS: f32 = 0.1;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Metal {
     pub fresnel: Fresnel,
-    pub uroughness: Tex,
-    pub vroughness: Tex,
+    pub uroughness: ConstOrTexture,
+    pub vroughness: ConstOrTexture,
 }
 
 impl Metal {
@@ -77,8 +78,20 @@ impl Metal {
             vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Metal {
+    fn textures(&self) -> Vec<TextureId> {
+        let fresnel = match &self.fresnel {
+            Fresnel::Reflectance(x) | Fresnel::Index(x) => Some(x),
+            Fresnel::Conductor { .. } => None,
+        };
+        let mut params: Vec<&ConstOrTexture> = fresnel.into_iter().collect();
+        params.extend([&self.uroughness, &self.vroughness]);
+        texture_ids(&params)
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         let fresnel = match self.fresnel {
             Fresnel::Conductor { eta, k } => ConductorFresnel::Complex { eta, k },
             Fresnel::Index(index) => ConductorFresnel::Complex {
@@ -91,16 +104,6 @@ impl Metal {
             fresnel,
             distrib: eval.roughness(self.uroughness, self.vroughness),
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        let fresnel = match &self.fresnel {
-            Fresnel::Reflectance(x) | Fresnel::Index(x) => Some(x),
-            Fresnel::Conductor { .. } => None,
-        };
-        let mut params: Vec<&Tex> = fresnel.into_iter().collect();
-        params.extend([&self.uroughness, &self.vroughness]);
-        texture_ids(&params)
     }
 }
 
@@ -142,19 +145,19 @@ fn metal2_fresnel(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Fres
             ));
         }
         return Ok(match params.tex_float("fresnel", DEFAULT_METAL2_INDEX)? {
-            TexValue::Const(c) => Fresnel::Index(Tex::Const(c)),
-            TexValue::Named { name, pos } => match ctx.find_texture(&name, true) {
-                Some(TexBinding::Fresnel(f)) => f,
-                Some(TexBinding::Texture(id)) if !ctx.texture_is_color(id) => {
-                    Fresnel::Index(Tex::Texture(id))
+            ConstOrTextureName::Const(c) => Fresnel::Index(ConstOrTexture::Const(c)),
+            ConstOrTextureName::Named { name, pos } => match ctx.find_texture(&name, true) {
+                Some(BoundTexture::Fresnel(f)) => f,
+                Some(BoundTexture::Texture(id)) if !ctx.texture_is_color(id) => {
+                    Fresnel::Index(ConstOrTexture::Texture(id))
                 }
-                Some(TexBinding::Texture(id)) => Fresnel::Reflectance(Tex::Texture(id)),
+                Some(BoundTexture::Texture(id)) => Fresnel::Reflectance(ConstOrTexture::Texture(id)),
                 None => {
                     ctx.warn(
                         &pos,
                         format!("no fresnel texture named \"{name}\"; using index 5"),
                     );
-                    Fresnel::Index(Tex::float(DEFAULT_METAL2_INDEX))
+                    Fresnel::Index(ConstOrTexture::float(DEFAULT_METAL2_INDEX))
                 }
             },
         });
@@ -164,5 +167,5 @@ fn metal2_fresnel(params: &ParamList, ctx: &mut dyn ParseContext) -> Result<Fres
             ctx.color_param(params, "Kr", 1.0, true)?,
         ));
     }
-    Ok(Fresnel::Index(Tex::float(DEFAULT_METAL2_INDEX)))
+    Ok(Fresnel::Index(ConstOrTexture::float(DEFAULT_METAL2_INDEX)))
 }

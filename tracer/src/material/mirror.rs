@@ -9,11 +9,12 @@
 //! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
 //! | `film` | float | 0; thin-film interference is not supported (a warning otherwise) |
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -22,7 +23,7 @@ pub const DEFAULT_KR: f32 = 1.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mirror {
-    pub kr: Tex,
+    pub kr: ConstOrTexture,
 }
 
 impl Mirror {
@@ -36,15 +37,17 @@ impl Mirror {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Mirror {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::Conductor(Conductor {
             fresnel: ConductorFresnel::Constant(eval.color(self.kr)),
             distrib: None,
         })
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr])
     }
 }

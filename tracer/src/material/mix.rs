@@ -15,9 +15,12 @@
 //! An undefined name warns and uses the default matte. The resolution down to a leaf material
 //! is [`Materials`](super::Materials)' (it needs the other materials).
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
+use super::matte::Matte;
+use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{MaterialId, Tex, TextureId};
+use crate::refs::{MaterialId, ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -29,7 +32,7 @@ pub struct Mix {
     pub a: MaterialId,
     pub b: MaterialId,
     /// Weight of `b`.
-    pub amount: Tex,
+    pub amount: ConstOrTexture,
 }
 
 impl Mix {
@@ -58,7 +61,7 @@ impl Mix {
     /// One level of the resolution: `u` chooses a side against the amount and is rescaled to
     /// [0, 1) within the chosen side, so nested mixes draw on the same number without
     /// correlation between levels. Returns the chosen material and the rescaled number.
-    pub fn choose(&self, eval: &TextureEval, u: f32) -> (MaterialId, f32) {
+    pub fn choose(&self, eval: &HitTextures, u: f32) -> (MaterialId, f32) {
         let mut u = u;
         let amount = eval.float(self.amount).clamp(0.0, 1.0);
         let next = if u < amount {
@@ -71,13 +74,21 @@ impl Mix {
         u = u.clamp(0.0, 1.0 - f32::EPSILON);
         (next, u)
     }
+}
 
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Mix {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[&self.amount])
     }
 
     /// The materials it mixes.
-    pub fn materials(&self) -> Vec<MaterialId> {
+    fn materials(&self) -> Vec<MaterialId> {
         vec![self.a, self.b]
+    }
+
+    /// Resolved to one of its materials by [`super::Materials`]; alone it shows the default
+    /// matte.
+    fn bxdf(&self, _eval: &HitTextures, _u: f32) -> Bxdf {
+        Matte::default_bxdf()
     }
 }

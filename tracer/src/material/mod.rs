@@ -10,32 +10,17 @@
 //! and `layered` materials (and shinymetal's two lobes) are resolved stochastically, a
 //! glossycoating's base is resolved under its coat, and the result is a plain value.
 //!
-//! A new material is one new file plus one line in [`MaterialDesc::read`]'s name table (and
-//! one line in each `match` below).
+//! A new material is one new file (its struct, its reader, its [`MaterialKind`] impl) plus
+//! one line in the kind list below, which generates the rest.
 //!
 //! Every material but `mix` and `null` may carry a bump or normal map ([`bump`]): read here
 //! for all of them, kept as a [`MaterialDesc::Bumped`] wrapper, applied to the shading normal
 //! in [`Materials::bsdf`].
 
 pub mod bump;
-pub mod carpaint;
-pub mod cloth;
 pub mod eval;
-pub mod glass;
-pub mod glossy;
-pub mod glossycoating;
-pub mod glossytranslucent;
-pub mod layered;
-pub mod matte;
-pub mod mattetranslucent;
-pub mod metal;
-pub mod mirror;
-pub mod mix;
+pub mod kind;
 pub mod nk;
-pub mod null;
-pub mod scatter;
-pub mod shinymetal;
-pub mod velvet;
 
 #[cfg(test)]
 mod cloth_tests;
@@ -46,73 +31,156 @@ use glam::Affine3A;
 
 pub use crate::bxdf::bsdf::{Bsdf, BsdfSample};
 pub use bump::Bump;
-pub use carpaint::CarPaint;
-pub use cloth::Cloth;
-pub use glass::Glass;
-pub use glossy::Glossy;
-pub use glossycoating::GlossyCoating;
-pub use glossytranslucent::GlossyTranslucent;
-pub use layered::Layered;
-pub use matte::Matte;
-pub use mattetranslucent::MatteTranslucent;
-pub use metal::Metal;
-pub use mirror::Mirror;
-pub use mix::Mix;
-pub use null::Null;
-pub use scatter::Scatter;
-pub use shinymetal::ShinyMetal;
-pub use velvet::Velvet;
+pub use kind::MaterialKind;
 
-use crate::bxdf::coating::Coating;
+use crate::bxdf::coat_over_base::Coating;
 use crate::bxdf::{ggx_albedo, Bxdf};
 use crate::diag::SourcePos;
 use crate::geometry::SurfaceHit;
 use crate::math::Frame;
-use crate::param::{MaterialId, Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::texture::{TexturePoint, Textures};
-use eval::TextureEval;
+use crate::refs::{ConstOrTexture, MaterialId, TextureId};
+use crate::texture::{LookupPoint, Textures};
+use eval::HitTextures;
 
-/// A material's description: plain data with LuxRender's defaults applied, indexed by
-/// [`MaterialId`].
-#[derive(Clone, Debug, PartialEq)]
-pub enum MaterialDesc {
-    Matte(Matte),
-    Glossy(Glossy),
-    Mirror(Mirror),
-    Glass(Glass),
-    Metal(Metal),
-    MatteTranslucent(MatteTranslucent),
-    Null(Null),
-    Mix(Mix),
-    CarPaint(CarPaint),
-    Velvet(Velvet),
-    ShinyMetal(ShinyMetal),
-    GlossyCoating(GlossyCoating),
-    GlossyTranslucent(GlossyTranslucent),
-    Layered(Layered),
-    Scatter(Scatter),
-    Cloth(Cloth),
-    /// A material with a bump or normal map (never a mix or null: LuxRender's take none).
-    Bumped(Box<MaterialDesc>, Bump),
+/// Generates the material family from its kind list (see [`materials!`]'s invocation below):
+/// each kind's module and re-export, the [`MaterialDesc`] variant, the name table from
+/// LuxRender's material names to the kind's readers, and every dispatch `match`, each arm a
+/// call of the kind's [`MaterialKind`] method.
+macro_rules! materials {
+    ($($module:ident::$kind:ident { $name:literal => $read:ident $(, $alias:literal => $read_alias:ident)* },)+) => {
+        $(pub mod $module;)+
+        $(pub use $module::$kind;)+
+
+        /// A material's description: plain data with LuxRender's defaults applied, indexed by
+        /// [`MaterialId`].
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum MaterialDesc {
+            $($kind($kind),)+
+            /// A material with a bump or normal map (never a mix or null: LuxRender's take none).
+            Bumped(Box<MaterialDesc>, Bump),
+        }
+
+        impl MaterialDesc {
+            /// The reader of LuxRender material type `ty` (the material without its bump map);
+            /// None for a type this renderer does not know.
+            fn reader(ty: &str) -> Option<MaterialReader> {
+                Some(match ty {
+                    $(
+                        $name => |params, pos, ctx| Ok(Self::$kind($kind::$read(params, pos, ctx)?)),
+                        $($alias => |params, pos, ctx| Ok(Self::$kind($kind::$read_alias(params, pos, ctx)?)),)*
+                    )+
+                    _ => return None,
+                })
+            }
+
+            /// The kind's LuxRender name: the first of the names read into it.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Self::$kind(_) => $name,)+
+                    Self::Bumped(m, _) => m.name(),
+                }
+            }
+
+            /// The textures the material reads directly, in parameter order.
+            pub fn textures(&self) -> Vec<TextureId> {
+                match self {
+                    $(Self::$kind(m) => m.textures(),)+
+                    Self::Bumped(m, bump) => m.textures().into_iter().chain([bump.map]).collect(),
+                }
+            }
+
+            /// The materials it refers to (those a `mix` or `layered` chooses between, a
+            /// glossycoating's base).
+            pub fn materials(&self) -> Vec<MaterialId> {
+                match self {
+                    $(Self::$kind(m) => m.materials(),)+
+                    Self::Bumped(m, _) => m.materials(),
+                }
+            }
+
+            /// The lobe of a leaf material at a hit, under its coat if it has one (`mix`,
+            /// `layered` and glossycoating resolved by [`Materials`] first; an unresolved one
+            /// shows the default matte). `u` in [0, 1) chooses shinymetal's lobe.
+            fn bxdf(&self, eval: &HitTextures, u: f32) -> Bxdf {
+                match self {
+                    $(Self::$kind(m) => m.bxdf(eval, u),)+
+                    Self::Bumped(m, _) => m.bxdf(eval, u),
+                }
+            }
+
+            /// The coat over [`MaterialDesc::bxdf`], for the materials that have one.
+            fn coating(&self, eval: &HitTextures) -> Option<Coating> {
+                match self {
+                    $(Self::$kind(m) => m.coating(eval),)+
+                    Self::Bumped(m, _) => m.coating(eval),
+                }
+            }
+
+            /// Whether the material needs the multibounce albedo tables.
+            fn multibounce(&self) -> bool {
+                match self {
+                    $(Self::$kind(m) => m.multibounce(),)+
+                    Self::Bumped(m, _) => m.multibounce(),
+                }
+            }
+        }
+    };
 }
+
+// The kinds: `module::Kind { "luxrender name" => reader, "another name" => reader, ... },`.
+materials! {
+    matte::Matte { "matte" => read },
+    glossy::Glossy { "glossy" => read, "glossy2" => read },
+    mirror::Mirror { "mirror" => read },
+    glass::Glass { "glass" => read, "roughglass" => read_rough, "glass2" => read_glass2 },
+    metal::Metal { "metal" => read, "metal2" => read_metal2 },
+    mattetranslucent::MatteTranslucent { "mattetranslucent" => read },
+    null::Null { "null" => read },
+    mix::Mix { "mix" => read },
+    carpaint::CarPaint { "carpaint" => read },
+    velvet::Velvet { "velvet" => read },
+    shinymetal::ShinyMetal { "shinymetal" => read },
+    glossycoating::GlossyCoating { "glossycoating" => read },
+    glossytranslucent::GlossyTranslucent { "glossytranslucent" => read },
+    layered::Layered { "layered" => read },
+    scatter::Scatter { "scatter" => read },
+    cloth::Cloth { "cloth" => read },
+}
+
+/// Reads a material kind from a statement's parameters.
+type MaterialReader =
+    fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<MaterialDesc, ParseError>;
 
 /// What a ray that no layer of a `layered` material catches meets.
 static PASS_THROUGH: MaterialDesc = MaterialDesc::Null(Null);
 
 impl MaterialDesc {
-    /// Reads `Material "ty"` (or `MakeNamedMaterial` with `"string type" ["ty"]`): the table
-    /// from LuxRender's material names to kinds. An unsupported type warns and becomes a matte
-    /// (with its Kd when given).
+    /// Reads `Material "ty"` (or `MakeNamedMaterial` with `"string type" ["ty"]`) through the
+    /// name table. An unsupported type warns and becomes a matte (with its Kd when given).
     pub fn read(
         ty: &str,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        let material = Self::read_kind(ty, params, pos, ctx)?;
+        let Some(read) = Self::reader(ty) else {
+            ctx.warn(
+                pos,
+                format!("material \"{ty}\" is not supported; using matte (with its Kd when given)"),
+            );
+            let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
+            for p in &params.params {
+                params.ignore(&p.name);
+            }
+            return Ok(Self::Matte(Matte {
+                kd,
+                sigma: ConstOrTexture::float(matte::DEFAULT_SIGMA),
+            }));
+        };
+        let material = read(params, pos, ctx)?;
         if matches!(material, Self::Mix(_) | Self::Null(_)) {
             return Ok(material);
         }
@@ -120,156 +188,6 @@ impl MaterialDesc {
             Some(bump) => Self::Bumped(Box::new(material), bump),
             None => material,
         })
-    }
-
-    /// The material of LuxRender type `ty`, without its bump map.
-    fn read_kind(
-        ty: &str,
-        params: &ParamList,
-        pos: &SourcePos,
-        ctx: &mut dyn ParseContext,
-    ) -> Result<Self, ParseError> {
-        Ok(match ty {
-            "matte" => Self::Matte(Matte::read(params, pos, ctx)?),
-            "glossy" => Self::Glossy(Glossy::read(params, pos, ctx)?),
-            "glossy2" => Self::Glossy(Glossy::read(params, pos, ctx)?),
-            "mirror" => Self::Mirror(Mirror::read(params, pos, ctx)?),
-            "glass" => Self::Glass(Glass::read(params, pos, ctx)?),
-            "roughglass" => Self::Glass(Glass::read_rough(params, pos, ctx)?),
-            "glass2" => Self::Glass(Glass::read_glass2(params, pos, ctx)?),
-            "metal" => Self::Metal(Metal::read(params, pos, ctx)?),
-            "metal2" => Self::Metal(Metal::read_metal2(params, pos, ctx)?),
-            "mattetranslucent" => Self::MatteTranslucent(MatteTranslucent::read(params, ctx)?),
-            "null" => Self::Null(Null),
-            "mix" => Self::Mix(Mix::read(params, pos, ctx)?),
-            "carpaint" => Self::CarPaint(CarPaint::read(params, pos, ctx)?),
-            "velvet" => Self::Velvet(Velvet::read(params, pos, ctx)?),
-            "shinymetal" => Self::ShinyMetal(ShinyMetal::read(params, pos, ctx)?),
-            "glossycoating" => Self::GlossyCoating(GlossyCoating::read(params, pos, ctx)?),
-            "glossytranslucent" => {
-                Self::GlossyTranslucent(GlossyTranslucent::read(params, pos, ctx)?)
-            }
-            "layered" => Self::Layered(Layered::read(params, pos, ctx)?),
-            "scatter" => Self::Scatter(Scatter::read(params, pos, ctx)?),
-            "cloth" => Self::Cloth(Cloth::read(params, pos, ctx)?),
-            other => {
-                ctx.warn(pos, format!("material \"{other}\" is not supported; using matte (with its Kd when given)"));
-                let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
-                for p in &params.params {
-                    params.ignore(&p.name);
-                }
-                Self::Matte(Matte {
-                    kd,
-                    sigma: Tex::float(matte::DEFAULT_SIGMA),
-                })
-            }
-        })
-    }
-
-    /// The kind's LuxRender name (glossy2, roughglass, glass2 and metal2 are read into the
-    /// glossy, glass and metal kinds).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Matte(_) => "matte",
-            Self::Glossy(_) => "glossy",
-            Self::Mirror(_) => "mirror",
-            Self::Glass(_) => "glass",
-            Self::Metal(_) => "metal",
-            Self::MatteTranslucent(_) => "mattetranslucent",
-            Self::Null(_) => "null",
-            Self::Mix(_) => "mix",
-            Self::CarPaint(_) => "carpaint",
-            Self::Velvet(_) => "velvet",
-            Self::ShinyMetal(_) => "shinymetal",
-            Self::GlossyCoating(_) => "glossycoating",
-            Self::GlossyTranslucent(_) => "glossytranslucent",
-            Self::Layered(_) => "layered",
-            Self::Scatter(_) => "scatter",
-            Self::Cloth(_) => "cloth",
-            Self::Bumped(m, _) => m.name(),
-        }
-    }
-
-    /// The textures the material reads directly, in parameter order.
-    pub fn textures(&self) -> Vec<TextureId> {
-        match self {
-            Self::Matte(m) => m.textures(),
-            Self::Glossy(m) => m.textures(),
-            Self::Mirror(m) => m.textures(),
-            Self::Glass(m) => m.textures(),
-            Self::Metal(m) => m.textures(),
-            Self::MatteTranslucent(m) => m.textures(),
-            Self::Null(m) => m.textures(),
-            Self::Mix(m) => m.textures(),
-            Self::CarPaint(m) => m.textures(),
-            Self::Velvet(m) => m.textures(),
-            Self::ShinyMetal(m) => m.textures(),
-            Self::GlossyCoating(m) => m.textures(),
-            Self::GlossyTranslucent(m) => m.textures(),
-            Self::Layered(m) => m.textures(),
-            Self::Scatter(m) => m.textures(),
-            Self::Cloth(m) => m.textures(),
-            Self::Bumped(m, bump) => m.textures().into_iter().chain([bump.map]).collect(),
-        }
-    }
-
-    /// The materials it refers to (those a `mix` or `layered` chooses between, a
-    /// glossycoating's base).
-    pub fn materials(&self) -> Vec<MaterialId> {
-        match self {
-            Self::Mix(m) => m.materials(),
-            Self::Layered(m) => m.materials(),
-            Self::GlossyCoating(m) => vec![m.base],
-            Self::Bumped(m, _) => m.materials(),
-            _ => Vec::new(),
-        }
-    }
-
-    /// The lobe of a leaf material at a hit, under its coat if it has one (`mix`, `layered`
-    /// and glossycoating resolved by [`Materials`] first; an unresolved one shows the default
-    /// matte). `u` in [0, 1) chooses shinymetal's lobe.
-    fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
-        match self {
-            Self::Matte(m) => m.bxdf(eval),
-            Self::Glossy(m) => m.bxdf(eval),
-            Self::Mirror(m) => m.bxdf(eval),
-            Self::Glass(m) => m.bxdf(eval),
-            Self::Metal(m) => m.bxdf(eval),
-            Self::MatteTranslucent(m) => m.bxdf(eval),
-            Self::Null(m) => m.bxdf(),
-            Self::CarPaint(m) => m.bxdf(eval),
-            Self::Velvet(m) => m.bxdf(eval),
-            Self::ShinyMetal(m) => m.bxdf(eval, u),
-            Self::GlossyTranslucent(m) => m.bxdf(eval),
-            Self::Scatter(m) => m.bxdf(eval),
-            Self::Cloth(m) => m.bxdf(eval),
-            Self::Mix(_) | Self::Layered(_) | Self::GlossyCoating(_) => Matte::default_bxdf(),
-            Self::Bumped(m, _) => m.bxdf(eval, u),
-        }
-    }
-
-    /// The coat over [`MaterialDesc::bxdf`], for the materials that have one.
-    fn coating(&self, eval: &TextureEval) -> Option<Coating> {
-        match self {
-            Self::Glossy(m) => Some(m.coating(eval)),
-            Self::CarPaint(m) => Some(m.coating(eval)),
-            Self::GlossyTranslucent(m) => Some(m.coating(eval)),
-            Self::Bumped(m, _) => m.coating(eval),
-            _ => None,
-        }
-    }
-
-    /// Whether the material needs the multibounce albedo tables.
-    fn multibounce(&self) -> bool {
-        match self {
-            Self::Glossy(m) => m.coat.multibounce,
-            Self::GlossyCoating(m) => m.coat.multibounce,
-            Self::GlossyTranslucent(m) => {
-                m.front.multibounce || m.back.as_ref().is_some_and(|b| b.multibounce)
-            }
-            Self::Bumped(m, _) => m.multibounce(),
-            _ => false,
-        }
     }
 }
 
@@ -292,7 +210,7 @@ impl Materials {
     fn resolve(
         &self,
         id: MaterialId,
-        eval: &TextureEval,
+        eval: &HitTextures,
         u_mix: f32,
     ) -> Option<(&MaterialDesc, f32, Option<&Bump>)> {
         let mut material = self.materials.get(id.0 as usize)?;
@@ -332,7 +250,7 @@ impl Materials {
     fn scattering(
         &self,
         id: MaterialId,
-        eval: &TextureEval,
+        eval: &HitTextures,
         u_mix: f32,
     ) -> (Bxdf, Option<Coating>, Option<&Bump>) {
         let Some((leaf, u, bump)) = self.resolve(id, eval, u_mix) else {
@@ -346,7 +264,7 @@ impl Materials {
             let MaterialDesc::GlossyCoating(g) = base else {
                 let bxdf = base.bxdf(eval, u);
                 let diffuse = matches!(bxdf, Bxdf::Diffuse(_) | Bxdf::Translucent(_));
-                return (bxdf, Some(coating.coating(eval, diffuse)), bump);
+                return (bxdf, Some(coating.coat_over(eval, diffuse)), bump);
             };
             let Some((next, next_u, next_bump)) = self.resolve(g.base, eval, u) else {
                 break;
@@ -370,9 +288,9 @@ impl Materials {
         textures: &Textures,
         u_mix: f32,
     ) -> Bsdf {
-        let eval = TextureEval {
+        let eval = HitTextures {
             textures,
-            at: TexturePoint {
+            at: LookupPoint {
                 p: world_to_object.transform_point3(hit.p),
                 p_world: hit.p,
                 uv: hit.uv,

@@ -15,11 +15,12 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::scatter::Scatter as ScatterLobe;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -29,8 +30,8 @@ pub const DEFAULT_G: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scatter {
-    pub kd: Tex,
-    pub g: Tex,
+    pub kd: ConstOrTexture,
+    pub g: ConstOrTexture,
 }
 
 impl Scatter {
@@ -44,8 +45,14 @@ impl Scatter {
             g: ctx.color_param(params, "g", DEFAULT_G, false)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
+impl MaterialKind for Scatter {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kd, &self.g])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         // The asymmetry may be negative: read it unclamped, then bound it to [-1, 1].
         let g = eval
             .textures
@@ -53,9 +60,5 @@ impl Scatter {
             .clamp(Vec3::splat(-1.0), Vec3::ONE);
         let g = Vec3::select(g.cmpeq(g), g, Vec3::ZERO);
         Bxdf::Scatter(ScatterLobe::new(eval.color(self.kd), g))
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kd, &self.g])
     }
 }

@@ -23,11 +23,12 @@
 
 use glam::Vec3;
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -38,10 +39,10 @@ pub const DEFAULT_ROUGHNESS: f32 = 0.1;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShinyMetal {
-    pub kr: Tex,
-    pub ks: Tex,
-    pub uroughness: Tex,
-    pub vroughness: Tex,
+    pub kr: ConstOrTexture,
+    pub ks: ConstOrTexture,
+    pub uroughness: ConstOrTexture,
+    pub vroughness: ConstOrTexture,
 }
 
 impl ShinyMetal {
@@ -64,9 +65,15 @@ impl ShinyMetal {
             vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
         })
     }
+}
+
+impl MaterialKind for ShinyMetal {
+    fn textures(&self) -> Vec<TextureId> {
+        texture_ids(&[&self.kr, &self.ks, &self.uroughness, &self.vroughness])
+    }
 
     /// The lobe chosen by `u` in [0, 1): the mirror or the glossy metal.
-    pub fn bxdf(&self, eval: &TextureEval, u: f32) -> Bxdf {
+    fn bxdf(&self, eval: &HitTextures, u: f32) -> Bxdf {
         let (kr, ks) = (eval.color(self.kr), eval.color(self.ks));
         let (sr, ss) = (kr.max_element(), ks.max_element());
         if sr + ss <= 0.0 {
@@ -92,9 +99,5 @@ impl ShinyMetal {
                 distrib: eval.roughness(self.uroughness, self.vroughness),
             })
         }
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr, &self.ks, &self.uroughness, &self.vroughness])
     }
 }

@@ -10,7 +10,7 @@ use glam::{Affine3A, Vec2, Vec3};
 use super::*;
 use crate::desc::MaterialDesc;
 use crate::geometry::SurfaceHit;
-use crate::param::{Fresnel, MaterialId, Tex};
+use crate::refs::{ConstOrTexture, Fresnel, MaterialId};
 use crate::sampler::PixelSampler;
 use crate::texture::Textures;
 use glossy::CoatParams;
@@ -40,12 +40,12 @@ fn bsdf_of(material: MaterialDesc) -> Bsdf {
     )
 }
 
-fn c(v: f32) -> Tex {
-    Tex::float(v)
+fn c(v: f32) -> ConstOrTexture {
+    ConstOrTexture::float(v)
 }
 
-fn rgb(r: f32, g: f32, b: f32) -> Tex {
-    Tex::color(Vec3::new(r, g, b))
+fn rgb(r: f32, g: f32, b: f32) -> ConstOrTexture {
+    ConstOrTexture::color(Vec3::new(r, g, b))
 }
 
 fn matte(kd: f32, sigma: f32) -> MaterialDesc {
@@ -133,7 +133,7 @@ fn velvet(kd: f32, p: [f32; 3], thickness: f32) -> MaterialDesc {
 fn scatter(kd: f32, g: Vec3) -> MaterialDesc {
     MaterialDesc::Scatter(Scatter {
         kd: c(kd),
-        g: Tex::color(g),
+        g: ConstOrTexture::color(g),
     })
 }
 
@@ -619,24 +619,32 @@ fn reciprocity() {
         ),
     ];
     for (name, material) in reciprocal {
-        let bsdf = bsdf_of(material);
-        let mut checked = 0;
-        for i in 0..4096 {
-            let mut s = sampler(0, 0, i, 4096, 5);
-            let a = uniform_sphere(s.get_2d());
-            let b = uniform_sphere(s.get_2d());
-            let (fab, fba) = (bsdf.eval(a, b), bsdf.eval(b, a));
-            let scale = fab.max_element().max(fba.max_element());
-            if scale > 0.0 {
-                checked += 1;
-                assert!(
-                    (fab - fba).abs().max_element() <= 1e-4 * scale,
-                    "{name}: f({a}, {b}) = {fab}, f({b}, {a}) = {fba}"
-                );
-            }
-        }
-        assert!(checked > 1000, "{name}: only {checked} non-zero pairs");
+        assert_reciprocal(name, &bsdf_of(material), 1000);
     }
+}
+
+/// Checks f(a, b) = f(b, a) on 4096 pairs of directions over the sphere, and that more than
+/// `min_nonzero` of the pairs are not black (so the check tested something).
+fn assert_reciprocal(name: &str, bsdf: &Bsdf, min_nonzero: usize) {
+    let mut checked = 0;
+    for i in 0..4096 {
+        let mut s = sampler(0, 0, i, 4096, 5);
+        let a = uniform_sphere(s.get_2d());
+        let b = uniform_sphere(s.get_2d());
+        let (fab, fba) = (bsdf.eval(a, b), bsdf.eval(b, a));
+        let scale = fab.max_element().max(fba.max_element());
+        if scale > 0.0 {
+            checked += 1;
+            assert!(
+                (fab - fba).abs().max_element() <= 1e-4 * scale,
+                "{name}: f({a}, {b}) = {fab}, f({b}, {a}) = {fba}"
+            );
+        }
+    }
+    assert!(
+        checked > min_nonzero,
+        "{name}: only {checked} non-zero pairs"
+    );
 }
 
 #[test]
@@ -675,24 +683,8 @@ fn extras_are_reciprocal() {
         ),
     ];
     for (name, materials) in reciprocal {
-        let bsdf = bsdf_of_set(materials);
-        let mut checked = 0;
-        for i in 0..4096 {
-            let mut s = sampler(0, 0, i, 4096, 5);
-            let a = uniform_sphere(s.get_2d());
-            let b = uniform_sphere(s.get_2d());
-            let (fab, fba) = (bsdf.eval(a, b), bsdf.eval(b, a));
-            let scale = fab.max_element().max(fba.max_element());
-            if scale > 0.0 {
-                checked += 1;
-                assert!(
-                    (fab - fba).abs().max_element() <= 1e-4 * scale,
-                    "{name}: f({a}, {b}) = {fab}, f({b}, {a}) = {fba}"
-                );
-            }
-        }
         // Velvet is zero where its clamped phase function is, a good part of the sphere.
-        assert!(checked > 500, "{name}: only {checked} non-zero pairs");
+        assert_reciprocal(name, &bsdf_of_set(materials), 500);
     }
 }
 

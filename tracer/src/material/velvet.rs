@@ -12,11 +12,12 @@
 //! | `p1`, `p2`, `p3` | float textures, Legendre coefficients of the phase function, clamped to [-100, 100] | -2, 20, 2 ([`DEFAULT_P`]) |
 //! | `thickness` | float texture, the layer's optical depth, clamped to [0, 1] | 0.1 ([`DEFAULT_THICKNESS`]) |
 
-use super::eval::{texture_ids, TextureEval};
+use super::eval::{texture_ids, HitTextures};
+use super::kind::MaterialKind;
 use crate::bxdf::velvet::Velvet as VelvetLobe;
 use crate::bxdf::Bxdf;
 use crate::diag::SourcePos;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -29,9 +30,9 @@ pub const MAX_P: f32 = 100.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Velvet {
-    pub kd: Tex,
-    pub p: [Tex; 3],
-    pub thickness: Tex,
+    pub kd: ConstOrTexture,
+    pub p: [ConstOrTexture; 3],
+    pub thickness: ConstOrTexture,
 }
 
 impl Velvet {
@@ -50,17 +51,10 @@ impl Velvet {
             thickness: ctx.float_param(params, "thickness", DEFAULT_THICKNESS)?,
         })
     }
+}
 
-    pub fn bxdf(&self, eval: &TextureEval) -> Bxdf {
-        let p = self.p.map(|t| eval.float(t).clamp(-MAX_P, MAX_P));
-        Bxdf::Velvet(VelvetLobe::new(
-            eval.color(self.kd),
-            p,
-            eval.float(self.thickness).clamp(0.0, 1.0),
-        ))
-    }
-
-    pub fn textures(&self) -> Vec<TextureId> {
+impl MaterialKind for Velvet {
+    fn textures(&self) -> Vec<TextureId> {
         texture_ids(&[
             &self.kd,
             &self.p[0],
@@ -68,5 +62,14 @@ impl Velvet {
             &self.p[2],
             &self.thickness,
         ])
+    }
+
+    fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
+        let p = self.p.map(|t| eval.float(t).clamp(-MAX_P, MAX_P));
+        Bxdf::Velvet(VelvetLobe::new(
+            eval.color(self.kd),
+            p,
+            eval.float(self.thickness).clamp(0.0, 1.0),
+        ))
     }
 }

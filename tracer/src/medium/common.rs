@@ -7,10 +7,10 @@
 use glam::Vec3;
 
 use crate::diag::SourcePos;
-use crate::param::Fresnel;
-use crate::parse::context::{ParseContext, TexBinding};
+use crate::parse::context::{BoundTexture, ParseContext};
 use crate::parse::error::ParseError;
-use crate::parse::params::{ParamList, TexValue};
+use crate::parse::params::{ConstOrTextureName, ParamList};
+use crate::refs::Fresnel;
 
 /// Index into [`Volumes::media`](super::Volumes::media).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -69,13 +69,13 @@ pub fn read_index(
     ctx: &mut dyn ParseContext,
 ) -> Result<f32, ParseError> {
     let index = match params.tex_float("fresnel", DEFAULT_FRESNEL)? {
-        TexValue::Const(c) => Some(c.x),
-        TexValue::Named { name, pos: at } => {
+        ConstOrTextureName::Const(c) => Some(c.x),
+        ConstOrTextureName::Named { name, pos: at } => {
             let found = match ctx.find_texture(&name, false) {
-                Some(TexBinding::Texture(id)) => {
-                    ctx.uniform_texture(crate::param::Tex::Texture(id))
+                Some(BoundTexture::Texture(id)) => {
+                    ctx.uniform_texture(crate::refs::ConstOrTexture::Texture(id))
                 }
-                Some(TexBinding::Fresnel(Fresnel::Index(t))) => ctx.uniform_texture(t),
+                Some(BoundTexture::Fresnel(Fresnel::Index(t))) => ctx.uniform_texture(t),
                 _ => None,
             };
             if found.is_none() {

@@ -43,10 +43,10 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::diag::SourcePos;
 use crate::mesh::TriangleMesh;
-use crate::param::Tex;
-use crate::parse::context::{ParseContext, TexBinding};
+use crate::parse::context::{BoundTexture, ParseContext};
 use crate::parse::error::ParseError;
-use crate::parse::params::{ParamList, ParamType, TexValue};
+use crate::parse::params::{ConstOrTextureName, ParamList, ParamType};
+use crate::refs::ConstOrTexture;
 
 /// Subdivision levels when the file gives neither `nsubdivlevels` nor `nlevels`.
 pub const DEFAULT_LEVELS: i32 = 0;
@@ -101,8 +101,8 @@ impl SubdivParams {
             None => None,
             Some(p) if p.ty == ParamType::String => params.string("displacementmap")?,
             Some(_) => match params.tex_float("displacementmap", 0.0)? {
-                TexValue::Named { name, .. } => Some(name),
-                TexValue::Const(_) => {
+                ConstOrTextureName::Named { name, .. } => Some(name),
+                ConstOrTextureName::Const(_) => {
                     let p = params.find("displacementmap").expect("found above");
                     return Err(params.error(p, "expected the name of a float texture"));
                 }
@@ -174,7 +174,7 @@ pub fn apply(
     ctx.check_primitives(triangles, pos)?;
     let texture = match &sub.displacement_map {
         Some(name) => match ctx.find_texture(name, false) {
-            Some(TexBinding::Texture(id)) => Some(Tex::Texture(id)),
+            Some(BoundTexture::Texture(id)) => Some(ConstOrTexture::Texture(id)),
             _ => {
                 ctx.warn(
                     pos,

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 
-use super::context::{ImageUse, ParseContext, TexBinding};
+use super::context::{BoundTexture, ImageUse, ParseContext};
 use super::error::ParseError;
 use super::luxrender_ignores::luxrender_ignores;
 use super::options::OptionsState;
@@ -26,7 +26,7 @@ use crate::lights::{map_cost, AreaLightParams, SkyLight};
 use crate::material::{Glass, Matte};
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
-use crate::param::{MaterialId, Tex, TextureId};
+use crate::refs::{ConstOrTexture, MaterialId, TextureId};
 use crate::shape::Geometry;
 use crate::texture::{self, Defined, Scale};
 use image::ImageDecoder;
@@ -47,7 +47,7 @@ struct GraphicsState {
 struct NamedTexture {
     name: String,
     is_color: bool,
-    binding: TexBinding,
+    binding: BoundTexture,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -637,7 +637,7 @@ impl<'s> Builder<'s> {
     // -----------------------------------------------------------------------------------------
     // Names
 
-    pub(super) fn bind_texture(&mut self, name: String, is_color: bool, binding: TexBinding) {
+    pub(super) fn bind_texture(&mut self, name: String, is_color: bool, binding: BoundTexture) {
         self.textures_in_scope.push(NamedTexture {
             name,
             is_color,
@@ -651,9 +651,9 @@ impl<'s> Builder<'s> {
             Some(Defined::Texture(desc)) => {
                 let is_color = desc.is_color;
                 let id = self.add_texture(desc);
-                self.bind_texture(name, is_color, TexBinding::Texture(id));
+                self.bind_texture(name, is_color, BoundTexture::Texture(id));
             }
-            Some(Defined::Fresnel(f)) => self.bind_texture(name, true, TexBinding::Fresnel(f)),
+            Some(Defined::Fresnel(f)) => self.bind_texture(name, true, BoundTexture::Fresnel(f)),
             None => {}
         }
     }
@@ -782,10 +782,10 @@ impl<'s> Builder<'s> {
         let index = self.volumes.index(media.interior) / self.volumes.index(media.exterior);
         let mut desc = self.materials[material.0 as usize].clone();
         match &mut desc {
-            MaterialDesc::Glass(g) => g.index = Tex::float(index),
+            MaterialDesc::Glass(g) => g.index = ConstOrTexture::float(index),
             MaterialDesc::Bumped(inner, _) => {
                 if let MaterialDesc::Glass(g) = inner.as_mut() {
-                    g.index = Tex::float(index);
+                    g.index = ConstOrTexture::float(index);
                 }
             }
             _ => {}
@@ -845,7 +845,7 @@ impl ParseContext for Builder<'_> {
         self.ctm
     }
 
-    fn find_texture(&self, name: &str, want_color: bool) -> Option<TexBinding> {
+    fn find_texture(&self, name: &str, want_color: bool) -> Option<BoundTexture> {
         let mut any = None;
         for t in self
             .textures_in_scope
@@ -865,7 +865,7 @@ impl ParseContext for Builder<'_> {
         self.textures[id.0 as usize].is_color
     }
 
-    fn uniform_texture(&self, tex: Tex) -> Option<Vec3> {
+    fn uniform_texture(&self, tex: ConstOrTexture) -> Option<Vec3> {
         texture::Textures::uniform_value(&self.textures, tex)
     }
 
@@ -876,8 +876,8 @@ impl ParseContext for Builder<'_> {
             name,
             is_color,
             kind: TextureKind::Scale(Scale {
-                tex1: Tex::Texture(id),
-                tex2: Tex::float(factor),
+                tex1: ConstOrTexture::Texture(id),
+                tex2: ConstOrTexture::float(factor),
             }),
         })
     }
@@ -980,7 +980,7 @@ impl ParseContext for Builder<'_> {
 
     fn eval_float_texture(
         &mut self,
-        tex: Tex,
+        tex: ConstOrTexture,
         points: &[(Vec3, glam::Vec2)],
         pos: &Pos,
     ) -> Result<Vec<f32>, ParseError> {
@@ -993,7 +993,7 @@ impl ParseContext for Builder<'_> {
         Ok(points
             .iter()
             .map(|&(p, uv)| {
-                let mut at = texture::TexturePoint::new(p, uv);
+                let mut at = texture::LookupPoint::new(p, uv);
                 at.p_world = self.ctm.transform_point3(p);
                 textures.eval(tex, &at).element_sum() / 3.0
             })

@@ -8,17 +8,17 @@ use std::sync::Arc;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::error::ParseError;
-use super::params::{ParamList, ParamType, TexValue, Values};
+use super::params::{ConstOrTextureName, ParamList, ParamType, Values};
 use crate::assets::AssetKind;
 use crate::diag::{Severity, SourcePos};
 use crate::mesh::TriangleMesh;
-use crate::param::{Fresnel, MaterialId, Tex, TextureId};
+use crate::refs::{ConstOrTexture, Fresnel, MaterialId, TextureId};
 use crate::spectra::metal_preset;
 
 /// What a texture name is bound to in the current attribute scope. Fresnel textures are not
 /// evaluated per hit: metal materials fold them into their description.
 #[derive(Clone, Debug)]
-pub enum TexBinding {
+pub enum BoundTexture {
     Texture(TextureId),
     Fresnel(Fresnel),
 }
@@ -71,14 +71,14 @@ pub trait ParseContext {
 
     /// The texture named `name` in scope, preferring one of the requested kind (a float
     /// texture used as a colour is splatted).
-    fn find_texture(&self, name: &str, want_color: bool) -> Option<TexBinding>;
+    fn find_texture(&self, name: &str, want_color: bool) -> Option<BoundTexture>;
 
     /// Whether texture `id` was declared "color" (else "float").
     fn texture_is_color(&self, id: TextureId) -> bool;
 
     /// The value of a texture-or-constant that is the same at every point (a constant, a
     /// blackbody, scale or mix of such), None if it varies over a surface.
-    fn uniform_texture(&self, tex: Tex) -> Option<Vec3>;
+    fn uniform_texture(&self, tex: ConstOrTexture) -> Option<Vec3>;
 
     /// A new texture: texture `id` times the constant `factor`.
     fn scaled_texture(&mut self, id: TextureId, factor: f32) -> TextureId;
@@ -119,7 +119,7 @@ pub trait ParseContext {
     /// reads while the shape is built. Fails if an image the textures read does not decode.
     fn eval_float_texture(
         &mut self,
-        tex: Tex,
+        tex: ConstOrTexture,
         points: &[(Vec3, Vec2)],
         pos: &SourcePos,
     ) -> Result<Vec<f32>, ParseError>;
@@ -130,14 +130,14 @@ pub trait ParseContext {
 
     /// Resolves a texture-or-constant parameter; an undefined texture name (or a fresnel
     /// texture where a colour or float is wanted) is a warning and falls back to `default`.
-    fn tex(&mut self, v: TexValue, want_color: bool, default: Vec3) -> Tex {
+    fn tex(&mut self, v: ConstOrTextureName, want_color: bool, default: Vec3) -> ConstOrTexture {
         match v {
-            TexValue::Const(c) => Tex::Const(c),
-            TexValue::Named { name, pos } => match self.find_texture(&name, want_color) {
-                Some(TexBinding::Texture(id)) => Tex::Texture(id),
-                Some(TexBinding::Fresnel(_)) => {
+            ConstOrTextureName::Const(c) => ConstOrTexture::Const(c),
+            ConstOrTextureName::Named { name, pos } => match self.find_texture(&name, want_color) {
+                Some(BoundTexture::Texture(id)) => ConstOrTexture::Texture(id),
+                Some(BoundTexture::Fresnel(_)) => {
                     self.warn(&pos, format!("texture \"{name}\" is a fresnel texture, usable only as metal2's fresnel; using the default"));
-                    Tex::Const(default)
+                    ConstOrTexture::Const(default)
                 }
                 // LuxRender's fallback too: a constant of the parameter's default.
                 None => {
@@ -145,7 +145,7 @@ pub trait ParseContext {
                         &pos,
                         format!("no texture named \"{name}\"; using the default"),
                     );
-                    Tex::Const(default)
+                    ConstOrTexture::Const(default)
                 }
             },
         }
@@ -172,10 +172,12 @@ pub trait ParseContext {
         name: &str,
         default: f32,
         clamp: bool,
-    ) -> Result<Tex, ParseError> {
+    ) -> Result<ConstOrTexture, ParseError> {
         let v = params.tex_color(name, Vec3::splat(default))?;
         Ok(match self.tex(v, true, Vec3::splat(default)) {
-            Tex::Const(c) if clamp => Tex::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
+            ConstOrTexture::Const(c) if clamp => {
+                ConstOrTexture::Const(c.clamp(Vec3::ZERO, Vec3::ONE))
+            }
             t => t,
         })
     }
@@ -186,7 +188,7 @@ pub trait ParseContext {
         params: &ParamList,
         name: &str,
         default: f32,
-    ) -> Result<Tex, ParseError> {
+    ) -> Result<ConstOrTexture, ParseError> {
         let v = params.tex_float(name, default)?;
         Ok(self.tex(v, false, Vec3::splat(default)))
     }

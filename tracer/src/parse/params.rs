@@ -100,7 +100,7 @@ impl Param {
 
 /// A texture-or-constant parameter before the texture name is resolved.
 #[derive(Clone, Debug, PartialEq)]
-pub enum TexValue {
+pub enum ConstOrTextureName {
     Const(Vec3),
     Named { name: String, pos: Pos },
 }
@@ -388,7 +388,7 @@ impl ParamList {
     }
 
     /// A texture reference: `"texture Kd" "name"` or a bare string given to a color or float.
-    fn texture_name(&self, p: &Param) -> Result<Option<TexValue>, ParseError> {
+    fn texture_name(&self, p: &Param) -> Result<Option<ConstOrTextureName>, ParseError> {
         match &p.values {
             Values::Strings(v)
                 if matches!(
@@ -399,7 +399,7 @@ impl ParamList {
                 if v.len() != 1 {
                     return Err(self.type_error(p, "one texture name"));
                 }
-                Ok(Some(TexValue::Named {
+                Ok(Some(ConstOrTextureName::Named {
                     name: v[0].clone(),
                     pos: p.pos.clone(),
                 }))
@@ -409,19 +409,19 @@ impl ParamList {
         }
     }
 
-    pub fn tex_color(&self, name: &str, default: Vec3) -> Result<TexValue, ParseError> {
+    pub fn tex_color(&self, name: &str, default: Vec3) -> Result<ConstOrTextureName, ParseError> {
         let Some(p) = self.find(name) else {
-            return Ok(TexValue::Const(default));
+            return Ok(ConstOrTextureName::Const(default));
         };
         if let Some(t) = self.texture_name(p)? {
             return Ok(t);
         }
-        Ok(TexValue::Const(self.color_of(p)?))
+        Ok(ConstOrTextureName::Const(self.color_of(p)?))
     }
 
-    pub fn tex_float(&self, name: &str, default: f32) -> Result<TexValue, ParseError> {
+    pub fn tex_float(&self, name: &str, default: f32) -> Result<ConstOrTextureName, ParseError> {
         let Some(p) = self.find(name) else {
-            return Ok(TexValue::Const(Vec3::splat(default)));
+            return Ok(ConstOrTextureName::Const(Vec3::splat(default)));
         };
         if let Some(t) = self.texture_name(p)? {
             return Ok(t);
@@ -430,7 +430,9 @@ impl ParamList {
             return Err(self.type_error(p, "one float or a texture name"));
         }
         let v = self.exactly(p, 1, "one float")?;
-        Ok(TexValue::Const(Vec3::splat(self.to_f32(p, 0, v[0])?)))
+        Ok(ConstOrTextureName::Const(Vec3::splat(
+            self.to_f32(p, 0, v[0])?,
+        )))
     }
 
     /// The number of values of a parameter, if present (without marking it used).
@@ -476,7 +478,7 @@ mod tests {
         assert!(l.bool("b", false).unwrap());
         assert_eq!(l.color("Ks", Vec3::ONE).unwrap(), Vec3::splat(0.4));
         assert!(
-            matches!(l.tex_color("Kd", Vec3::ONE).unwrap(), TexValue::Named { name, .. } if name == "tex")
+            matches!(l.tex_color("Kd", Vec3::ONE).unwrap(), ConstOrTextureName::Named { name, .. } if name == "tex")
         );
         assert_eq!(l.unused().count(), 0);
     }

@@ -23,7 +23,7 @@ use crate::lights::Lights;
 use crate::material::{Bsdf, Materials};
 use crate::math::Ray;
 use crate::medium::{ShapeMedia, Volumes};
-use crate::param::MaterialId;
+use crate::refs::MaterialId;
 use crate::sampler::{PacketSampler, PixelSampler};
 use crate::texture::Textures;
 

@@ -13,11 +13,13 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
-use crate::param::Tex;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 1.0;
 pub const DEFAULT_TEX2: f32 = 1.0;
@@ -31,12 +33,32 @@ pub enum Op {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Arithmetic {
     pub op: Op,
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
 }
 
 impl Arithmetic {
-    pub fn read(
+    /// `Texture "name" "float"|"color" "add"`.
+    pub fn read_add(
+        decl: &Declared,
+        params: &ParamList,
+        _pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read(Op::Add, decl, params, ctx)
+    }
+
+    /// `Texture "name" "float"|"color" "subtract"`.
+    pub fn read_subtract(
+        decl: &Declared,
+        params: &ParamList,
+        _pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read(Op::Subtract, decl, params, ctx)
+    }
+
+    fn read(
         op: Op,
         decl: &Declared,
         params: &ParamList,
@@ -49,15 +71,22 @@ impl Arithmetic {
         })
     }
 
+}
+
+impl TextureType for Arithmetic {
     /// LuxRender's type name.
-    pub fn name(&self) -> &'static str {
+    fn name(&self) -> &'static str {
         match self.op {
             Op::Add => "add",
             Op::Subtract => "subtract",
         }
     }
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+    fn references(&self) -> Vec<ConstOrTexture> {
+        vec![self.tex1, self.tex2]
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let (a, b) = (textures.eval(self.tex1, at), textures.eval(self.tex2, at));
         match self.op {
             Op::Add => a + b,

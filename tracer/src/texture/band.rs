@@ -14,12 +14,13 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_TEX: f32 = 0.0;
 pub const DEFAULT_AMOUNT: f32 = 0.0;
@@ -28,8 +29,8 @@ pub const DEFAULT_AMOUNT: f32 = 0.0;
 pub struct Band {
     /// Ascending, at least one, as many as `textures`.
     pub offsets: Vec<f32>,
-    pub textures: Vec<Tex>,
-    pub amount: Tex,
+    pub textures: Vec<ConstOrTexture>,
+    pub amount: ConstOrTexture,
 }
 
 impl Band {
@@ -58,8 +59,18 @@ impl Band {
             amount: ctx.tex(amount, false, Vec3::splat(DEFAULT_AMOUNT)),
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Band {
+    fn name(&self) -> &'static str {
+        "band"
+    }
+
+    fn references(&self) -> Vec<ConstOrTexture> {
+        self.textures.iter().copied().chain([self.amount]).collect()
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let a = textures.eval(self.amount, at).x;
         let (first, last) = (self.offsets[0], self.offsets[self.offsets.len() - 1]);
         if a.is_nan() || a < first {

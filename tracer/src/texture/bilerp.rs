@@ -15,12 +15,13 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_V00: f32 = 0.0;
 pub const DEFAULT_V01: f32 = 1.0;
@@ -58,8 +59,18 @@ impl Bilerp {
             mapping: Mapping2D::read(params, pos, ctx)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Bilerp {
+    fn name(&self) -> &'static str {
+        "bilerp"
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        Some(&self.mapping)
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         let (s, t) = (st.x - st.x.floor(), st.y - st.y.floor());
         (1.0 - s) * (1.0 - t) * self.v00

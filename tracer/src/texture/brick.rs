@@ -24,13 +24,14 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_BOND: &str = "running";
 pub const DEFAULT_BRICKTEX: f32 = 1.0;
@@ -58,9 +59,9 @@ pub enum Bond {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Brick {
     pub bond: Bond,
-    pub brick: Tex,
-    pub mortar: Tex,
-    pub modulation: Tex,
+    pub brick: ConstOrTexture,
+    pub mortar: ConstOrTexture,
+    pub modulation: ConstOrTexture,
     /// Brick size along x, y, z (width, depth, height) after the bond's adjustments.
     pub size: Vec3,
     pub mortar_size: f32,
@@ -154,20 +155,6 @@ impl Brick {
         }
     }
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
-        match self.brick_at(self.mapping.map(at)) {
-            Some(index) => {
-                let brick = TexturePoint {
-                    p: index,
-                    p_world: index,
-                    ..*at
-                };
-                textures.eval(self.brick, at) * textures.eval(self.modulation, &brick)
-            }
-            None => textures.eval(self.mortar, at),
-        }
-    }
-
     fn inside(b: Vec3, mortar: Vec3) -> bool {
         b.z > mortar.z && b.y > mortar.y && b.x > mortar.x
     }
@@ -243,5 +230,29 @@ impl Brick {
             }
         }
         (by > mortar.z && bx > mortar.x).then_some(Vec3::new(ix, iy, 0.0))
+    }
+}
+
+impl TextureType for Brick {
+    fn name(&self) -> &'static str {
+        "brick"
+    }
+
+    fn references(&self) -> Vec<ConstOrTexture> {
+        vec![self.brick, self.mortar, self.modulation]
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
+        match self.brick_at(self.mapping.map(at)) {
+            Some(index) => {
+                let brick = LookupPoint {
+                    p: index,
+                    p_world: index,
+                    ..*at
+                };
+                textures.eval(self.brick, at) * textures.eval(self.modulation, &brick)
+            }
+            None => textures.eval(self.mortar, at),
+        }
     }
 }

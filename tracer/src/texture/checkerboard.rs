@@ -15,10 +15,11 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use super::kind::TextureType;
 use super::mapping::{Mapping2D, Mapping3D};
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -29,19 +30,20 @@ pub const DEFAULT_TEX2: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard2D {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     pub mapping: Mapping2D,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkerboard3D {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     pub mapping: Mapping3D,
 }
 
 /// What `"checkerboard"` reads as, by its dimension.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Checkerboard {
     D2(Checkerboard2D),
     D3(Checkerboard3D),
@@ -78,7 +80,7 @@ impl Checkerboard {
 }
 
 impl Checkerboard2D {
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+    pub fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at).floor();
         let first = (st.x + st.y).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
@@ -86,9 +88,36 @@ impl Checkerboard2D {
 }
 
 impl Checkerboard3D {
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+    pub fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let p = self.mapping.map(at).floor();
         let first = (p.x + p.y + p.z).rem_euclid(2.0) == 0.0;
         textures.eval(if first { self.tex1 } else { self.tex2 }, at)
+    }
+}
+
+impl TextureType for Checkerboard {
+    fn name(&self) -> &'static str {
+        "checkerboard"
+    }
+
+    fn references(&self) -> Vec<ConstOrTexture> {
+        match self {
+            Checkerboard::D2(t) => vec![t.tex1, t.tex2],
+            Checkerboard::D3(t) => vec![t.tex1, t.tex2],
+        }
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        match self {
+            Checkerboard::D2(t) => Some(&t.mapping),
+            Checkerboard::D3(_) => None,
+        }
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
+        match self {
+            Checkerboard::D2(t) => t.eval(at, textures),
+            Checkerboard::D3(t) => t.eval(at, textures),
+        }
     }
 }

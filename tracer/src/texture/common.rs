@@ -4,14 +4,15 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::param::Tex;
+use crate::image_io::RgbImage;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::ConstOrTexture;
 
 /// What a texture lookup needs to know about the surface point.
 #[derive(Clone, Copy, Debug)]
-pub struct TexturePoint {
+pub struct LookupPoint {
     /// Position in the shaded shape's object space: planar, spherical, cylindrical and 3D
     /// checkerboard mappings project it (then apply the Texture's own transform). The seed
     /// scenes are composed this way: their planar-mapped walls are scaled unit quads that show
@@ -25,7 +26,7 @@ pub struct TexturePoint {
     pub prim: u32,
 }
 
-impl TexturePoint {
+impl LookupPoint {
     /// A point whose object and world positions coincide (tests, bakes).
     pub fn new(p: Vec3, uv: Vec2) -> Self {
         Self {
@@ -40,9 +41,13 @@ impl TexturePoint {
 /// Evaluates a texture-or-constant parameter: what a texture that combines other textures
 /// (scale, mix, checkerboard, ...) calls for its inputs. [`Textures`](super::Textures)
 /// implements it.
-pub trait TextureEval {
+pub trait ReferencedTextures {
     /// The value of `tex` at `at` (a constant is itself; an id naming no texture is black).
-    fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3;
+    fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3;
+
+    /// The decoded file of the texture being evaluated (one whose
+    /// [`TextureType::file`](super::kind::TextureType::file) names one).
+    fn image(&self) -> &RgbImage;
 }
 
 /// The `Texture "name" "float"|"color" "type"` header a texture reader is given with the
@@ -62,7 +67,7 @@ impl Declared<'_> {
         params: &ParamList,
         name: &str,
         default: f32,
-    ) -> Result<Tex, ParseError> {
+    ) -> Result<ConstOrTexture, ParseError> {
         if self.is_color {
             ctx.color_param(params, name, default, false)
         } else {

@@ -11,9 +11,12 @@
 
 use glam::Vec3;
 
-use super::common::Declared;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
 
 pub const DEFAULT_VALUE: f32 = 1.0;
 
@@ -23,7 +26,12 @@ pub struct Constant {
 }
 
 impl Constant {
-    pub fn read(decl: &Declared, params: &ParamList) -> Result<Self, ParseError> {
+    pub fn read(
+        decl: &Declared,
+        params: &ParamList,
+        _pos: &SourcePos,
+        _ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
         let value = if decl.is_color {
             params.color("value", Vec3::splat(DEFAULT_VALUE))?
         } else {
@@ -31,8 +39,14 @@ impl Constant {
         };
         Ok(Constant { value })
     }
+}
 
-    pub fn eval(&self) -> Vec3 {
+impl TextureType for Constant {
+    fn name(&self) -> &'static str {
+        "constant"
+    }
+
+    fn eval(&self, _at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         self.value
     }
 }

@@ -13,14 +13,15 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use super::noise::noise2;
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_INSIDE: f32 = 1.0;
 pub const DEFAULT_OUTSIDE: f32 = 0.0;
@@ -29,8 +30,8 @@ pub const RADIUS: f32 = 0.35;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dots {
-    pub inside: Tex,
-    pub outside: Tex,
+    pub inside: ConstOrTexture,
+    pub outside: ConstOrTexture,
     pub mapping: Mapping2D,
 }
 
@@ -61,8 +62,22 @@ impl Dots {
         let (ds, dt) = (s - centre_s, t - centre_t);
         ds * ds + dt * dt < RADIUS * RADIUS
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Dots {
+    fn name(&self) -> &'static str {
+        "dots"
+    }
+
+    fn references(&self) -> Vec<ConstOrTexture> {
+        vec![self.outside, self.inside]
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        Some(&self.mapping)
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         let tex = if Self::inside(st.x, st.y) {
             self.inside

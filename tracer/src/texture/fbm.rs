@@ -14,13 +14,14 @@
 
 use glam::Vec3;
 
-use super::common::TexturePoint;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use super::noise::{fbm, MAX_OCTAVES};
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_OCTAVES: i32 = 8;
 pub const DEFAULT_ROUGHNESS: f32 = 0.5;
@@ -54,14 +55,21 @@ pub struct Fbm(pub Octaves);
 
 impl Fbm {
     pub fn read(
+        _decl: &Declared,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         Ok(Self(Octaves::read(params, pos, ctx)?))
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Fbm {
+    fn name(&self) -> &'static str {
+        "fbm"
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let o = &self.0;
         Vec3::splat(fbm(o.mapping.map(at), o.roughness, o.octaves))
     }

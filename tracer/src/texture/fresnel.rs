@@ -19,10 +19,10 @@
 use glam::Vec3;
 
 use crate::diag::SourcePos;
-use crate::param::{Fresnel, Tex};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::{ConstOrTexture, Fresnel};
 
 pub const DEFAULT_KR: f32 = 0.5;
 pub const DEFAULT_METAL: &str = "aluminium";
@@ -54,7 +54,7 @@ pub fn read(
             let (eta, k) = ctx.metal_by_name(&name, pos);
             Fresnel::Conductor { eta, k }
         }
-        "constant" => Fresnel::Index(Tex::float(params.float("value", DEFAULT_INDEX)?)),
+        "constant" => Fresnel::Index(ConstOrTexture::float(params.float("value", DEFAULT_INDEX)?)),
         other => {
             for p in &params.params {
                 params.ignore(&p.name);

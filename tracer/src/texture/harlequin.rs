@@ -10,7 +10,12 @@
 
 use glam::Vec3;
 
-use super::common::TexturePoint;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use super::kind::TextureType;
+use crate::diag::SourcePos;
+use crate::parse::context::ParseContext;
+use crate::parse::error::ParseError;
+use crate::parse::params::ParamList;
 
 /// LuxRender's palette size.
 pub const PALETTE_SIZE: u32 = 31;
@@ -30,6 +35,15 @@ fn radical_inverse(mut i: u32, base: u32) -> f32 {
 }
 
 impl Harlequin {
+    pub fn read(
+        _decl: &Declared,
+        _params: &ParamList,
+        _pos: &SourcePos,
+        _ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Ok(Self)
+    }
+
     /// Palette entry `i` (LuxRender's table, built from 3i + 1).
     pub fn colour(i: u32) -> Vec3 {
         let n = i * 3 + 1;
@@ -39,8 +53,14 @@ impl Harlequin {
             radical_inverse(n, 5),
         )
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Harlequin {
+    fn name(&self) -> &'static str {
+        "harlequin"
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         Self::colour(at.prim % PALETTE_SIZE)
     }
 }

@@ -24,13 +24,14 @@
 
 use glam::{Vec2, Vec3};
 
-use super::common::{Declared, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::image_io::{Edge, RgbImage};
 use crate::parse::context::{ImageUse, ParseContext};
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_GAMMA: f32 = 1.0;
 pub const DEFAULT_GAIN: f32 = 1.0;
@@ -101,7 +102,7 @@ impl ImageMap {
     }
 
     /// The texel value at a surface point, `image` being this texture's decoded file.
-    pub fn eval(&self, at: &TexturePoint, image: &RgbImage) -> Vec3 {
+    pub fn texel(&self, at: &LookupPoint, image: &RgbImage) -> Vec3 {
         lookup(image, self.mapping.map(at), self.wrap, self.gain)
     }
 }
@@ -117,4 +118,23 @@ pub fn lookup(image: &RgbImage, st: Vec2, wrap: Wrap, gain: f32) -> Vec3 {
     };
     let (inside, outside_weight) = image.bilinear(st, edge, edge);
     inside * gain + border * outside_weight
+
+}
+
+impl TextureType for ImageMap {
+    fn name(&self) -> &'static str {
+        "imagemap"
+    }
+
+    fn file(&self) -> Option<(&str, f32)> {
+        Some((&self.filename, self.gamma))
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        Some(&self.mapping)
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
+        self.texel(at, textures.image())
+    }
 }

@@ -16,6 +16,7 @@
 //! incandescent lamps and the candle are blackbodies ([`BLACKBODY_LAMPS`]), their measured
 //! data being poorly calibrated.
 
+use super::common::Declared;
 use glam::Vec3;
 
 use super::constant::Constant;
@@ -116,6 +117,7 @@ pub fn lamp(name: &str) -> Option<Vec3> {
 }
 
 pub fn read(
+    _decl: &Declared,
     params: &ParamList,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,

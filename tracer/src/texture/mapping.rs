@@ -33,7 +33,7 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::common::TexturePoint;
+use super::common::LookupPoint;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -159,7 +159,7 @@ impl Mapping2D {
     }
 
     /// Texture coordinates (s, t) of a surface point.
-    pub fn map(&self, at: &TexturePoint) -> Vec2 {
+    pub fn map(&self, at: &LookupPoint) -> Vec2 {
         match *self {
             Mapping2D::Uv {
                 uscale,
@@ -273,7 +273,7 @@ impl Mapping3D {
     }
 
     /// The texture-space point of a surface point.
-    pub fn map(&self, at: &TexturePoint) -> Vec3 {
+    pub fn map(&self, at: &LookupPoint) -> Vec3 {
         let p = match self.coordinates {
             Coordinates::Global => at.p_world,
             Coordinates::Local => at.p,
@@ -287,8 +287,8 @@ impl Mapping3D {
 mod tests {
     use super::*;
 
-    fn at(p: Vec3, uv: Vec2) -> TexturePoint {
-        TexturePoint::new(p, uv)
+    fn at(p: Vec3, uv: Vec2) -> LookupPoint {
+        LookupPoint::new(p, uv)
     }
 
     #[test]

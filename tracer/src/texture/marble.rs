@@ -18,13 +18,14 @@
 
 use glam::Vec3;
 
-use super::common::TexturePoint;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::fbm::Octaves;
 use super::noise::fbm;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 pub const DEFAULT_SCALE: f32 = 1.0;
 pub const DEFAULT_VARIATION: f32 = 0.2;
@@ -52,6 +53,7 @@ pub struct Marble {
 
 impl Marble {
     pub fn read(
+        _decl: &Declared,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
@@ -63,8 +65,14 @@ impl Marble {
             variation: params.float("variation", DEFAULT_VARIATION)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Marble {
+    fn name(&self) -> &'static str {
+        "marble"
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let o = &self.octaves;
         let p = o.mapping.map(at) * self.scale;
         let marble = p.y + self.variation * fbm(p, o.roughness, o.octaves);

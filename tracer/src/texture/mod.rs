@@ -9,45 +9,28 @@
 //! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator
 //! interface and the statement header every texture file shares.
 //!
-//! This file maps names to kinds (one line each in [`TextureKind::read`]), says what a kind is
-//! called and what it references, and evaluates the scene's textures ([`Textures`]: built once
-//! per scene, images decoded once and shared).
+//! This file lists the types (one line each, from which a macro generates the name table and
+//! the dispatch) and evaluates the scene's textures ([`Textures`]: built once per scene,
+//! images decoded once and shared).
 //!
 //! Float textures are evaluated like colour textures and their value is splatted over RGB
 //! (an image used as a float texture gives the mean of its channels, LuxRender's default
 //! "channel").
 //!
-//! A new texture type is a new file here (struct, defaults, `read`, `eval`) plus its lines in
-//! [`TextureKind`]: the variant, the name table, `name()`, `references()` and the dispatch in
-//! [`Textures::eval`]. A texture that evaluates other textures takes `&impl TextureEval`.
+//! A new texture type is a new file here (struct, defaults, `read`, its [`TextureType`] impl)
+//! plus one line in the type list below, which generates the rest. A texture that evaluates
+//! other textures does so through the `&impl ReferencedTextures` its `eval` is given.
 
-pub mod arithmetic;
-pub mod band;
-pub mod bilerp;
 pub mod blackbody;
-pub mod blender;
-pub mod brick;
-pub mod checkerboard;
 pub mod common;
-pub mod constant;
-pub mod dots;
 pub mod equalenergy;
-pub mod fbm;
 pub mod fresnel;
 pub mod gaussian;
-pub mod harlequin;
-pub mod imagemap;
+pub mod kind;
 pub mod lampspectrum;
 pub mod mapping;
-pub mod marble;
-pub mod mix;
 pub mod noise;
-pub mod normalmap;
-pub mod scale;
 pub mod tabulateddata;
-pub mod uv;
-pub mod windy;
-pub mod wrinkled;
 
 #[cfg(test)]
 mod procedural_tests;
@@ -61,30 +44,19 @@ use glam::Vec3;
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
 use crate::image_io::{self, RgbImage};
-use crate::param::{Fresnel, Tex, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::refs::{ConstOrTexture, Fresnel, TextureId};
 
-pub use arithmetic::{Arithmetic, Op};
-pub use band::Band;
-pub use bilerp::Bilerp;
-pub use brick::{Bond, Brick};
-pub use checkerboard::{Checkerboard, Checkerboard2D, Checkerboard3D};
-pub use common::{Declared, TextureEval, TexturePoint};
-pub use constant::Constant;
-pub use dots::Dots;
-pub use fbm::{Fbm, Octaves};
-pub use harlequin::Harlequin;
-pub use imagemap::{ImageMap, Wrap};
+pub use arithmetic::Op;
+pub use brick::Bond;
+pub use checkerboard::{Checkerboard2D, Checkerboard3D};
+pub use common::{Declared, LookupPoint, ReferencedTextures};
+pub use fbm::Octaves;
+pub use imagemap::Wrap;
+pub use kind::TextureType;
 pub use mapping::{Coordinates, Mapping2D, Mapping3D};
-pub use marble::Marble;
-pub use mix::Mix;
-pub use normalmap::NormalMap;
-pub use scale::Scale;
-pub use uv::Uv;
-pub use windy::Windy;
-pub use wrinkled::Wrinkled;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureDesc {
@@ -94,27 +66,101 @@ pub struct TextureDesc {
     pub kind: TextureKind,
 }
 
-#[derive(Clone, Debug, PartialEq)]
-pub enum TextureKind {
-    ImageMap(ImageMap),
-    Checkerboard2D(Checkerboard2D),
-    Checkerboard3D(Checkerboard3D),
-    Constant(Constant),
-    Scale(Scale),
-    Arithmetic(Arithmetic),
-    Mix(Mix),
-    Band(Band),
-    Bilerp(Bilerp),
-    Uv(Uv),
-    Harlequin(Harlequin),
-    Dots(Dots),
-    Brick(Brick),
-    Fbm(Fbm),
-    Wrinkled(Wrinkled),
-    Windy(Windy),
-    Marble(Marble),
-    NormalMap(NormalMap),
-    Blender(blender::Blender),
+/// Generates the texture family from its type list (see [`textures!`]'s invocation below):
+/// each type's module and re-export, the [`TextureKind`] variant, the name table from
+/// LuxRender's texture types to the readers, and every dispatch `match`, each arm a call of
+/// the type's [`TextureType`] method.
+macro_rules! textures {
+    ($($module:ident::$kind:ident { $($name:literal => $read:expr),* },)+) => {
+        $(pub mod $module;)+
+        $(pub use $module::$kind;)+
+
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum TextureKind {
+            $($kind($kind),)+
+        }
+
+        impl TextureKind {
+            /// The reader of a LuxRender type the table names; None for another.
+            fn reader(class: &str) -> Option<TextureReader> {
+                Some(match class {
+                    $($($name => |decl, params, pos, ctx| Ok(Self::$kind(($read)(decl, params, pos, ctx)?)),)*)+
+                    _ => return None,
+                })
+            }
+
+            /// The LuxRender type name (a texture read as a constant, as blackbody is, says
+            /// "constant").
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Self::$kind(t) => t.name(),)+
+                }
+            }
+
+            /// The textures (or constants) this texture reads, in parameter order.
+            pub fn references(&self) -> Vec<ConstOrTexture> {
+                match self {
+                    $(Self::$kind(t) => t.references(),)+
+                }
+            }
+
+            /// The image file this texture reads, and the gamma it is decoded with.
+            pub fn file(&self) -> Option<(&str, f32)> {
+                match self {
+                    $(Self::$kind(t) => t.file(),)+
+                }
+            }
+
+            /// The 2D mapping this texture looks itself up with, if it has one.
+            pub fn mapping(&self) -> Option<&Mapping2D> {
+                match self {
+                    $(Self::$kind(t) => t.mapping(),)+
+                }
+            }
+
+            /// The value at `at` (see [`TextureType::eval`]).
+            fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
+                match self {
+                    $(Self::$kind(t) => t.eval(at, textures),)+
+                }
+            }
+        }
+    };
+}
+
+/// Reads a texture type from a statement's header and parameters.
+type TextureReader =
+    fn(&Declared, &ParamList, &SourcePos, &mut dyn ParseContext) -> Result<TextureKind, ParseError>;
+
+// The types: `module::Type { "luxrender type" => reader, ... },`; the blender_* types are read
+// by [`Blender::read`], which knows their names.
+textures! {
+    imagemap::ImageMap { "imagemap" => ImageMap::read },
+    checkerboard::Checkerboard { "checkerboard" => Checkerboard::read },
+    constant::Constant {
+        "constant" => Constant::read,
+        "blackbody" => |_, params, _, _| blackbody::read(params),
+        "gaussian" => |_, params, _, _| gaussian::read(params),
+        "equalenergy" => |_, params, _, _| equalenergy::read(params),
+        "lampspectrum" => lampspectrum::read,
+        "tabulateddata" => tabulateddata::read_file,
+        "irregulardata" => tabulateddata::read_inline
+    },
+    scale::Scale { "scale" => Scale::read },
+    arithmetic::Arithmetic { "add" => Arithmetic::read_add, "subtract" => Arithmetic::read_subtract },
+    mix::Mix { "mix" => Mix::read },
+    band::Band { "band" => Band::read },
+    bilerp::Bilerp { "bilerp" => Bilerp::read },
+    uv::Uv { "uv" => Uv::read },
+    harlequin::Harlequin { "harlequin" => Harlequin::read },
+    dots::Dots { "dots" => Dots::read },
+    brick::Brick { "brick" => Brick::read },
+    fbm::Fbm { "fbm" => Fbm::read },
+    wrinkled::Wrinkled { "wrinkled" => Wrinkled::read },
+    windy::Windy { "windy" => Windy::read },
+    marble::Marble { "marble" => Marble::read },
+    normalmap::NormalMap { "normalmap" => NormalMap::read },
+    blender::Blender {},
 }
 
 /// What a `Texture` statement defines under its name.
@@ -179,115 +225,10 @@ impl TextureKind {
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Option<Self>, ParseError> {
-        Ok(Some(match class {
-            "imagemap" => Self::ImageMap(ImageMap::read(decl, params, pos, ctx)?),
-            "checkerboard" => Checkerboard::read(decl, params, pos, ctx)?.into(),
-            "constant" => Self::Constant(Constant::read(decl, params)?),
-            "scale" => Self::Scale(Scale::read(decl, params, ctx)?),
-            "add" => Self::Arithmetic(Arithmetic::read(Op::Add, decl, params, ctx)?),
-            "subtract" => Self::Arithmetic(Arithmetic::read(Op::Subtract, decl, params, ctx)?),
-            "mix" => Self::Mix(Mix::read(decl, params, ctx)?),
-            "band" => Self::Band(Band::read(decl, params, pos, ctx)?),
-            "bilerp" => Self::Bilerp(Bilerp::read(decl, params, pos, ctx)?),
-            "uv" => Self::Uv(Uv::read(params, pos, ctx)?),
-            "harlequin" => Self::Harlequin(Harlequin),
-            "dots" => Self::Dots(Dots::read(decl, params, pos, ctx)?),
-            "brick" => Self::Brick(Brick::read(decl, params, pos, ctx)?),
-            "fbm" => Self::Fbm(Fbm::read(params, pos, ctx)?),
-            "wrinkled" => Self::Wrinkled(Wrinkled::read(params, pos, ctx)?),
-            "windy" => Self::Windy(Windy::read(params, pos, ctx)?),
-            "marble" => Self::Marble(Marble::read(params, pos, ctx)?),
-            "normalmap" => Self::NormalMap(NormalMap::read(decl, params, pos, ctx)?),
-            "blackbody" => Self::Constant(blackbody::read(params)?),
-            "gaussian" => Self::Constant(gaussian::read(params)?),
-            "equalenergy" => Self::Constant(equalenergy::read(params)?),
-            "lampspectrum" => Self::Constant(lampspectrum::read(params, pos, ctx)?),
-            "tabulateddata" => Self::Constant(tabulateddata::read_file(params, pos, ctx)?),
-            "irregulardata" => Self::Constant(tabulateddata::read_inline(params, pos, ctx)?),
-            _ => match blender::Blender::read(class, decl, params, pos, ctx)? {
-                Some(b) => Self::Blender(b),
-                None => return Ok(None),
-            },
-        }))
-    }
-
-    /// The LuxRender type name (a blackbody reads as a constant).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::ImageMap(_) => "imagemap",
-            Self::Checkerboard2D(_) | Self::Checkerboard3D(_) => "checkerboard",
-            Self::Constant(_) => "constant",
-            Self::Scale(_) => "scale",
-            Self::Arithmetic(t) => t.name(),
-            Self::Mix(_) => "mix",
-            Self::Band(_) => "band",
-            Self::Bilerp(_) => "bilerp",
-            Self::Uv(_) => "uv",
-            Self::Harlequin(_) => "harlequin",
-            Self::Dots(_) => "dots",
-            Self::Brick(_) => "brick",
-            Self::Fbm(_) => "fbm",
-            Self::Wrinkled(_) => "wrinkled",
-            Self::Windy(_) => "windy",
-            Self::Marble(_) => "marble",
-            Self::NormalMap(_) => "normalmap",
-            Self::Blender(t) => t.name(),
+        if let Some(read) = Self::reader(class) {
+            return Ok(Some(read(decl, params, pos, ctx)?));
         }
-    }
-
-    /// The textures (or constants) this texture reads, in parameter order.
-    pub fn references(&self) -> Vec<Tex> {
-        match self {
-            Self::ImageMap(_)
-            | Self::Constant(_)
-            | Self::Bilerp(_)
-            | Self::Uv(_)
-            | Self::Harlequin(_)
-            | Self::Fbm(_)
-            | Self::Wrinkled(_)
-            | Self::Windy(_)
-            | Self::Marble(_)
-            | Self::NormalMap(_) => Vec::new(),
-            Self::Checkerboard2D(t) => vec![t.tex1, t.tex2],
-            Self::Checkerboard3D(t) => vec![t.tex1, t.tex2],
-            Self::Scale(t) => vec![t.tex1, t.tex2],
-            Self::Arithmetic(t) => vec![t.tex1, t.tex2],
-            Self::Mix(t) => vec![t.tex1, t.tex2, t.amount],
-            Self::Band(t) => t.textures.iter().copied().chain([t.amount]).collect(),
-            Self::Dots(t) => vec![t.outside, t.inside],
-            Self::Brick(t) => vec![t.brick, t.mortar, t.modulation],
-            Self::Blender(t) => t.references(),
-        }
-    }
-
-    /// The image file this texture reads, and the gamma it is decoded with.
-    pub fn file(&self) -> Option<(&str, f32)> {
-        match self {
-            Self::ImageMap(t) | Self::NormalMap(NormalMap(t)) => Some((&t.filename, t.gamma)),
-            _ => None,
-        }
-    }
-
-    /// The 2D mapping this texture looks itself up with, if it has one.
-    pub fn mapping(&self) -> Option<&Mapping2D> {
-        match self {
-            Self::ImageMap(ImageMap { mapping, .. })
-            | Self::NormalMap(NormalMap(ImageMap { mapping, .. }))
-            | Self::Checkerboard2D(Checkerboard2D { mapping, .. })
-            | Self::Dots(Dots { mapping, .. })
-            | Self::Bilerp(Bilerp { mapping, .. })
-            | Self::Uv(Uv { mapping }) => Some(mapping),
-            _ => None,
-        }
-    }
-}
-
-impl From<Checkerboard> for TextureKind {
-    fn from(c: Checkerboard) -> Self {
-        match c {
-            Checkerboard::D2(c) => Self::Checkerboard2D(c),
-            Checkerboard::D3(c) => Self::Checkerboard3D(c),
-        }
+        Ok(Blender::read(class, decl, params, pos, ctx)?.map(Self::Blender))
     }
 }
 
@@ -327,7 +268,7 @@ impl Textures {
         let mut textures = Vec::with_capacity(descs.len());
         for (index, desc) in descs.iter().enumerate() {
             for tex in desc.kind.references() {
-                if let Tex::Texture(TextureId(used)) = tex {
+                if let ConstOrTexture::Texture(TextureId(used)) = tex {
                     if used as usize >= index {
                         return Err(TextureError::ForwardReference {
                             texture: desc.name.clone(),
@@ -361,39 +302,24 @@ impl Textures {
     }
 
     /// The value of a parameter at a surface point. An id that names no texture gives black.
-    pub fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3 {
+    pub fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3 {
         match tex {
-            Tex::Const(c) => c,
-            Tex::Texture(TextureId(id)) => match self.textures.get(id as usize) {
+            ConstOrTexture::Const(c) => c,
+            ConstOrTexture::Texture(TextureId(id)) => match self.textures.get(id as usize) {
                 Some(texture) => self.eval_texture(texture, at),
                 None => Vec3::ZERO,
             },
         }
     }
 
-    fn eval_texture(&self, texture: &Texture, at: &TexturePoint) -> Vec3 {
-        let value = match &texture.kind {
-            TextureKind::ImageMap(t) => t.eval(at, self.image(texture)),
-            TextureKind::Checkerboard2D(t) => t.eval(at, self),
-            TextureKind::Checkerboard3D(t) => t.eval(at, self),
-            TextureKind::Constant(t) => t.eval(),
-            TextureKind::Scale(t) => t.eval(at, self),
-            TextureKind::Arithmetic(t) => t.eval(at, self),
-            TextureKind::Mix(t) => t.eval(at, self),
-            TextureKind::Band(t) => t.eval(at, self),
-            TextureKind::Bilerp(t) => t.eval(at),
-            TextureKind::Uv(t) => t.eval(at),
-            TextureKind::Harlequin(t) => t.eval(at),
-            TextureKind::Dots(t) => t.eval(at, self),
-            TextureKind::Brick(t) => t.eval(at, self),
-            TextureKind::Fbm(t) => t.eval(at),
-            TextureKind::Wrinkled(t) => t.eval(at),
-            TextureKind::Windy(t) => t.eval(at),
-            TextureKind::Marble(t) => t.eval(at),
-            // A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
-            TextureKind::NormalMap(_) => Vec3::ZERO,
-            TextureKind::Blender(t) => t.eval(at, self),
-        };
+    fn eval_texture(&self, texture: &Texture, at: &LookupPoint) -> Vec3 {
+        let value = texture.kind.eval(
+            at,
+            &Evaluating {
+                textures: self,
+                texture,
+            },
+        );
         if texture.is_color {
             value
         } else {
@@ -403,8 +329,8 @@ impl Textures {
 
     /// The tangent-space normal (x along u, y along v, z along the normal; not normalised) of
     /// `tex` at `at` when it is a normal map, else `None`.
-    pub fn normal_map(&self, tex: Tex, at: &TexturePoint) -> Option<Vec3> {
-        let Tex::Texture(TextureId(id)) = tex else {
+    pub fn normal_map(&self, tex: ConstOrTexture, at: &LookupPoint) -> Option<Vec3> {
+        let ConstOrTexture::Texture(TextureId(id)) = tex else {
             return None;
         };
         let texture = self.textures.get(id as usize)?;
@@ -424,9 +350,9 @@ impl Textures {
     /// such. What a light colour
     /// given as a texture reads (LuxRender accepts a texture wherever a colour goes). None
     /// for a texture that varies over a surface or reads a file.
-    pub fn uniform_value(descs: &[TextureDesc], tex: Tex) -> Option<Vec3> {
-        fn uniform(descs: &[TextureDesc], tex: Tex) -> bool {
-            let Tex::Texture(TextureId(id)) = tex else {
+    pub fn uniform_value(descs: &[TextureDesc], tex: ConstOrTexture) -> Option<Vec3> {
+        fn uniform(descs: &[TextureDesc], tex: ConstOrTexture) -> bool {
+            let ConstOrTexture::Texture(TextureId(id)) = tex else {
                 return true;
             };
             descs.get(id as usize).is_some_and(|d| {
@@ -438,8 +364,8 @@ impl Textures {
                         | TextureKind::Arithmetic(_)
                 ) && d.kind.references().into_iter().all(|r| match r {
                     // Only earlier textures: rules out cycles.
-                    Tex::Texture(TextureId(used)) => used < id && uniform(descs, r),
-                    Tex::Const(_) => true,
+                    ConstOrTexture::Texture(TextureId(used)) => used < id && uniform(descs, r),
+                    ConstOrTexture::Const(_) => true,
                 })
             })
         }
@@ -458,13 +384,24 @@ impl Textures {
                 .collect(),
             images: Vec::new(),
         };
-        let origin = TexturePoint::new(Vec3::ZERO, glam::Vec2::ZERO);
+        let origin = LookupPoint::new(Vec3::ZERO, glam::Vec2::ZERO);
         Some(textures.eval(tex, &origin))
     }
 }
 
-impl TextureEval for Textures {
-    fn eval(&self, tex: Tex, at: &TexturePoint) -> Vec3 {
-        Textures::eval(self, tex, at)
+/// What a texture sees of the scene's textures while it is evaluated: the others, and its own
+/// decoded file.
+struct Evaluating<'a> {
+    textures: &'a Textures,
+    texture: &'a Texture,
+}
+
+impl ReferencedTextures for Evaluating<'_> {
+    fn eval(&self, tex: ConstOrTexture, at: &LookupPoint) -> Vec3 {
+        self.textures.eval(tex, at)
+    }
+
+    fn image(&self) -> &RgbImage {
+        self.textures.image(self.texture)
     }
 }

@@ -14,8 +14,10 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TexturePoint};
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::imagemap::ImageMap;
+use super::kind::TextureType;
+use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::image_io::RgbImage;
 use crate::parse::context::ParseContext;
@@ -42,7 +44,26 @@ impl NormalMap {
 
     /// The tangent-space normal at a surface point (not normalised; `image` is the decoded
     /// file).
-    pub fn normal(&self, at: &TexturePoint, image: &RgbImage) -> Vec3 {
-        self.0.eval(at, image) * 2.0 - Vec3::ONE
+    pub fn normal(&self, at: &LookupPoint, image: &RgbImage) -> Vec3 {
+        self.0.texel(at, image) * 2.0 - Vec3::ONE
+    }
+}
+
+impl TextureType for NormalMap {
+    fn name(&self) -> &'static str {
+        "normalmap"
+    }
+
+    fn file(&self) -> Option<(&str, f32)> {
+        self.0.file()
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        self.0.mapping()
+    }
+
+    /// A normal map is no height: 0 wherever it is read as a value (LuxRender's too).
+    fn eval(&self, _at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
+        Vec3::ZERO
     }
 }

@@ -28,8 +28,8 @@ fn eval_at(t: &(Textures, Vec<String>), name: &str, p: Vec3, uv: Vec2) -> Vec3 {
             .rposition(|n| n == name)
             .expect("texture defined");
     t.0.eval(
-        Tex::Texture(TextureId(id as u32)),
-        &TexturePoint::new(p, uv),
+        ConstOrTexture::Texture(TextureId(id as u32)),
+        &LookupPoint::new(p, uv),
     )
 }
 
@@ -315,9 +315,10 @@ fn local_and_uv_coordinates_read_the_object_position_and_the_uv() {
          Texture \"local\" \"float\" \"fbm\" \"string coordinates\" \"local\"\n\
          Texture \"uv\" \"float\" \"fbm\" \"string coordinates\" \"uv\"",
     );
-    let id =
-        |name: &str| Tex::Texture(TextureId(t.1.iter().position(|n| n == name).unwrap() as u32));
-    let at = TexturePoint {
+    let id = |name: &str| {
+        ConstOrTexture::Texture(TextureId(t.1.iter().position(|n| n == name).unwrap() as u32))
+    };
+    let at = LookupPoint {
         p: Vec3::new(0.3, 0.7, -1.2),
         p_world: Vec3::new(12.25, -3.5, 0.125),
         uv: Vec2::new(-7.9, 100.3),
@@ -381,10 +382,10 @@ fn harlequin_gives_each_primitive_its_colour() {
     let t = textures("Texture \"h\" \"color\" \"harlequin\"");
     let colour = |prim: u32| {
         t.0.eval(
-            Tex::Texture(TextureId(0)),
-            &TexturePoint {
+            ConstOrTexture::Texture(TextureId(0)),
+            &LookupPoint {
                 prim,
-                ..TexturePoint::new(Vec3::ZERO, Vec2::ZERO)
+                ..LookupPoint::new(Vec3::ZERO, Vec2::ZERO)
             },
         )
     };

@@ -14,25 +14,28 @@
 
 use glam::Vec3;
 
-use super::common::{Declared, TextureEval, TexturePoint};
-use crate::param::Tex;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
+use crate::diag::SourcePos;
 
 pub const DEFAULT_TEX1: f32 = 1.0;
 pub const DEFAULT_TEX2: f32 = 1.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scale {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
 }
 
 impl Scale {
     pub fn read(
         decl: &Declared,
         params: &ParamList,
+        _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         Ok(Scale {
@@ -40,8 +43,18 @@ impl Scale {
             tex2: decl.tex(ctx, params, "tex2", DEFAULT_TEX2)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Scale {
+    fn name(&self) -> &'static str {
+        "scale"
+    }
+
+    fn references(&self) -> Vec<ConstOrTexture> {
+        vec![self.tex1, self.tex2]
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         textures.eval(self.tex1, at) * textures.eval(self.tex2, at)
     }
 }

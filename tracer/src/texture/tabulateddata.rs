@@ -22,6 +22,7 @@
 //! A file that cannot be read, or that holds more than [`MAX_SAMPLES`] samples, is an error
 //! naming it.
 
+use super::common::Declared;
 use super::constant::Constant;
 use crate::assets::AssetKind;
 use crate::diag::SourcePos;
@@ -175,6 +176,7 @@ pub fn parse(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
 
 /// Reads `tabulateddata`: the file's spectrum as a constant colour.
 pub fn read_file(
+    _decl: &Declared,
     params: &ParamList,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
@@ -206,6 +208,7 @@ pub fn read_file(
 
 /// Reads `irregulardata`: the inline spectrum as a constant colour.
 pub fn read_inline(
+    _decl: &Declared,
     params: &ParamList,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,

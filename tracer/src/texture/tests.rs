@@ -60,12 +60,12 @@ fn imagemap(wrap: Wrap, gamma: f32, gain: f32, mapping: Mapping2D) -> TextureDes
     }
 }
 
-fn at_uv(u: f32, v: f32) -> TexturePoint {
-    TexturePoint::new(Vec3::ZERO, Vec2::new(u, v))
+fn at_uv(u: f32, v: f32) -> LookupPoint {
+    LookupPoint::new(Vec3::ZERO, Vec2::new(u, v))
 }
 
 /// Texture coordinates of the centre of texel (x, y), which may lie outside the image.
-fn centre(x: i32, y: i32) -> TexturePoint {
+fn centre(x: i32, y: i32) -> LookupPoint {
     at_uv((x as f32 + 0.5) / W as f32, (y as f32 + 0.5) / H as f32)
 }
 
@@ -80,7 +80,7 @@ fn imagemap_returns_texels_at_their_centres_with_row_zero_on_top() {
         &source(),
     )
     .unwrap();
-    let tex = Tex::Texture(TextureId(0));
+    let tex = ConstOrTexture::Texture(TextureId(0));
     for y in 0..H {
         for x in 0..W {
             let got = textures.eval(tex, &centre(x as i32, y as i32));
@@ -110,7 +110,7 @@ fn blender_uv_convention_puts_v_zero_at_the_bottom_of_the_image() {
         vdelta: 1.0,
     };
     let textures = Textures::new(&[imagemap(Wrap::Clamp, 1.0, 1.0, blender)], &source()).unwrap();
-    let bottom_left = textures.eval(Tex::Texture(TextureId(0)), &at_uv(0.01, 0.01));
+    let bottom_left = textures.eval(ConstOrTexture::Texture(TextureId(0)), &at_uv(0.01, 0.01));
     assert!(
         close(bottom_left, texel_linear(0, H - 1, 1.0)),
         "{bottom_left}"
@@ -136,7 +136,7 @@ fn wrap_modes_outside_the_image() {
     for (wrap, left_of_row_1, right_of_row_0) in cases {
         let textures =
             Textures::new(&[imagemap(wrap, 1.0, 1.0, uv_identity())], &source()).unwrap();
-        let tex = Tex::Texture(TextureId(0));
+        let tex = ConstOrTexture::Texture(TextureId(0));
         let left = textures.eval(tex, &centre(-1, 1));
         let right = textures.eval(tex, &centre(W as i32, 0));
         assert!(close(left, left_of_row_1), "{wrap:?} left: {left}");
@@ -154,7 +154,7 @@ fn wrap_modes_outside_the_image() {
     )
     .unwrap();
     let far = textures.eval(
-        Tex::Texture(TextureId(0)),
+        ConstOrTexture::Texture(TextureId(0)),
         &at_uv(-3.0 + 2.5 / W as f32, 7.75),
     );
     assert!(close(far, texel_linear(2, 1, 1.0)), "{far}");
@@ -167,9 +167,9 @@ fn gamma_gain_and_float_textures() {
     let descs = [imagemap(Wrap::Repeat, 2.2, 2.0, uv_identity()), float];
     let textures = Textures::new(&descs, &source()).unwrap();
     let expected = texel_linear(1, 0, 2.2) * 2.0;
-    let color = textures.eval(Tex::Texture(TextureId(0)), &centre(1, 0));
+    let color = textures.eval(ConstOrTexture::Texture(TextureId(0)), &centre(1, 0));
     assert!(close(color, expected), "{color} vs {expected}");
-    let mean = textures.eval(Tex::Texture(TextureId(1)), &centre(1, 0));
+    let mean = textures.eval(ConstOrTexture::Texture(TextureId(1)), &centre(1, 0));
     assert!(
         close(mean, Vec3::splat(expected.element_sum() / 3.0)),
         "{mean}"
@@ -192,25 +192,25 @@ fn checkerboards_alternate() {
         TextureDesc {
             name: "check2d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard2D(Checkerboard2D {
-                tex1: Tex::color(Vec3::ONE),
-                tex2: Tex::color(Vec3::ZERO),
+            kind: TextureKind::Checkerboard(Checkerboard::D2(Checkerboard2D {
+                tex1: ConstOrTexture::color(Vec3::ONE),
+                tex2: ConstOrTexture::color(Vec3::ZERO),
                 mapping: Mapping2D::Uv {
                     uscale: 4.0,
                     vscale: 4.0,
                     udelta: 0.0,
                     vdelta: 0.0,
                 },
-            }),
+            })),
         },
         TextureDesc {
             name: "check3d".into(),
             is_color: true,
-            kind: TextureKind::Checkerboard3D(Checkerboard3D {
-                tex1: Tex::color(Vec3::ONE),
-                tex2: Tex::color(Vec3::ZERO),
+            kind: TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
+                tex1: ConstOrTexture::color(Vec3::ONE),
+                tex2: ConstOrTexture::color(Vec3::ZERO),
                 mapping: Mapping3D::global(Mat4::from_scale(Vec3::splat(2.0))),
-            }),
+            })),
         },
     ];
     let textures = Textures::new(&descs, &MemorySource::new()).unwrap();
@@ -218,7 +218,7 @@ fn checkerboards_alternate() {
         for j in 0..8 {
             let uv = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / 4.0 - Vec2::splat(1.0);
             let got = textures
-                .eval(Tex::Texture(TextureId(0)), &at_uv(uv.x, uv.y))
+                .eval(ConstOrTexture::Texture(TextureId(0)), &at_uv(uv.x, uv.y))
                 .x;
             let expected = if (i + j) % 2 == 0 { 1.0 } else { 0.0 };
             assert_eq!(got, expected, "2D cell ({i},{j})");
@@ -233,8 +233,8 @@ fn checkerboards_alternate() {
     ] {
         let got = textures
             .eval(
-                Tex::Texture(TextureId(1)),
-                &TexturePoint::new(p, Vec2::ZERO),
+                ConstOrTexture::Texture(TextureId(1)),
+                &LookupPoint::new(p, Vec2::ZERO),
             )
             .x;
         assert_eq!(got, expected, "3D at {p}");
@@ -252,29 +252,35 @@ fn scale_and_mix_combine_their_inputs() {
             name: "scale".into(),
             is_color: true,
             kind: TextureKind::Scale(Scale {
-                tex1: Tex::Texture(TextureId(0)),
-                tex2: Tex::Texture(TextureId(1)),
+                tex1: ConstOrTexture::Texture(TextureId(0)),
+                tex2: ConstOrTexture::Texture(TextureId(1)),
             }),
         },
         TextureDesc {
             name: "mix".into(),
             is_color: true,
             kind: TextureKind::Mix(Mix {
-                tex1: Tex::Texture(TextureId(0)),
-                tex2: Tex::Texture(TextureId(1)),
-                amount: Tex::float(0.25),
+                tex1: ConstOrTexture::Texture(TextureId(0)),
+                tex2: ConstOrTexture::Texture(TextureId(1)),
+                amount: ConstOrTexture::float(0.25),
             }),
         },
     ];
     let textures = Textures::new(&descs, &MemorySource::new()).unwrap();
     let at = at_uv(0.0, 0.0);
-    assert!(close(textures.eval(Tex::Texture(TextureId(2)), &at), a * b));
     assert!(close(
-        textures.eval(Tex::Texture(TextureId(3)), &at),
+        textures.eval(ConstOrTexture::Texture(TextureId(2)), &at),
+        a * b
+    ));
+    assert!(close(
+        textures.eval(ConstOrTexture::Texture(TextureId(3)), &at),
         a * 0.75 + b * 0.25
     ));
     // An id naming no texture is black rather than a panic.
-    assert_eq!(textures.eval(Tex::Texture(TextureId(99)), &at), Vec3::ZERO);
+    assert_eq!(
+        textures.eval(ConstOrTexture::Texture(TextureId(99)), &at),
+        Vec3::ZERO
+    );
 }
 
 #[test]
@@ -295,8 +301,8 @@ fn bad_inputs_are_errors() {
         name: "scale".into(),
         is_color: true,
         kind: TextureKind::Scale(Scale {
-            tex1: Tex::Texture(TextureId(0)),
-            tex2: Tex::float(1.0),
+            tex1: ConstOrTexture::Texture(TextureId(0)),
+            tex2: ConstOrTexture::float(1.0),
         }),
     };
     let err = Textures::new(&[forward], &MemorySource::new())

@@ -11,12 +11,13 @@
 
 use glam::Vec3;
 
-use super::common::TexturePoint;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping2D;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Uv {
@@ -25,6 +26,7 @@ pub struct Uv {
 
 impl Uv {
     pub fn read(
+        _decl: &Declared,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
@@ -33,8 +35,18 @@ impl Uv {
             mapping: Mapping2D::read(params, pos, ctx)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Uv {
+    fn name(&self) -> &'static str {
+        "uv"
+    }
+
+    fn mapping(&self) -> Option<&Mapping2D> {
+        Some(&self.mapping)
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let st = self.mapping.map(at);
         Vec3::new(st.x - st.x.floor(), st.y - st.y.floor(), 0.0)
     }

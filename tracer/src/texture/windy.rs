@@ -11,13 +11,14 @@
 
 use glam::Vec3;
 
-use super::common::TexturePoint;
+use super::common::{Declared, ReferencedTextures, LookupPoint};
 use super::mapping::Mapping3D;
 use super::noise::fbm;
 use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use super::kind::TextureType;
 
 /// LuxRender's fixed wind and wave constants.
 const WIND_FREQUENCY: f32 = 0.1;
@@ -32,6 +33,7 @@ pub struct Windy {
 
 impl Windy {
     pub fn read(
+        _decl: &Declared,
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
@@ -40,8 +42,14 @@ impl Windy {
             mapping: Mapping3D::read(params, pos, ctx)?,
         })
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint) -> Vec3 {
+impl TextureType for Windy {
+    fn name(&self) -> &'static str {
+        "windy"
+    }
+
+    fn eval(&self, at: &LookupPoint, _textures: &impl ReferencedTextures) -> Vec3 {
         let p = self.mapping.map(at);
         let wind = fbm(WIND_FREQUENCY * p, OMEGA, WIND_OCTAVES);
         let waves = fbm(p, OMEGA, WAVE_OCTAVES);

@@ -9,7 +9,7 @@ use glam::Vec3;
 use yat_tracer::assets::{FsSource, MemorySource};
 use yat_tracer::desc::*;
 use yat_tracer::film::{Film, MAX_UNIT_SUM};
-use yat_tracer::lights::{PointLight, SkyLight, SunLight};
+use yat_tracer::lights::{LightKind, PointLight, SkyLight, SunLight};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{blackbody_rgb, parse_scene};
 use yat_tracer::render::{plan_units, RenderOverrides, RenderScene, RenderSettings};

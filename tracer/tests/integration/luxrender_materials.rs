@@ -78,12 +78,15 @@ fn carpaint_presets_and_custom_layers() {
     let preset = |name: &str| {
         CarPaint::from_preset(
             carpaint::preset(name).unwrap(),
-            Tex::float(0.0),
-            Tex::float(0.0),
+            ConstOrTexture::float(0.0),
+            ConstOrTexture::float(0.0),
         )
     };
     assert_eq!(paint(0), preset("bmw339"));
-    assert_eq!(paint(0).kd, Tex::color(Vec3::new(0.012, 0.015, 0.016)));
+    assert_eq!(
+        paint(0).kd,
+        ConstOrTexture::color(Vec3::new(0.012, 0.015, 0.016))
+    );
     // An unknown preset warns and is ford f8, LuxRender's default.
     assert_eq!(paint(1), preset("ford f8"));
     assert!(d
@@ -93,13 +96,16 @@ fn carpaint_presets_and_custom_layers() {
     // No name: every missing layer parameter is ford f8's.
     assert_eq!(paint(2), preset("ford f8"));
     let custom = paint(3);
-    assert_eq!(custom.kd, Tex::color(Vec3::new(0.5, 0.1, 0.1)));
-    assert_eq!(custom.m[1], Tex::float(0.25));
+    assert_eq!(custom.kd, ConstOrTexture::color(Vec3::new(0.5, 0.1, 0.1)));
+    assert_eq!(custom.m[1], ConstOrTexture::float(0.25));
     assert_eq!(custom.m[0], preset("ford f8").m[0]);
     assert_eq!(custom.ks, preset("ford f8").ks);
     assert_eq!(
         (custom.ka, custom.depth),
-        (Tex::color(Vec3::new(0.1, 0.2, 0.3)), Tex::float(0.5))
+        (
+            ConstOrTexture::color(Vec3::new(0.1, 0.2, 0.3)),
+            ConstOrTexture::float(0.5)
+        )
     );
     // With a preset, LuxRender ignores the layer parameters (a warning says so).
     assert_eq!(paint(4), preset("white"));
@@ -120,7 +126,7 @@ fn glossytranslucent_back_face_parameters() {
     else {
         panic!()
     };
-    assert_eq!(front.ks, Tex::float(0.2));
+    assert_eq!(front.ks, ConstOrTexture::float(0.2));
     assert!(
         back.is_none(),
         "onesided (the default) shares the front coat"
@@ -131,7 +137,11 @@ fn glossytranslucent_back_face_parameters() {
     let back = back.as_ref().expect("a back coat");
     assert_eq!(
         (back.ks, back.uroughness, back.vroughness),
-        (Tex::float(0.7), Tex::float(0.3), Tex::float(0.0))
+        (
+            ConstOrTexture::float(0.7),
+            ConstOrTexture::float(0.3),
+            ConstOrTexture::float(0.0)
+        )
     );
     assert!(d.warnings.is_empty(), "{:?}", d.warnings);
 }

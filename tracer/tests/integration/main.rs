@@ -7,7 +7,6 @@ mod branching;
 mod bump_render;
 mod daylight;
 mod estimates;
-mod fuzz_regressions;
 mod geometry_on_scenes;
 mod glossy_split;
 #[path = "../../../tests/fixtures/hostile.rs"]

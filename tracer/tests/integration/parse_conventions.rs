@@ -11,7 +11,7 @@ use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
-use yat_tracer::texture::{Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
+use yat_tracer::texture::{Checkerboard, Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
 
 fn source(files: &[(&str, &[u8])]) -> MemorySource {
     let mut s = MemorySource::new();
@@ -136,7 +136,7 @@ fn nested_attribute_blocks_restore_state() {
     assert!(!outer.reverse_orientation && outer.area_light.is_none());
     // The texture defined inside the block went out of scope with it.
     let MaterialDesc::Matte(Matte {
-        kd: Tex::Texture(id),
+        kd: ConstOrTexture::Texture(id),
         ..
     }) = d.materials[outer.material.0 as usize]
     else {
@@ -268,8 +268,8 @@ fn material_defaults_and_rules() {
     assert_eq!(
         *mat(0),
         MaterialDesc::Matte(Matte {
-            kd: Tex::color(Vec3::splat(0.9)),
-            sigma: Tex::float(0.0)
+            kd: ConstOrTexture::color(Vec3::splat(0.9)),
+            sigma: ConstOrTexture::float(0.0)
         })
     );
     let MaterialDesc::Glossy(Glossy {
@@ -289,17 +289,24 @@ fn material_defaults_and_rules() {
     };
     assert_eq!(
         *kd,
-        Tex::color(Vec3::new(1.0, 0.5, 0.0)),
+        ConstOrTexture::color(Vec3::new(1.0, 0.5, 0.0)),
         "Kd clamped to [0, 1]"
     );
-    let Tex::Const(ks) = ks else { panic!() };
+    let ConstOrTexture::Const(ks) = ks else {
+        panic!()
+    };
     assert!(
         close(*ks, Vec3::splat(0.04)),
         "Ks x ((1.5-1)/(1.5+1))^2: {ks}"
     );
     assert_eq!(
         (*ka, *depth, *uroughness, *multibounce),
-        (Tex::float(0.0), Tex::float(0.0), Tex::float(0.1), false)
+        (
+            ConstOrTexture::float(0.0),
+            ConstOrTexture::float(0.0),
+            ConstOrTexture::float(0.1),
+            false
+        )
     );
     let MaterialDesc::Glossy(Glossy {
         kd,
@@ -310,7 +317,7 @@ fn material_defaults_and_rules() {
     };
     assert_eq!(
         (*ks, *kd),
-        (Tex::float(0.4), Tex::float(1.0)),
+        (ConstOrTexture::float(0.4), ConstOrTexture::float(1.0)),
         "\"float Ks\" is a grey colour"
     );
     let MaterialDesc::Glass(Glass {
@@ -327,11 +334,11 @@ fn material_defaults_and_rules() {
     assert_eq!(
         (*kr, *kt, *index, *architectural, *uroughness),
         (
-            Tex::float(1.0),
-            Tex::float(1.0),
-            Tex::float(1.5),
+            ConstOrTexture::float(1.0),
+            ConstOrTexture::float(1.0),
+            ConstOrTexture::float(1.5),
             false,
-            Tex::float(0.001)
+            ConstOrTexture::float(0.001)
         )
     );
     let MaterialDesc::Mix(material::Mix { a, b, amount }) = mat(4) else {
@@ -340,14 +347,14 @@ fn material_defaults_and_rules() {
     assert_eq!(
         d.materials[a.0 as usize],
         MaterialDesc::Mirror(Mirror {
-            kr: Tex::float(1.0)
+            kr: ConstOrTexture::float(1.0)
         })
     );
     assert!(matches!(
         d.materials[b.0 as usize],
         MaterialDesc::Matte(Matte { .. })
     ));
-    assert_eq!(*amount, Tex::float(0.25));
+    assert_eq!(*amount, ConstOrTexture::float(0.25));
     // NamedMaterial stays current for later shapes.
     assert_eq!(d.shapes[5].material, d.shapes[4].material);
 }
@@ -358,8 +365,8 @@ fn shape_without_material_is_default_matte() {
     assert_eq!(
         d.materials[d.shapes[0].material.0 as usize],
         MaterialDesc::Matte(Matte {
-            kd: Tex::color(Vec3::splat(0.9)),
-            sigma: Tex::float(0.0)
+            kd: ConstOrTexture::color(Vec3::splat(0.9)),
+            sigma: ConstOrTexture::float(0.0)
         })
     );
 }
@@ -385,7 +392,7 @@ fn metals_and_fresnel_textures() {
             uroughness,
             ..
         }) => {
-            assert_eq!(*uroughness, Tex::float(0.1));
+            assert_eq!(*uroughness, ConstOrTexture::float(0.1));
             fresnel.clone()
         }
         other => panic!("metal expected, got {other:?}"),
@@ -402,16 +409,16 @@ fn metals_and_fresnel_textures() {
         ".nk files fall back to aluminium"
     );
     assert!(d.warnings.iter().any(|w| w.message.contains("Au.nk")));
-    assert_eq!(fresnel(3), Fresnel::Index(Tex::float(5.0)));
-    assert_eq!(fresnel(4), Fresnel::Index(Tex::float(2.5)));
-    assert_eq!(fresnel(5), Fresnel::Reflectance(Tex::float(0.4)));
+    assert_eq!(fresnel(3), Fresnel::Index(ConstOrTexture::float(5.0)));
+    assert_eq!(fresnel(4), Fresnel::Index(ConstOrTexture::float(2.5)));
+    assert_eq!(fresnel(5), Fresnel::Reflectance(ConstOrTexture::float(0.4)));
     assert_eq!(
         fresnel(6),
-        Fresnel::Reflectance(Tex::color(Vec3::new(0.8, 0.8, 0.2)))
+        Fresnel::Reflectance(ConstOrTexture::color(Vec3::new(0.8, 0.8, 0.2)))
     );
     assert_eq!(
         fresnel(7),
-        Fresnel::Reflectance(Tex::color(Vec3::new(0.9, 0.6, 0.2)))
+        Fresnel::Reflectance(ConstOrTexture::color(Vec3::new(0.9, 0.6, 0.2)))
     );
     assert_eq!(fresnel(8), conductor("copper"));
     assert!(
@@ -467,19 +474,19 @@ fn textures_map_to_descriptions() {
     assert!(!d.textures[1].is_color && d.textures[0].is_color);
     assert_eq!(
         *t(2),
-        TextureKind::Checkerboard3D(Checkerboard3D {
-            tex1: Tex::float(1.0),
-            tex2: Tex::Texture(TextureId(1)),
+        TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
+            tex1: ConstOrTexture::float(1.0),
+            tex2: ConstOrTexture::Texture(TextureId(1)),
             // 3D mappings take the CTM uninverted, as LuxRender 1.x does.
             mapping: Mapping3D::global(Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)))
-        })
+        }))
     );
     assert_eq!(
         *t(3),
         TextureKind::Mix(Mix {
-            tex1: Tex::Texture(TextureId(0)),
-            tex2: Tex::float(1.0),
-            amount: Tex::float(0.3)
+            tex1: ConstOrTexture::Texture(TextureId(0)),
+            tex2: ConstOrTexture::float(1.0),
+            amount: ConstOrTexture::float(0.3)
         })
     );
     let TextureKind::Constant(Constant { value: c }) = t(4) else {

@@ -12,7 +12,7 @@ use yat_tracer::lights::InfiniteLight;
 use yat_tracer::material::Matte;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings, WorkUnit};
 use yat_tracer::sampler::PixelSampler;
-use yat_tracer::texture::Checkerboard2D;
+use yat_tracer::texture::{Checkerboard, Checkerboard2D};
 
 use crate::scene::empty_scene as scene;
 
@@ -136,8 +136,8 @@ fn white_furnace_converges_to_the_sky_radiance() {
             Vec3::ZERO,
             1.0,
             MaterialDesc::Matte(Matte {
-                kd: Tex::float(albedo),
-                sigma: Tex::float(0.0),
+                kd: ConstOrTexture::float(albedo),
+                sigma: ConstOrTexture::float(0.0),
             }),
         );
         constant_sky(&mut desc, Vec3::splat(0.5));
@@ -172,8 +172,8 @@ fn saturated_interreflection_converges_without_fireflies() {
         Vec3::ZERO,
         2.0,
         MaterialDesc::Matte(Matte {
-            kd: Tex::color(albedo),
-            sigma: Tex::float(0.0),
+            kd: ConstOrTexture::color(albedo),
+            sigma: ConstOrTexture::float(0.0),
         }),
     );
     let shape = desc.shapes.last_mut().unwrap();
@@ -214,8 +214,8 @@ fn zero_lens_radius_gives_exactly_the_pinhole_image() {
             Vec3::ZERO,
             1.0,
             MaterialDesc::Matte(Matte {
-                kd: Tex::float(0.7),
-                sigma: Tex::float(0.0),
+                kd: ConstOrTexture::float(0.7),
+                sigma: ConstOrTexture::float(0.0),
             }),
         );
         constant_sky(&mut desc, Vec3::ONE);
@@ -242,8 +242,8 @@ fn thin_lens_blurs_out_of_focus_objects() {
             Vec3::ZERO,
             1.0,
             MaterialDesc::Matte(Matte {
-                kd: Tex::float(0.0),
-                sigma: Tex::float(0.0),
+                kd: ConstOrTexture::float(0.0),
+                sigma: ConstOrTexture::float(0.0),
             }),
         );
         constant_sky(&mut desc, Vec3::ONE);
@@ -342,8 +342,8 @@ fn rendering_is_deterministic_in_any_order() {
         Vec3::ZERO,
         1.0,
         MaterialDesc::Matte(Matte {
-            kd: Tex::float(0.8),
-            sigma: Tex::float(0.0),
+            kd: ConstOrTexture::float(0.8),
+            sigma: ConstOrTexture::float(0.0),
         }),
     );
     constant_sky(&mut desc, Vec3::new(0.3, 0.5, 0.9));
@@ -380,9 +380,9 @@ fn planar_mapping_follows_the_object_space() {
     desc.textures.push(TextureDesc {
         name: "checks".into(),
         is_color: true,
-        kind: TextureKind::Checkerboard2D(Checkerboard2D {
-            tex1: Tex::float(1.0),
-            tex2: Tex::float(0.0),
+        kind: TextureKind::Checkerboard(Checkerboard::D2(Checkerboard2D {
+            tex1: ConstOrTexture::float(1.0),
+            tex2: ConstOrTexture::float(0.0),
             mapping: Mapping2D::Planar {
                 world_to_texture: Mat4::IDENTITY,
                 v1: Vec3::X,
@@ -390,11 +390,11 @@ fn planar_mapping_follows_the_object_space() {
                 udelta: 0.0,
                 vdelta: 0.0,
             },
-        }),
+        })),
     });
     desc.materials.push(MaterialDesc::Matte(Matte {
-        kd: Tex::Texture(TextureId(0)),
-        sigma: Tex::float(0.0),
+        kd: ConstOrTexture::Texture(TextureId(0)),
+        sigma: ConstOrTexture::float(0.0),
     }));
     desc.shapes.push(ShapeDesc {
         name: "quad".into(),

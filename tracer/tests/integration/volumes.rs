@@ -192,12 +192,12 @@ WorldEnd
         MaterialDesc::Glass(Glass { index, .. }) => *index,
         other => panic!("{other:?}"),
     };
-    assert_eq!(index(0), Tex::float(1.33));
-    assert_eq!(index(1), Tex::float(1.7 / 1.33));
+    assert_eq!(index(0), ConstOrTexture::float(1.33));
+    assert_eq!(index(1), ConstOrTexture::float(1.7 / 1.33));
     // The same glass2 and volumes share one material.
     assert_eq!(desc.shapes[1].material, desc.shapes[2].material);
-    assert_eq!(index(3), Tex::float(1.0));
-    assert_eq!(index(4), Tex::float(1.6));
+    assert_eq!(index(3), ConstOrTexture::float(1.0));
+    assert_eq!(index(4), ConstOrTexture::float(1.6));
 }
 
 /// Through a slab of glass2 whose interior is an index-matched (fresnel 1) clear volume of

@@ -36,8 +36,10 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 
-use super::emission::emits;
-use super::infinite::{map_cost, Environment, LatLongConvention};
+use super::emission::{self, emits};
+use super::error::LightError;
+use super::infinite::{map_cost, Environment};
+use super::kind::{LatLongConvention, LightKind, MapSource};
 
 pub use hosek::Hosek;
 pub use preetham::Preetham;
@@ -88,13 +90,31 @@ impl SkyLight {
     }
 
     /// Reads `sky` (`hosek` false) or `sky2` (`hosek` true).
-    pub(crate) fn read(
-        hosek: bool,
-        gain: f32,
+    /// `LightSource "sky"`: Preetham's model.
+    pub(crate) fn read_preetham(
         params: &ParamList,
         pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
+        Self::read(false, params, pos, ctx)
+    }
+
+    /// `LightSource "sky2"`: Hosek and Wilkie's model.
+    pub(crate) fn read_hosek(
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        Self::read(true, params, pos, ctx)
+    }
+
+    fn read(
+        hosek: bool,
+        params: &ParamList,
+        pos: &SourcePos,
+        ctx: &mut dyn ParseContext,
+    ) -> Result<Self, ParseError> {
+        let gain = params.float("gain", emission::DEFAULT_GAIN)?;
         let name = if hosek { "sky2" } else { "sky" };
         let Some(sundir) = params.vec3("sundir", DEFAULT_SUNDIR)?.try_normalize() else {
             return Err(ParseError::Invalid {
@@ -120,14 +140,6 @@ impl SkyLight {
         })
     }
 
-    /// The LuxRender type name.
-    pub fn name(&self) -> &'static str {
-        match self.model {
-            SkyModel::Preetham { .. } => "sky",
-            SkyModel::Hosek => "sky2",
-        }
-    }
-
     /// Radiance per unit gain from a unit light-space direction: the model itself, before
     /// tabulation (None if the model refuses its parameters).
     pub fn model(&self) -> Option<impl Fn(Vec3) -> Vec3 + Sync> {
@@ -148,9 +160,8 @@ impl SkyLight {
         })
     }
 
-    /// The light to sample, if it emits: the model tabulated on a LatLong grid in
-    /// LuxRender's convention.
-    pub fn light(&self) -> Option<Environment> {
+    /// The model tabulated on a LatLong grid in LuxRender's convention, if it emits.
+    fn tabulated(&self) -> Option<Environment> {
         if !(self.gain > 0.0 && self.gain.is_finite()) {
             return None;
         }
@@ -187,5 +198,21 @@ impl SkyLight {
             &self.light_to_world,
             LatLongConvention::LuxRender,
         ))
+    }
+}
+
+impl LightKind for SkyLight {
+    type Sampler = Environment;
+
+    /// The LuxRender type name.
+    fn name(&self) -> &'static str {
+        match self.model {
+            SkyModel::Preetham { .. } => "sky",
+            SkyModel::Hosek => "sky2",
+        }
+    }
+
+    fn light(&self, _maps: &MapSource) -> Result<Option<Environment>, LightError> {
+        Ok(self.tabulated())
     }
 }

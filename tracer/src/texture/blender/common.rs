@@ -18,7 +18,7 @@
 use glam::Vec3;
 
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -35,8 +35,8 @@ pub const DEFAULT_NOISEDEPTH: i32 = 2;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Base {
-    pub tex1: Tex,
-    pub tex2: Tex,
+    pub tex1: ConstOrTexture,
+    pub tex2: ConstOrTexture,
     pub bright: f32,
     pub contrast: f32,
     pub mapping: Mapping3D,

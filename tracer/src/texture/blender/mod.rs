@@ -25,11 +25,12 @@ mod tests;
 use glam::Vec3;
 
 use crate::diag::SourcePos;
-use crate::param::Tex;
+use crate::refs::ConstOrTexture;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::texture::common::{Declared, TextureEval, TexturePoint};
+use crate::texture::common::{Declared, ReferencedTextures, LookupPoint};
+use crate::texture::kind::TextureType;
 pub use common::{Base, Pattern};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -92,21 +93,6 @@ impl Blender {
         Ok(Some(blender))
     }
 
-    /// LuxRender's type name.
-    pub fn name(&self) -> &'static str {
-        match self.kind {
-            BlenderKind::Clouds(_) => "blender_clouds",
-            BlenderKind::Wood(_) => "blender_wood",
-            BlenderKind::Marble(_) => "blender_marble",
-            BlenderKind::Musgrave(_) => "blender_musgrave",
-            BlenderKind::Stucci(_) => "blender_stucci",
-            BlenderKind::Noise(_) => "blender_noise",
-            BlenderKind::Voronoi(_) => "blender_voronoi",
-            BlenderKind::DistortedNoise(_) => "blender_distortednoise",
-            BlenderKind::Magic(_) => "blender_magic",
-            BlenderKind::Blend(_) => "blender_blend",
-        }
-    }
 
     /// Whether the pattern depends on Blender's tabulated noise (all but magic, blend, the
     /// noise-free wood types and cell noise).
@@ -129,10 +115,6 @@ impl Blender {
         }
     }
 
-    /// The textures it blends.
-    pub fn references(&self) -> Vec<Tex> {
-        vec![self.base.tex1, self.base.tex2]
-    }
 
     /// The pattern's raw result at texture-space point `p`.
     pub fn pattern(&self, p: Vec3) -> Pattern {
@@ -149,8 +131,31 @@ impl Blender {
             BlenderKind::Blend(t) => t.pattern(p),
         }
     }
+}
 
-    pub fn eval(&self, at: &TexturePoint, textures: &impl TextureEval) -> Vec3 {
+impl TextureType for Blender {
+    /// LuxRender's type name.
+    fn name(&self) -> &'static str {
+        match self.kind {
+            BlenderKind::Clouds(_) => "blender_clouds",
+            BlenderKind::Wood(_) => "blender_wood",
+            BlenderKind::Marble(_) => "blender_marble",
+            BlenderKind::Musgrave(_) => "blender_musgrave",
+            BlenderKind::Stucci(_) => "blender_stucci",
+            BlenderKind::Noise(_) => "blender_noise",
+            BlenderKind::Voronoi(_) => "blender_voronoi",
+            BlenderKind::DistortedNoise(_) => "blender_distortednoise",
+            BlenderKind::Magic(_) => "blender_magic",
+            BlenderKind::Blend(_) => "blender_blend",
+        }
+    }
+
+    /// The textures it blends.
+    fn references(&self) -> Vec<ConstOrTexture> {
+        vec![self.base.tex1, self.base.tex2]
+    }
+
+    fn eval(&self, at: &LookupPoint, textures: &impl ReferencedTextures) -> Vec3 {
         let f = self.base.weight(self.pattern(self.base.mapping.map(at)));
         let (a, b) = (
             textures.eval(self.base.tex1, at),

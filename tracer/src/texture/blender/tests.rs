@@ -6,9 +6,9 @@ use glam::{Vec2, Vec3};
 
 use super::noise_basis::{voronoi, Metric, NoiseBasis};
 use crate::assets::MemorySource;
-use crate::param::{Tex, TextureId};
+use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::parse_scene;
-use crate::texture::{TexturePoint, Textures};
+use crate::texture::{LookupPoint, Textures};
 
 /// The textures of `statements` (warnings allowed: the noise-table note) and a lookup of the
 /// last one at a point.
@@ -28,7 +28,7 @@ fn texture(statements: &str) -> impl Fn(Vec3) -> f32 {
     let textures = Textures::new(&desc.textures, &source).unwrap();
     move |p| {
         textures
-            .eval(Tex::Texture(last), &TexturePoint::new(p, Vec2::ZERO))
+            .eval(ConstOrTexture::Texture(last), &LookupPoint::new(p, Vec2::ZERO))
             .x
     }
 }

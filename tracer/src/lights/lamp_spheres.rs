@@ -10,20 +10,20 @@ use crate::math::Cone;
 
 /// Lamps tested one by one; a scene with more says "maybe" everywhere (a split vertex costs a
 /// few rays, a test per lamp at every glossy vertex would cost more).
-pub const MAX_LAMP_CONES: usize = 64;
+pub const MAX_LAMP_SPHERES: usize = 64;
 
 /// The lamps' bounding spheres.
 #[derive(Clone, Debug, Default)]
-pub struct LampCones {
+pub struct LampSpheres {
     spheres: Vec<(Vec3, f32)>,
-    /// More lamps than [`MAX_LAMP_CONES`]: every cone may reach one.
+    /// More lamps than [`MAX_LAMP_SPHERES`]: every cone may reach one.
     too_many: bool,
 }
 
-impl LampCones {
+impl LampSpheres {
     /// From the lamps' bounding boxes.
     pub fn new(boxes: &[(Vec3, Vec3)]) -> Self {
-        if boxes.len() > MAX_LAMP_CONES {
+        if boxes.len() > MAX_LAMP_SPHERES {
             return Self {
                 spheres: Vec::new(),
                 too_many: true,
@@ -87,7 +87,7 @@ mod tests {
     #[test]
     fn a_cone_reaching_a_lamp_is_never_missed() {
         let lamp = (Vec3::new(-0.5, -0.5, 4.0), Vec3::new(0.5, 0.5, 4.0));
-        let cones = LampCones::new(&[lamp]);
+        let cones = LampSpheres::new(&[lamp]);
         let p = Vec3::ZERO;
         let (centre, radius) = (Vec3::new(0.0, 0.0, 4.0), 0.5f32.sqrt());
         let mut state = 12345u64;
@@ -126,7 +126,7 @@ mod tests {
     #[test]
     fn a_ray_at_a_lamp_is_never_missed() {
         let lamp = (Vec3::new(-0.5, -0.5, 4.0), Vec3::new(0.5, 0.5, 4.0));
-        let cones = LampCones::new(&[lamp]);
+        let cones = LampSpheres::new(&[lamp]);
         let mut state = 777u64;
         let mut next = || {
             state = crate::sampler::mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
@@ -146,7 +146,7 @@ mod tests {
         }
         // From two thousand lamp sizes away, rays at the lamp's corners (on its sphere) are
         // still said to reach it, and rays passing 1% of its radius outside the sphere are not.
-        let far = LampCones::new(&[(Vec3::new(-0.5, -0.5, 2000.0), Vec3::new(0.5, 0.5, 2000.0))]);
+        let far = LampSpheres::new(&[(Vec3::new(-0.5, -0.5, 2000.0), Vec3::new(0.5, 0.5, 2000.0))]);
         let radius = 0.5f32.sqrt();
         for corner in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
             let p = Vec3::new(3.0, -2.0, 0.0);

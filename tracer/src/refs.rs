@@ -16,17 +16,17 @@ pub struct MaterialId(pub u32);
 /// A material or texture parameter: a constant or a reference to a texture. Float parameters
 /// store their constant splatted over the three channels and read `.x`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Tex {
+pub enum ConstOrTexture {
     Const(Vec3),
     Texture(TextureId),
 }
 
-impl Tex {
+impl ConstOrTexture {
     pub fn float(v: f32) -> Self {
-        Tex::Const(Vec3::splat(v))
+        ConstOrTexture::Const(Vec3::splat(v))
     }
     pub fn color(c: Vec3) -> Self {
-        Tex::Const(c)
+        ConstOrTexture::Const(c)
     }
 }
 
@@ -35,9 +35,9 @@ impl Tex {
 pub enum Fresnel {
     /// Normal-incidence reflectance colour (a `fresnelcolor` texture, or the course's
     /// `color fresnel` / `color Kr` on metal2).
-    Reflectance(Tex),
+    Reflectance(ConstOrTexture),
     /// A real index of refraction with no absorption (`float fresnel`).
-    Index(Tex),
+    Index(ConstOrTexture),
     /// Complex index of refraction per RGB channel (metal presets, `fresnelname`).
     Conductor { eta: Vec3, k: Vec3 },
 }

@@ -1,6 +1,6 @@
-//! Inputs the fuzzer (`fuzz/`, `yat-fuzz parser`) found panicking, minimized, run the way the
-//! fuzzer runs them: parsed from memory, built, and one small unit rendered. Each must end in a
-//! value (a scene, or an error), never a panic.
+//! Inputs the fuzzer (`yat-fuzz parser`) found panicking, minimized, run the way the fuzzer
+//! runs them ([`crate::parser_target`]): parsed from memory, built, and one small unit
+//! rendered. Each must end in a value (a scene, or an error), never a panic.
 //!
 //! Every panic found so far was in the BVH build (obvhs) on huge world coordinates. Geometry
 //! beyond the world range (`geometry/world_range.rs`) is skipped with a warning; nearer far-out
@@ -10,40 +10,23 @@
 use std::sync::Arc;
 
 use yat_tracer::assets::MemorySource;
-use yat_tracer::desc::LatLongConvention;
 use yat_tracer::parse::parse_scene;
-use yat_tracer::render::{RenderScene, RenderSettings, WorkUnit};
+use yat_tracer::render::RenderScene;
 
-/// Parses `main` (with `includes`), builds it and renders one 8x8 unit at 2 samples per pixel;
-/// any step may refuse the input, none may panic.
+use crate::parser_target::{render_settings, UNIT};
+
+/// Parses `main` (with `includes`), builds it and renders one 8x8 unit at 2 samples per pixel
+/// with the fuzzer's settings; any step may refuse the input, none may panic.
 fn parse_build_render(main: &str, includes: &[(&str, &str)]) {
     let mut source = MemorySource::new();
     source.insert("main.lxs", Arc::from(main.as_bytes()));
     for (name, text) in includes {
         source.insert(*name, Arc::from(text.as_bytes()));
     }
-    let settings = RenderSettings {
-        width: 8,
-        height: 8,
-        spp: 2,
-        max_depth: 4,
-        seed: 1,
-        latlong: LatLongConvention::LuxRender,
-    };
-    let unit = WorkUnit {
-        index: 0,
-        x0: 0,
-        y0: 0,
-        x1: 8,
-        y1: 8,
-        sample_start: 0,
-        sample_end: 2,
-        mask: None,
-    };
     // A panic fails the test by itself, with its message.
     if let Ok(desc) = parse_scene("main.lxs", &source) {
-        if let Ok(scene) = RenderScene::build(&desc, &source, &settings) {
-            let (buffer, _) = scene.render_unit(&unit);
+        if let Ok(scene) = RenderScene::build(&desc, &source, &render_settings()) {
+            let (buffer, _) = scene.render_unit(&UNIT);
             assert_eq!(buffer.weight.len(), 64);
         }
     }

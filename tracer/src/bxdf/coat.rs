@@ -1,6 +1,6 @@
 //! A glossy coat: the clear layer of LuxRender's Glossy2 (glossy, glossytranslucent,
 //! glossycoating) and carpaint's three flake lobes. What lies under it is another lobe;
-//! [`coating`](super::coating) puts the two together.
+//! [`coat_over_base`](super::coat_over_base) puts the two together.
 //!
 //! - Up to [`MAX_LOBES`] GGX microfacet reflections, each with Schlick's Fresnel from its own
 //!   normal-incidence reflectance `r0` and scaled by a `weight` (1 for glossy, whose Ks is

@@ -22,7 +22,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::coated::{Coat, CoatSample};
+use super::coat::{Coat, CoatSample};
 use super::local::{flip_z, same_hemisphere};
 use super::sample::LocalSample;
 use super::Bxdf;
