@@ -1,4 +1,4 @@
-//! Camera paths that branch at their first broad vertex (`integrator::path::MAX_BRANCHES`,
+//! Camera paths that branch at their first broad vertex (`integrator::MAX_BRANCHES`,
 //! `render::branching`): the estimate keeps the single path's mean, lamps seen directly and
 //! through a mirror included, its noise drops where light comes through the first bounce, and
 //! the pilot gives the seed scenes the counts measured to pay.

@@ -1,6 +1,6 @@
 //! Paths split at their first glossy vertex that may see a lamp (`GLOSSY_SPLIT` BSDF samples
-//! for the lamps it sees directly, in `tracer/src/integrator/path.rs`): the estimate keeps the
-//! one-sample path tracer's mean and its highlights are less noisy.
+//! for the lamps it sees directly, in `tracer/src/integrator/glossy_split.rs`): the estimate
+//! keeps the one-sample path tracer's mean and its highlights are less noisy.
 
 use glam::Vec3;
 use yat_tracer::integrator::PathScene;
