@@ -247,6 +247,9 @@ impl Materials {
     /// The lobe, coat and bump map of material `id`: a glossycoating's coat over its base's
     /// lobe (whose own coat, if any, is dropped; its bump map applies when the coating has
     /// none).
+    // Inlined into `bsdf`: a call away, its lobe and coat are returned through a temporary and
+    // copied into the BSDF (memcpy on every hit).
+    #[inline(always)]
     fn scattering(
         &self,
         id: MaterialId,
