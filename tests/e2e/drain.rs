@@ -110,8 +110,15 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
             };
             client.handshake(hello).await.unwrap().into_inner().threads
         });
-    child.kill().unwrap();
-    child.wait().unwrap();
+    // Terminated, not killed: the worker's log lines are written by a thread of their own,
+    // which a SIGKILL may stop before it has written the start line; SIGTERM drains (nothing
+    // to drain here) and exits, flushing them.
+    signal(child.id(), "TERM");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while child.try_wait().unwrap().is_none() {
+        assert!(Instant::now() < deadline, "the worker exits on SIGTERM");
+        std::thread::sleep(Duration::from_millis(20));
+    }
     let mut log = String::new();
     child
         .stderr
