@@ -38,13 +38,17 @@ pub struct RenderRequest {
     pub sample_map: Option<PathBuf>,
     /// When an adaptive render stops at a round boundary.
     pub deadline: Option<Instant>,
+    /// What the caller should tell the user before the render: a folder dropped from the
+    /// Film's filename.
+    pub warnings: Vec<String>,
 }
 
 impl RenderRequest {
     /// A render of `scene` with the settings `overrides` resolve from it, checked (and the
     /// film checked against the scene's memory budget), into `output_png`, or, when None, the
-    /// PNG the scene's Film names in the current folder (with a warning on stderr when the
-    /// scene names a folder). No EXR, sample map or deadline: set those fields after.
+    /// PNG the scene's Film names in the current folder (with a warning in
+    /// [`Self::warnings`] when the scene names a folder). No EXR, sample map or deadline: set
+    /// those fields after.
     pub fn new(
         scene: ParsedScene,
         overrides: &RenderOverrides,
@@ -58,14 +62,11 @@ impl RenderRequest {
             a.check().with_context(cannot_render)?;
         }
         scene.check_film(&settings, adaptive.is_some())?;
-        let output_png = match output_png {
-            Some(output) => output,
+        let (output_png, warnings) = match output_png {
+            Some(output) => (output, Vec::new()),
             None => {
                 let (output, warning) = film_output_path(&scene.desc.film.filename)?;
-                if let Some(warning) = warning {
-                    eprintln!("warning: {warning}");
-                }
-                output
+                (output, warning.into_iter().collect())
             }
         };
         check_output_path(&output_png)?;
@@ -77,6 +78,7 @@ impl RenderRequest {
             exr: false,
             sample_map: None,
             deadline: None,
+            warnings,
         })
     }
 }

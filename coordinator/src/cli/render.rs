@@ -144,6 +144,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         min_spp: args.min_spp,
     });
     let mut request = RenderRequest::new(scene, &overrides, adaptive, args.output.clone())?;
+    for warning in &request.warnings {
+        eprintln!("warning: {warning}");
+    }
     let every = |name, value| seconds(name, value).map(|every| (!every.is_zero()).then_some(every));
     let checkpoint_every = every("checkpoint-every", args.checkpoint_every)?;
     let preview_every = every("preview-every", args.preview_every)?;
