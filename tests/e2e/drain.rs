@@ -114,11 +114,8 @@ fn threads_default_to_the_cpus_the_worker_may_use() {
     // which a SIGKILL may stop before it has written the start line; SIGTERM drains (nothing
     // to drain here) and exits, flushing them.
     signal(child.id(), "TERM");
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while child.try_wait().unwrap().is_none() {
-        assert!(Instant::now() < deadline, "the worker exits on SIGTERM");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let exited = wait_for_exit(&mut child, Duration::from_secs(30));
+    assert!(exited.is_some(), "the worker exits on SIGTERM");
     let mut log = String::new();
     child
         .stderr

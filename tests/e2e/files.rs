@@ -175,13 +175,9 @@ fn a_film_filename_cannot_leave_the_current_folder() {
 
 /// Waits for `child` at most `limit`; kills it and fails the test past that.
 fn wait_at_most(mut child: Child, limit: Duration) -> Output {
-    let started = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if started.elapsed() > limit {
-            let _ = child.kill();
-            panic!("still running after {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
+    if wait_for_exit(&mut child, limit).is_none() {
+        let _ = child.kill();
+        panic!("still running after {limit:?}");
     }
     child.wait_with_output().unwrap()
 }

@@ -282,14 +282,7 @@ impl Worker {
         &mut self,
         limit: std::time::Duration,
     ) -> Option<std::process::ExitStatus> {
-        let started = std::time::Instant::now();
-        while started.elapsed() < limit {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                return Some(status);
-            }
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        None
+        wait_for_exit(&mut self.child, limit)
     }
 
     /// Sends a signal (STOP, CONT, TERM).
@@ -339,6 +332,21 @@ pub fn next_line_after(output: &mut impl BufRead, prefix: &str) -> String {
         .strip_prefix(prefix)
         .unwrap_or_else(|| panic!("expected a line starting {prefix:?}, got {line:?}"))
         .to_string()
+}
+
+/// `child`'s exit status, once it ends within `limit` (polled: its pipes stay the caller's).
+pub fn wait_for_exit(
+    child: &mut std::process::Child,
+    limit: std::time::Duration,
+) -> Option<std::process::ExitStatus> {
+    let started = std::time::Instant::now();
+    while started.elapsed() < limit {
+        if let Some(status) = child.try_wait().unwrap() {
+            return Some(status);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    None
 }
 
 /// Sends process `pid` a signal (INT, TERM, STOP, CONT) with the `kill` command.
