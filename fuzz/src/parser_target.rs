@@ -19,8 +19,7 @@ use std::sync::{Arc, Mutex};
 
 use fastrand::Rng;
 use yat_tracer::assets::{AssetError, AssetSource, FsSource, MemorySource};
-use yat_tracer::desc::{Geometry, LatLongConvention, LightDesc, SceneDesc};
-use yat_tracer::mesh::tessellate::tessellate;
+use yat_tracer::desc::{LatLongConvention, LightDesc, SceneDesc};
 use yat_tracer::parse::parse_scene;
 use yat_tracer::render::{RenderScene, RenderSettings, WorkUnit};
 
@@ -40,7 +39,7 @@ const ERROR_POOL_ODDS: u32 = 16;
 
 /// Scenes with more triangles or shapes than this are parsed but not built: building them is
 /// slow without finding more (H4's build budgets bound them in the tracer).
-const MAX_BUILD_TRIANGLES: usize = 200_000;
+const MAX_BUILD_TRIANGLES: u64 = 200_000;
 const MAX_BUILD_SHAPES: usize = 20_000;
 /// Sky lights a built input may hold: each is a 1024x512 table (about 0.1 s of CPU), and the
 /// tracer's texel budget admits a thousand, so inputs that repeat a sky line would spend the
@@ -427,7 +426,7 @@ impl Target for ParserTarget {
         );
         // The exporter's path: analytic shapes as triangles.
         for shape in desc.shapes.iter().take(MAX_TESSELLATED_SHAPES) {
-            if let Some(mesh) = tessellate(&shape.geometry, TESSELLATION_SEGMENTS) {
+            if let Some(mesh) = shape.geometry.tessellate(TESSELLATION_SEGMENTS) {
                 features.push(skeleton_hash(
                     "tessellated",
                     &format!("{}", mesh.indices.is_empty()),
@@ -538,13 +537,10 @@ impl Target for ParserTarget {
 }
 
 fn is_too_big_to_build(desc: &SceneDesc) -> bool {
-    let triangles: usize = desc
+    let triangles: u64 = desc
         .shapes
         .iter()
-        .map(|s| match &s.geometry {
-            Geometry::Mesh(m) => m.indices.len(),
-            _ => 1,
-        })
+        .map(|s| s.geometry.primitive_count())
         .sum();
     let skies = desc
         .lights

@@ -22,7 +22,7 @@ pub use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 pub use crate::mesh::TriangleMesh;
 pub use crate::refs::{ConstOrTexture, Fresnel, MaterialId, TextureId};
 pub use crate::sampler::SamplerDesc;
-pub use crate::shape::{AreaLightDesc, Geometry, ShapeDesc};
+pub use crate::shape::{AreaLightDesc, Cylinder, Disk, Geometry, Plane, ShapeDesc, Sphere};
 pub use crate::texture::{Mapping2D, TextureDesc, TextureKind, Wrap};
 
 #[derive(Clone, Debug)]

@@ -8,7 +8,6 @@ use std::sync::Arc;
 use glam::{Mat3, Vec2, Vec3};
 use yat_tracer::desc::{Geometry, MaterialDesc, SceneDesc, ShapeDesc, TriangleMesh};
 use yat_tracer::material::Null;
-use yat_tracer::mesh::tessellate::{plane_quad, tessellate};
 use yat_tracer::texture::LookupPoint;
 
 use crate::bake::material_bake;
@@ -79,15 +78,15 @@ fn export_shape(
 ) -> Result<Option<Vec<u8>>, ExportError> {
     let mesh: Arc<TriangleMesh> = match &shape.geometry {
         Geometry::Mesh(m) => m.clone(),
-        Geometry::Plane { normal } => {
+        Geometry::Plane(plane) => {
             notes.push(format!(
                 "shape \"{}\": infinite plane as a {}-unit square",
                 shape.name,
                 2.0 * PLANE_HALF_SIZE
             ));
-            Arc::new(plane_quad(*normal, PLANE_HALF_SIZE))
+            Arc::new(plane.quad(PLANE_HALF_SIZE))
         }
-        g => match tessellate(g, opts.segments) {
+        g => match g.tessellate(opts.segments) {
             Some(m) => {
                 notes.push(format!(
                     "shape \"{}\": tessellated into {} triangles",

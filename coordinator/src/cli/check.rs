@@ -239,13 +239,7 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
             _ => 0,
         })
         .sum();
-    let shape_kinds = counts(d.shapes.iter().map(|sh| match sh.geometry {
-        Geometry::Mesh(_) => "mesh",
-        Geometry::Sphere { .. } => "sphere",
-        Geometry::Disk { .. } => "disk",
-        Geometry::Cylinder { .. } => "cylinder",
-        Geometry::Plane { .. } => "plane",
-    }));
+    let shape_kinds = counts(d.shapes.iter().map(|sh| sh.geometry.name()));
     let _ = writeln!(
         s,
         "shapes       {} ({shape_kinds}), {triangles} triangles",

@@ -29,8 +29,7 @@ use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::BvhBuildParams;
 
 use crate::math::Ray;
-use crate::shape::Geometry;
-use crate::shape::ShapeDesc;
+use crate::shape::{Placement, ShapeDesc};
 
 pub use analytic::AnalyticShape;
 pub use footprint::placed_bytes;
@@ -98,8 +97,8 @@ impl SceneGeometry {
             let index = index as u32;
             let m = &shape.object_to_world;
             let ro = shape.reverse_orientation;
-            match &shape.geometry {
-                Geometry::Mesh(mesh) => {
+            match shape.geometry.placement() {
+                Placement::Triangles(mesh) => {
                     let (world, issues) = WorldMesh::new(index, mesh, m, ro);
                     if issues.bad_triangles > 0 || issues.dropped_normals || issues.dropped_uvs {
                         tracing::warn!(
@@ -124,11 +123,13 @@ impl SceneGeometry {
                     }
                     meshes.push(world);
                 }
-                Geometry::Plane { normal } => match InfinitePlane::new(index, *normal, m, ro) {
+                Placement::Unbounded(normal) => match InfinitePlane::new(index, normal, m, ro) {
                     Some(plane) => planes.push(plane),
                     None => tracing::warn!("shape \"{}\": degenerate plane skipped", shape.name),
                 },
-                quadric => match AnalyticShape::new(index, quadric, m, ro) {
+                Placement::Exact(surface) => match surface
+                    .and_then(|s| AnalyticShape::new(index, s, m, ro))
+                {
                     Some(s)
                         if !s.world_bounds().valid()
                             || !within_world(s.world_bounds().min.into())
@@ -251,8 +252,7 @@ impl SceneGeometry {
             }
             Some(&Prim::Analytic(a)) => {
                 // The details of the accepted root, computed as the traversal's test did.
-                let shape = &self.analytic[a as usize];
-                Some(shape.hit(shape.hit_at(origin, dir, hit.t), hit.prim))
+                Some(self.analytic[a as usize].hit(origin, dir, hit.t, hit.prim))
             }
             None => {
                 let plane = self.planes.get(hit.prim as usize - self.prims.len())?;

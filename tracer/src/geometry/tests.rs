@@ -7,6 +7,7 @@ use super::*;
 use crate::desc::*;
 use crate::material::Matte;
 use crate::math::Ray;
+use crate::shape::Placement;
 
 #[path = "../../../tests/fixtures/scene.rs"]
 mod fixture;
@@ -58,12 +59,12 @@ pub(crate) fn mesh(positions: Vec<Vec3>, indices: Vec<[u32; 3]>) -> TriangleMesh
 }
 
 pub(crate) fn sphere(radius: f32) -> Geometry {
-    Geometry::Sphere {
+    Geometry::Sphere(Sphere {
         radius,
         zmin: -radius,
         zmax: radius,
         phimax: 360.0,
-    }
+    })
 }
 
 fn unit_triangle() -> TriangleMesh {
@@ -273,12 +274,12 @@ fn sphere_hits_have_pbrt_t_normal_uv_and_tangent() {
 #[test]
 fn sphere_z_and_phi_limits_clip_hits() {
     // Top cut at z = 1: a ray straight down passes the hole and meets the inside bottom.
-    let cut = Geometry::Sphere {
+    let cut = Geometry::Sphere(Sphere {
         radius: 2.0,
         zmin: -2.0,
         zmax: 1.0,
         phimax: 360.0,
-    };
+    });
     let geometry =
         SceneGeometry::build(&scene_desc(vec![shape(cut, Mat4::IDENTITY)], vec![]).shapes);
     let hit = geometry
@@ -293,12 +294,12 @@ fn sphere_z_and_phi_limits_clip_hits() {
     assert!((hit.p.z + 1.75f32.sqrt()).abs() < 1e-4);
 
     // phimax 90: only the quarter with x, y >= 0 exists.
-    let quarter = Geometry::Sphere {
+    let quarter = Geometry::Sphere(Sphere {
         radius: 1.0,
         zmin: -1.0,
         zmax: 1.0,
         phimax: 90.0,
-    };
+    });
     let geometry =
         SceneGeometry::build(&scene_desc(vec![shape(quarter, Mat4::IDENTITY)], vec![]).shapes);
     let d = Vec3::new(1.0, 1.0, 0.0).normalize();
@@ -321,12 +322,12 @@ fn sphere_z_and_phi_limits_clip_hits() {
 
 #[test]
 fn disk_and_cylinder_hits_follow_pbrt() {
-    let disk = Geometry::Disk {
+    let disk = Geometry::Disk(Disk {
         height: 0.5,
         radius: 2.0,
         inner_radius: 1.0,
         phimax: 360.0,
-    };
+    });
     let geometry =
         SceneGeometry::build(&scene_desc(vec![shape(disk, Mat4::IDENTITY)], vec![]).shapes);
     let hit = geometry
@@ -346,12 +347,12 @@ fn disk_and_cylinder_hits_follow_pbrt() {
         .intersect(&down(Vec3::new(0.0, 2.5, 3.0)), f32::INFINITY)
         .is_none());
 
-    let cylinder = Geometry::Cylinder {
+    let cylinder = Geometry::Cylinder(Cylinder {
         radius: 1.0,
         zmin: -1.0,
         zmax: 3.0,
         phimax: 360.0,
-    };
+    });
     let m = Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2);
     let geometry = SceneGeometry::build(&scene_desc(vec![shape(cylinder, m)], vec![]).shapes);
     // Object z = 2 is world -y = 2 after the rotation about x; the outside faces -x here.
@@ -374,7 +375,7 @@ fn disk_and_cylinder_hits_follow_pbrt() {
 
 #[test]
 fn planes_are_hit_without_the_bvh() {
-    let plane = Geometry::Plane { normal: Vec3::Z };
+    let plane = Geometry::Plane(Plane { normal: Vec3::Z });
     let desc = scene_desc(
         vec![
             shape(plane, Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0))),
@@ -417,7 +418,10 @@ fn bad_input_is_skipped_without_panics() {
             ),
             shape(sphere(-1.0), Mat4::IDENTITY),
             shape(sphere(1.0), Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))),
-            shape(Geometry::Plane { normal: Vec3::ZERO }, Mat4::IDENTITY),
+            shape(
+                Geometry::Plane(Plane { normal: Vec3::ZERO }),
+                Mat4::IDENTITY,
+            ),
         ],
         vec![],
     );
@@ -466,24 +470,24 @@ fn random_scene(rng: &mut fastrand::Rng) -> SceneDesc {
             * Mat4::from_axis_angle(random_unit(rng), rng.f32() * 6.0)
             * Mat4::from_scale(Vec3::new(0.5 + rng.f32(), 0.5 + rng.f32(), 0.5 + rng.f32()));
         let geometry = match rng.u32(0..3) {
-            0 => Geometry::Sphere {
+            0 => Geometry::Sphere(Sphere {
                 radius: 0.5,
                 zmin: -0.5 + rng.f32() * 0.4,
                 zmax: 0.5,
                 phimax: 180.0 + rng.f32() * 180.0,
-            },
-            1 => Geometry::Disk {
+            }),
+            1 => Geometry::Disk(Disk {
                 height: 0.1,
                 radius: 0.6,
                 inner_radius: 0.2,
                 phimax: 270.0,
-            },
-            _ => Geometry::Cylinder {
+            }),
+            _ => Geometry::Cylinder(Cylinder {
                 radius: 0.3,
                 zmin: -0.5,
                 zmax: 0.5,
                 phimax: 300.0,
-            },
+            }),
         };
         shapes.push(shape(geometry, m));
     }
@@ -551,14 +555,14 @@ fn bvh_matches_brute_force_and_occluded_matches_intersect() {
 fn quadric_area_sampling_density_integrates_to_the_world_area() {
     // A unit disk stretched to an ellipse with semi-axes 2 and 3: area 6 pi, while the
     // sampler works uniformly in object space. E[1 / pdf] is the world area.
-    let disk = Geometry::Disk {
+    let disk = Geometry::Disk(Disk {
         height: 0.0,
         radius: 1.0,
         inner_radius: 0.0,
         phimax: 360.0,
-    };
+    });
     let m = Mat4::from_rotation_y(0.3) * Mat4::from_scale(Vec3::new(2.0, 3.0, 1.0));
-    let shape = AnalyticShape::new(0, &disk, &m, false).unwrap();
+    let shape = placed_exactly(&disk, &m);
     let n = 200_000;
     let mut rng = fastrand::Rng::with_seed(3);
     let mean: f64 = (0..n)
@@ -573,7 +577,7 @@ fn quadric_area_sampling_density_integrates_to_the_world_area() {
     // An ellipsoid (1, 1, 2): the density varies over the surface; its integral is the area
     // (by quadrature over the spheroid x = sin t cos p, y = sin t sin p, z = 2 cos t).
     let m = Mat4::from_scale(Vec3::new(1.0, 1.0, 2.0));
-    let shape = AnalyticShape::new(0, &sphere(1.0), &m, false).unwrap();
+    let shape = placed_exactly(&sphere(1.0), &m);
     let quadrature: f64 = (0..2000)
         .map(|i| {
             // Area element of the spheroid x = sin t cos p, y = sin t sin p, z = 2 cos t.
@@ -595,6 +599,14 @@ fn quadric_area_sampling_density_integrates_to_the_world_area() {
         (mean / quadrature - 1.0).abs() < 0.01,
         "mean {mean}, area {quadrature}"
     );
+}
+
+/// An exact shape placed by `m`.
+fn placed_exactly(geometry: &Geometry, m: &Mat4) -> AnalyticShape {
+    let Placement::Exact(Some(surface)) = geometry.placement() else {
+        panic!("{geometry:?} is not an exact shape");
+    };
+    AnalyticShape::new(0, surface, m, false).expect("an invertible transform")
 }
 
 /// A closed bumpy sphere of about 4 x segments^2 triangles.
@@ -884,7 +896,7 @@ fn occlusion_looks_through_crossed_shapes_only() {
         ),
         shape(Geometry::Mesh(Arc::new(big(4.0))), Mat4::IDENTITY),
         shape(Geometry::Mesh(Arc::new(aside)), Mat4::IDENTITY),
-        shape(Geometry::Plane { normal: Vec3::Z }, Mat4::IDENTITY),
+        shape(Geometry::Plane(Plane { normal: Vec3::Z }), Mat4::IDENTITY),
     ];
     let ray = down(Vec3::new(0.0, 0.0, 10.0));
     let blocked_before = |crossed: [bool; 4], tmax: f32| {

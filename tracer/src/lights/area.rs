@@ -388,8 +388,7 @@ impl AreaLight {
         let uv = match on {
             SampledSurface::Triangle(triangle) => triangle.uv_at(p),
             SampledSurface::Quadric(shape) => {
-                let hit = shape.hit_at(Vec3A::from(from), Vec3A::from(wi), dist);
-                shape.hit(hit, 0).uv
+                shape.hit(Vec3A::from(from), Vec3A::from(wi), dist, 0).uv
             }
         };
         texture.at(p, uv)

@@ -6,7 +6,7 @@ use glam::{DVec3, Mat4, Vec2, Vec3};
 
 use super::*;
 use crate::assets::MemorySource;
-use crate::desc::{AreaLightDesc, Geometry, ShapeDesc};
+use crate::desc::{AreaLightDesc, Disk, Geometry, ShapeDesc, Sphere};
 use crate::geometry::tests::{mesh, scene_desc, shape, sphere};
 use crate::math::{luminance, Frame, Ray};
 
@@ -62,12 +62,12 @@ fn square_facing_down(side: f32) -> Geometry {
 }
 
 fn disk(radius: f32) -> Geometry {
-    Geometry::Disk {
+    Geometry::Disk(Disk {
         height: 0.0,
         radius,
         inner_radius: 0.0,
         phimax: 360.0,
-    }
+    })
 }
 
 fn point(position: Vec3, intensity: f32) -> LightDesc {
@@ -176,12 +176,12 @@ fn pdf_hit_agrees_with_sample_at_the_sampled_point() {
         ),
         // A partial sphere and a stretched disk take the uniform-area path.
         emitter(
-            Geometry::Sphere {
+            Geometry::Sphere(Sphere {
                 radius: 0.7,
                 zmin: -0.7,
                 zmax: 0.3,
                 phimax: 270.0,
-            },
+            }),
             Mat4::from_translation(Vec3::new(-3.0, 0.0, 1.0)),
             Vec3::splat(2.0),
         ),

@@ -1,8 +1,7 @@
 //! Triangle meshes: the data every mesh-like shape becomes, reading them from inline shape
 //! parameters ([`inline`]) and from PLY files ([`ply`]), Loop subdivision and displacement
-//! ([`subdiv`]), heightfields ([`heightfield`]), the swept quadrics ([`quadric`]), and
-//! making them from the analytic shapes ([`tessellate`]) on the shared parametric grid
-//! ([`grid`]).
+//! ([`subdiv`]), heightfields ([`heightfield`]), the swept quadrics ([`quadric`]), on the
+//! parametric grid ([`grid`]) the tessellated shapes share.
 
 pub mod grid;
 pub mod heightfield;
@@ -10,7 +9,6 @@ pub mod inline;
 pub mod ply;
 pub mod quadric;
 pub mod subdiv;
-pub mod tessellate;
 
 use glam::Vec3;
 

@@ -634,8 +634,14 @@ fn meshes_quads_uvs_and_planes() {
     assert_eq!(m.uvs.as_ref().unwrap()[2], [1.0, 1.0]);
     assert_eq!(m.normals.as_ref().unwrap().len(), 4);
     assert_eq!(d.shapes[0].name, "quad");
-    assert_eq!(d.shapes[1].geometry, Geometry::Plane { normal: Vec3::Z });
-    assert_eq!(d.shapes[2].geometry, Geometry::Plane { normal: Vec3::Z });
+    assert_eq!(
+        d.shapes[1].geometry,
+        Geometry::Plane(Plane { normal: Vec3::Z })
+    );
+    assert_eq!(
+        d.shapes[2].geometry,
+        Geometry::Plane(Plane { normal: Vec3::Z })
+    );
 }
 
 #[test]
@@ -743,7 +749,7 @@ fn free_form_layout_and_optional_brackets() {
     assert_eq!((d.film.xresolution, d.film.yresolution), (320, 240));
     assert_eq!(d.camera.kind, CameraKind::Perspective { fov: 30.0 });
     assert!(
-        matches!(d.shapes[0].geometry, Geometry::Sphere { radius, zmin, zmax, phimax } if (radius, zmin, zmax, phimax) == (2.0, -2.0, 2.0, 360.0))
+        matches!(d.shapes[0].geometry, Geometry::Sphere(Sphere { radius, zmin, zmax, phimax }) if (radius, zmin, zmax, phimax) == (2.0, -2.0, 2.0, 360.0))
     );
 }
 

@@ -38,12 +38,12 @@ fn add_sphere(desc: &mut SceneDesc, centre: Vec3, radius: f32, material: Materia
     desc.materials.push(material);
     desc.shapes.push(ShapeDesc {
         name: "sphere".into(),
-        geometry: Geometry::Sphere {
+        geometry: Geometry::Sphere(Sphere {
             radius,
             zmin: -radius,
             zmax: radius,
             phimax: 360.0,
-        },
+        }),
         object_to_world: Mat4::from_translation(centre),
         reverse_orientation: false,
         material: MaterialId(desc.materials.len() as u32 - 1),

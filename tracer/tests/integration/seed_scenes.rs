@@ -187,7 +187,7 @@ fn depth_of_field_spheres_and_lens() {
         let spheres = d
             .shapes
             .iter()
-            .filter(|s| matches!(s.geometry, Geometry::Sphere { .. }))
+            .filter(|s| matches!(s.geometry, Geometry::Sphere(_)))
             .count();
         assert_eq!(spheres, 3, "{scene}");
         assert_eq!(d.camera.lens_radius, lens, "{scene}");
