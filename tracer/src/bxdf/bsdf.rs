@@ -52,6 +52,27 @@ impl Bsdf {
         matches!(self.bxdf, Bxdf::PassThrough(_))
     }
 
+    /// What a pane of architectural glass lets straight through along `w` (either way), as a
+    /// shadow ray crossing it sees it: see
+    /// [`Dielectric::straight_transmittance`](super::dielectric::Dielectric::straight_transmittance). None for
+    /// every other BSDF.
+    pub fn straight_transmittance(&self, w: Vec3) -> Option<Vec3> {
+        match (&self.bxdf, &self.coating) {
+            (Bxdf::Dielectric(d), None) => d.straight_transmittance(self.frame.to_local(w)),
+            _ => None,
+        }
+    }
+
+    /// For a pane of architectural glass, the weight of the straight transmission when
+    /// `u_lobe` chooses it over the reflection (the choice [`Self::sample`] makes with the same
+    /// `u_lobe`); None when it reflects, and for every other BSDF.
+    pub fn sample_straight(&self, wo: Vec3, u_lobe: f32) -> Option<Vec3> {
+        match (&self.bxdf, &self.coating) {
+            (Bxdf::Dielectric(d), None) => d.sample_straight(self.frame.to_local(wo), u_lobe),
+            _ => None,
+        }
+    }
+
     /// A bare Lambert BSDF's shading frame, geometric normal and value (the same for every
     /// pair of directions it reflects): what a path traced in lanes shades with. None for
     /// every other BSDF, and for a value that is zero or not finite.

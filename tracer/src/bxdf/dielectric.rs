@@ -65,17 +65,22 @@ impl Dielectric {
         }
     }
 
-    fn sample_thin(&self, wo: Vec3, u_lobe: f32) -> Option<LocalSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        // Light bounces between the two faces of the pane: sum the geometric series of the
-        // internal reflections (pbrt-v4's ThinDielectricBxDF).
+    /// A thin pane seen along `wo`: its reflectance, the internal reflections between its two
+    /// faces summed as a geometric series (pbrt-v4's ThinDielectricBxDF), and the probability
+    /// of sampling the reflection.
+    fn thin_split(&self, wo: Vec3) -> (f32, f32) {
         let mut r = fresnel::dielectric(wo.z.abs(), self.eta);
         if r < 1.0 {
             r += (1.0 - r) * (1.0 - r) * r / (1.0 - r * r);
         }
-        let p_reflect = self.reflect_probability(r);
+        (r, self.reflect_probability(r))
+    }
+
+    fn sample_thin(&self, wo: Vec3, u_lobe: f32) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let (r, p_reflect) = self.thin_split(wo);
         if u_lobe < p_reflect {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             LocalSample::specular(wi, self.kr * (r / wi.z.abs()), p_reflect)
@@ -83,6 +88,28 @@ impl Dielectric {
             let wi = -wo;
             LocalSample::specular(wi, self.kt * ((1.0 - r) / wi.z.abs()), 1.0 - p_reflect)
         }
+    }
+
+    /// What a pane of architectural glass lets straight through along `wo` (either way):
+    /// its transmission tint times the light its faces do not reflect. None for every other
+    /// interface, which bends or scatters what it transmits.
+    pub fn straight_transmittance(&self, wo: Vec3) -> Option<Vec3> {
+        if !matches!(self.surface, Surface::Thin) || wo.z == 0.0 {
+            return None;
+        }
+        let (r, _) = self.thin_split(wo);
+        Some(self.kt * (1.0 - r))
+    }
+
+    /// The pane's lobe choice of [`Lobe::sample`] for `u_lobe`, when it is the straight
+    /// transmission: the sample's weight (f cos / pdf). None when it reflects, and for every
+    /// other interface.
+    pub fn sample_straight(&self, wo: Vec3, u_lobe: f32) -> Option<Vec3> {
+        if !matches!(self.surface, Surface::Thin) || wo.z == 0.0 {
+            return None;
+        }
+        let (r, p_reflect) = self.thin_split(wo);
+        (u_lobe >= p_reflect).then(|| self.kt * ((1.0 - r) / (1.0 - p_reflect)))
     }
 
     /// The generalized half vector of a reflection or refraction pair, facing up; None for

@@ -4,7 +4,8 @@
 use glam::Vec3;
 
 use super::mis::power_heuristic;
-use super::scene::PathScene;
+use super::scene::{Crossing, PathScene};
+use super::shadow::pane_transmittance;
 use super::state::MAX_PASS_THROUGH;
 use crate::geometry::SurfaceHit;
 use crate::lights::Lights;
@@ -82,7 +83,7 @@ pub(super) fn split_bsdf_light<S: PathScene>(
                 power_heuristic(count * bs.pdf, (1.0 - image_share) * pdf_light)
             }
         };
-        let scale = bs.f * (bs.wi.dot(hit.ns).abs() / (bs.pdf * count));
+        let mut scale = bs.f * (bs.wi.dot(hit.ns).abs() / (bs.pdf * count));
         let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
         for _ in 0..=MAX_PASS_THROUGH {
             seen.rays += 1;
@@ -93,8 +94,10 @@ pub(super) fn split_bsdf_light<S: PathScene>(
             if le != Vec3::ZERO {
                 seen.radiance += scale * le * weight_of(lights.pdf_hit(hit.p, &next));
             }
-            if !scene.is_pass_through(next.shape) {
-                break;
+            match scene.crossing(next.shape) {
+                Crossing::Blocks => break,
+                Crossing::Null => {}
+                Crossing::Pane => scale *= pane_transmittance(scene, &next, bs.wi),
             }
             ray = Ray::new(offset_origin(next.p, next.ng, bs.wi), bs.wi);
         }

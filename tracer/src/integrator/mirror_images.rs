@@ -108,8 +108,9 @@ pub(super) fn direct_light_via_mirror<S: PathScene>(
 }
 
 /// The flat mirror the vertex at `hit` (reached from `wo`) is, when the path's sample `bs`
-/// reflects in it straight after a vertex that sampled lamp images (`prev`; no null surface
-/// between).
+/// reflects in it straight after a vertex that sampled lamp images (`prev`; nothing `crossed`
+/// between, neither a null surface nor a pane: an image's light sample needs the mirror to be
+/// the first surface it meets).
 #[inline(always)]
 pub(super) fn mirror_after(
     lights: &Lights,
@@ -117,10 +118,10 @@ pub(super) fn mirror_after(
     wo: Vec3,
     prev: &PrevScatter,
     bs: &BsdfSample,
-    crossed_null: bool,
+    crossed: bool,
 ) -> Option<BeforeMirror> {
     let after_images = !prev.specular && prev.image_share > 0.0;
-    if !bs.specular || !after_images || crossed_null {
+    if !bs.specular || !after_images || crossed {
         return None;
     }
     lights

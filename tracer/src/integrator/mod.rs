@@ -33,7 +33,7 @@ use crate::sampler::PixelSampler;
 pub use branch::MAX_BRANCHES;
 pub use glossy_split::GLOSSY_SPLIT;
 pub use options::{IntegratorDesc, RussianRoulette};
-pub use scene::PathScene;
+pub use scene::{Crossing, PathScene};
 pub use state::PathResult;
 
 /// Radiance along the camera ray `ray`, drawn from `sampler`.

@@ -13,7 +13,7 @@ use super::media::{travel, Segment, Travel};
 use super::mirror_images::mirror_after;
 use super::mis::power_heuristic;
 use super::roulette::survives;
-use super::scene::PathScene;
+use super::scene::{Crossing, PathScene};
 use super::state::{BranchPoint, PathResult, PathState, PrevScatter, MAX_PASS_THROUGH};
 use super::vertex::Vertex;
 use crate::lights::IMAGE_SHARE;
@@ -37,6 +37,7 @@ pub(super) fn walk<S: PathScene>(
     let lights = scene.lights();
     let volumes = scene.volumes();
     let has_media = !volumes.media.is_empty();
+    let panes = scene.has_panes();
     let PathState {
         mut ray,
         mut traced,
@@ -135,9 +136,19 @@ pub(super) fn walk<S: PathScene>(
         // fixed whatever the material.
         let u = sampler.get_vertex();
         let bsdf = scene.bsdf_at(&hit, u.mix);
-        if bsdf.is_pass_through() {
+        let straight = if bsdf.is_pass_through() {
             // Only the mix choice is used: the next vertex's dimensions follow it.
             sampler.unread_after_mix();
+            Some(Vec3::ONE)
+        } else if panes && scene.crossing(hit.shape) == Crossing::Pane {
+            // A pane that transmits goes on as a shadow ray through it does, so that the light
+            // behind it is weighed against the previous vertex's light sample.
+            bsdf.sample_straight(wo, u.lobe)
+        } else {
+            None
+        };
+        if let Some(transmittance) = straight {
+            throughput *= transmittance;
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
                 break;
@@ -146,7 +157,7 @@ pub(super) fn walk<S: PathScene>(
             ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
             continue;
         }
-        let crossed_null = pass_through > 0;
+        let crossed = pass_through > 0;
         pass_through = 0;
         if depth >= max_depth {
             break;
@@ -217,7 +228,7 @@ pub(super) fn walk<S: PathScene>(
             break;
         }
 
-        let before_mirror = mirror_after(lights, &hit, wo, &prev, &bs, crossed_null);
+        let before_mirror = mirror_after(lights, &hit, wo, &prev, &bs, crossed);
         prev = PrevScatter {
             p: hit.p,
             pdf: bs.pdf,

@@ -6,6 +6,22 @@ use crate::lights::Lights;
 use crate::material::Bsdf;
 use crate::medium::{ShapeMedia, Volumes};
 
+/// How a shadow ray meets a shape. Paths cross the same shapes the same way (a `null` always,
+/// a pane when its lobe choice is the straight transmission), so light sampling and BSDF
+/// sampling see the same light behind them and multiple importance sampling weighs them as one
+/// strategy pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// It stops there.
+    Blocks,
+    /// `null`: it goes on unchanged (the geometry's occlusion test looks through it).
+    Null,
+    /// A pane of architectural glass (LuxRender's `architectural` glass): it goes on without
+    /// bending, carrying the pane's straight transmittance
+    /// ([`Bsdf::straight_transmittance`]).
+    Pane,
+}
+
 /// What the path tracer needs from the scene. The renderer's built scene implements it, so the
 /// integrator does not depend on how the scene is built.
 pub trait PathScene {
@@ -21,12 +37,14 @@ pub trait PathScene {
     fn volumes(&self) -> &Volumes;
     /// The volumes on the two sides of shape `shape`.
     fn shape_media(&self, shape: u32) -> ShapeMedia;
-    /// Whether shape `shape` is `null` (shadow rays cross it, as paths do: the geometry's
-    /// occlusion test looks through it).
-    fn is_pass_through(&self, shape: u32) -> bool;
+    /// How a shadow ray crosses shape `shape` (and a path that goes straight on through it).
+    fn crossing(&self, shape: u32) -> Crossing;
+    /// Whether some shape is a [`Crossing::Pane`]: shadow rays then walk from surface to
+    /// surface, as in a scene with volumes.
+    fn has_panes(&self) -> bool;
     /// Whether paths split at glossy vertices ([`GLOSSY_SPLIT`](super::glossy_split::GLOSSY_SPLIT)): the integrator allows it, the
     /// scene has lamps and metals, and no volumes or material that lets rays through at some
-    /// hits only (a split sample crosses a surface only where [`Self::is_pass_through`] says so).
+    /// hits only (a split sample crosses a surface only where [`Self::crossing`] says so).
     fn glossy_split(&self) -> bool;
     /// The continuations a camera path's first broad scattering vertex sends on (see
     /// [`MAX_BRANCHES`](super::branch::MAX_BRANCHES); 1: the path goes on alone).

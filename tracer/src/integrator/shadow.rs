@@ -1,20 +1,24 @@
-//! Shadow rays: what reaches a light sample's point, through null surfaces and volumes.
+//! Shadow rays: what reaches a light sample's point, through null surfaces, panes of
+//! architectural glass and volumes.
 
 use glam::Vec3;
 
-use super::scene::PathScene;
+use super::scene::{Crossing, PathScene};
 use super::state::MAX_PASS_THROUGH;
+use crate::geometry::SurfaceHit;
 use crate::lanes::Lanes;
 use crate::math::{offset_origin, Ray};
 use crate::medium::MediumId;
 use crate::vec3_lanes::{dot, V3};
 
 /// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
-/// a surface blocks the way, else the volumes' transmittance. `null` surfaces let the ray
-/// through (into the volume behind them), as LuxRender's shadow rays cross them and as paths
-/// do, so light sampling sees what BSDF sampling sees: the sky behind a `null` lamp, or a light
-/// inside a null-bounded volume. (A shadow ray stopped there would lose the light samples of
-/// what BSDF samples find behind it, while MIS weighs each as if the other could: dark.)
+/// a surface blocks the way, else the volumes' and panes' transmittance. `null` surfaces let
+/// the ray through (into the volume behind them), as LuxRender's shadow rays cross them and as
+/// paths do, so light sampling sees what BSDF sampling sees: the sky behind a `null` lamp, or a
+/// light inside a null-bounded volume. (A shadow ray stopped there would lose the light samples
+/// of what BSDF samples find behind it, while MIS weighs each as if the other could: dark.)
+/// Panes of architectural glass let it through with their transmittance, as LuxRender's
+/// shadow rays cross them: the sun through a window is light-sampled.
 pub(super) fn shadow_transmittance<S: PathScene>(
     scene: &S,
     origin: Vec3,
@@ -23,7 +27,7 @@ pub(super) fn shadow_transmittance<S: PathScene>(
     medium: Option<MediumId>,
     rays: &mut u32,
 ) -> Vec3 {
-    if scene.volumes().media.is_empty() {
+    if scene.volumes().media.is_empty() && !scene.has_panes() {
         *rays += 1;
         let blocked = scene.geometry().occluded(&Ray::new(origin, dir), tmax);
         return if blocked { Vec3::ZERO } else { Vec3::ONE };
@@ -31,8 +35,8 @@ pub(super) fn shadow_transmittance<S: PathScene>(
     shadow_walk(scene, origin, dir, tmax, medium, rays)
 }
 
-/// [`shadow_transmittance`] in a scene with volumes: surface by surface. Out of line: the path
-/// loop of a scene without volumes stays small.
+/// [`shadow_transmittance`] in a scene with volumes or panes: surface by surface. Out of line:
+/// the path loop of a scene without them stays small.
 #[inline(never)]
 fn shadow_walk<S: PathScene>(
     scene: &S,
@@ -61,7 +65,12 @@ fn shadow_walk<S: PathScene>(
         let (Some(h), Some(sides)) = (hit, sides) else {
             return tr;
         };
-        if !scene.is_pass_through(h.shape) || tr == Vec3::ZERO {
+        match scene.crossing(h.shape) {
+            Crossing::Blocks => return Vec3::ZERO,
+            Crossing::Null => {}
+            Crossing::Pane => tr *= pane_transmittance(scene, &h, dir),
+        }
+        if tr == Vec3::ZERO {
             return Vec3::ZERO;
         }
         medium = sides.toward(dir, h.ng);
@@ -73,6 +82,15 @@ fn shadow_walk<S: PathScene>(
         }
     }
     Vec3::ZERO
+}
+
+/// What the pane at `hit` lets straight through along `dir`: its material evaluated there
+/// (a pane's material is a glass, never a mix: nothing to choose).
+pub(super) fn pane_transmittance<S: PathScene>(scene: &S, hit: &SurfaceHit, dir: Vec3) -> Vec3 {
+    scene
+        .bsdf_at(hit, 0.0)
+        .straight_transmittance(dir)
+        .unwrap_or(Vec3::ZERO)
 }
 
 /// The distance a shadow ray from `origin` travels to a light sampled at `dist` from `p`:

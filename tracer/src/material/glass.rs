@@ -11,7 +11,7 @@
 //! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
 //! | `Kt` | color texture (likewise) | 1 ([`DEFAULT_KT`]) |
 //! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 has none: its index is its shape's `Interior` volume's `fresnel` over its `Exterior`'s, 1 for a side with no volume ([`GLASS2_INDEX_WITHOUT_VOLUMES`] when it has neither), set per shape by the parser |
-//! | `architectural` | bool | false |
+//! | `architectural` | bool | false: a thin pane (a window) that does not bend light; shadow rays cross it with its straight transmittance, as LuxRender's do ([`crate::integrator::Crossing::Pane`]) |
 //! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
 //! | `film`, `cauchyb` | float | 0; not supported (a warning otherwise) |
 //! | `dispersion` | bool, glass2 only | ignored |

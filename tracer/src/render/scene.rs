@@ -15,7 +15,7 @@ use crate::filter::PixelFilter;
 use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
-use crate::integrator::{trace_path, PathResult, PathScene, MAX_BRANCHES};
+use crate::integrator::{trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::Avx2Cpu;
 use crate::lanes::{Lanes, OnLanes};
@@ -78,6 +78,10 @@ pub struct RenderScene {
     lights: Lights,
     /// Per shape, for the object-space positions 3D texture mappings use.
     world_to_object: Vec<glam::Affine3A>,
+    /// Per shape, see [`PathScene::crossing`].
+    crossings: Vec<Crossing>,
+    /// See [`PathScene::has_panes`].
+    has_panes: bool,
     /// See [`PathScene::glossy_split`].
     glossy_split: bool,
     /// See [`PathScene::first_vertex_branches`]: chosen by [`branching::choose`].
@@ -109,12 +113,12 @@ impl RenderScene {
         check_budget(desc, guard)?;
         guard.check_cancel()?;
         let mut geometry = SceneGeometry::build(&desc.shapes);
-        geometry.cross_in_occlusion(
-            desc.shapes
-                .iter()
-                .map(|s| is_null(desc, s.material))
-                .collect(),
-        );
+        let crossings: Vec<Crossing> = desc
+            .shapes
+            .iter()
+            .map(|s| crossing(desc, s.material))
+            .collect();
+        geometry.cross_in_occlusion(crossings.iter().map(|&c| c == Crossing::Null).collect());
         guard.check_cancel()?;
         let textures = Arc::new(Textures::new(&desc.textures, source)?);
         guard.check_cancel()?;
@@ -145,6 +149,8 @@ impl RenderScene {
                 .iter()
                 .map(|s| crate::math::affine_inverse(&glam::Affine3A::from_mat4(s.object_to_world)))
                 .collect(),
+            has_panes: crossings.contains(&Crossing::Pane),
+            crossings,
             glossy_split: glossy_split(desc),
             first_vertex_branches: 1,
             packets: false,
@@ -458,6 +464,19 @@ fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
         .collect()
 }
 
+/// How shadow rays cross the shapes material `id` is on: a `null` always, a pane of
+/// architectural glass (bumped or not; inside a mix it is a choice a shadow ray cannot make,
+/// and it blocks) with its transmittance.
+fn crossing(desc: &SceneDesc, id: MaterialId) -> Crossing {
+    let pane = |m: &MaterialDesc| matches!(m, MaterialDesc::Glass(g) if g.architectural);
+    match desc.materials.get(id.0 as usize) {
+        Some(MaterialDesc::Null(_)) => Crossing::Null,
+        Some(m) if pane(m) => Crossing::Pane,
+        Some(MaterialDesc::Bumped(m, _)) if pane(m) => Crossing::Pane,
+        _ => Crossing::Blocks,
+    }
+}
+
 /// Whether material `id` is `null`: paths and shadow rays cross the shapes it is on.
 fn is_null(desc: &SceneDesc, id: MaterialId) -> bool {
     matches!(
@@ -542,10 +561,14 @@ impl PathScene for RenderScene {
         self.first_vertex_branches
     }
 
-    fn is_pass_through(&self, shape: u32) -> bool {
-        self.desc
-            .shapes
+    fn crossing(&self, shape: u32) -> Crossing {
+        self.crossings
             .get(shape as usize)
-            .is_some_and(|s| is_null(&self.desc, s.material))
+            .copied()
+            .unwrap_or(Crossing::Blocks)
+    }
+
+    fn has_panes(&self) -> bool {
+        self.has_panes
     }
 }

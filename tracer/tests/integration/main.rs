@@ -14,6 +14,7 @@ mod hostile;
 mod hostile_scenes;
 mod luxrender_materials;
 mod mirror_images;
+mod panes;
 mod parse_conventions;
 mod parse_errors;
 mod render;

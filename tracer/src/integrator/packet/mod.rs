@@ -34,10 +34,11 @@ use vectors::LaneVec3s;
 use walk::{walk_packet, LanePrevScatter, Packet};
 
 /// Whether `scene`'s camera paths may be traced in packets: no volumes (a packet's lanes all
-/// travel in none). Any material, light or camera: lanes that meet what a packet does not
-/// follow leave it.
+/// travel in none) and no panes of architectural glass (a lane's shadow ray is blocked or not,
+/// never dimmed). Any material, light or camera: lanes that meet what a packet does not follow
+/// leave it.
 pub fn covers<S: PathScene>(scene: &S) -> bool {
-    scene.volumes().media.is_empty() && scene.volumes().camera.is_none()
+    scene.volumes().media.is_empty() && scene.volumes().camera.is_none() && !scene.has_panes()
 }
 
 /// Traces the packet's camera rays (`None`: no ray, black) to the end, one [`PathResult`] per
