@@ -6,6 +6,7 @@ use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 
 use crate::math::Frame;
+use crate::shape::kind::area_scale;
 use crate::shape::{AnalyticSurface, ExactSurface, SurfaceFrame};
 
 use super::hit::{SurfaceHit, SurfaceSample};
@@ -108,7 +109,7 @@ impl AnalyticShape {
     /// World-space area: exact under similarity transforms, otherwise the object area scaled
     /// by |det|^(2/3) (used only to estimate a light's power).
     pub fn area(&self) -> f32 {
-        self.surface.area() * libm::powf(self.abs_det, 2.0 / 3.0)
+        self.surface.area() * area_scale(self.abs_det)
     }
 
     /// A point sampled uniformly by object-space area; `pdf_area` is the density in world

@@ -119,8 +119,10 @@ impl ExactSurface for NotExact {
 /// The mean area scale of a transform, |det|^(2/3): exact under similarity transforms, what
 /// the area of an exact shape under a non-uniform scale is estimated with.
 pub fn mean_area_scale(object_to_world: &Mat4) -> f32 {
-    libm::powf(
-        Mat3::from_mat4(*object_to_world).determinant().abs(),
-        2.0 / 3.0,
-    )
+    area_scale(Mat3::from_mat4(*object_to_world).determinant().abs())
+}
+
+/// [`mean_area_scale`] of a transform whose determinant has magnitude `abs_det`.
+pub fn area_scale(abs_det: f32) -> f32 {
+    libm::powf(abs_det, 2.0 / 3.0)
 }
