@@ -19,7 +19,11 @@
 //! Film positions are raster coordinates: (0, 0) is the top-left corner of the image, x grows
 //! right and y down, one unit per pixel.
 
-use glam::{Mat4, Vec2, Vec3};
+mod importance;
+
+pub use importance::CameraView;
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::bxdf::local::concentric_disk;
 use crate::diag::SourcePos;
@@ -154,6 +158,10 @@ enum Projection {
 pub struct Camera {
     projection: Projection,
     camera_to_world: Mat4,
+    world_to_camera: Mat4,
+    /// How the camera transform scales areas (1 for a rigid camera): camera-space areas times
+    /// this are world areas.
+    area_scale: f32,
     /// Screen window [xmin, xmax, ymin, ymax].
     window: [f32; 4],
     width: f32,
@@ -176,6 +184,10 @@ impl Camera {
         Self {
             projection,
             camera_to_world: desc.camera_to_world,
+            world_to_camera: crate::math::inverse(&desc.camera_to_world),
+            area_scale: crate::shape::kind::area_scale(
+                Mat3::from_mat4(desc.camera_to_world).determinant().abs(),
+            ),
             window: desc.screen_window,
             width: width as f32,
             height: height as f32,
