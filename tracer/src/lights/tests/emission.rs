@@ -451,3 +451,60 @@ fn light_points_are_on_the_lights_their_samples_reached() {
     println!("light points per emitter: {seen:?}");
     assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
 }
+
+#[test]
+fn a_textured_lamp_emits_its_texture_where_its_rays_start() {
+    // A unit quad under a world-space checkerboard of cells of side 1/3, three by three cells
+    // in an odd layer: 4 of the 9 emit `bright`, so its flux is pi A bright 4/9 when each ray
+    // carries the texture at its own origin (the texture's mean over the uv square, which
+    // an untextured lamp would emit, is 5/9 of it).
+    use crate::refs::{ConstOrTexture, TextureId};
+    use crate::texture::{Checkerboard, Checkerboard3D, Mapping3D, TextureDesc, TextureKind};
+    let bright = Vec3::new(2.0, 1.0, 0.5);
+    let checker = TextureDesc {
+        name: "checks".into(),
+        is_color: true,
+        kind: TextureKind::Checkerboard(Checkerboard::D3(Checkerboard3D {
+            tex1: ConstOrTexture::color(bright),
+            tex2: ConstOrTexture::color(Vec3::ZERO),
+            mapping: Mapping3D::global(Mat4::from_scale(Vec3::splat(3.0))),
+        })),
+    };
+    let textures = Arc::new(Textures::new(&[checker], &MemorySource::new()).unwrap());
+    let lamp = ShapeDesc {
+        area_light: Some(AreaLightDesc {
+            l: ConstOrTexture::Texture(TextureId(0)),
+            ..AreaLightDesc::constant(Vec3::ZERO)
+        }),
+        media: Default::default(),
+        ..shape(
+            square_facing_down(1.0),
+            Mat4::from_translation(Vec3::new(1.0 / 6.0, 1.0 / 6.0, 0.4)),
+        )
+    };
+    let desc = scene_desc(vec![lamp], vec![]);
+    let geometry = SceneGeometry::build(&desc.shapes);
+    let lights = Lights::build(
+        &desc.shapes,
+        &desc.lights,
+        &geometry,
+        &textures,
+        &MemorySource::new(),
+        LatLongConvention::Seed,
+    )
+    .unwrap();
+    let e = estimate_emission(&lights, 200_000, 17);
+    let expected = (PI * bright * 4.0 / 9.0).as_dvec3();
+    println!(
+        "textured quad: flux {} expected {expected} (stderr {:.2e})",
+        e.mean, e.stderr
+    );
+    for c in 0..3 {
+        assert!(
+            (e.mean[c] / expected[c] - 1.0).abs() < 0.01,
+            "flux {} expected {expected}",
+            e.mean
+        );
+    }
+    assert!(e.pdf_err < 1e-4);
+}
