@@ -525,7 +525,7 @@ impl Lights {
     /// ray's start, which no density needs (an area light's depends on its normal only, the
     /// discs' are uniform). pdf_dir is zero where sampling could not have produced the ray
     /// (behind an area light, outside a spot's cone); both are zero for an emitter that is
-    /// not one.
+    /// not one, and for an area light given no normal.
     pub fn emission_pdf(
         &self,
         emitter: Emitter,
