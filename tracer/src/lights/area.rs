@@ -25,13 +25,16 @@
 //!
 //! Points are sampled uniformly by area over the whole shape (triangles chosen by an area
 //! table), except whole spheres, which are sampled inside the cone they subtend (only their
-//! visible cap).
+//! visible cap). Rays leaving the light (for light subpaths) start at a point uniform by area,
+//! on whole spheres too (no shading point to see a cap from), and go cosine-weighted about the
+//! front normal.
 
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3, Vec3A};
 
+use crate::bxdf::local::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::diag::SourcePos;
 use crate::geometry::{AnalyticShape, ShapeSurface, SurfaceSample, TriangleSurface};
 use crate::math::{luminance, Frame};
@@ -44,7 +47,7 @@ use crate::texture::{LookupPoint, Textures};
 
 use super::distribution::Distribution1D;
 use super::emission::{emits, normalised_gain, surface_color, DEFAULT_GAIN, DEFAULT_L};
-use super::sample::LightSample;
+use super::sample::{EmittedRay, LightSample};
 
 /// `power`, watts.
 pub const DEFAULT_POWER: f32 = 100.0;
@@ -220,6 +223,21 @@ pub struct EmitterSample {
     pub pdf: f32,
     /// The radiance the point emits towards the shading point.
     pub li: Vec3,
+    /// The front normal at the point.
+    pub n: Vec3,
+}
+
+impl EmitterSample {
+    /// The light sample, for a light chosen with probability `pmf`.
+    pub fn chosen(&self, pmf: f32) -> LightSample {
+        LightSample {
+            wi: self.wi,
+            li: self.li,
+            pdf: pmf * self.pdf,
+            dist: self.dist,
+            delta: false,
+        }
+    }
 }
 
 impl AreaLight {
@@ -334,6 +352,48 @@ impl AreaLight {
     #[inline(always)]
     pub fn sample(&self, from: Vec3, u: Vec2) -> Option<EmitterSample> {
         let (point, on) = match &self.emitter {
+            Emitter::Sphere {
+                centre,
+                radius,
+                shape,
+            } => {
+                if from.distance_squared(*centre) <= radius * radius * ON_SPHERE {
+                    self.sample_area(u)?
+                } else {
+                    let (wi, dist, pdf) =
+                        sample_sphere_cone(from, *centre, *radius, shape.orientation(), u)?;
+                    let li = self.li(from, wi, dist, SampledSurface::Quadric(shape));
+                    let n = (from + wi * dist - *centre).normalize() * shape.orientation();
+                    return Some(EmitterSample {
+                        wi,
+                        dist,
+                        pdf,
+                        li,
+                        n,
+                    });
+                }
+            }
+            _ => self.sample_area(u)?,
+        };
+        let to_light = point.p - from;
+        let dist2 = to_light.length_squared();
+        let dist = dist2.sqrt();
+        let wi = to_light / dist;
+        let cos_light = -point.n.dot(wi);
+        let pdf = point.pdf_area * dist2 / cos_light;
+        (cos_light > 0.0 && pdf.is_finite()).then(|| EmitterSample {
+            wi,
+            dist,
+            pdf,
+            li: self.li(from, wi, dist, on),
+            n: point.n,
+        })
+    }
+
+    /// A point uniform by area over the whole surface, and the surface it is on.
+    #[inline(always)]
+    fn sample_area(&self, u: Vec2) -> Option<(SurfaceSample, SampledSurface<'_>)> {
+        Some(match &self.emitter {
             Emitter::Triangles {
                 triangles,
                 by_area,
@@ -347,39 +407,56 @@ impl AreaLight {
                 };
                 (s, SampledSurface::Triangle(&triangles[i]))
             }
-            Emitter::Quadric(shape) => (shape.sample(u), SampledSurface::Quadric(shape)),
-            Emitter::Sphere {
-                centre,
-                radius,
-                shape,
-            } => {
-                if from.distance_squared(*centre) <= radius * radius * ON_SPHERE {
-                    (shape.sample(u), SampledSurface::Quadric(shape))
-                } else {
-                    let (wi, dist, pdf) =
-                        sample_sphere_cone(from, *centre, *radius, shape.orientation(), u)?;
-                    let li = self.li(from, wi, dist, SampledSurface::Quadric(shape));
-                    return Some(EmitterSample { wi, dist, pdf, li });
-                }
+            Emitter::Sphere { shape, .. } | Emitter::Quadric(shape) => {
+                (shape.sample(u), SampledSurface::Quadric(shape))
             }
-        };
-        let to_light = point.p - from;
-        let dist2 = to_light.length_squared();
-        let dist = dist2.sqrt();
-        let wi = to_light / dist;
-        let cos_light = -point.n.dot(wi);
-        let pdf = point.pdf_area * dist2 / cos_light;
-        (cos_light > 0.0 && pdf.is_finite()).then(|| EmitterSample {
-            wi,
-            dist,
-            pdf,
-            li: self.li(from, wi, dist, on),
         })
+    }
+
+    /// The area density of [`Self::sample_area`] at a point with front normal `n`.
+    fn pdf_area(&self, n: Vec3) -> f32 {
+        match &self.emitter {
+            Emitter::Triangles { area, .. } => 1.0 / area,
+            Emitter::Sphere { shape, .. } | Emitter::Quadric(shape) => shape.pdf_area(n),
+        }
+    }
+
+    /// A ray leaving the light: `u_pos` chooses the point (uniform by area), `u_dir` the
+    /// direction (cosine-weighted about the front normal). The radiance is the texture's at
+    /// the point, as a ray hitting it there would see it.
+    pub fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmittedRay> {
+        let (point, on) = self.sample_area(u_pos)?;
+        let dir = Frame::from_normal(point.n).to_world(sample_cosine_hemisphere(u_dir));
+        // The density from the direction itself, not from the hemisphere sample's cosine: it
+        // is what `emission_pdf` computes for this ray.
+        let (pdf_pos, pdf_dir) = self.emission_pdf(point.n, dir);
+        (pdf_dir > 0.0 && pdf_pos.is_finite()).then(|| EmittedRay {
+            origin: point.p,
+            dir,
+            normal: Some(point.n),
+            le: self.li(point.p, point.n, 0.0, on),
+            pdf_pos,
+            pdf_dir,
+            delta_position: false,
+            delta_direction: false,
+        })
+    }
+
+    /// The (area, solid-angle) densities of [`Self::sample_emission`] for a ray leaving the
+    /// light point with front normal `n` along unit `dir`; no direction density behind it.
+    pub fn emission_pdf(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        let cos = n.dot(dir);
+        let pdf_dir = if cos > 0.0 {
+            cosine_hemisphere_pdf(cos)
+        } else {
+            0.0
+        };
+        (self.pdf_area(n), pdf_dir)
     }
 
     /// The radiance of the light point `from + dist wi` of surface `on`, at the uv a ray from
     /// `from` would hit there (interpolated on the triangle, or the quadric's own
-    /// parametrisation of the point).
+    /// parametrisation of the point; with `dist` 0, the point `from` itself).
     fn li(&self, from: Vec3, wi: Vec3, dist: f32, on: SampledSurface) -> Vec3 {
         let Some(texture) = &self.texture else {
             return self.radiance;
@@ -396,14 +473,7 @@ impl AreaLight {
 
     /// [`Self::sample`] as a light sample, for a light chosen with probability `pmf`.
     pub fn sample_chosen(&self, from: Vec3, u: Vec2, pmf: f32) -> Option<LightSample> {
-        let s = self.sample(from, u)?;
-        Some(LightSample {
-            wi: s.wi,
-            li: s.li,
-            pdf: pmf * s.pdf,
-            dist: s.dist,
-            delta: false,
-        })
+        Some(self.sample(from, u)?.chosen(pmf))
     }
 
     /// The solid-angle density of [`Self::sample`] from `from` at the light point `p` with
@@ -416,20 +486,15 @@ impl AreaLight {
             return 0.0;
         }
         let pdf_area = match &self.emitter {
-            Emitter::Triangles { area, .. } => 1.0 / area,
-            Emitter::Quadric(shape) => shape.pdf_area(n),
-            Emitter::Sphere {
-                centre,
-                radius,
-                shape,
-            } => {
+            Emitter::Sphere { centre, radius, .. } => {
                 let dc2 = from.distance_squared(*centre);
                 if dc2 <= radius * radius * ON_SPHERE {
-                    shape.pdf_area(n)
+                    self.pdf_area(n)
                 } else {
                     return 1.0 / (TAU * one_minus_cos_max(radius * radius / dc2));
                 }
             }
+            _ => self.pdf_area(n),
         };
         let pdf = pdf_area * dist2 / cos_light;
         if pdf.is_finite() {

@@ -14,7 +14,7 @@
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::diag::SourcePos;
 use crate::math::luminance;
@@ -25,7 +25,7 @@ use crate::parse::params::ParamList;
 use super::emission::{emits, Emission};
 use super::error::LightError;
 use super::kind::{LightKind, MapSource};
-use super::sample::DeltaSample;
+use super::sample::{DeltaSample, EmittedRay, SceneSphere};
 
 /// `from`.
 pub const DEFAULT_FROM: Vec3 = Vec3::ZERO;
@@ -76,6 +76,29 @@ impl DistantLight {
     /// The flux through a disk of the scene's size.
     pub fn power(&self, scene_radius: f32) -> f32 {
         PI * scene_radius * scene_radius * luminance(self.radiance)
+    }
+
+    /// A ray of the light entering the scene `sphere` bounds, from a point uniform on the
+    /// disc it crosses (so its flux, irradiance x disc area, is what the rays carry).
+    pub fn sample_emission(&self, sphere: &SceneSphere, u: Vec2) -> EmittedRay {
+        let dir = -self.to_light;
+        let (pdf_pos, pdf_dir) = self.emission_pdf(sphere);
+        EmittedRay {
+            origin: sphere.entry_point(dir, u),
+            dir,
+            normal: None,
+            le: self.radiance,
+            pdf_pos,
+            pdf_dir,
+            delta_position: false,
+            delta_direction: true,
+        }
+    }
+
+    /// The (position, direction) densities of [`Self::sample_emission`]: the disc's area
+    /// density, and 1 for the delta direction.
+    pub fn emission_pdf(&self, sphere: &SceneSphere) -> (f32, f32) {
+        (sphere.pdf_area(), 1.0)
     }
 }
 

@@ -32,6 +32,7 @@ use super::distribution::Distribution2D;
 use super::emission::{emits, Emission};
 use super::error::LightError;
 use super::kind::{LatLongConvention, LightKind, MapSource};
+use super::sample::uniform_sphere;
 use super::facing::{FacingTables, FACING_BINS, MAX_FACING_CELLS};
 
 /// `mapping`: the only one modelled.
@@ -198,16 +199,7 @@ impl Environment {
     /// then sampled by its facing tables ([`super::facing`]), which give no density behind it.
     pub fn sample(&self, u: Vec2, facing: Option<Vec3>) -> Option<(Vec3, f32, Vec3)> {
         match &self.map {
-            None => {
-                let z = 1.0 - 2.0 * u.x;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let (sin, cos) = libm::sincosf(TAU * u.y);
-                Some((
-                    Vec3::new(r * cos, r * sin, z),
-                    1.0 / (4.0 * PI),
-                    self.radiance,
-                ))
-            }
+            None => Some((uniform_sphere(u), 1.0 / (4.0 * PI), self.radiance)),
             Some(map) => {
                 // The texels looked up below sit in the sampled cell nearly always: their load
                 // starts alongside the tables' own last cache miss.

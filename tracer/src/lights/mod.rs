@@ -10,6 +10,19 @@
 //! and `pdf_environment` return for an escaping ray, so MIS sees the same numbers from both
 //! sides.
 //!
+//! For a bidirectional integrator the sampler also starts rays at the lights
+//! ([`Lights::sample_emission`], [`EmissionSample`]) and says how likely a given ray leaving a
+//! light was ([`Lights::emission_pdf`]), pbrt-v4's `SampleLe` and `PDF_Le`: each kind samples
+//! its own rays (area lights a point by area and a cosine-weighted direction, point lights the
+//! sphere, spots their cone), and light from a direction (distant lights, the lights at
+//! infinity) enters through a disc of the scene's bounding sphere ([`sample::SceneSphere`]).
+//! The lights at infinity emit as the one mixture they are for escaping rays: a direction
+//! sampled from any member carries the mixture's radiance and density. The mixture's choice
+//! probability (the sum of its members') goes with the position density, as a light's choice
+//! does, and its direction density is the mixture's divided by it, a density over the sphere
+//! (integrating to 1), so `le / (pdf_pos pdf_dir)` estimates the mixture's flux into the
+//! scene.
+//!
 //! Area lights are also sampled through flat mirrors, as their images (`mirrored`): scenes
 //! whose lamps light a room by way of a mirror get that light by next-event estimation
 //! instead of by BSDF samples that happen to find the lamp.
@@ -58,7 +71,7 @@ pub use error::LightError;
 pub use infinite::{map_cost, EnvMapDesc};
 pub use kind::{LatLongConvention, LightKind, MapSource};
 pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
-pub use sample::LightSample;
+pub use sample::{EmissionSample, Emitter, LightPoint, LightSample};
 pub use sky::SkyModel;
 pub use sun::sun_rgb;
 pub use triangle_lamps::{LightSamples, TriangleLamps};
@@ -68,6 +81,7 @@ use distribution::Distribution1D;
 use infinite::Environment;
 use lamp_spheres::LampSpheres;
 use mirrored::MirrorImages;
+use sample::{EmittedRay, SceneSphere};
 use spot::SpotCone;
 use sun::SunDisc;
 
@@ -252,6 +266,10 @@ pub struct Lights {
     lamp_spheres: LampSpheres,
     /// The lights as tables for packets, when they are a few plain triangle lamps.
     triangle_lamps: Option<TriangleLamps>,
+    /// Around the geometry: what rays from distant lights and the lights at infinity enter by.
+    sphere: SceneSphere,
+    /// The probability of choosing one of the lights at infinity, the mixture they form.
+    environment_pmf: f32,
 }
 
 impl Lights {
@@ -300,9 +318,12 @@ impl Lights {
             lights.extend(desc.light(&maps)?);
         }
 
-        let scene_radius = geometry
-            .bounds()
-            .map_or(1.0, |(lo, hi)| (0.5 * (hi - lo).length()).max(1e-3));
+        let bounds = geometry.bounds();
+        let scene_radius = bounds.map_or(1.0, |(lo, hi)| (0.5 * (hi - lo).length()).max(1e-3));
+        let sphere = SceneSphere {
+            centre: bounds.map_or(Vec3::ZERO, |(lo, hi)| 0.5 * (lo + hi)),
+            radius: scene_radius,
+        };
         let mut powers: Vec<f32> = lights
             .iter()
             .map(|light| match light {
@@ -324,11 +345,12 @@ impl Lights {
                 *power = power.max(INFINITE_POWER_FLOOR * finite_power);
             }
         }
-        let infinite = (0..lights.len() as u32)
+        let infinite: Vec<u32> = (0..lights.len() as u32)
             .filter(|&i| matches!(lights[i as usize], Light::Infinite(_)))
             .collect();
         let lamp_boxes: Vec<(Vec3, Vec3)> = area_lights(&lights).map(|(_, l)| l.bounds()).collect();
         let selection = Distribution1D::new(powers);
+        let environment_pmf = infinite.iter().map(|&i| selection.pmf(i as usize)).sum();
         let lamps = lights.iter().map(|light| match light {
             Light::Area(lamp) => Some(lamp),
             _ => None,
@@ -341,6 +363,8 @@ impl Lights {
             shape_light,
             infinite,
             images: Default::default(),
+            sphere,
+            environment_pmf,
         })
     }
 
@@ -400,6 +424,148 @@ impl Lights {
             dist: f32::INFINITY,
             delta: false,
         })
+    }
+
+    /// A light point seen from `p`, for connecting a subpath vertex there to a light: the
+    /// light sample [`Self::sample`] returns for `facing` None and the same numbers (the same
+    /// bits), and the point it reached on the light.
+    pub fn sample_light_point(
+        &self,
+        p: Vec3,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<(LightSample, LightPoint)> {
+        let (index, pmf, _) = self.selection.sample_discrete(u_select)?;
+        let emitter = Emitter::Light(index as u32);
+        Some(match &self.lights[index] {
+            Light::Area(light) => {
+                let s = light.sample(p, u)?;
+                let on = LightPoint::finite(emitter, p + s.wi * s.dist, Some(s.n));
+                (s.chosen(pmf), on)
+            }
+            Light::Point(light) => (
+                light.sample(p)?.chosen(pmf),
+                LightPoint::finite(emitter, light.position, None),
+            ),
+            Light::Spot(light) => (
+                light.sample(p)?.chosen(pmf),
+                LightPoint::finite(emitter, light.position(), None),
+            ),
+            Light::Distant(light) => {
+                let s = light.sample().chosen(pmf);
+                (s, LightPoint::at_infinity(emitter, p, s.wi, &self.sphere))
+            }
+            Light::Infinite(light) => {
+                let s = self.sample_environment(light, None, u, pmf)?;
+                let at = LightPoint::at_infinity(Emitter::Environment, p, s.wi, &self.sphere);
+                (s, at)
+            }
+        })
+    }
+
+    /// Samples a ray leaving one of the lights: `u_select` chooses the light (as in
+    /// [`Self::sample`]), `u_pos` the point, `u_dir` the direction. None when the chosen light
+    /// emits nothing that way.
+    pub fn sample_emission(
+        &self,
+        u_select: f32,
+        u_pos: Vec2,
+        u_dir: Vec2,
+    ) -> Option<EmissionSample> {
+        let (index, pmf, _) = self.selection.sample_discrete(u_select)?;
+        let ray = match &self.lights[index] {
+            Light::Area(light) => light.sample_emission(u_pos, u_dir)?,
+            Light::Point(light) => light.sample_emission(u_dir),
+            Light::Spot(light) => light.sample_emission(u_dir)?,
+            Light::Distant(light) => light.sample_emission(&self.sphere, u_pos),
+            Light::Infinite(light) => {
+                let ray = self.sample_environment_emission(light, u_pos, u_dir)?;
+                return Some(ray.chosen(Emitter::Environment, self.environment_pmf));
+            }
+        };
+        Some(ray.chosen(Emitter::Light(index as u32), pmf))
+    }
+
+    /// A ray of the mixture at infinity whose direction member `light` sampled: the
+    /// mixture's radiance, the disc's position density (the mixture's choice probability still
+    /// to multiply it) and the mixture's direction density given that choice.
+    fn sample_environment_emission(
+        &self,
+        light: &AtInfinity,
+        u_pos: Vec2,
+        u_dir: Vec2,
+    ) -> Option<EmittedRay> {
+        let (wi, _, _) = light.sample(u_dir, None)?;
+        let dir = -wi;
+        let (le, pdf_dir) = self.environment_emission(dir);
+        (pdf_dir > 0.0).then(|| EmittedRay {
+            origin: self.sphere.entry_point(dir, u_pos),
+            dir,
+            normal: None,
+            le,
+            pdf_pos: self.sphere.pdf_area(),
+            pdf_dir,
+            delta_position: false,
+            delta_direction: false,
+        })
+    }
+
+    /// The mixture at infinity's radiance travelling along `dir` and its density of that
+    /// direction given the mixture's choice (what [`Self::pdf_environment`] says of `-dir`,
+    /// over the mixture's choice probability).
+    fn environment_emission(&self, dir: Vec3) -> (Vec3, f32) {
+        let (le, pdf) = self.environment_and_pdf(-dir, None);
+        (le, pdf / self.environment_pmf)
+    }
+
+    /// The (pdf_pos, pdf_dir) [`Self::sample_emission`] has for a ray leaving `emitter` along
+    /// unit `dir` (front normal `normal` for an area light): for an area light hit by a camera
+    /// path, for a light point [`Self::sample_light_point`] reached, for an escaping ray
+    /// (`Emitter::Environment`, `dir` minus the escaping ray's direction). `_origin` is the
+    /// ray's start, which no density needs (an area light's depends on its normal only, the
+    /// discs' are uniform). pdf_dir is zero where sampling could not have produced the ray
+    /// (behind an area light, outside a spot's cone); both are zero for an emitter that is
+    /// not one, and for an area light given no normal.
+    pub fn emission_pdf(
+        &self,
+        emitter: Emitter,
+        _origin: Vec3,
+        normal: Option<Vec3>,
+        dir: Vec3,
+    ) -> (f32, f32) {
+        let index = match emitter {
+            Emitter::Light(index) => index as usize,
+            Emitter::Environment => return self.environment_emission_pdf(dir),
+        };
+        let (pdf_pos, pdf_dir) = match (self.lights.get(index), normal) {
+            (Some(Light::Area(light)), Some(n)) => light.emission_pdf(n, dir),
+            (Some(Light::Point(light)), _) => light.emission_pdf(),
+            (Some(Light::Spot(light)), _) => light.emission_pdf(dir),
+            (Some(Light::Distant(light)), _) => light.emission_pdf(&self.sphere),
+            (Some(Light::Infinite(_)), _) => return self.environment_emission_pdf(dir),
+            (Some(Light::Area(_)), None) | (None, _) => return (0.0, 0.0),
+        };
+        (self.selection.pmf(index) * pdf_pos, pdf_dir)
+    }
+
+    fn environment_emission_pdf(&self, dir: Vec3) -> (f32, f32) {
+        if self.environment_pmf <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let pdf_pos = self.environment_pmf * self.sphere.pdf_area();
+        (pdf_pos, self.environment_emission(dir).1)
+    }
+
+    /// The emitter of shape `shape`'s area light, if it has one.
+    pub fn emitter_of_shape(&self, shape: u32) -> Option<Emitter> {
+        self.area_light(shape)
+            .map(|(index, _)| Emitter::Light(index))
+    }
+
+    /// The scene's bounding sphere (centre, radius): the discs rays from distant lights and the
+    /// lights at infinity start on are its size.
+    pub fn scene_sphere(&self) -> (Vec3, f32) {
+        (self.sphere.centre, self.sphere.radius)
     }
 
     fn area_light(&self, shape: u32) -> Option<(u32, &AreaLight)> {

@@ -15,7 +15,7 @@
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::diag::SourcePos;
 use crate::math::luminance;
@@ -26,7 +26,7 @@ use crate::parse::params::ParamList;
 use super::emission::{emits, normalised_gain, Emission};
 use super::error::LightError;
 use super::kind::{LightKind, MapSource};
-use super::sample::DeltaSample;
+use super::sample::{uniform_sphere, DeltaSample, EmittedRay};
 
 /// `from`.
 pub const DEFAULT_FROM: Vec3 = Vec3::ZERO;
@@ -78,6 +78,27 @@ impl PointLight {
 
     pub fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
+    }
+
+    /// A ray leaving the light, in a direction uniform over the sphere.
+    pub fn sample_emission(&self, u: Vec2) -> EmittedRay {
+        let (pdf_pos, pdf_dir) = self.emission_pdf();
+        EmittedRay {
+            origin: self.position,
+            dir: uniform_sphere(u),
+            normal: None,
+            le: self.intensity,
+            pdf_pos,
+            pdf_dir,
+            delta_position: true,
+            delta_direction: false,
+        }
+    }
+
+    /// The (position, direction) densities of [`Self::sample_emission`], the same for every
+    /// ray: the position is a delta (its density is taken as 1).
+    pub fn emission_pdf(&self) -> (f32, f32) {
+        (1.0, 1.0 / (4.0 * PI))
     }
 }
 

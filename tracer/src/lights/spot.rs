@@ -15,12 +15,12 @@
 //! | `power`          | 0       | watts; with `efficacy` > 0 the gain is scaled to emit that many lumens |
 //! | `efficacy`       | 0       | lumens per watt                                            |
 
-use std::f32::consts::PI;
+use std::f32::consts::{PI, TAU};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::diag::SourcePos;
-use crate::math::luminance;
+use crate::math::{luminance, Frame};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
@@ -29,7 +29,7 @@ use super::emission::{emits, normalised_gain, Emission};
 use super::error::LightError;
 use super::kind::{LightKind, MapSource};
 use super::point::PointLight;
-use super::sample::DeltaSample;
+use super::sample::{uniform_cone, DeltaSample, EmittedRay};
 
 /// `from`.
 pub const DEFAULT_FROM: Vec3 = Vec3::ZERO;
@@ -120,6 +120,10 @@ pub struct SpotCone {
     cos_total: f32,
     /// cos(coneangle - conedeltaangle): full intensity inside.
     cos_falloff_start: f32,
+    /// Around `direction`, for rays leaving the light.
+    frame: Frame,
+    /// 1 - cos(coneangle), without the cancellation of a narrow cone.
+    one_minus_cos_total: f32,
 }
 
 impl SpotCone {
@@ -133,15 +137,23 @@ impl SpotCone {
     ) -> Self {
         let cone = cone_angle.clamp(0.0, 180.0);
         let start = (cone - cone_delta_angle.max(0.0)).max(0.0);
+        let direction = direction.normalize_or(Vec3::Z);
+        let half_sin = libm::sinf(0.5 * cone.to_radians());
         Self {
             point: PointLight {
                 position,
                 intensity,
             },
-            direction: direction.normalize_or(Vec3::Z),
+            direction,
             cos_total: libm::cosf(cone.to_radians()),
             cos_falloff_start: libm::cosf(start.to_radians()),
+            frame: Frame::from_normal(direction),
+            one_minus_cos_total: 2.0 * half_sin * half_sin,
         }
+    }
+
+    pub fn position(&self) -> Vec3 {
+        self.point.position
     }
 
     pub fn sample(&self, from: Vec3) -> Option<DeltaSample> {
@@ -165,6 +177,37 @@ impl SpotCone {
         let t = ((cos_theta - self.cos_total) / (self.cos_falloff_start - self.cos_total))
             .clamp(0.0, 1.0);
         t * t * (3.0 - 2.0 * t)
+    }
+
+    /// A ray leaving the light, in a direction uniform inside the cone (pbrt-v4 samples
+    /// only to where the falloff ends, which is the cone's edge here); None where the falloff
+    /// leaves nothing, on the edge.
+    pub fn sample_emission(&self, u: Vec2) -> Option<EmittedRay> {
+        let dir = self
+            .frame
+            .to_world(uniform_cone(u, self.one_minus_cos_total))
+            .normalize_or_zero();
+        let falloff = self.falloff(dir.dot(self.direction));
+        let (pdf_pos, pdf_dir) = self.emission_pdf(dir);
+        (falloff > 0.0 && pdf_dir > 0.0).then(|| EmittedRay {
+            origin: self.point.position,
+            dir,
+            normal: None,
+            le: self.point.intensity * falloff,
+            pdf_pos,
+            pdf_dir,
+            delta_position: true,
+            delta_direction: false,
+        })
+    }
+
+    /// The (position, direction) densities of [`Self::sample_emission`] along unit `dir`:
+    /// the delta position's 1, and 1 / the cone's solid angle inside it, 0 outside (where the
+    /// falloff is 0 too: a sample with light is always inside).
+    pub fn emission_pdf(&self, dir: Vec3) -> (f32, f32) {
+        let solid_angle = TAU * self.one_minus_cos_total;
+        let inside = dir.dot(self.direction) >= self.cos_total && solid_angle > 0.0;
+        (1.0, if inside { 1.0 / solid_angle } else { 0.0 })
     }
 
     /// pbrt-v4's estimate: the full cone to where the falloff starts, half of the falloff band.

@@ -38,6 +38,7 @@ use crate::spectra::emission_rgb;
 use super::emission::{self, emits};
 use super::error::LightError;
 use super::kind::{LightKind, MapSource};
+use super::sample::uniform_cone;
 
 /// `sundir` (LuxRender 1.x's sun default points down: a sun with no direction is set).
 pub const DEFAULT_SUNDIR: Vec3 = Vec3::new(0.0, 0.0, -1.0);
@@ -184,14 +185,9 @@ impl SunDisc {
 
     /// A direction uniform in the cone, its density and radiance.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, f32, Vec3)> {
-        // 1 - cos theta uniform in [0, 1 - cos theta_max]; sin theta from it directly.
-        let h = u.x * self.one_minus_cos;
-        let cos = 1.0 - h;
-        let sin = (h * (2.0 - h)).max(0.0).sqrt();
-        let (sp, cp) = libm::sincosf(TAU * u.y);
         let dir = self
             .frame
-            .to_world(Vec3::new(sin * cp, sin * sp, cos))
+            .to_world(uniform_cone(u, self.one_minus_cos))
             .normalize_or_zero();
         // Rounding can put a sample on the rim a hair outside what `contains` accepts; keep
         // the two consistent so MIS sees the same density from both sides.

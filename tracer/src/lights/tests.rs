@@ -1051,3 +1051,5 @@ fn triangle_lamps_are_only_a_few_plain_triangle_lamps() {
     ));
     assert!(!tabulated(vec![], vec![]));
 }
+
+mod emission;
