@@ -11,7 +11,11 @@
 //! the four sums per pixel once per source plane (`FilmFrame::source_planes`), then come the
 //! half sums (four i64 per pixel), each block's samples so far as the film counted them (u32),
 //! the round's number and each block's planned samples (u32): all the decisions so far, so the
-//! next ones are the same on resume.
+//! next ones are the same on resume. A render whose units carry light splats
+//! (`FilmFrame::light_splats`, never adaptive) has after its sums the light splats' three i64
+//! sums per pixel and the light paths they are over (u64). Like the adaptive layout, this one
+//! is the render's own, so the format's version stays: checkpoints of every other render read
+//! as they always did.
 //!
 //! The file is only written through an exclusive temporary file renamed over it, and only read
 //! when it is a regular file of exactly the size this render's checkpoint has
@@ -26,7 +30,7 @@ use anyhow::Context;
 use prost::Message;
 use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
-use yat_tracer::film::{BufferMismatch, Film, SampleBuffer};
+use yat_tracer::film::{BufferMismatch, Film, FilmSplats, SampleBuffer};
 use yat_tracer::render::adaptive::{self, AdaptiveSettings, BlockGrid, Round};
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{plan_units, RenderSettings, WorkUnit, PLAN_VERSION};
@@ -87,17 +91,13 @@ pub struct Checkpoint {
 
 impl Checkpoint {
     /// Nothing rendered yet: the plan's units to do, or an adaptive render's round 0; the film
-    /// takes units' buffers of the scene's filter `border` (`FilterDesc::border`).
+    /// is of `frame` (`RenderSettings::film_frame`: the settings' size, the scene filter's
+    /// border, whether units carry light splats).
     pub fn new(
         settings: &RenderSettings,
-        border: [u32; 2],
+        frame: FilmFrame,
         adaptive: Option<&AdaptiveSettings>,
     ) -> Self {
-        let frame = FilmFrame {
-            width: settings.width,
-            height: settings.height,
-            border,
-        };
         let (film, round) = match adaptive {
             Some(a) => (Film::adaptive(frame), Some(Round::first(settings, a))),
             None => (Film::new(frame), None),
@@ -166,6 +166,7 @@ impl Checkpoint {
                 index: buffer.unit.index,
                 width: self.film.width(),
                 height: self.film.height(),
+                reason: format!("the plan has {} units", self.done.len()),
             });
         };
         if *done {
@@ -267,6 +268,14 @@ impl Checkpoint {
             }
             out.write_all(&pixel)?;
         }
+        if let Some(splats) = self.film.splats() {
+            for sum in &splats.sums {
+                for v in sum {
+                    out.write_all(&v.to_le_bytes())?;
+                }
+            }
+            out.write_all(&splats.light_paths.to_le_bytes())?;
+        }
         for samples in self.film.block_samples() {
             out.write_all(&samples.to_le_bytes())?;
         }
@@ -283,20 +292,20 @@ impl Checkpoint {
     /// The size of the file of a checkpoint with these settings.
     fn file_len(
         settings: &RenderSettings,
-        border: [u32; 2],
+        frame: FilmFrame,
         adaptive: Option<&AdaptiveSettings>,
     ) -> u64 {
         let pixels = u64::from(settings.width) * u64::from(settings.height);
         let fixed = (HEADER_LEN + DIGEST_LEN) as u64;
         match adaptive {
-            None => fixed + (plan_units(settings).len() as u64).div_ceil(8) + pixels * 32,
+            None => {
+                fixed
+                    + (plan_units(settings).len() as u64).div_ceil(8)
+                    + pixels * 32
+                    + splats_len(&frame, pixels) as u64
+            }
             Some(_) => {
                 let blocks = BlockGrid::of(settings).len() as u64;
-                let frame = FilmFrame {
-                    width: settings.width,
-                    height: settings.height,
-                    border,
-                };
                 let planes = frame.source_planes() as u64;
                 fixed
                     + (adaptive::max_round_units(settings) as u64).div_ceil(8)
@@ -313,7 +322,7 @@ impl Checkpoint {
         bytes: &[u8],
         identity: &RenderIdentity,
         settings: &RenderSettings,
-        border: [u32; 2],
+        frame: FilmFrame,
         adaptive: Option<&AdaptiveSettings>,
     ) -> Result<Self, CheckpointError> {
         if bytes.len() < HEADER_LEN + DIGEST_LEN || &bytes[..MAGIC.len()] != MAGIC {
@@ -338,7 +347,7 @@ impl Checkpoint {
         {
             return Err(CheckpointError::OtherRender);
         }
-        let mut checkpoint = Self::new(settings, border, adaptive);
+        let mut checkpoint = Self::new(settings, frame, adaptive);
         let pixels = width as usize * height as usize;
         let bitmap_len = checkpoint.bitmap_bits.div_ceil(8);
         let blocks = BlockGrid::of(settings).len();
@@ -347,19 +356,17 @@ impl Checkpoint {
             Some(_) => ((planes + 1) * pixels, 4 * blocks + 4 + 4 * blocks),
             None => (pixels, 0),
         };
+        let splat_len = splats_len(&frame, pixels as u64);
         let rest = &body[HEADER_LEN..];
-        if rest.len() != bitmap_len + sum_count * 32 + round_len {
+        if rest.len() != bitmap_len + sum_count * 32 + splat_len + round_len {
             return Err(CheckpointError::Corrupt);
         }
         let (bitmap, rest) = rest.split_at(bitmap_len);
-        let (sum_bytes, round_bytes) = rest.split_at(sum_count * 32);
+        let (sum_bytes, rest) = rest.split_at(sum_count * 32);
+        let (splat_bytes, round_bytes) = rest.split_at(splat_len);
         let mut sums: Vec<[i64; 4]> = sum_bytes
             .chunks_exact(32)
-            .map(|pixel| {
-                std::array::from_fn(|c| {
-                    i64::from_le_bytes(pixel[c * 8..c * 8 + 8].try_into().expect("8 bytes"))
-                })
-            })
+            .map(|pixel| std::array::from_fn(|c| i64_at(pixel, c * 8)))
             .collect();
         let words: Vec<u32> = round_bytes
             .chunks_exact(4)
@@ -377,7 +384,17 @@ impl Checkpoint {
         } else {
             Vec::new()
         };
-        checkpoint.film = Film::from_sums(checkpoint.film.frame(), sums, half, block_samples)
+        let splats = frame.light_splats.then(|| {
+            let (sums, light_paths) = splat_bytes.split_at(splat_bytes.len() - 8);
+            FilmSplats {
+                sums: sums
+                    .chunks_exact(24)
+                    .map(|pixel| std::array::from_fn(|c| i64_at(pixel, c * 8)))
+                    .collect(),
+                light_paths: u64::from_le_bytes(light_paths.try_into().expect("8 bytes")),
+            }
+        });
+        checkpoint.film = Film::from_sums(frame, sums, half, block_samples, splats)
             .ok_or(CheckpointError::Corrupt)?;
         if let (Some(a), Some(_)) = (adaptive, &checkpoint.round) {
             let round = Round {
@@ -400,6 +417,21 @@ impl Checkpoint {
         checkpoint.done_count = checkpoint.done.iter().filter(|&&d| d).count();
         Ok(checkpoint)
     }
+}
+
+/// Bytes of a checkpoint's light splats: three i64 sums per pixel and the light paths (u64),
+/// for a render whose units carry them; none otherwise.
+fn splats_len(frame: &FilmFrame, pixels: u64) -> usize {
+    if frame.light_splats {
+        (pixels * 24 + 8) as usize
+    } else {
+        0
+    }
+}
+
+/// The little-endian i64 at `at` of `bytes`.
+fn i64_at(bytes: &[u8], at: usize) -> i64 {
+    i64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"))
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -444,14 +476,14 @@ impl CheckpointFile {
     pub fn load(
         &self,
         settings: &RenderSettings,
-        border: [u32; 2],
+        frame: FilmFrame,
         adaptive: Option<&AdaptiveSettings>,
     ) -> Result<Option<Checkpoint>, CheckpointError> {
-        let expected = Checkpoint::file_len(settings, border, adaptive);
+        let expected = Checkpoint::file_len(settings, frame, adaptive);
         let Some(bytes) = read_regular_file(&self.path, expected)? else {
             return Ok(None);
         };
-        Checkpoint::decode(&bytes, &self.identity, settings, border, adaptive).map(Some)
+        Checkpoint::decode(&bytes, &self.identity, settings, frame, adaptive).map(Some)
     }
 
     /// The checkpoint to start from: the one on disk when it belongs to this render, else an
@@ -459,11 +491,11 @@ impl CheckpointFile {
     pub fn resume(
         &self,
         settings: &RenderSettings,
-        border: [u32; 2],
+        frame: FilmFrame,
         adaptive: Option<&AdaptiveSettings>,
         quiet: bool,
     ) -> Checkpoint {
-        match self.load(settings, border, adaptive) {
+        match self.load(settings, frame, adaptive) {
             Ok(Some(checkpoint)) => {
                 if !quiet {
                     let (done, total) = checkpoint.samples(settings, adaptive);
@@ -481,13 +513,13 @@ impl CheckpointFile {
                 }
                 checkpoint
             }
-            Ok(None) => Checkpoint::new(settings, border, adaptive),
+            Ok(None) => Checkpoint::new(settings, frame, adaptive),
             Err(e) => {
                 eprintln!(
                     "not resuming from {}: it is {e}; starting afresh",
                     self.path.display()
                 );
-                Checkpoint::new(settings, border, adaptive)
+                Checkpoint::new(settings, frame, adaptive)
             }
         }
     }
@@ -559,9 +591,8 @@ mod tests {
 
     fn frame() -> FilmFrame {
         FilmFrame {
-            width: settings().width,
-            height: settings().height,
             border: BORDER,
+            ..FilmFrame::unbordered(settings().width, settings().height)
         }
     }
 
@@ -588,7 +619,7 @@ mod tests {
     /// A checkpoint holding every third unit of the plan, with distinct sums per unit.
     fn partial() -> (Checkpoint, Vec<WorkUnit>) {
         let units = plan_units(&settings());
-        let mut checkpoint = Checkpoint::new(&settings(), BORDER, None);
+        let mut checkpoint = Checkpoint::new(&settings(), frame(), None);
         for unit in units.iter().step_by(3) {
             let mut buffer = SampleBuffer::new(*unit, &frame());
             for (i, (rgb, w)) in buffer.rgb.iter_mut().zip(&mut buffer.weight).enumerate() {
@@ -605,13 +636,59 @@ mod tests {
     fn a_checkpoint_reads_back_exactly() {
         let (checkpoint, units) = partial();
         let id = identity("a.lxs");
-        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), BORDER, None)
+        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), frame(), None)
             .expect("own checkpoint");
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.done, checkpoint.done);
         assert_eq!(back.done_count(), units.len().div_ceil(3));
         assert!(back.is_done(&units[3]) && !back.is_done(&units[4]));
         assert!(back.done_samples(&units) > 0 && !back.is_complete());
+    }
+
+    /// A render whose units carry light splats keeps their sums and light paths exactly, in a
+    /// file of its own length; damaged splat sums are refused.
+    #[test]
+    fn a_checkpoint_keeps_light_splats_exactly() {
+        let splat_frame = FilmFrame {
+            light_splats: true,
+            ..frame()
+        };
+        let units = plan_units(&settings());
+        let mut checkpoint = Checkpoint::new(&settings(), splat_frame, None);
+        for unit in units.iter().step_by(2) {
+            let mut buffer = SampleBuffer::new(*unit, &splat_frame);
+            let pixels: Vec<u32> = (0..40).map(|k| unit.index % 20 * 7 + k * 67).collect();
+            buffer.splats.rgb = pixels
+                .iter()
+                .map(|&p| [p as f32 * 0.125, -0.5, 1e-3 * unit.index as f32])
+                .collect();
+            buffer.splats.pixels = pixels;
+            assert!(checkpoint.add(&buffer).unwrap());
+        }
+        let splats = checkpoint.film().splats().unwrap().clone();
+        let samples: u64 = units.iter().step_by(2).map(WorkUnit::sample_count).sum();
+        assert_eq!(splats.light_paths, samples);
+        assert!(splats.sums.iter().any(|s| s[0] != 0));
+        let id = identity("a.lxs");
+        let bytes = encode(&checkpoint, &id);
+        assert_eq!(
+            bytes.len() as u64,
+            Checkpoint::file_len(&settings(), splat_frame, None)
+        );
+        let pixels = (settings().width * settings().height) as u64;
+        assert_eq!(
+            Checkpoint::file_len(&settings(), splat_frame, None)
+                - Checkpoint::file_len(&settings(), frame(), None),
+            pixels * 24 + 8
+        );
+        let back = Checkpoint::decode(&bytes, &id, &settings(), splat_frame, None).unwrap();
+        assert_eq!(back.film().splats(), Some(&splats));
+        assert_eq!(back.film().sums(), checkpoint.film().sums());
+        assert_eq!(back.film().radiance(), checkpoint.film().radiance());
+        // The layout without splats is not read as one with them, nor the reverse.
+        let plain = encode(&Checkpoint::new(&settings(), frame(), None), &id);
+        assert!(Checkpoint::decode(&plain, &id, &settings(), splat_frame, None).is_err());
+        assert!(Checkpoint::decode(&bytes, &id, &settings(), frame(), None).is_err());
     }
 
     #[test]
@@ -621,7 +698,7 @@ mod tests {
             min_spp: 2,
         };
         let s = settings();
-        let mut checkpoint = Checkpoint::new(&s, BORDER, Some(&a));
+        let mut checkpoint = Checkpoint::new(&s, frame(), Some(&a));
         // Round 0, then round 1 after a noisy film, then part of round 1.
         let fill = |checkpoint: &mut Checkpoint, every: usize| {
             for (n, unit) in checkpoint
@@ -656,9 +733,9 @@ mod tests {
         let bytes = encode(&checkpoint, &id);
         assert_eq!(
             bytes.len() as u64,
-            Checkpoint::file_len(&s, BORDER, Some(&a))
+            Checkpoint::file_len(&s, frame(), Some(&a))
         );
-        let back = Checkpoint::decode(&bytes, &id, &s, BORDER, Some(&a)).unwrap();
+        let back = Checkpoint::decode(&bytes, &id, &s, frame(), Some(&a)).unwrap();
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.film().half_sums(), checkpoint.film().half_sums());
         assert_eq!(
@@ -674,7 +751,7 @@ mod tests {
         forged.round.as_mut().unwrap().planned[0] = 3;
         let bytes = encode(&forged, &id);
         assert!(matches!(
-            Checkpoint::decode(&bytes, &id, &s, BORDER, Some(&a)),
+            Checkpoint::decode(&bytes, &id, &s, frame(), Some(&a)),
             Err(CheckpointError::Corrupt)
         ));
     }
@@ -685,7 +762,7 @@ mod tests {
         let id = identity("a.lxs");
         let bytes = encode(&checkpoint, &id);
         let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
-            Checkpoint::decode(bytes, id, settings, BORDER, None).err()
+            Checkpoint::decode(bytes, id, settings, frame(), None).err()
         };
         assert!(matches!(
             decode(&bytes, &identity("b.lxs"), &settings()),
@@ -725,12 +802,12 @@ mod tests {
         let output = dir.path().join("out.png");
         let file = CheckpointFile::beside(&output, identity("a.lxs"), Duration::from_secs(1));
         assert_eq!(file.path(), dir.path().join("out.resume"));
-        assert!(file.load(&settings(), BORDER, None).unwrap().is_none());
+        assert!(file.load(&settings(), frame(), None).unwrap().is_none());
         let (checkpoint, _) = partial();
-        file.save(&Checkpoint::new(&settings(), BORDER, None))
+        file.save(&Checkpoint::new(&settings(), frame(), None))
             .unwrap();
         file.save(&checkpoint).unwrap();
-        let loaded = file.resume(&settings(), BORDER, None, true);
+        let loaded = file.resume(&settings(), frame(), None, true);
         assert_eq!(loaded.film().sums(), checkpoint.film().sums());
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
@@ -741,7 +818,7 @@ mod tests {
         let stranger = CheckpointFile::beside(&output, identity("b.lxs"), Duration::ZERO);
         assert_eq!(
             stranger
-                .resume(&settings(), BORDER, None, true)
+                .resume(&settings(), frame(), None, true)
                 .done_count(),
             0
         );

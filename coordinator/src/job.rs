@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use yat_tracer::film::Film;
 use yat_tracer::render::adaptive::{self, AdaptiveSettings, Round};
+use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats};
 
 use crate::checkpoint::Checkpoint;
@@ -118,17 +119,18 @@ pub struct SceneBuild {
 }
 
 impl RenderJob {
-    /// The border of every unit's sample buffer: the scene's pixel filter's.
-    pub fn border(&self) -> [u32; 2] {
-        self.scene.desc.filter.border()
+    /// The frame of the render's film (its size, the border of every unit's sample buffer,
+    /// whether units carry light splats), as every node derives it.
+    pub fn frame(&self) -> FilmFrame {
+        self.settings.film_frame(&self.scene.desc)
     }
 
     /// The render to start from: the checkpoint a previous run of this render left, or nothing.
     pub fn resume(&self) -> Checkpoint {
         let adaptive = self.adaptive.as_ref();
         match &self.interim.checkpoint {
-            Some(file) => file.resume(&self.settings, self.border(), adaptive, self.quiet),
-            None => Checkpoint::new(&self.settings, self.border(), adaptive),
+            Some(file) => file.resume(&self.settings, self.frame(), adaptive, self.quiet),
+            None => Checkpoint::new(&self.settings, self.frame(), adaptive),
         }
     }
 

@@ -11,7 +11,6 @@ use yat_tracer::budget::{BuildBudget, BuildGuard, Limit};
 use yat_tracer::desc::SceneDesc;
 use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene_guarded;
-use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderScene, RenderSettings};
 
 /// A scene file parsed, with where its files come from.
@@ -81,12 +80,7 @@ impl ParsedScene {
     /// Bytes the film of a render of `settings` (an adaptive one's if `adaptive`) takes here:
     /// the coordinator's, whether it renders in-process or merges workers' units.
     pub fn film_bytes(&self, settings: &RenderSettings, adaptive: bool) -> u64 {
-        let frame = FilmFrame {
-            width: settings.width,
-            height: settings.height,
-            border: self.desc.filter.border(),
-        };
-        Film::memory_bytes(frame, adaptive)
+        Film::memory_bytes(settings.film_frame(&self.desc), adaptive)
     }
 
     /// Fails unless the film of [`Self::film_bytes`] fits the memory budget with what the

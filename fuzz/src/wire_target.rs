@@ -5,7 +5,8 @@
 //!   hash of blob chunks, [`RenderSettings::try_from`] and the scene id of a load request,
 //!   [`unit_from_wire`] against the session's settings, the token check ([`RequireToken`])
 //!   on hostile `authorization` metadata;
-//! - a coordinator: [`decode_pixels`] of a reply for the session's unit, the buffer merged
+//! - a coordinator: [`decode_pixels`] and [`decode_splats`] of a reply for the session's
+//!   unit (a film with light splats when the settings' seed is odd), the buffer merged
 //!   into a [`Film`] and tone mapped for display, [`UnitStats`] from the reply, a drain
 //!   signal ([`is_draining`]) in a status read from hostile trailers.
 //!
@@ -27,12 +28,14 @@ use tonic::metadata::{MetadataMap, MetadataValue};
 use tonic::service::Interceptor;
 use tonic::{Request, Status};
 use yat_proto::auth::RequireToken;
-use yat_proto::convert::{decode_pixels, unit_from_wire, BYTES_PER_PIXEL};
+use yat_proto::convert::{
+    decode_pixels, decode_splats, encode_splats, unit_from_wire, BYTES_PER_PIXEL,
+};
 use yat_proto::drain::{is_draining, DRAINING_KEY};
 use yat_proto::hash::{is_sha256_hex, sha256_hex, Sha256Stream};
 use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::desc::{FilmDesc, ToneMap};
-use yat_tracer::film::Film;
+use yat_tracer::film::{Film, LightSplats};
 use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter, WeightBounds};
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
@@ -343,15 +346,19 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 return 2;
             }
             let _stats = UnitStats::from(reply.stats.unwrap_or_default());
-            let Ok(buffer) = decode_pixels(unit, &frame_for(settings), &WEIGHTS, &reply.pixels)
-            else {
+            let frame = frame_for(settings);
+            let Ok(mut buffer) = decode_pixels(unit, &frame, &WEIGHTS, &reply.pixels) else {
                 return 3;
             };
-            let Some(film) = &mut state.film else {
+            let Ok(splats) = decode_splats(unit.index, &frame, &reply.light_splats) else {
                 return 4;
             };
-            if film.add(&buffer).is_err() {
+            buffer.splats = splats;
+            let Some(film) = &mut state.film else {
                 return 5;
+            };
+            if film.add(&buffer).is_err() {
+                return 6;
             }
             let tonemap = match reply.pixels.len() / BYTES_PER_PIXEL % 4 {
                 0 => ToneMap::AutoLinear,
@@ -376,7 +383,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 haltspp: None,
                 halttime: None,
             });
-            6 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
+            7 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),
         Kind::StatsRequest => decoded(pb::StatsRequest::decode(bytes), |_| 0),
         Kind::StatsReply => decoded(pb::StatsReply::decode(bytes), |r| {
@@ -427,12 +434,14 @@ const FILTER: FilterDesc = FilterDesc {
 static WEIGHTS: LazyLock<WeightBounds> =
     LazyLock::new(|| PixelFilter::new(&FILTER).weight_bounds());
 
-/// The frame of the settings' film.
+/// The frame of the settings' film; an odd seed makes it one whose units carry light splats,
+/// so that inputs reach both kinds of film.
 fn frame_for(settings: &RenderSettings) -> FilmFrame {
     FilmFrame {
         width: settings.width,
         height: settings.height,
         border: FILTER.border(),
+        light_splats: settings.seed % 2 == 1,
     }
 }
 
@@ -635,17 +644,17 @@ fn write_field(out: &mut Vec<u8>, number: u64, wire_type: u64, field: &Field<'_>
 fn seed_sessions() -> Vec<Session> {
     let frame = |kind, bytes: Vec<u8>| Frame { kind, bytes };
     let mut sessions = Vec::new();
-    for (width, height, spp, tile) in [
-        (100, 50, 16, (64, 0, 100, 50)),
-        (8, 8, 1, (0, 0, 8, 8)),
-        (65_536, 4096, 1 << 24, (0, 0, 64, 64)),
+    for (seed, width, height, spp, tile) in [
+        (7, 100, 50, 16, (64, 0, 100, 50)),
+        (8, 8, 8, 1, (0, 0, 8, 8)),
+        (9, 65_536, 4096, 1 << 24, (0, 0, 64, 64)),
     ] {
         let settings = pb::RenderSettings {
             width,
             height,
             spp,
             max_depth: 5,
-            seed: 7,
+            seed,
             latlong: pb::LatLongConvention::LatlongLuxrender.into(),
         };
         let hash = sha256_hex(b"WorldBegin\nWorldEnd\n");
@@ -693,6 +702,14 @@ fn seed_sessions() -> Vec<Session> {
                 dropped: 1,
             }),
             render_seconds: 0.25,
+            // A film with light splats (odd seeds) takes a few, anywhere on it.
+            light_splats: match seed % 2 {
+                1 => encode_splats(&LightSplats {
+                    pixels: vec![0, width + 1, width * height - 1],
+                    rgb: vec![[0.5, 1.0, 2.0], [0.0; 3], [1e3, 0.0, 7.0]],
+                }),
+                _ => Default::default(),
+            },
         };
         sessions.push(Session {
             frames: vec![
@@ -805,14 +822,15 @@ mod tests {
     fn the_seed_sessions_take_the_deep_paths() {
         let target = WireTarget::new();
         let first = target.execute(&target.corpus[0]).features;
-        // Settings accepted, unit accepted, reply merged into the film and displayed.
+        // Settings accepted, unit accepted, reply (with light splats: an odd seed) merged into
+        // the film and displayed.
         let load = Kind::LoadSceneRequest as u64 * 16;
         let unit = Kind::RenderUnitRequest as u64 * 16;
         let reply = Kind::RenderUnitReply as u64 * 16;
         assert!(first.contains(&(load + 4)), "{first:?}");
         assert!(first.contains(&(unit + 3)), "{first:?}");
         assert!(
-            first.contains(&(reply + 8)) || first.contains(&(reply + 7)),
+            first.contains(&(reply + 9)) || first.contains(&(reply + 8)),
             "{first:?}"
         );
         let last = target.execute(target.corpus.last().unwrap()).features;

@@ -5,7 +5,7 @@ use std::ops::Range;
 
 use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
-use yat_tracer::film::{SampleBuffer, MAX_SUM};
+use yat_tracer::film::{LightSplats, SampleBuffer, MAX_SPLAT_PIXELS, MAX_SUM};
 use yat_tracer::filter::WeightBounds;
 use yat_tracer::render::unit::{FilmFrame, PixelRect, BLOCK_SIZE, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
@@ -14,6 +14,9 @@ use crate::pb;
 
 /// Bytes per pixel in a sample buffer: RGB sums and the weight sum, four f32.
 pub const BYTES_PER_PIXEL: usize = 16;
+
+/// Bytes per light splat pixel on the wire: its index (u32) and its RGB sums (three f32).
+pub const BYTES_PER_SPLAT: usize = 16;
 
 /// Largest unit a worker renders, in pixels of its tile: its reply (the tile and a border of at
 /// most `MAX_BORDER` pixels) stays under 4.5 MiB, under every message limit.
@@ -49,6 +52,13 @@ pub enum WireError {
     },
     #[error("unit {index}: {reason}")]
     Stats { index: u32, reason: String },
+    #[error("unit {index}: the light splats take {got} bytes, not a whole number of {BYTES_PER_SPLAT}-byte pixels up to {max} pixels")]
+    SplatsLength { index: u32, got: usize, max: usize },
+    #[error("unit {index}: {misfit}")]
+    Splats {
+        index: u32,
+        misfit: yat_tracer::film::SplatMisfit,
+    },
 }
 
 impl From<&RenderSettings> for pb::RenderSettings {
@@ -196,6 +206,57 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
         }
     }
     out.freeze()
+}
+
+/// The wire form of a unit's light splats: per pixel, its index as a little-endian u32, then
+/// its r, g, b sums as little-endian f32.
+pub fn encode_splats(splats: &LightSplats) -> Bytes {
+    let mut out = BytesMut::with_capacity(splats.len() * BYTES_PER_SPLAT);
+    for (&pixel, rgb) in splats.pixels.iter().zip(&splats.rgb) {
+        out.put_u32_le(pixel);
+        rgb.iter().for_each(|&v| out.put_f32_le(v));
+    }
+    out.freeze()
+}
+
+/// Reads the light splats of unit `index` back from their wire form: whole pixels, no more than
+/// a unit of `frame` reports (none unless it has light splats; at most its pixels and
+/// [`MAX_SPLAT_PIXELS`]), checked before anything is allocated; then what
+/// [`LightSplats::check`] asks (sorted pixels inside the film, values a unit reports).
+pub fn decode_splats(
+    index: u32,
+    frame: &FilmFrame,
+    bytes: &[u8],
+) -> Result<LightSplats, WireError> {
+    let film_pixels = u64::from(frame.width) * u64::from(frame.height);
+    let max = if frame.light_splats {
+        MAX_SPLAT_PIXELS.min(usize::try_from(film_pixels).unwrap_or(usize::MAX))
+    } else {
+        0
+    };
+    let count = bytes.len() / BYTES_PER_SPLAT;
+    if !bytes.len().is_multiple_of(BYTES_PER_SPLAT) || count > max {
+        return Err(WireError::SplatsLength {
+            index,
+            got: bytes.len(),
+            max,
+        });
+    }
+    let mut splats = LightSplats {
+        pixels: Vec::with_capacity(count),
+        rgb: Vec::with_capacity(count),
+    };
+    let word = |at: &[u8]| <[u8; 4]>::try_from(at).expect("4 bytes");
+    for pixel in bytes.chunks_exact(BYTES_PER_SPLAT) {
+        splats.pixels.push(u32::from_le_bytes(word(&pixel[..4])));
+        splats.rgb.push(std::array::from_fn(|c| {
+            f32::from_le_bytes(word(&pixel[4 + 4 * c..8 + 4 * c]))
+        }));
+    }
+    splats
+        .check(frame)
+        .map_err(|misfit| WireError::Splats { index, misfit })?;
+    Ok(splats)
 }
 
 /// Bytes of a unit's sample buffer on the wire: its region of `frame` (the tile and the
@@ -359,7 +420,7 @@ fn axis_reach(max: &[f32], pixels: Range<u32>, sources: Range<u32>) -> Vec<(f64,
 }
 
 /// A worker's reply to `unit`, checked: the unit's own index, a sample buffer that
-/// [`decode_pixels`] accepts, and counters an honest render of the unit gives (exactly its
+/// [`decode_pixels`] accepts, light splats that [`decode_splats`] accepts, and counters an honest render of the unit gives (exactly its
 /// samples, no more dropped than taken, rays within [`MAX_RAYS_PER_SAMPLE`] per sample).
 pub fn result_from_wire(
     unit: WorkUnit,
@@ -373,7 +434,8 @@ pub fn result_from_wire(
             got: reply.index,
         });
     }
-    let buffer = decode_pixels(unit, frame, weights, &reply.pixels)?;
+    let mut buffer = decode_pixels(unit, frame, weights, &reply.pixels)?;
+    buffer.splats = decode_splats(unit.index, frame, &reply.light_splats)?;
     let stats = UnitStats::from(reply.stats.unwrap_or_default());
     let samples = unit.sample_count();
     let wrong = |reason: String| WireError::Stats {
@@ -411,6 +473,8 @@ mod tests {
     };
     use yat_tracer::parse::parse_scene;
     use yat_tracer::render::{plan_units, RenderScene};
+
+    use prost::Message;
 
     use super::*;
 
@@ -516,6 +580,7 @@ mod tests {
             weight: (0..6).map(|i| 1.0 + i as f32 / 3.0).collect(),
             half_rgb: Vec::new(),
             half_weight: Vec::new(),
+            splats: LightSplats::default(),
         };
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 6 * BYTES_PER_PIXEL);
@@ -548,9 +613,8 @@ mod tests {
             mask: None,
         };
         let frame = FilmFrame {
-            width: 6,
-            height: 8,
             border: [2, 1],
+            ..FilmFrame::unbordered(6, 8)
         };
         // Columns 0..6 (7 clipped to the film), rows 0..3 (-1 clipped).
         assert_eq!(pixels_len(&unit, &frame), 6 * 3 * BYTES_PER_PIXEL);
@@ -695,9 +759,8 @@ mod tests {
             mask: None,
         };
         let frame = FilmFrame {
-            width: 16,
-            height: 16,
             border: [2, 2],
+            ..FilmFrame::unbordered(16, 16)
         };
         (unit, frame)
     }
@@ -919,6 +982,7 @@ mod tests {
             weight: vec![4.0, values[3]],
             half_rgb: Vec::new(),
             half_weight: Vec::new(),
+            splats: LightSplats::default(),
         };
         let reply = pb::RenderUnitReply {
             index: unit.index,
@@ -929,6 +993,7 @@ mod tests {
                 dropped: 0,
             }),
             render_seconds: 0.1,
+            light_splats: Bytes::new(),
         };
         (unit, reply)
     }
@@ -1018,5 +1083,148 @@ mod tests {
             ..reply
         };
         assert!(check_2x1(unit, &without_stats).is_err());
+    }
+
+    /// A 4x4 tile at (4, 4) of a 32x16 film with light splats, and `k` splat pixels spread
+    /// over the film.
+    fn splat_unit(k: u32) -> (WorkUnit, FilmFrame, SampleBuffer) {
+        let frame = FilmFrame {
+            light_splats: true,
+            ..FilmFrame::unbordered(32, 16)
+        };
+        let unit = WorkUnit {
+            index: 2,
+            x0: 4,
+            y0: 4,
+            x1: 8,
+            y1: 8,
+            sample_start: 0,
+            sample_end: 4,
+            mask: None,
+        };
+        let mut buffer = SampleBuffer::new(unit, &frame);
+        buffer.weight[5] = 4.0;
+        buffer.rgb[5] = [1.0, 2.0, 3.0];
+        buffer.splats = LightSplats {
+            pixels: (0..k).map(|i| i * 512 / k.max(1)).collect(),
+            rgb: (0..k)
+                .map(|i| [i as f32 * 0.3, -0.0, f32::MIN_POSITIVE * i as f32])
+                .collect(),
+        };
+        (unit, frame, buffer)
+    }
+
+    fn reply_of(buffer: &SampleBuffer) -> pb::RenderUnitReply {
+        pb::RenderUnitReply {
+            index: buffer.unit.index,
+            pixels: encode_pixels(buffer),
+            stats: Some(pb::UnitStats {
+                samples: buffer.unit.sample_count(),
+                rays: 100,
+                dropped: 0,
+            }),
+            render_seconds: 0.5,
+            light_splats: encode_splats(&buffer.splats),
+        }
+    }
+
+    /// A reply with light splats reads back bit-exactly, splats included.
+    #[test]
+    fn light_splats_round_trip_bit_exactly() {
+        let (unit, frame, buffer) = splat_unit(37);
+        let weights = box_weights(frame.border);
+        let reply = pb::RenderUnitReply::decode(reply_of(&buffer).encode_to_vec().as_slice());
+        let (back, _) = result_from_wire(unit, &frame, &weights, &reply.unwrap()).unwrap();
+        assert_eq!(back, buffer);
+        let bits = |b: &SampleBuffer| -> Vec<u32> {
+            b.splats.rgb.iter().flatten().map(|v| v.to_bits()).collect()
+        };
+        assert_eq!(bits(&back), bits(&buffer));
+        assert_eq!(back.splats.len(), 37);
+    }
+
+    /// What a splat pixel costs on the wire: its 16 bytes, and a few bytes of framing per
+    /// reply.
+    #[test]
+    fn a_splat_pixel_costs_16_bytes_on_the_wire() {
+        let size = |k: u32| reply_of(&splat_unit(k).2).encoded_len();
+        let base = size(0);
+        for k in [1, 10, 100, 512] {
+            let per_pixel = (size(k) - base) as f64 / f64::from(k);
+            println!(
+                "{k} splat pixels: {} bytes more, {per_pixel:.3} per pixel",
+                size(k) - base
+            );
+            // The field's tag and length: 2 to 4 bytes per reply.
+            assert!(
+                per_pixel >= 16.0 && per_pixel <= 16.0 + 4.0 / f64::from(k),
+                "{per_pixel}"
+            );
+        }
+        assert_eq!(BYTES_PER_SPLAT, 16);
+        assert_eq!(MAX_SPLAT_PIXELS * BYTES_PER_SPLAT, 4 << 20);
+    }
+
+    /// Hostile splats are refused before a film sees them: a partial pixel, more pixels than
+    /// the film has, splats on a film that keeps none, unsorted or repeated pixels, a pixel
+    /// outside the film, non-finite or huge values.
+    #[test]
+    fn hostile_light_splats_are_refused() {
+        let (unit, frame, buffer) = splat_unit(3);
+        let weights = box_weights(frame.border);
+        let check = |frame: &FilmFrame, light_splats: Bytes| {
+            let reply = pb::RenderUnitReply {
+                light_splats,
+                ..reply_of(&buffer)
+            };
+            result_from_wire(unit, frame, &weights, &reply).map(|_| ())
+        };
+        assert!(check(&frame, encode_splats(&buffer.splats)).is_ok());
+        let encoded = encode_splats(&buffer.splats);
+        let partial = encoded.slice(..encoded.len() - 1);
+        assert!(matches!(
+            check(&frame, partial),
+            Err(WireError::SplatsLength {
+                index: 2,
+                max: 512,
+                ..
+            })
+        ));
+        let too_many = encode_splats(&LightSplats {
+            pixels: (0..513).collect(),
+            rgb: vec![[0.0; 3]; 513],
+        });
+        assert!(matches!(
+            check(&frame, too_many),
+            Err(WireError::SplatsLength { got: 8208, .. })
+        ));
+        let without = FilmFrame {
+            light_splats: false,
+            ..frame
+        };
+        assert!(matches!(
+            check(&without, encode_splats(&buffer.splats)),
+            Err(WireError::SplatsLength { max: 0, .. })
+        ));
+        assert!(check(&without, Bytes::new()).is_ok());
+        for (pixels, rgb, what) in [
+            (vec![9, 3], [1.0; 3], "not strictly increasing"),
+            (vec![3, 3], [1.0; 3], "not strictly increasing"),
+            (vec![511, 512], [1.0; 3], "outside the film"),
+            (vec![0, 1], [0.0, f32::NAN, 0.0], "not finite"),
+            (vec![0, 1], [f32::INFINITY, 0.0, 0.0], "not finite"),
+            (vec![0, 1], [0.0, 0.0, -1e12], "not finite or exceeds"),
+        ] {
+            let splats = LightSplats {
+                pixels,
+                rgb: vec![rgb; 2],
+            };
+            let error = check(&frame, encode_splats(&splats)).unwrap_err();
+            assert!(
+                matches!(error, WireError::Splats { index: 2, .. }),
+                "{error}"
+            );
+            assert!(error.to_string().contains(what), "{error}");
+        }
     }
 }

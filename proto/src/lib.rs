@@ -18,11 +18,12 @@ pub use pb::render_node_client::RenderNodeClient;
 pub use pb::render_node_server::{RenderNode, RenderNodeServer};
 
 /// The version of `render.proto` this build speaks. Bump it on any incompatible change.
-pub const PROTOCOL_VERSION: u32 = 5;
+pub const PROTOCOL_VERSION: u32 = 6;
 
 /// Bytes of a blob sent in one `BlobChunk`.
 pub const BLOB_CHUNK_BYTES: usize = 1 << 20;
 
-/// Default ceiling on one decoded gRPC message: a chunk, or the sample buffer of a 64x64 tile
-/// (64 KiB), fit with a wide margin; a hostile peer cannot make either end buffer more.
+/// Default ceiling on one decoded gRPC message: a chunk, or the reply of a 64x64 tile (its
+/// sample buffer of 64 KiB and up to 4 MiB of light splats, `MAX_SPLAT_PIXELS`), fit with a
+/// margin; a hostile peer cannot make either end buffer more.
 pub const DEFAULT_MAX_MESSAGE_BYTES: usize = 8 << 20;

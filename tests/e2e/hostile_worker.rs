@@ -216,6 +216,7 @@ impl yat_proto::RenderNode for FakeNode {
                 dropped: 0,
             }),
             render_seconds: 0.0,
+            light_splats: Default::default(),
         };
         let reply = match self.0.misbehaviour() {
             Misbehaviour::NeverAnswers => std::future::pending().await,

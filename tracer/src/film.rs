@@ -1,7 +1,8 @@
 //! `Film "fleximage" "integer xresolution" [800] "integer yresolution" [600] ...`: the film's
 //! description, LuxRender's defaults and their reading; sample buffers and the film: per-pixel
 //! sums from units, merged in an order-independent way (exact fixed-point sums), tone mapped
-//! and written as PNG or linear EXR.
+//! and written as PNG or linear EXR. A bidirectional render's units carry light splats too,
+//! merged into sums of their own ([`splats`]).
 //!
 //! | parameter | type | default |
 //! |---|---|---|
@@ -28,6 +29,10 @@ use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
+
+pub mod splats;
+
+pub use splats::{FilmSplats, LightSplats, SplatMisfit, SplatSums, MAX_SPLAT_PIXELS};
 
 /// The film type every `Film` statement is read as.
 pub const FILM_TYPE: &str = "fleximage";
@@ -168,7 +173,8 @@ impl FilmDesc {
 /// the weights (16 bytes per pixel). An adaptive unit (one with a block mask) keeps these sums
 /// per source plane ([`FilmFrame::source_planes`] regions, plane-major: a sample's sums go to the
 /// plane of the block it was taken in), and the plain sums over its odd-index samples too, the
-/// half the adaptive error estimate compares with the whole.
+/// half the adaptive error estimate compares with the whole. A unit of a film with light splats
+/// carries those as well, wherever on the film they land.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleBuffer {
     pub unit: WorkUnit,
@@ -180,6 +186,8 @@ pub struct SampleBuffer {
     /// Sums of the odd-index samples: as long as `rgb` for a masked unit, else empty.
     pub half_rgb: Vec<[f32; 3]>,
     pub half_weight: Vec<f32>,
+    /// The unit's light splats; empty unless its film keeps them ([`FilmFrame::light_splats`]).
+    pub splats: LightSplats,
 }
 
 impl SampleBuffer {
@@ -198,6 +206,7 @@ impl SampleBuffer {
             weight: vec![0.0; planes * n],
             half_rgb: vec![[0.0; 3]; half],
             half_weight: vec![0.0; half],
+            splats: LightSplats::default(),
         }
     }
 }
@@ -244,24 +253,30 @@ pub struct Film {
     /// An adaptive film's samples per pixel of each block (row-major), as its buffers added
     /// them; empty otherwise.
     block_samples: Vec<u32>,
+    /// The light splats' sums, kept only when the frame has light splats.
+    splats: Option<FilmSplats>,
 }
 
 #[derive(Debug, thiserror::Error)]
-#[error("sample buffer of unit {index} does not fit the {width}x{height} film")]
+#[error("sample buffer of unit {index} does not fit the {width}x{height} film: {reason}")]
 pub struct BufferMismatch {
     pub index: u32,
     pub width: u32,
     pub height: u32,
+    pub reason: String,
 }
 
 impl Film {
-    /// An empty film of `frame`'s size, taking buffers of `frame`'s border.
+    /// An empty film of `frame`'s size, taking buffers of `frame`'s border (and light splats,
+    /// if the frame has them).
     pub fn new(frame: FilmFrame) -> Self {
+        let pixels = frame.width as usize * frame.height as usize;
         Self {
             frame,
-            sums: vec![[0; 4]; frame.width as usize * frame.height as usize],
+            sums: vec![[0; 4]; pixels],
             half: Vec::new(),
             block_samples: Vec::new(),
+            splats: frame.light_splats.then(|| FilmSplats::new(pixels)),
         }
     }
 
@@ -271,25 +286,37 @@ impl Film {
     pub fn memory_bytes(frame: FilmFrame, adaptive: bool) -> u64 {
         let pixels = u64::from(frame.width) * u64::from(frame.height);
         let sum = std::mem::size_of::<[i64; 4]>() as u64;
+        let splat_sum = std::mem::size_of::<[i64; 3]>() as u64;
         let sums = if adaptive {
             pixels * sum * (frame.source_planes() as u64 + 1)
                 + block_count(&frame) as u64 * std::mem::size_of::<u32>() as u64
         } else {
             pixels * sum
-        };
+        } + u64::from(frame.light_splats) * pixels * splat_sum;
         let output = pixels * 2 * std::mem::size_of::<Vec3>() as u64;
         2 * sums + output
     }
 
     /// The film of an adaptive render: it keeps its sums per source plane, the sums of the
     /// odd-index samples and each block's samples, and takes only buffers of masked units.
+    ///
+    /// # Panics
+    ///
+    /// If `frame` has light splats: a bidirectional render is never adaptive (its light
+    /// splats land outside the blocks whose samples an adaptive film counts, so no block's
+    /// error estimate would hold them), and the render is refused before a film is made.
     pub fn adaptive(frame: FilmFrame) -> Self {
+        assert!(
+            !frame.light_splats,
+            "adaptive sampling is refused for renders with light splats"
+        );
         let pixels = frame.width as usize * frame.height as usize;
         Self {
             frame,
             sums: vec![[0; 4]; frame.source_planes() * pixels],
             half: vec![[0; 4]; pixels],
             block_samples: vec![0; block_count(&frame)],
+            splats: None,
         }
     }
 
@@ -327,14 +354,22 @@ impl Film {
         &self.half
     }
 
+    /// The light splats' sums and the light paths they are over: Some exactly when the frame
+    /// has light splats. With [`Film::from_sums`], kept and resumed losslessly as the sums are.
+    pub fn splats(&self) -> Option<&FilmSplats> {
+        self.splats.as_ref()
+    }
+
     /// A film of `frame` holding these sums: a uniform film's (width x height sums, no half
-    /// sums, no block samples) or an adaptive one's (as [`Film::adaptive`] has them); None
-    /// otherwise.
+    /// sums, no block samples) or an adaptive one's (as [`Film::adaptive`] has them), with
+    /// light splat sums over width x height pixels exactly when the frame has light splats
+    /// (and is not adaptive); None otherwise.
     pub fn from_sums(
         frame: FilmFrame,
         sums: Vec<[i64; 4]>,
         half: Vec<[i64; 4]>,
         block_samples: Vec<u32>,
+        splats: Option<FilmSplats>,
     ) -> Option<Self> {
         let pixels = frame.width as usize * frame.height as usize;
         let fits = if half.is_empty() {
@@ -343,19 +378,28 @@ impl Film {
             sums.len() == frame.source_planes() * pixels
                 && half.len() == pixels
                 && block_samples.len() == block_count(&frame)
+                && !frame.light_splats
         };
-        fits.then_some(Self {
+        let splats_fit = match &splats {
+            Some(splats) => frame.light_splats && splats.sums.len() == pixels,
+            None => !frame.light_splats,
+        };
+        (fits && splats_fit).then_some(Self {
             frame,
             sums,
             half,
             block_samples,
+            splats,
         })
     }
 
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
     /// gives the same bits, overlapping borders included. A buffer that does not fit (a tile
     /// outside the film, another region than the film's border gives the tile, a length not
-    /// the region's, half sums where the film keeps none or none where it does) is refused.
+    /// the region's, half sums where the film keeps none or none where it does, light splats
+    /// that fail [`LightSplats::check`]) is refused. The unit's light paths (one per camera
+    /// sample) count toward the film's when it keeps light splats, whether or not any of them
+    /// reached the camera.
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
         let u = &buffer.unit;
         let region = buffer.region;
@@ -377,13 +421,22 @@ impl Film {
             && buffer.weight.len() == planes * n
             && buffer.half_rgb.len() == half_len
             && buffer.half_weight.len() == half_len;
+        let misfit = |reason: String| BufferMismatch {
+            index: u.index,
+            width: self.frame.width,
+            height: self.frame.height,
+            reason,
+        };
         if !fits {
-            return Err(BufferMismatch {
-                index: u.index,
-                width: self.frame.width,
-                height: self.frame.height,
-            });
+            return Err(misfit(format!(
+                "its tile, region or lengths are not those the film's border of {:?} gives",
+                self.frame.border
+            )));
         }
+        buffer
+            .splats
+            .check(&self.frame)
+            .map_err(|e| misfit(e.to_string()))?;
         let width = self.frame.width;
         let pixels = width as usize * self.frame.height as usize;
         let planes = self.sums.chunks_exact_mut(pixels);
@@ -411,6 +464,9 @@ impl Film {
                 &buffer.half_weight,
             );
         }
+        if let Some(splats) = &mut self.splats {
+            splats.add(&buffer.splats, u.sample_count());
+        }
         Ok(())
     }
 
@@ -426,11 +482,12 @@ impl Film {
     /// bias at every edge between blocks that no number of samples removes. So each source
     /// plane's sums (the samples of one block, [`FilmFrame::source_plane`]) are divided by that
     /// block's samples per pixel before they are added: every block then weighs as it would in
-    /// a uniform render, whatever its samples.
+    /// a uniform render, whatever its samples. A film with light splats adds their estimate
+    /// ([`FilmSplats`]) to the weighted mean.
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
         let i = (y * self.frame.width + x) as usize;
         if !self.has_half() {
-            return mean(&self.sums[i]);
+            return self.with_splats(i, mean(&self.sums[i]));
         }
         let pixels = self.frame.width as usize * self.frame.height as usize;
         let [bx, by] = self.frame.border;
@@ -463,7 +520,8 @@ impl Film {
 
     /// The plain weighted mean of all the samples that reach pixel `i` (row-major), whatever
     /// block they were taken in: what the half sums estimate too, so the two compare (the
-    /// adaptive error estimate). The same as [`Film::pixel`] for a uniform film.
+    /// adaptive error estimate). The same as [`Film::pixel`] for a uniform film, light splats
+    /// included.
     pub fn plain_pixel(&self, i: usize) -> Vec3 {
         let pixels = self.frame.width as usize * self.frame.height as usize;
         let mut total = [0i64; 4];
@@ -472,7 +530,16 @@ impl Film {
                 *t = t.saturating_add(s);
             }
         }
-        mean(&total)
+        self.with_splats(i, mean(&total))
+    }
+
+    /// `camera`, the camera samples' estimate of pixel `i`, with the light splats' added when
+    /// the film keeps them (and exactly `camera` when it does not).
+    fn with_splats(&self, i: usize, camera: Vec3) -> Vec3 {
+        match &self.splats {
+            Some(splats) => camera + splats.radiance(i),
+            None => camera,
+        }
     }
 
     /// Linear radiance of every pixel, rows top to bottom.
@@ -635,6 +702,174 @@ mod tests {
         }
     }
 
+    /// A light-splat frame of 4x2 pixels.
+    fn splat_frame() -> FilmFrame {
+        FilmFrame {
+            light_splats: true,
+            ..FilmFrame::unbordered(4, 2)
+        }
+    }
+
+    /// `u`'s buffer of [`splat_frame`] with sums from [`buffer`] and splats to `pixels`.
+    fn splat_buffer(u: WorkUnit, seed: u32, pixels: &[u32]) -> SampleBuffer {
+        let mut b = buffer(u, &splat_frame(), seed);
+        b.splats = LightSplats {
+            pixels: pixels.to_vec(),
+            rgb: pixels
+                .iter()
+                .map(|&p| {
+                    let v = (p.wrapping_mul(2_654_435_761) ^ seed) as f32 / u32::MAX as f32;
+                    [v * 3e3, v * 1e-5, 0.5 + v]
+                })
+                .collect(),
+        };
+        b
+    }
+
+    /// Buffers with light splats merged in different orders give the same bits, sample sums,
+    /// splat sums and light paths alike; the light paths are the units' camera samples.
+    #[test]
+    fn light_splats_merge_in_any_order() {
+        let frame = splat_frame();
+        let splat_pixels: [&[u32]; 4] = [&[0, 3, 7], &[3], &[], &[1, 2, 3, 4, 5, 6, 7]];
+        let bufs: Vec<_> = splat_pixels
+            .iter()
+            .enumerate()
+            .map(|(i, pixels)| {
+                let u = WorkUnit {
+                    sample_end: 3 + i as u32,
+                    ..unit(i as u32, (i as u32 % 2) * 2, 0, (i as u32 % 2) * 2 + 2, 2)
+                };
+                splat_buffer(u, 31 * i as u32, pixels)
+            })
+            .collect();
+        let films: Vec<_> = [[0, 1, 2, 3], [3, 2, 1, 0], [2, 0, 3, 1]]
+            .iter()
+            .map(|order| {
+                let mut film = Film::new(frame);
+                order.iter().for_each(|&i| film.add(&bufs[i]).unwrap());
+                film
+            })
+            .collect();
+        for film in &films[1..] {
+            assert_eq!(film.sums, films[0].sums);
+            assert_eq!(film.splats, films[0].splats);
+        }
+        let splats = films[0].splats().unwrap();
+        // 4 pixels per tile, 3 + i samples each.
+        assert_eq!(splats.light_paths, 4 * (3 + 4 + 5 + 6));
+        // Pixel 3: the second splat of buffer 0, the first of 1 and the third of 3.
+        let expected: i64 = [(0, 1), (1, 0), (3, 2)]
+            .iter()
+            .map(|&(b, at)| to_fixed(bufs[b].splats.rgb[at][0]))
+            .sum();
+        assert_eq!(splats.sums[3][0], expected);
+    }
+
+    /// A pixel of a film with light splats is the camera samples' weighted mean plus the splat
+    /// sum times the film's 8 pixels over the light paths.
+    #[test]
+    fn splats_are_normalised_by_light_paths_per_pixel() {
+        let frame = splat_frame();
+        let mut film = Film::new(frame);
+        assert_eq!(film.pixel(1, 0), Vec3::ZERO, "no light paths yet");
+        // Two units of the whole film: 8 pixels x 5 samples, 8 x 2: N = 56 light paths.
+        let units = [(0, 5), (1, 2)].map(|(index, samples)| WorkUnit {
+            sample_end: samples,
+            ..unit(index, 0, 0, 4, 2)
+        });
+        let mut a = SampleBuffer::new(units[0], &frame);
+        let mut b = SampleBuffer::new(units[1], &frame);
+        a.rgb[1] = [2.0, 4.0, 8.0];
+        a.weight[1] = 2.0;
+        b.rgb[1] = [1.0, 0.0, 0.0];
+        b.weight[1] = 2.0;
+        a.splats = LightSplats {
+            pixels: vec![1, 6],
+            rgb: vec![[0.75, 1.5, 0.0], [9.0, 9.0, 9.0]],
+        };
+        b.splats = LightSplats {
+            pixels: vec![1],
+            rgb: vec![[0.25, 0.5, 7.0]],
+        };
+        film.add(&a).unwrap();
+        film.add(&b).unwrap();
+        assert_eq!(film.splats().unwrap().light_paths, 56);
+        let mean = Vec3::new(3.0, 4.0, 8.0) / 4.0;
+        let splat = Vec3::new(1.0, 2.0, 7.0);
+        let expected = mean + splat * 8.0 / 56.0;
+        let got = film.pixel(1, 0);
+        assert!(
+            (got - expected).abs().max_element() <= 2.0 * f32::EPSILON * expected.max_element(),
+            "{got} {expected}"
+        );
+        assert_eq!(film.plain_pixel(1), got);
+        // A pixel with splats alone.
+        let alone = Vec3::splat(9.0 * 8.0 / 56.0);
+        assert!((film.pixel(2, 1) - alone).abs().max_element() <= 4.0 * f32::EPSILON);
+        assert_eq!(film.radiance()[6], film.pixel(2, 1));
+    }
+
+    /// Splats a film cannot hold, or on a film that keeps none, are refused with the reason.
+    #[test]
+    fn hostile_light_splats_are_refused() {
+        let frame = splat_frame();
+        let u = unit(0, 0, 0, 4, 2);
+        for (pixels, rgb) in [
+            (vec![3, 1], vec![[1.0; 3]; 2]),
+            (vec![2, 2], vec![[1.0; 3]; 2]),
+            (vec![8], vec![[1.0; 3]]),
+            (vec![0], vec![[f32::NAN; 3]]),
+            (vec![0], vec![[MAX_SUM; 3]]),
+            (vec![0, 1], vec![[1.0; 3]]),
+        ] {
+            let mut film = Film::new(frame);
+            let mut b = buffer(u, &frame, 1);
+            b.splats = LightSplats { pixels, rgb };
+            let error = film.add(&b).unwrap_err();
+            assert!(error.reason.contains("light splat"), "{error}");
+            assert_eq!(film.splats().unwrap().light_paths, 0, "nothing merged");
+        }
+        let plain = FilmFrame::unbordered(4, 2);
+        let mut film = Film::new(plain);
+        let mut b = buffer(u, &plain, 1);
+        b.splats = LightSplats {
+            pixels: vec![0],
+            rgb: vec![[1.0; 3]],
+        };
+        assert!(film.add(&b).unwrap_err().reason.contains("keeps none"));
+        b.splats = LightSplats::default();
+        film.add(&b).unwrap();
+        assert!(film.splats().is_none());
+    }
+
+    /// Sums restored from a film's own give the same film; splat sums where the frame keeps
+    /// none (or none where it does, or of another length) do not.
+    #[test]
+    fn splat_sums_restore_exactly_and_only_where_they_fit() {
+        let frame = splat_frame();
+        let mut film = Film::new(frame);
+        film.add(&splat_buffer(unit(0, 0, 0, 4, 2), 5, &[0, 5]))
+            .unwrap();
+        let back = Film::from_sums(
+            frame,
+            film.sums().to_vec(),
+            Vec::new(),
+            Vec::new(),
+            film.splats().cloned(),
+        )
+        .unwrap();
+        assert_eq!(back.splats(), film.splats());
+        assert_eq!(back.radiance(), film.radiance());
+        let sums = || film.sums().to_vec();
+        assert!(Film::from_sums(frame, sums(), Vec::new(), Vec::new(), None).is_none());
+        let short = FilmSplats::new(7);
+        assert!(Film::from_sums(frame, sums(), Vec::new(), Vec::new(), Some(short)).is_none());
+        let plain = FilmFrame::unbordered(4, 2);
+        let splats = film.splats().cloned();
+        assert!(Film::from_sums(plain, sums(), Vec::new(), Vec::new(), splats).is_none());
+    }
+
     fn buffer(u: WorkUnit, frame: &FilmFrame, seed: u32) -> SampleBuffer {
         let mut b = SampleBuffer::new(u, frame);
         for (i, (c, w)) in b.rgb.iter_mut().zip(&mut b.weight).enumerate() {
@@ -665,9 +900,8 @@ mod tests {
     #[test]
     fn overlapping_borders_merge_in_any_order() {
         let frame = FilmFrame {
-            width: 10,
-            height: 7,
             border: [2, 1],
+            ..FilmFrame::unbordered(10, 7)
         };
         let tiles = [
             (0, 0, 4, 4),
@@ -731,9 +965,8 @@ mod tests {
     #[test]
     fn a_buffer_of_another_border_is_refused() {
         let frame = FilmFrame {
-            width: 16,
-            height: 16,
             border: [2, 2],
+            ..FilmFrame::unbordered(16, 16)
         };
         let mut film = Film::new(frame);
         let u = unit(0, 4, 4, 8, 8);

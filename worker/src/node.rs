@@ -242,13 +242,15 @@ impl Node {
         c.units_done.fetch_add(1, Ordering::Relaxed);
         c.samples_done
             .fetch_add(rendered.stats.samples, Ordering::Relaxed);
+        let sent = rendered.pixels.len() + rendered.splats.len();
         c.result_bytes_sent
-            .fetch_add(rendered.pixels.len() as u64, Ordering::Relaxed);
+            .fetch_add(sent as u64, Ordering::Relaxed);
         Ok(pb::RenderUnitReply {
             index: unit.index,
             pixels: rendered.pixels,
             stats: Some(rendered.stats.into()),
             render_seconds: rendered.elapsed.as_secs_f64(),
+            light_splats: rendered.splats,
         })
     }
 

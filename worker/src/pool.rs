@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use prost::bytes::Bytes;
 use tokio::sync::{watch, Semaphore};
-use yat_proto::convert::encode_pixels;
+use yat_proto::convert::{encode_pixels, encode_splats};
 use yat_tracer::render::{UnitStats, WorkUnit};
 
 use crate::error::NodeError;
@@ -30,10 +30,11 @@ pub struct RenderPool {
     throttle: Duration,
 }
 
-/// A unit's sample buffer in its wire form, its counters, and the time the render took (not
-/// counting the wait for a thread).
+/// A unit's sample buffer and light splats in their wire forms, its counters, and the time the
+/// render took (not counting the wait for a thread).
 pub struct RenderedUnit {
     pub pixels: Bytes,
+    pub splats: Bytes,
     pub stats: UnitStats,
     pub elapsed: Duration,
 }
@@ -117,7 +118,7 @@ impl RenderPool {
             // A renderer bug fails this unit, not the whole worker.
             let rendered = std::panic::catch_unwind(AssertUnwindSafe(|| {
                 let (buffer, stats) = loaded.scene.render_unit_cancellable(&unit, &cancel)?;
-                Some((encode_pixels(&buffer), stats))
+                Some((encode_pixels(&buffer), encode_splats(&buffer.splats), stats))
             }));
             let _ = done.send(rendered.map(|r| r.map(|r| (r, started.elapsed()))));
         });
@@ -125,9 +126,11 @@ impl RenderPool {
             .await
             .map_err(|_| NodeError::RenderThreadVanished)?
             .map_err(|_| NodeError::UnitPanicked(unit.index))?;
-        let ((pixels, stats), elapsed) = rendered.ok_or(NodeError::UnitCancelled(unit.index))?;
+        let ((pixels, splats, stats), elapsed) =
+            rendered.ok_or(NodeError::UnitCancelled(unit.index))?;
         Ok(RenderedUnit {
             pixels,
+            splats,
             stats,
             elapsed,
         })

@@ -169,6 +169,7 @@ impl RenderNode for FakeWorker {
                 ..Default::default()
             }),
             render_seconds: took.as_secs_f64(),
+            light_splats: Default::default(),
         }))
     }
 

@@ -135,11 +135,7 @@ impl RenderScene {
         let mut scene = Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: PixelFilter::new(&desc.filter),
-            frame: FilmFrame {
-                width: settings.width,
-                height: settings.height,
-                border: desc.filter.border(),
-            },
+            frame: settings.film_frame(desc),
             textures,
             materials: Materials::new(desc.materials.clone()),
             geometry,

@@ -2,6 +2,7 @@
 //! command-line overrides they are resolved from.
 
 use crate::desc::{LatLongConvention, SceneDesc};
+use crate::render::unit::FilmFrame;
 
 /// Everything besides the scene that decides the image. Identical settings and scene give
 /// bit-identical images whatever renders them.
@@ -87,6 +88,19 @@ impl RenderSettings {
             return Err(SettingsError::Depth(self.max_depth));
         }
         Ok(())
+    }
+
+    /// The frame of this render's film: the image size, the border the scene's pixel filter
+    /// gives every unit's buffer, and whether units carry light splats (none yet: the
+    /// bidirectional integrator will derive that from `desc.integrator` here). Every node makes
+    /// its frame with this, so a peer's buffer is checked against the same frame everywhere.
+    pub fn film_frame(&self, desc: &SceneDesc) -> FilmFrame {
+        FilmFrame {
+            width: self.width,
+            height: self.height,
+            border: desc.filter.border(),
+            light_splats: false,
+        }
     }
 
     pub fn resolve(desc: &SceneDesc, overrides: &RenderOverrides) -> Self {

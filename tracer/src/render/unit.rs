@@ -102,10 +102,11 @@ impl PixelRect {
     }
 }
 
-/// What decides which pixels a unit's samples reach: the film's size and how many pixels the
-/// pixel filter reaches beyond the pixel a sample lies in, per axis (`filter.rs`). Every node
-/// derives it from the settings and the scene alike, so a unit's buffer has the same extent
-/// everywhere and a peer's buffer length is checked exactly.
+/// What decides which pixels a unit's samples reach: the film's size, how many pixels the
+/// pixel filter reaches beyond the pixel a sample lies in, per axis (`filter.rs`), and whether
+/// units carry light splats besides. Every node derives it from the settings and the scene
+/// alike (`RenderSettings::film_frame`), so a unit's buffer has the same extent everywhere and
+/// a peer's buffer is checked exactly.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FilmFrame {
     pub width: u32,
@@ -113,16 +114,24 @@ pub struct FilmFrame {
     /// Pixels a sample's filter reaches to the left and right (`border[0]`), above and below
     /// (`border[1]`) of its own pixel.
     pub border: [u32; 2],
+    /// Whether the render's units carry light splats (`film::LightSplats`): contributions of
+    /// light subpaths connected to the camera, which land anywhere on the film rather than in
+    /// the unit's region. Only a bidirectional integrator makes them; a film of such a frame
+    /// keeps their sums (and takes no adaptive render: `Film::adaptive`). False for every
+    /// render until that integrator derives it from the scene in `RenderSettings::film_frame`,
+    /// the one place every node's frame comes from.
+    pub light_splats: bool,
 }
 
 impl FilmFrame {
     /// A frame whose filter reaches no neighbour (a box of half-width 0.5, or a synthetic
-    /// film in tests).
+    /// film in tests), without light splats.
     pub fn unbordered(width: u32, height: u32) -> Self {
         Self {
             width,
             height,
             border: [0, 0],
+            light_splats: false,
         }
     }
 
@@ -187,9 +196,8 @@ mod tests {
     fn a_pixel_gets_at_most_one_block_per_source_plane() {
         for border in 0..=8u32 {
             let frame = FilmFrame {
-                width: 64,
-                height: 64,
                 border: [border, border.saturating_sub(1)],
+                ..FilmFrame::unbordered(64, 64)
             };
             let k = frame.plane_period();
             for y in 0..64u32 {
@@ -224,9 +232,8 @@ mod tests {
         }
         let planes = |border| {
             FilmFrame {
-                width: 1,
-                height: 1,
                 border: [border, 0],
+                ..FilmFrame::unbordered(1, 1)
             }
             .source_planes()
         };

@@ -13,9 +13,10 @@ use crate::manifest::SceneManifest;
 
 /// What node loops tell the render loop.
 pub enum SessionEvent {
-    /// A unit's result, the first one for that unit.
+    /// A unit's result, the first one for that unit (boxed: a buffer's vectors and light
+    /// splats make it ten times a notice's size).
     Result {
-        buffer: SampleBuffer,
+        buffer: Box<SampleBuffer>,
         stats: UnitStats,
     },
     /// A message for the terminal.
