@@ -583,6 +583,7 @@ mod tests {
             max_depth: 3,
             seed: 0,
             latlong: LatLongConvention::Seed,
+            transport: Default::default(),
         }
     }
 

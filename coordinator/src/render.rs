@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
+use yat_tracer::integrator::Transport;
 use yat_tracer::render::adaptive::AdaptiveSettings;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
@@ -60,6 +61,12 @@ impl RenderRequest {
         settings.check().with_context(cannot_render)?;
         if let Some(a) = &adaptive {
             a.check().with_context(cannot_render)?;
+            if settings.transport == Transport::Bidirectional {
+                anyhow::bail!(
+                    "{}: adaptive sampling (--noise-threshold) does not work with bidirectional                      path tracing yet: the light subpaths' splats land outside the blocks a                      round renders; render with a fixed --spp, or with --integrator path",
+                    cannot_render()
+                );
+            }
         }
         scene.check_film(&settings, adaptive.is_some())?;
         let (output_png, warnings) = match output_png {

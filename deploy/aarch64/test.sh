@@ -4,9 +4,10 @@
 # same image as one machine gives:
 #
 #   1. every scene in scenes/ (and the seed project's compared scenes, when present) rendered
-#      in-process by both builds, the aarch64 one run by qemu-user: the same EXR bytes;
+#      in-process by both builds, the aarch64 one run by qemu-user: the same EXR bytes; a few
+#      of them with bidirectional path tracing as well;
 #   2. a render over gRPC on an aarch64 worker, merged by the x86-64 coordinator: the same EXR
-#      bytes as the x86-64 in-process render.
+#      bytes as the x86-64 in-process render, path-traced and bidirectional.
 #
 # What used to differ: the C library's float functions (glibc's acosf, tanf, atanf, sinhf,
 # expm1f, ... give other last bits on aarch64) and glam's f32 matrix inverses (SSE2 and NEON
@@ -148,6 +149,19 @@ for scene in "${scenes[@]}"; do
         fail "$scene: the aarch64 render failed"
     cmp -s "$tmp/$name-x86.exr" "$tmp/$name-arm.exr" || differ+=("$scene")
 done
+# Bidirectional path tracing too: its light subpaths' splats land anywhere on the film.
+for scene in scenes/cornell/cornell-box.lxs scenes/cornell/cornell-fisheye-90.lxs scenes/dof/dof-0.1.lxs \
+    scenes/envmap/envmap-hdr.lxs scenes/sunroom/sunroom.lxs; do
+    [[ -f $scene ]] || continue
+    name=$(basename "$scene" .lxs)-bidirectional
+    timeout "$RENDER_SECONDS" "$x86" render "$scene" "${render_flags[@]}" --integrator bidirectional \
+        -o "$tmp/$name-x86.png" 2>>"$tmp/x86.log" || fail "$scene: the x86-64 bidirectional render failed"
+    timeout "$RENDER_SECONDS" "${arm[@]}" render "$scene" "${render_flags[@]}" --integrator bidirectional \
+        -o "$tmp/$name-arm.png" 2>>"$tmp/arm.log" ||
+        fail "$scene: the aarch64 bidirectional render failed"
+    cmp -s "$tmp/$name-x86.exr" "$tmp/$name-arm.exr" || differ+=("$scene (bidirectional)")
+    scenes+=("$scene (bidirectional)")
+done
 if ((${#differ[@]})); then
     fail "aarch64 renders other bytes than x86-64 for: ${differ[*]}"
 fi
@@ -186,7 +200,16 @@ sys.exit(0 if merged == figures["units"] > 1 else 1)
 EOF
 cmp -s "$tmp/alone.exr" "$tmp/worker.exr" ||
     fail "the render on the aarch64 worker differs from the in-process render"
+# A bidirectional render: its units' light splats travel with their results.
+timeout "$RENDER_SECONDS" "$x86" render "$scene" "${cluster_flags[@]}" --integrator bidirectional \
+    --threads 2 -o "$tmp/alone-bidirectional.png" 2>>"$tmp/x86.log" ||
+    fail "the in-process bidirectional render failed"
+timeout "$RENDER_SECONDS" "$x86" render "$scene" "${cluster_flags[@]}" --integrator bidirectional \
+    --workers "$arm_worker" -o "$tmp/worker-bidirectional.png" 2>>"$tmp/coordinator.log" ||
+    fail "the bidirectional render on the aarch64 worker failed"
+cmp -s "$tmp/alone-bidirectional.exr" "$tmp/worker-bidirectional.exr" ||
+    fail "the bidirectional render on the aarch64 worker differs from the in-process render"
 passed=$((passed + 1))
-say "PASS: a render on an aarch64 worker equals the x86-64 in-process render byte for byte"
+say "PASS: path-traced and bidirectional renders on an aarch64 worker equal the x86-64 in-process renders byte for byte"
 
 echo "aarch64: $passed passed, 0 failed"

@@ -5,7 +5,7 @@
 #
 #   1. a render submitted with sbatch equals an in-process render of the same settings, byte for
 #      byte;
-#   2. so does the same render on two nodes (two workers);
+#   2. so does the same render on two nodes (two workers), and a bidirectional one;
 #   3. a job whose workers cannot start fails at once, saying so;
 #   4. a longer render cancelled (scancel) once its checkpoint exists, then submitted again,
 #      resumes from the checkpoint and still equals the in-process render byte for byte; the
@@ -311,9 +311,21 @@ state=$(wait_job_end "$job" 300) || fail "job $job did not end within 300 s"
 workers_used=$(grep -c '^worker .* ready' "$tmp/jobs/job-$job.log") || true
 ((workers_used == 2)) || fail "job $job rendered on $workers_used workers, not 2"
 expect_same_image "$tmp/small-two.png" "$tmp/small-ref.png"
-sbatch_options=(--nodes=1 --exclusive)
 step_done
 pass "a two-node sbatch render (two workers) equals the in-process render byte for byte"
+
+# Bidirectional path tracing: the units' light splats land anywhere on the film and travel
+# with their results.
+bidirectional=(--resolution 192x108 --spp 16 --seed 0 --integrator bidirectional)
+step "in-process and two-node sbatch render, ${bidirectional[*]}"
+reference "$tmp/bidirectional-ref.png" "${bidirectional[@]}"
+submit "$tmp/bidirectional-two.png" "${bidirectional[@]}"
+state=$(wait_job_end "$job" 300) || fail "job $job did not end within 300 s"
+[[ $state == COMPLETED ]] || fail "job $job ended $state"
+expect_same_image "$tmp/bidirectional-two.png" "$tmp/bidirectional-ref.png"
+sbatch_options=(--nodes=1 --exclusive)
+step_done
+pass "a two-node bidirectional sbatch render equals the in-process render byte for byte"
 
 step "sbatch render whose workers cannot start"
 # A cache folder inside a file: every worker exits at start. The job must fail soon after,

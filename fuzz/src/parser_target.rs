@@ -59,6 +59,7 @@ pub(crate) fn render_settings() -> RenderSettings {
         max_depth: 4,
         seed: 1,
         latlong: LatLongConvention::LuxRender,
+        transport: Default::default(),
     }
 }
 

@@ -656,6 +656,7 @@ fn seed_sessions() -> Vec<Session> {
             max_depth: 5,
             seed,
             latlong: pb::LatLongConvention::LatlongLuxrender.into(),
+            transport: pb::Transport::Path.into(),
         };
         let hash = sha256_hex(b"WorldBegin\nWorldEnd\n");
         let load = pb::LoadSceneRequest {

@@ -7,6 +7,7 @@ use prost::bytes::{BufMut, Bytes, BytesMut};
 use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{LightSplats, SampleBuffer, MAX_SPLAT_PIXELS, MAX_SUM};
 use yat_tracer::filter::WeightBounds;
+use yat_tracer::integrator::Transport;
 use yat_tracer::render::unit::{FilmFrame, PixelRect, BLOCK_SIZE, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
@@ -74,6 +75,11 @@ impl From<&RenderSettings> for pb::RenderSettings {
             max_depth: s.max_depth,
             seed: s.seed,
             latlong: latlong.into(),
+            transport: match s.transport {
+                Transport::Path => pb::Transport::Path,
+                Transport::Bidirectional => pb::Transport::Bidirectional,
+            }
+            .into(),
         }
     }
 }
@@ -92,6 +98,16 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
                 )))
             }
         };
+        let transport = match pb::Transport::try_from(s.transport) {
+            Ok(pb::Transport::Path) => Transport::Path,
+            Ok(pb::Transport::Bidirectional) => Transport::Bidirectional,
+            Err(_) => {
+                return Err(WireError::Settings(format!(
+                    "unknown transport {}",
+                    s.transport
+                )))
+            }
+        };
         let settings = Self {
             width: s.width,
             height: s.height,
@@ -99,6 +115,7 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
             max_depth: s.max_depth,
             seed: s.seed,
             latlong,
+            transport,
         };
         settings
             .check()
@@ -506,6 +523,7 @@ mod tests {
             max_depth: 5,
             seed: 7,
             latlong: LatLongConvention::LuxRender,
+            transport: Default::default(),
         }
     }
 
@@ -883,6 +901,7 @@ mod tests {
             max_depth: 4,
             seed: 3,
             latlong: LatLongConvention::LuxRender,
+            transport: Default::default(),
         };
         let scene = RenderScene::build(&desc, &source, &settings).unwrap();
         (scene, settings)

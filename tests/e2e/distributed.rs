@@ -10,6 +10,8 @@ use yat::exec::distributed::config::DistributedConfig;
 use yat::render::{Executor, Observers};
 use yat::shutdown::Interrupt;
 use yat_proto::flags::ClientTlsFlags;
+use yat_tracer::integrator::Transport;
+use yat_tracer::render::RenderOverrides;
 
 use crate::util::*;
 
@@ -399,4 +401,49 @@ fn local_workers_do_not_outlive_a_killed_coordinator() {
         );
         std::thread::sleep(Duration::from_millis(20));
     }
+}
+
+/// A bidirectional render's light-tracing splats land anywhere on the film and travel with
+/// their unit's result: the image is the in-process render's bytes on two workers, one of
+/// them killed mid-render (its units requeued, their splats merged once), and it is not the
+/// path tracer's image (the splats are there).
+#[test]
+fn a_bidirectional_render_is_the_same_bytes_on_workers_killed_or_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, [mut a, b]) = two_slow_workers(dir.path(), "100");
+    let bidirectional = RenderOverrides {
+        transport: Some(Transport::Bidirectional),
+        ..SETTINGS_OVERRIDES
+    };
+    let reference = dir.path().join("bidirectional-in-process.png");
+    render_here(
+        request_with(&scene, &reference, &bidirectional, None),
+        two_threads(),
+    )
+    .unwrap();
+    let expected = image_bytes(&reference);
+    let path_traced = dir.path().join("path.png");
+    render_here(request(&scene, &path_traced), two_threads()).unwrap();
+    assert!(
+        image_bytes(&path_traced).1 != expected.1,
+        "the bidirectional image is its own"
+    );
+
+    let out = dir.path().join("bidirectional.png");
+    let json = dir.path().join("bidirectional.json");
+    let coordinator = spawn_render(
+        request_with(&scene, &out, &bidirectional, None),
+        reporting_to(&json, workers_at(&[&a.address, &b.address])),
+        Observers::none(),
+        Interrupt::default(),
+    );
+    wait_for_units(&[&a, &b], 12);
+    a.kill();
+    coordinator.join().unwrap().unwrap();
+    assert_same_image(&out, &expected);
+    let report = workers_report(&json);
+    assert!(
+        report["result_bytes_per_unit_pixel"].as_f64().unwrap() > 16.0 * 13200.0 / 12288.0,
+        "the results carry light splats: {report:#}"
+    );
 }

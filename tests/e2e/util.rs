@@ -145,6 +145,7 @@ pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
     seed: Some(0),
     resolution: Some((128, 96)),
     latlong: yat_tracer::desc::LatLongConvention::Seed,
+    transport: None,
 };
 
 /// [`SETTINGS_OVERRIDES`] with `spp` samples per pixel.

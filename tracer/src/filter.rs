@@ -217,6 +217,44 @@ impl AxisWeights {
             .collect()
     }
 
+    /// The weight's integral over offsets in [-radius, radius], in pixels: the interpolated
+    /// table's, exactly (a trapezoid rule over its entries).
+    #[cfg(test)]
+    fn integral(&self) -> f32 {
+        let inner: f32 = self.table.windows(2).map(|w| w[0] + w[1]).sum();
+        inner * (self.radius / TABLE_SIZE as f32)
+    }
+
+    /// Per pixel `c` of an axis `size` pixels long: the weight a sample gives `c` integrated
+    /// over the sample's position along the axis within the film (`c`'s filter mass in the
+    /// film: the full integral away from the edges, less near them, where the film has no
+    /// samples beyond). Integrated with the taps themselves, at [`MASS_STEPS`] positions in
+    /// each pixel.
+    fn film_mass(&self, size: u32) -> Vec<f32> {
+        let b = self.border as usize;
+        // The weight's integral over a sample's position in a pixel `k - border` pixels from
+        // the one weighed (by the midpoint rule; the table is linear between entries).
+        let mut per_offset = vec![0.0f64; 2 * b + 1];
+        let far = (2 * b + 1) as u32;
+        for i in 0..MASS_STEPS {
+            let u = (i as f32 + 0.5) / MASS_STEPS as f32;
+            let taps = self.taps(far, u, 0, 2 * far + 1);
+            for (j, &w) in taps.weights().iter().enumerate() {
+                let offset = (taps.first + j as u32) as i64 - i64::from(far);
+                per_offset[(offset + b as i64) as usize] += f64::from(w) / MASS_STEPS as f64;
+            }
+        }
+        (0..i64::from(size))
+            .map(|c| {
+                let mass: f64 = (-(b as i64)..=b as i64)
+                    .filter(|&k| (0..i64::from(size)).contains(&(c - k)))
+                    .map(|k| per_offset[(k + b as i64) as usize])
+                    .sum();
+                mass as f32
+            })
+            .collect()
+    }
+
     /// Whether some weight is negative: some table entry is (a weight lies between two).
     fn has_negative_weights(&self) -> bool {
         self.table.iter().any(|&v| v < 0.0)
@@ -369,6 +407,19 @@ impl PixelFilter {
         self.y.taps(y, u, lo, hi)
     }
 
+    /// Each pixel's filter mass in a `width` x `height` film: what its weight sum grows by
+    /// per sample per pixel of area (the filter's integral over the film around the pixel;
+    /// less at the edges, which have no samples beyond). A light splat, which no weight sum
+    /// divides, is spread through the filter with each pixel's weight divided by that pixel's
+    /// mass, so the pixel converges to the filtered mean its camera samples' weighted mean
+    /// converges to, at the edges too.
+    pub fn film_mass(&self, width: u32, height: u32) -> FilmMass {
+        FilmMass {
+            columns: self.x.film_mass(width),
+            rows: self.y.film_mass(height),
+        }
+    }
+
     /// What the filter lets one sample add to a pixel's weight sum: the bounds an honest unit's
     /// buffer keeps.
     pub fn weight_bounds(&self) -> WeightBounds {
@@ -377,6 +428,24 @@ impl PixelFilter {
             x: self.x.max_weights(),
             y: self.y.max_weights(),
         }
+    }
+}
+
+/// Sample positions per pixel [`PixelFilter::film_mass`] integrates over.
+const MASS_STEPS: usize = 1024;
+
+/// Each pixel's filter mass in a film ([`PixelFilter::film_mass`]), per column and per row
+/// (the filter is separable).
+#[derive(Clone, Debug)]
+pub struct FilmMass {
+    columns: Vec<f32>,
+    rows: Vec<f32>,
+}
+
+impl FilmMass {
+    /// The mass of pixel (x, y), which must lie in the film.
+    pub fn at(&self, x: u32, y: u32) -> f32 {
+        self.columns[x as usize] * self.rows[y as usize]
     }
 }
 
@@ -463,6 +532,67 @@ mod tests {
             xwidth: width,
             ywidth: width,
         })
+    }
+
+    /// A sample's weights summed over the pixels it reaches, averaged over its position in its
+    /// pixel, are the integral; a pixel's film mass is that inside the film, less at its edge:
+    /// what light splats are normalised by.
+    #[test]
+    fn the_integral_is_the_mean_weight_a_sample_gives() {
+        for (kind, width) in [
+            (FilterKind::Box, 0.5),
+            (FilterKind::Box, 1.5),
+            (FilterKind::Gaussian { alpha: 2.0 }, 2.0),
+            (
+                FilterKind::Mitchell {
+                    b: 1.0 / 3.0,
+                    c: 1.0 / 3.0,
+                },
+                2.0,
+            ),
+            (FilterKind::BlackmanHarris, 1.5),
+        ] {
+            let f = filter(kind, width);
+            let n = 4000;
+            let mean: f64 = (0..n)
+                .map(|i| {
+                    let u = (i as f32 + 0.5) / n as f32;
+                    f64::from(f.taps_x(10, u, 0, 20).weights().iter().sum::<f32>())
+                })
+                .sum::<f64>()
+                / f64::from(n);
+            let axis = f.x.integral();
+            assert!(
+                (mean / f64::from(axis) - 1.0).abs() < 1e-3,
+                "{kind:?} {width}: {mean} vs {axis}"
+            );
+            // Inside the film a pixel's mass is the integral; at the edge the part beyond.
+            let mass = f.film_mass(20, 20);
+            let inside = mass.at(10, 10);
+            assert!((inside / (axis * axis) - 1.0).abs() < 1e-3, "{inside}");
+            let edge: f64 = (0..n)
+                .map(|i| {
+                    let u = (i as f32 + 0.5) / n as f32;
+                    // Samples in pixels 0, 1, 2 and 3 (the widest border here is 2) weigh pixel 0.
+                    (0..4u32)
+                        .map(|p| {
+                            let taps = f.taps_x(p, u, 0, 20);
+                            if taps.first == 0 {
+                                f64::from(taps.weights()[0])
+                            } else {
+                                0.0
+                            }
+                        })
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / f64::from(n);
+            let got = f64::from(mass.at(0, 10) / axis);
+            assert!(
+                (got / edge - 1.0).abs() < 1e-3,
+                "{kind:?} {width}: edge {got} vs {edge}"
+            );
+        }
     }
 
     #[test]

@@ -221,6 +221,20 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         "integrator   path, max depth {} (file asks for \"{}\"), rr {:?} {}",
         i.max_depth, i.requested, i.rr_strategy, i.rr_continue_prob
     );
+    let _ = writeln!(
+        s,
+        "             --integrator bidirectional: eye depth {}, light depth {}, rr thresholds \
+         {} (eye) {} (light){}",
+        i.max_depth,
+        i.light_depth,
+        i.eye_rr_threshold,
+        i.light_rr_threshold,
+        if d.volumes.media.is_empty() {
+            ""
+        } else {
+            "; this scene has volumes, which it renders with path tracing"
+        }
+    );
     let spp = d
         .sampler
         .pixel_samples

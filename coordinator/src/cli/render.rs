@@ -9,6 +9,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
+use yat_tracer::integrator::Transport;
 use yat_tracer::render::adaptive::{AdaptiveSettings, DEFAULT_MIN_SPP};
 use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::RenderOverrides;
@@ -23,6 +24,22 @@ use crate::shutdown::Interrupt;
 use crate::status::server::StatusServer;
 use crate::status::snapshot::{SceneInfo, SettingsInfo};
 use crate::status::StatusBoard;
+
+/// `--integrator`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum IntegratorArg {
+    Path,
+    Bidirectional,
+}
+
+impl From<IntegratorArg> for Transport {
+    fn from(arg: IntegratorArg) -> Self {
+        match arg {
+            IntegratorArg::Path => Transport::Path,
+            IntegratorArg::Bidirectional => Transport::Bidirectional,
+        }
+    }
+}
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -58,9 +75,15 @@ pub struct RenderArgs {
     /// With --noise-threshold: write a PNG of the samples each pixel got (grey, log scale).
     #[arg(long, value_name = "PNG", requires = "noise_threshold")]
     pub sample_map: Option<PathBuf>,
-    /// Maximum path depth (default: the scene's integrator depth).
+    /// Maximum path depth (default: the scene's integrator depth; a bidirectional render's
+    /// camera subpath depth).
     #[arg(long)]
     pub maxdepth: Option<u32>,
+    /// The light transport: path tracing (what every scene renders with by default, a
+    /// SurfaceIntegrator "bidirectional" included) or bidirectional path tracing (with the
+    /// scene's eyedepth and lightdepth).
+    #[arg(long, value_enum)]
+    pub integrator: Option<IntegratorArg>,
     /// Render threads for an in-process render [default: the CPUs this process may use].
     #[arg(long)]
     pub threads: Option<usize>,
@@ -138,6 +161,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         seed: Some(args.seed),
         resolution: args.resolution,
         latlong: args.latlong.into(),
+        transport: args.integrator.map(Into::into),
     };
     let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
         threshold,

@@ -25,7 +25,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Camera, Projection};
+use super::rays::{Camera, Projection};
 use crate::bxdf::local::sample_disk_concentric;
 
 /// A world point as the camera sees it through a lens point: the light-tracing connection.
@@ -213,7 +213,7 @@ mod tests {
     use glam::Mat4;
 
     use super::*;
-    use crate::camera::{CameraDesc, CameraKind};
+    use crate::camera::desc::{CameraDesc, CameraKind};
 
     fn camera(kind: CameraKind, lens_radius: f32) -> Camera {
         let camera_to_world = Mat4::from_translation(Vec3::new(0.3, -4.0, 1.7))

@@ -11,6 +11,7 @@
 //! segments through volumes, [`glossy_split`], [`mirror_images`] and [`branch`] the vertices
 //! that take more than one sample.
 
+pub mod bdpt;
 mod branch;
 mod direct;
 mod glossy_split;
@@ -32,7 +33,7 @@ use crate::sampler::PixelSampler;
 
 pub use branch::MAX_BRANCHES;
 pub use glossy_split::GLOSSY_SPLIT;
-pub use options::{IntegratorDesc, RussianRoulette};
+pub use options::{IntegratorDesc, RussianRoulette, Transport};
 pub use scene::{Crossing, PathScene};
 pub use state::PathResult;
 

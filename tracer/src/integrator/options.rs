@@ -3,7 +3,9 @@
 //!
 //! | parameter | type | default |
 //! |---|---|---|
-//! | `maxdepth` (path), `eyedepth` (bidirectional) | integer | 16 |
+//! | `maxdepth` (path) | integer | 16 |
+//! | `eyedepth`, `lightdepth` (bidirectional) | integer | 8 (LuxRender 1.x's) |
+//! | `eyerrthreshold`, `lightrrthreshold` (bidirectional) | float | 0: the least survival probability of each subpath's roulette |
 //! | `rrstrategy` | string: efficiency, probability, none | efficiency |
 //! | `rrcontinueprob` | float | 0.65 |
 //! | `includeenvironment` | bool | true |
@@ -19,6 +21,8 @@ use crate::parse::params::ParamList;
 
 /// Bounces per path when the file does not say.
 pub const DEFAULT_MAX_DEPTH: i32 = 16;
+/// Scattering vertices of each bidirectional subpath when the file does not say.
+pub const DEFAULT_SUBPATH_DEPTH: i32 = 8;
 /// Survival probability of `rrstrategy "probability"` when the file does not say.
 pub const DEFAULT_RR_CONTINUE_PROB: f32 = 0.65;
 /// Whether camera rays that escape see the environment.
@@ -51,6 +55,41 @@ pub struct IntegratorDesc {
     pub glossy_split: bool,
     /// The SurfaceIntegrator the file named (e.g. "bidirectional" rendered as path).
     pub requested: String,
+    /// Scattering vertices of a bidirectional light subpath at most (`lightdepth`).
+    pub light_depth: u32,
+    /// The least survival probabilities of a bidirectional camera and light subpath's
+    /// roulette (`eyerrthreshold`, `lightrrthreshold`).
+    pub eye_rr_threshold: f32,
+    pub light_rr_threshold: f32,
+}
+
+/// The light transport an image is rendered with: the scene's SurfaceIntegrator or the
+/// command line's choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Transport {
+    /// Path tracing with next-event estimation ([`crate::integrator::trace_path`]).
+    #[default]
+    Path,
+    /// Bidirectional path tracing ([`crate::integrator::bdpt`]).
+    Bidirectional,
+}
+
+impl Transport {
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Path => "path",
+            Transport::Bidirectional => "bidirectional",
+        }
+    }
+
+    /// The transport named `name` (as the command line and the wire write it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "path" => Some(Transport::Path),
+            "bidirectional" => Some(Transport::Bidirectional),
+            _ => None,
+        }
+    }
 }
 
 impl IntegratorDesc {
@@ -64,6 +103,9 @@ impl IntegratorDesc {
             mirror_images: DEFAULT_MIRROR_IMAGES,
             glossy_split: DEFAULT_GLOSSY_SPLIT,
             requested: requested.to_string(),
+            light_depth: DEFAULT_SUBPATH_DEPTH as u32,
+            eye_rr_threshold: 0.0,
+            light_rr_threshold: 0.0,
         }
     }
 
@@ -74,8 +116,8 @@ impl IntegratorDesc {
         params: &ParamList,
         pos: &SourcePos,
     ) -> Result<Self, ParseError> {
-        let depth = |name: &str| -> Result<u32, ParseError> {
-            let d = params.int(name, DEFAULT_MAX_DEPTH)?;
+        let depth = |name: &str, default: i32| -> Result<u32, ParseError> {
+            let d = params.int(name, default)?;
             match params.find(name) {
                 Some(p) if d < 0 => Err(params.error(p, "the depth cannot be negative")),
                 _ => Ok(d as u32),
@@ -96,35 +138,43 @@ impl IntegratorDesc {
                 params.ignore("lightstrategy");
                 params.ignore("shadowraycount");
                 Ok(IntegratorDesc {
-                    max_depth: depth("maxdepth")?,
+                    max_depth: depth("maxdepth", DEFAULT_MAX_DEPTH)?,
                     rr_strategy,
                     rr_continue_prob: params.float("rrcontinueprob", DEFAULT_RR_CONTINUE_PROB)?,
                     include_environment: params
                         .bool("includeenvironment", DEFAULT_INCLUDE_ENVIRONMENT)?,
                     mirror_images: params.bool("mirrorimages", DEFAULT_MIRROR_IMAGES)?,
                     glossy_split: params.bool("glossysplit", DEFAULT_GLOSSY_SPLIT)?,
-                    requested: ty.to_string(),
+                    ..Self::path_defaults(ty)
                 })
             }
             "bidirectional" => {
-                let max_depth = depth("eyedepth")?;
-                for name in [
-                    "lightdepth",
-                    "lightraycount",
-                    "lightpathstrategy",
-                    "lightstrategy",
-                    "eyerrthreshold",
-                    "lightrrthreshold",
-                ] {
+                let max_depth = depth("eyedepth", DEFAULT_SUBPATH_DEPTH)?;
+                let light_depth = depth("lightdepth", DEFAULT_SUBPATH_DEPTH)?;
+                let threshold = |name: &str| -> Result<f32, ParseError> {
+                    let v = params.float(name, 0.0)?;
+                    match params.find(name) {
+                        Some(p) if !(0.0..=1.0).contains(&v) => {
+                            Err(params.error(p, "a survival probability lies in [0, 1]"))
+                        }
+                        _ => Ok(v),
+                    }
+                };
+                let (eye_rr_threshold, light_rr_threshold) =
+                    (threshold("eyerrthreshold")?, threshold("lightrrthreshold")?);
+                for name in ["lightraycount", "lightpathstrategy", "lightstrategy"] {
                     params.ignore(name);
                 }
                 ctx.note_once(
                     "bidirectional".into(),
                     pos,
-                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth): the same image once converged, except caustics of point, spot and distant lights, which path tracing cannot carry"),
+                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth) unless --integrator bidirectional is given: the same image once converged, except caustics of point, spot and distant lights, which path tracing cannot carry"),
                 );
                 Ok(IntegratorDesc {
                     max_depth,
+                    light_depth,
+                    eye_rr_threshold,
+                    light_rr_threshold,
                     ..Self::path_defaults(ty)
                 })
             }

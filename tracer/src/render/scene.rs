@@ -10,9 +10,10 @@ use crate::assets::AssetSource;
 use crate::budget::{BuildGuard, Cancelled, Limit, OverBudget};
 use crate::camera::Camera;
 use crate::desc::{Geometry, MaterialDesc, SceneDesc};
-use crate::film::{unit_sum, SampleBuffer};
-use crate::filter::PixelFilter;
+use crate::film::{unit_sum, SampleBuffer, SplatSums};
+use crate::filter::{FilmMass, PixelFilter};
 use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
+use crate::integrator::bdpt::{trace_bidirectional, BidirectionalScene, LightSplat, Subpaths};
 use crate::integrator::options::IntegratorDesc;
 use crate::integrator::packet;
 use crate::integrator::{trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES};
@@ -70,6 +71,10 @@ pub struct RenderScene {
     settings: RenderSettings,
     camera: Camera,
     filter: PixelFilter,
+    /// Each pixel's filter mass in the film, for light splats: a bidirectional render's only.
+    film_mass: Option<FilmMass>,
+    /// The one bidirectional strategy rendered ([`Self::with_only_strategy`]); None: all.
+    only_strategy: Option<(usize, usize)>,
     frame: FilmFrame,
     geometry: SceneGeometry,
     /// Shared with the area lights whose colour is a texture.
@@ -135,6 +140,9 @@ impl RenderScene {
         let mut scene = Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
             filter: PixelFilter::new(&desc.filter),
+            film_mass: settings
+                .renders_bidirectional(desc)
+                .then(|| PixelFilter::new(&desc.filter).film_mass(settings.width, settings.height)),
             frame: settings.film_frame(desc),
             textures,
             materials: Materials::new(desc.materials.clone()),
@@ -149,6 +157,7 @@ impl RenderScene {
             crossings,
             glossy_split: glossy_split(desc),
             first_vertex_branches: 1,
+            only_strategy: None,
             packets: false,
             desc: desc.clone(),
             settings: settings.clone(),
@@ -162,6 +171,13 @@ impl RenderScene {
     /// The continuations camera paths take at their first broad vertex.
     pub fn first_vertex_branches(&self) -> usize {
         self.first_vertex_branches
+    }
+
+    /// The scene rendering bidirectional strategy (`s` light vertices, `t` camera vertices)
+    /// alone, at full weight: what the tests compare each strategy's image with.
+    pub fn with_only_strategy(mut self, s: usize, t: usize) -> Self {
+        self.only_strategy = Some((s, t));
+        self
     }
 
     /// The scene with `branches` continuations (clamped to 1 ..= [`MAX_BRANCHES`]) in place of
@@ -246,6 +262,9 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
+        if self.bidirectional() {
+            return self.render_unit_bidirectional(unit, cancel);
+        }
         #[cfg(target_arch = "x86_64")]
         if let Some(cpu) = Avx2Cpu::detect().filter(|_| self.packets) {
             return cpu.run(&UnitOnLanes {
@@ -328,6 +347,87 @@ impl RenderScene {
             }
         }
         Some((sums.into_buffer(), stats))
+    }
+
+    /// Whether units render with bidirectional path tracing
+    /// ([`RenderSettings::renders_bidirectional`]): their buffers then carry light splats.
+    pub fn bidirectional(&self) -> bool {
+        self.frame.light_splats
+    }
+
+    /// [`Self::render_unit_cancellable`] with bidirectional path tracing, one sample at a
+    /// time: each sample's camera path into the unit's sums, its light subpath's splats into
+    /// the unit's light splats, wherever on the film they land.
+    fn render_unit_bidirectional(
+        &self,
+        unit: &WorkUnit,
+        cancel: &AtomicBool,
+    ) -> Option<(SampleBuffer, UnitStats)> {
+        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
+        let mut stats = UnitStats::default();
+        let mut splat_sums = SplatSums::new();
+        let mass = self
+            .film_mass
+            .as_ref()
+            .expect("a bidirectional scene has its film mass");
+        let mut subpaths = Subpaths::new();
+        let mut splats = Vec::with_capacity(crate::integrator::bdpt::MAX_DEPTH as usize + 1);
+        let seed = self.settings.seed;
+        for y in unit.y0..unit.y1 {
+            for x in unit.x0..unit.x1 {
+                if !unit.renders(x, y) {
+                    continue;
+                }
+                for index in unit.sample_start..unit.sample_end {
+                    if ((index - unit.sample_start) as usize).is_multiple_of(CANCEL_CHECK_SAMPLES)
+                        && cancel.load(Ordering::Relaxed)
+                    {
+                        return None;
+                    }
+                    let mut sampler = if unit.mask.is_some() {
+                        PixelSampler::nested(x, y, index, seed)
+                    } else {
+                        PixelSampler::new(x, y, index, self.settings.spp, seed)
+                    };
+                    let (u, ray) = self.camera_sample(x, y, &mut sampler);
+                    splats.clear();
+                    let path =
+                        trace_bidirectional(self, ray, &mut sampler, &mut subpaths, &mut splats);
+                    self.add_sample(&mut sums, &mut stats, (x, y, index), u, path);
+                    for splat in &splats {
+                        self.add_light_splat(mass, &mut splat_sums, splat);
+                    }
+                }
+            }
+        }
+        // Splats that are not finite, or beyond what a unit may report, are dropped as such
+        // samples are.
+        stats.dropped += splat_sums.dropped() + splat_sums.refused();
+        let mut buffer = sums.into_buffer();
+        buffer.splats = splat_sums.into_splats();
+        Some((buffer, stats))
+    }
+
+    /// Adds a light subpath's splat to every film pixel its filter reaches, weighed by the
+    /// filter over each pixel's filter mass (no weight sum divides a splat: see
+    /// [`PixelFilter::film_mass`]).
+    fn add_light_splat(&self, mass: &FilmMass, splat_sums: &mut SplatSums, splat: &LightSplat) {
+        let (width, height) = (self.frame.width, self.frame.height);
+        let (px, py) = (splat.raster.x.floor(), splat.raster.y.floor());
+        if !(0.0..width as f32).contains(&px) || !(0.0..height as f32).contains(&py) {
+            return;
+        }
+        let (x, y) = (px as u32, py as u32);
+        let columns = self.filter.taps_x(x, splat.raster.x - px, 0, width);
+        let rows = self.filter.taps_y(y, splat.raster.y - py, 0, height);
+        for (row, &wy) in rows.weights().iter().enumerate() {
+            let y = rows.first + row as u32;
+            for (column, &wx) in columns.weights().iter().enumerate() {
+                let x = columns.first + column as u32;
+                let weight = wx * wy / mass.at(x, y);
+                splat_sums.add(y * width + x, splat.radiance * weight);
+            }
+        }
     }
 
     /// Counts sample `index` of pixel (x, y), at `u` in the pixel, and splats its light (a
@@ -514,6 +614,20 @@ impl PilotScene for RenderScene {
     /// None outside a fisheye's circle.
     fn camera_ray(&self, x: u32, y: u32, sampler: &mut PixelSampler) -> Option<Ray> {
         self.camera_sample(x, y, sampler).1
+    }
+}
+
+impl BidirectionalScene for RenderScene {
+    fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    fn light_depth(&self) -> u32 {
+        self.desc.integrator.light_depth
+    }
+
+    fn only_strategy(&self) -> Option<(usize, usize)> {
+        self.only_strategy
     }
 }
 

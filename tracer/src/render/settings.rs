@@ -2,6 +2,7 @@
 //! command-line overrides they are resolved from.
 
 use crate::desc::{LatLongConvention, SceneDesc};
+use crate::integrator::options::Transport;
 use crate::render::unit::FilmFrame;
 
 /// Everything besides the scene that decides the image. Identical settings and scene give
@@ -14,6 +15,7 @@ pub struct RenderSettings {
     pub max_depth: u32,
     pub seed: u64,
     pub latlong: LatLongConvention,
+    pub transport: Transport,
 }
 
 #[cfg(test)]
@@ -28,6 +30,7 @@ impl RenderSettings {
             max_depth: 4,
             seed: 0,
             latlong: LatLongConvention::Seed,
+            transport: Transport::Path,
         }
     }
 }
@@ -40,6 +43,7 @@ pub struct RenderOverrides {
     pub seed: Option<u64>,
     pub resolution: Option<(u32, u32)>,
     pub latlong: LatLongConvention,
+    pub transport: Option<Transport>,
 }
 
 /// Samples per pixel when neither the file nor the command line says.
@@ -91,16 +95,23 @@ impl RenderSettings {
     }
 
     /// The frame of this render's film: the image size, the border the scene's pixel filter
-    /// gives every unit's buffer, and whether units carry light splats (none yet: the
-    /// bidirectional integrator will derive that from `desc.integrator` here). Every node makes
-    /// its frame with this, so a peer's buffer is checked against the same frame everywhere.
+    /// gives every unit's buffer, and whether units carry light splats (a bidirectional
+    /// render's, [`Self::renders_bidirectional`]). Every node makes its frame with this, so a
+    /// peer's buffer is checked against the same frame everywhere.
     pub fn film_frame(&self, desc: &SceneDesc) -> FilmFrame {
         FilmFrame {
             width: self.width,
             height: self.height,
             border: desc.filter.border(),
-            light_splats: false,
+            light_splats: self.renders_bidirectional(desc),
         }
+    }
+
+    /// Whether `desc` renders with bidirectional path tracing under these settings: they
+    /// choose it, and the scene has no volumes (the bidirectional walk does not enter them;
+    /// such a scene renders with the path tracer, as `yat check` says).
+    pub fn renders_bidirectional(&self, desc: &SceneDesc) -> bool {
+        self.transport == Transport::Bidirectional && desc.volumes.media.is_empty()
     }
 
     pub fn resolve(desc: &SceneDesc, overrides: &RenderOverrides) -> Self {
@@ -120,6 +131,10 @@ impl RenderSettings {
             max_depth: overrides.max_depth.unwrap_or(desc.integrator.max_depth),
             seed: overrides.seed.unwrap_or(0),
             latlong: overrides.latlong,
+            // A scene's "bidirectional" renders with the path tracer unless the command line
+            // chooses: the bidirectional integrator is new, and the course's scenes, which all
+            // ask for it, are path tracing's strength (docs/architecture.md, "Integrators").
+            transport: overrides.transport.unwrap_or_default(),
         }
     }
 }
@@ -136,6 +151,7 @@ mod tests {
             max_depth,
             seed: 0,
             latlong: LatLongConvention::Seed,
+            transport: Transport::Path,
         }
     }
 

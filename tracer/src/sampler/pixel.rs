@@ -29,6 +29,10 @@ const DIMENSION_STEP: u64 = 0x9e37_79b9_7f4a_7c15;
 /// Keys the streams of a path's branches ([`PixelSampler::branch`]) apart from the pixel's.
 const BRANCH_KEY: u64 = 0x6272_616e_6368_0000;
 
+/// Keys a sample's light subpath stream ([`PixelSampler::light_subpath`]) apart from its
+/// camera path's and its branches'.
+const LIGHT_SUBPATH_KEY: u64 = 0x6c69_6768_7470_6174;
+
 /// The first block of [`PixelSampler::nested`]'s indices: the default first round of an
 /// adaptive render, so that rounds of that default are exactly the blocks.
 pub const NESTED_FIRST_BLOCK: u32 = 16;
@@ -108,6 +112,18 @@ impl PixelSampler {
     pub(super) fn sample_at(&self, index: u32) -> Self {
         Self {
             index,
+            ..self.clone()
+        }
+    }
+
+    /// The stream of this sample's light subpath (bidirectional path tracing): dimensions of
+    /// its own from the first, scrambled and permuted by hashes of their own, over the same
+    /// permutation range as the camera path's, so a pixel's light subpaths are stratified
+    /// as its camera paths are.
+    pub fn light_subpath(&self) -> Self {
+        Self {
+            pixel_hash: mix64(self.pixel_hash ^ LIGHT_SUBPATH_KEY),
+            dimension_key: 0,
             ..self.clone()
         }
     }

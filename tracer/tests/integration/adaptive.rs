@@ -47,6 +47,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         max_depth: 8,
         seed,
         latlong: LatLongConvention::Seed,
+        transport: Default::default(),
     }
 }
 

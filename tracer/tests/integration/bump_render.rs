@@ -20,6 +20,7 @@ fn render(text: &str, spp: u32) -> Film {
         max_depth: desc.integrator.max_depth,
         seed: 1,
         latlong: Default::default(),
+        transport: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     let mut film = Film::new(scene.frame());

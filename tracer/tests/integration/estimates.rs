@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 use yat_tracer::assets::MemorySource;
+use yat_tracer::diag::Severity;
 use yat_tracer::film::Film;
+use yat_tracer::integrator::Transport;
 use yat_tracer::parse::parse_scene;
 use yat_tracer::render::{plan_units, RenderScene, RenderSettings};
 
@@ -39,7 +41,8 @@ pub fn quad(material: &str, points: [&str; 4]) -> String {
     )
 }
 
-/// The scene `text` (which must parse without warnings) built for a `size` x `size` render.
+/// The scene `text` (which must parse without a warning that it renders otherwise than
+/// LuxRender would) built for a `size` x `size` render.
 pub fn build(text: &str, size: u32, spp: u32, seed: u64) -> (RenderScene, RenderSettings) {
     build_with(text, &[], size, spp, seed)
 }
@@ -52,13 +55,29 @@ pub fn build_with(
     spp: u32,
     seed: u64,
 ) -> (RenderScene, RenderSettings) {
+    build_for(text, files, size, spp, seed, Transport::Path)
+}
+
+/// [`build_with`], rendered with `transport`.
+pub fn build_for(
+    text: &str,
+    files: &[(&str, &[u8])],
+    size: u32,
+    spp: u32,
+    seed: u64,
+    transport: Transport,
+) -> (RenderScene, RenderSettings) {
     let mut source = MemorySource::new();
     source.insert("main.lxs", text.as_bytes().into());
     for (name, bytes) in files {
         source.insert(*name, (*bytes).into());
     }
     let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let differs = desc
+        .warnings
+        .iter()
+        .filter(|w| w.severity == Severity::Differs);
+    assert_eq!(differs.count(), 0, "{:?}", desc.warnings);
     let settings = RenderSettings {
         width: size,
         height: size,
@@ -66,6 +85,7 @@ pub fn build_with(
         max_depth: desc.integrator.max_depth,
         seed,
         latlong: Default::default(),
+        transport,
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     (scene, settings)

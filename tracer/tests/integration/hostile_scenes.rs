@@ -263,6 +263,7 @@ fn settings(desc: &SceneDesc) -> RenderSettings {
         max_depth: 3,
         seed: 0,
         latlong: LatLongConvention::Seed,
+        transport: Default::default(),
     }
 }
 

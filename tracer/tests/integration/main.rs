@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod area_texture;
+mod bidirectional;
 mod branching;
 mod bump_render;
 mod daylight;

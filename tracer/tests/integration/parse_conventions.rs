@@ -253,6 +253,36 @@ fn bidirectional_renders_as_path_at_eyedepth_with_one_warning() {
 }
 
 #[test]
+fn bidirectional_reads_luxrenders_depths_and_thresholds() {
+    let d = parse(
+        "SurfaceIntegrator \"bidirectional\" \"integer eyedepth\" [5] \"integer lightdepth\" [3] \
+         \"float eyerrthreshold\" [0.25] \"float lightrrthreshold\" [0.5]\nWorldBegin\nWorldEnd",
+    );
+    let i = &d.integrator;
+    assert_eq!(
+        (
+            i.max_depth,
+            i.light_depth,
+            i.eye_rr_threshold,
+            i.light_rr_threshold
+        ),
+        (5, 3, 0.25, 0.5)
+    );
+    // LuxRender 1.x's defaults: 8 vertices a subpath, thresholds 0.
+    let d = parse("SurfaceIntegrator \"bidirectional\"\nWorldBegin\nWorldEnd");
+    let i = &d.integrator;
+    assert_eq!(
+        (
+            i.max_depth,
+            i.light_depth,
+            i.eye_rr_threshold,
+            i.light_rr_threshold
+        ),
+        (8, 8, 0.0, 0.0)
+    );
+}
+
+#[test]
 fn material_defaults_and_rules() {
     let d = world(
         "Material \"matte\"\nShape \"sphere\"\n\

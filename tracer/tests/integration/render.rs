@@ -68,6 +68,7 @@ fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
         max_depth: desc.integrator.max_depth,
         seed: 1,
         latlong: LatLongConvention::Seed,
+        transport: Default::default(),
     }
 }
 

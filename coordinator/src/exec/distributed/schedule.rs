@@ -279,6 +279,7 @@ mod tests {
             max_depth: 4,
             seed: 0,
             latlong: LatLongConvention::Seed,
+            transport: Default::default(),
         })
     }
 

@@ -74,6 +74,7 @@ fn scene(spp: u32, branches: usize, light: &str) -> (RenderScene, RenderSettings
         max_depth: desc.integrator.max_depth,
         seed: 3,
         latlong: Default::default(),
+        transport: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     assert!(super::covers(&scene), "packets cover the scene");

@@ -1,0 +1,164 @@
+//! Bidirectional path tracing (`SurfaceIntegrator "bidirectional"`): a camera subpath and a
+//! light subpath per sample, joined by every strategy their lengths allow and weighed by
+//! multiple importance sampling (power heuristic; Veach 1997, chapter 10; pbrt-v4's
+//! formulation). The light subpath's vertices seen by the camera (light tracing) land anywhere
+//! on the film: they come back as [`LightSplat`]s for the renderer to add to the unit's light
+//! splats, which the film divides by the light subpaths per pixel (`film.rs`).
+//!
+//! Files: `scene` (what the integrator needs of the scene, its bounds, the splats it returns:
+//! the leaf), `vertex` (a subpath vertex and its densities), `walk` (a subpath's random walk),
+//! `connect` (the strategies), `weight` (their MIS weight). The BSDFs, lights, camera, shadow
+//! rays and sampler are the path tracer's.
+//!
+//! LuxRender's parameters: `eyedepth` and `lightdepth` bound the scattering vertices of each
+//! subpath (8 each by default, at most [`MAX_DEPTH`]), `eyerrthreshold` and
+//! `lightrrthreshold` are the least survival probabilities of LuxRender's roulette (0).
+//! Volumes are not walked through (a scene with volumes renders with the path tracer).
+
+mod connect;
+mod scene;
+mod vertex;
+mod walk;
+mod weight;
+
+pub use self::scene::{BidirectionalScene, LightSplat, MAX_DEPTH};
+
+use glam::Vec3;
+
+use self::scene::MAX_VERTICES;
+use self::vertex::{Kind, LightVertex, PathVertex};
+use self::walk::{walk, Carries};
+use self::weight::Limits;
+use super::state::PathResult;
+use crate::math::{offset_origin, Ray};
+use crate::sampler::PixelSampler;
+
+/// The subpaths of one sample, kept from sample to sample so that a unit allocates them once.
+#[derive(Default)]
+pub struct Subpaths {
+    camera: Vec<PathVertex>,
+    light: Vec<PathVertex>,
+}
+
+impl Subpaths {
+    pub fn new() -> Self {
+        Self {
+            camera: Vec::with_capacity(MAX_VERTICES),
+            light: Vec::with_capacity(MAX_VERTICES),
+        }
+    }
+}
+
+/// One bidirectional sample: the radiance along `camera_ray` (None: the camera has no ray
+/// there, as outside a fisheye's circle; the light subpath is traced all the same, since the
+/// film counts one per camera sample), with the light subpath's splats pushed to `splats`.
+pub fn trace_bidirectional<S: BidirectionalScene>(
+    scene: &S,
+    camera_ray: Option<Ray>,
+    sampler: &mut PixelSampler,
+    subpaths: &mut Subpaths,
+    splats: &mut Vec<LightSplat>,
+) -> PathResult {
+    let integrator = scene.integrator();
+    let limits = Limits {
+        max_camera: scene.max_depth().min(MAX_DEPTH) as usize + 1,
+        max_light: scene.light_depth().min(MAX_DEPTH) as usize + 1,
+        only: scene.only_strategy(),
+    };
+    let Subpaths { camera, light } = subpaths;
+    camera.clear();
+    light.clear();
+    let mut rays = 0;
+    let mut light_sampler = sampler.light_subpath();
+    if let Some(ray) = camera_ray {
+        camera.push(PathVertex {
+            kind: Kind::Camera,
+            p: ray.origin,
+            ng: Vec3::ZERO,
+            beta: Vec3::ONE,
+            pdf_fwd: 0.0,
+            pdf_rev: 0.0,
+            delta: false,
+        });
+        rays += walk(
+            scene,
+            camera,
+            ray,
+            Vec3::ONE,
+            limits.max_camera,
+            Carries::Radiance,
+            integrator.eye_rr_threshold,
+            sampler,
+        );
+    }
+    rays += light_subpath(scene, light, limits.max_light, &mut light_sampler);
+
+    let mut radiance = Vec3::ZERO;
+    for t in 2..=camera.len() {
+        radiance += connect::camera_hits_light(scene, camera, t, limits);
+        if t < camera.len() || !camera[t - 1].at_infinity() {
+            radiance += connect::camera_samples_light(scene, camera, t, limits, &mut rays);
+        }
+        for s in 2..=light.len() {
+            radiance += connect::join(scene, light, s, camera, t, limits, &mut rays);
+        }
+    }
+    for s in 2..=light.len() {
+        if let Some(splat) = connect::camera_sees_light_vertex(scene, light, s, limits, &mut rays) {
+            splats.push(splat);
+        }
+    }
+    PathResult { radiance, rays }
+}
+
+/// Samples a light subpath into `light`: a ray leaving a light, then its walk.
+fn light_subpath<S: BidirectionalScene>(
+    scene: &S,
+    light: &mut Vec<PathVertex>,
+    max_vertices: usize,
+    sampler: &mut PixelSampler,
+) -> u32 {
+    let lights = scene.lights();
+    let u_select = sampler.get_1d();
+    let (u_pos, u_dir) = (sampler.get_2d(), sampler.get_2d());
+    let Some(e) = lights.sample_emission(u_select, u_pos, u_dir) else {
+        return 0;
+    };
+    if e.pdf_pos <= 0.0 || e.pdf_dir <= 0.0 || e.le == Vec3::ZERO {
+        return 0;
+    }
+    let at_infinity = e.delta_direction || matches!(e.emitter, crate::lights::Emitter::Environment);
+    let normal = e.normal.unwrap_or(Vec3::ZERO);
+    let mut start = PathVertex {
+        kind: Kind::Light(LightVertex {
+            emitter: e.emitter,
+            toward: at_infinity.then_some(-e.dir),
+            delta_position: e.delta_position,
+            delta_direction: e.delta_direction,
+        }),
+        p: e.origin,
+        ng: normal,
+        beta: e.le / e.pdf_pos,
+        pdf_fwd: 0.0,
+        pdf_rev: 0.0,
+        delta: false,
+    };
+    start.pdf_fwd = start.pdf_light_origin(scene, &start);
+    light.push(start);
+    let cos = e.normal.map_or(1.0, |n| n.dot(e.dir).abs());
+    let beta = e.le * (cos / (e.pdf_pos * e.pdf_dir));
+    // Off the lamp's surface, as any ray leaving a surface (else it may hit the lamp itself).
+    let origin = e
+        .normal
+        .map_or(e.origin, |n| offset_origin(e.origin, n, e.dir));
+    walk(
+        scene,
+        light,
+        Ray::new(origin, e.dir),
+        beta,
+        max_vertices,
+        Carries::Importance,
+        scene.integrator().light_rr_threshold,
+        sampler,
+    )
+}

@@ -1,0 +1,243 @@
+//! A vertex of a camera or light subpath, and the densities multiple importance sampling asks
+//! of it: the area density with which one vertex samples the next (pbrt-v4's and Veach's
+//! formulation), the density of a light's own sampling of an emitter point, and of its
+//! emission toward a point.
+
+use glam::Vec3;
+
+use super::scene::BidirectionalScene;
+use crate::geometry::SurfaceHit;
+use crate::lights::Emitter;
+use crate::material::Bsdf;
+use crate::medium::ShapeMedia;
+use crate::sampler::VertexSamples;
+
+/// A subpath vertex: where it is, what it carries and the densities of reaching it from either
+/// side (area measure; solid angle for a vertex at infinity).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PathVertex {
+    pub(super) kind: Kind,
+    pub(super) p: Vec3,
+    /// Geometric normal (zero off surfaces: the camera, point and spot lights, infinity).
+    pub(super) ng: Vec3,
+    /// The subpath's throughput up to here (for a light vertex, its emission over its density).
+    pub(super) beta: Vec3,
+    /// The density of this vertex as its own subpath sampled it.
+    pub(super) pdf_fwd: f32,
+    /// The density of this vertex as the other subpath would sample it.
+    pub(super) pdf_rev: f32,
+    /// Whether the subpath scattered specularly here: no strategy connects at such a vertex.
+    pub(super) delta: bool,
+}
+
+// Most vertices are surfaces, kept in a subpath's vector allocated once per unit: boxing the
+// large variant would allocate per vertex.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Kind {
+    /// The camera's lens point (the pinhole without a lens).
+    Camera,
+    /// A point on a light, or the lights at infinity seen along `toward`.
+    Light(LightVertex),
+    Surface(SurfaceVertex),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LightVertex {
+    pub(super) emitter: Emitter,
+    /// For a light at infinity (the environment, a distant light): the unit direction from the
+    /// scene toward it.
+    pub(super) toward: Option<Vec3>,
+    pub(super) delta_position: bool,
+    pub(super) delta_direction: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SurfaceVertex {
+    pub(super) hit: SurfaceHit,
+    pub(super) bsdf: Bsdf,
+    /// Unit direction toward the subpath's previous vertex.
+    pub(super) wo: Vec3,
+    pub(super) sides: ShapeMedia,
+    /// The vertex's random numbers: its light sample's (a camera vertex's connection to a
+    /// light) and lens sample's (a light vertex's connection to the camera) among them.
+    pub(super) u: VertexSamples,
+}
+
+impl PathVertex {
+    pub(super) fn surface(&self) -> Option<&SurfaceVertex> {
+        match &self.kind {
+            Kind::Surface(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Whether the vertex is a light at infinity (its densities are per solid angle).
+    pub(super) fn at_infinity(&self) -> bool {
+        matches!(
+            self.kind,
+            Kind::Light(LightVertex {
+                toward: Some(_),
+                ..
+            })
+        )
+    }
+
+    /// Whether a light vertex is a delta light (a point, a spot, a distant light), which no
+    /// path can hit.
+    pub(super) fn is_delta_light(&self) -> bool {
+        matches!(self.kind, Kind::Light(l) if l.delta_position || l.delta_direction)
+    }
+
+    /// The emitter the vertex is on: a light vertex's, or the area light of a surface a camera
+    /// path hit.
+    pub(super) fn emitter<S: BidirectionalScene>(&self, scene: &S) -> Option<Emitter> {
+        match &self.kind {
+            Kind::Light(l) => Some(l.emitter),
+            Kind::Surface(s) => scene.lights().emitter_of_shape(s.hit.shape),
+            Kind::Camera => None,
+        }
+    }
+
+    /// The solid-angle density `pdf` of a direction leaving this vertex toward `next`, as an
+    /// area density at `next` (unchanged for a vertex at infinity).
+    pub(super) fn area_density(&self, pdf: f32, next: &PathVertex) -> f32 {
+        if next.at_infinity() {
+            return pdf;
+        }
+        let d = next.p - self.p;
+        let dist2 = d.length_squared();
+        if dist2 <= 0.0 {
+            return 0.0;
+        }
+        let cos = if next.ng == Vec3::ZERO {
+            1.0
+        } else {
+            (next.ng.dot(d) / dist2.sqrt()).abs()
+        };
+        pdf * cos / dist2
+    }
+
+    /// The unit direction from this vertex to `next` (toward infinity for a light there).
+    pub(super) fn direction_to(&self, next: &PathVertex) -> Vec3 {
+        match next.kind {
+            Kind::Light(LightVertex {
+                toward: Some(w), ..
+            }) => w,
+            _ => (next.p - self.p).normalize_or_zero(),
+        }
+    }
+
+    /// The area density with which this vertex, reached from `prev`, samples `next`: the
+    /// camera's ray density, a light's emission, or the BSDF's sample.
+    pub(super) fn pdf_toward<S: BidirectionalScene>(
+        &self,
+        scene: &S,
+        prev: Option<&PathVertex>,
+        next: &PathVertex,
+    ) -> f32 {
+        match &self.kind {
+            Kind::Camera => {
+                if next.at_infinity() {
+                    return 0.0;
+                }
+                let cos = if next.ng == Vec3::ZERO {
+                    1.0
+                } else {
+                    next.ng.dot(self.direction_to(next)).abs()
+                };
+                scene.camera().density_at(self.p, next.p) * cos
+            }
+            Kind::Light(_) => self.pdf_light(scene, next),
+            Kind::Surface(s) => {
+                let Some(prev) = prev else {
+                    return 0.0;
+                };
+                let pdf = s.bsdf.pdf(self.direction_to(prev), self.direction_to(next));
+                self.area_density(pdf, next)
+            }
+        }
+    }
+
+    /// The area density at `next` of this emitter vertex's emission toward it (a light's
+    /// sampling of a light subpath's first direction; the disc of a light at infinity).
+    pub(super) fn pdf_light<S: BidirectionalScene>(&self, scene: &S, next: &PathVertex) -> f32 {
+        let Some(emitter) = self.emitter(scene) else {
+            return 0.0;
+        };
+        let lights = scene.lights();
+        let cos_next = |w: Vec3| {
+            if next.ng == Vec3::ZERO {
+                1.0
+            } else {
+                next.ng.dot(w).abs()
+            }
+        };
+        if let Kind::Light(LightVertex {
+            toward: Some(toward),
+            ..
+        }) = self.kind
+        {
+            // Light from infinity leaves a disc as wide as the scene: its density is the
+            // disc's, per area across the light's direction.
+            let (_, radius) = lights.scene_sphere();
+            return cos_next(toward) / (std::f32::consts::PI * radius * radius);
+        }
+        let dir = self.direction_to(next);
+        let normal = (self.ng != Vec3::ZERO).then_some(self.ng);
+        let (_, pdf_dir) = lights.emission_pdf(emitter, self.p, normal, dir);
+        self.area_density(pdf_dir, next)
+    }
+
+    /// The density with which the lights choose this emitter point (per area; per solid angle
+    /// for the lights at infinity) as a light subpath's start: 0 for delta lights, which only
+    /// light subpaths and light samples reach.
+    pub(super) fn pdf_light_origin<S: BidirectionalScene>(
+        &self,
+        scene: &S,
+        next: &PathVertex,
+    ) -> f32 {
+        if self.is_delta_light() {
+            return 0.0;
+        }
+        let Some(emitter) = self.emitter(scene) else {
+            return 0.0;
+        };
+        let lights = scene.lights();
+        if let Kind::Light(LightVertex {
+            toward: Some(toward),
+            ..
+        }) = self.kind
+        {
+            return lights.pdf_environment(toward, None);
+        }
+        let dir = self.direction_to(next);
+        let normal = (self.ng != Vec3::ZERO).then_some(self.ng);
+        lights.emission_pdf(emitter, self.p, normal, dir).0
+    }
+
+    /// The radiance a camera path's last vertex (on an area light, or at infinity) sends back
+    /// along the path.
+    pub(super) fn emitted<S: BidirectionalScene>(&self, scene: &S) -> Vec3 {
+        match &self.kind {
+            Kind::Light(LightVertex {
+                toward: Some(toward),
+                ..
+            }) => scene.lights().environment(*toward),
+            Kind::Surface(s) => scene.lights().emitted(&s.hit, s.wo),
+            _ => Vec3::ZERO,
+        }
+    }
+}
+
+/// The factor that keeps light carried from the lights (importance's adjoint) consistent with
+/// shading normals: `|wo.ns| |wi.ng| / (|wo.ng| |wi.ns|)`, `wo` toward where the light came
+/// from and `wi` where it goes (Veach 1997, 5.3).
+pub(super) fn shading_correction(s: &SurfaceVertex, wo: Vec3, wi: Vec3) -> f32 {
+    let (ng, ns) = (s.hit.ng, s.hit.ns);
+    let denom = wo.dot(ng).abs() * wi.dot(ns).abs();
+    if denom <= 0.0 {
+        return 0.0;
+    }
+    wo.dot(ns).abs() * wi.dot(ng).abs() / denom
+}
