@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Renders a scene exported by `yat export-luxcore` with LuxCoreRender's CPU path tracer
-(pyluxcore, PATHCPU) and writes linear RGB as EXR plus its figures as JSON. bench.py runs it
-in the benchmark's virtualenv, one process per render (as it runs yat).
+(pyluxcore, PATHCPU) or its bidirectional one (--engine BIDIRCPU: --depth is the eye path's
+depth, --light-depth the light path's) and writes linear RGB as EXR plus its figures as JSON.
+bench.py runs it in the benchmark's virtualenv, one process per render (as it runs yat).
 
     luxcore.py EXPORT_DIR --spp N --depth D --threads T [--width W --height H] \
-        --out rgb.exr --stats stats.json
+        [--engine BIDIRCPU --light-depth L] --out rgb.exr --stats stats.json
 
 Timing starts when RenderSession.Start() returns (scene and BVH ready) and stops when the
 halt condition is met, like yat's render_seconds; render_cpu_seconds is the process's CPU time
@@ -25,7 +26,10 @@ def main():
     ap.add_argument("--spp", type=int, required=True)
     ap.add_argument("--depth", type=int, required=True)
     ap.add_argument("--threads", type=int, required=True)
-    ap.add_argument("--sampler", default="SOBOL", help="SOBOL (LuxCore's default) or RANDOM")
+    ap.add_argument("--sampler", default="SOBOL",
+                    help="SOBOL (LuxCore's default), RANDOM or METROPOLIS")
+    ap.add_argument("--engine", default="PATHCPU", help="PATHCPU or BIDIRCPU")
+    ap.add_argument("--light-depth", type=int, help="BIDIRCPU's light path depth (default --depth)")
     ap.add_argument("--adaptive-strength", type=float,
                     help="sampler.sobol.adaptive.strength (LuxCore's default: 0.95)")
     ap.add_argument("--seed", type=int, default=1)
@@ -44,7 +48,7 @@ def main():
     os.chdir(args.export_dir)
     cfg = pyluxcore.Properties("render.cfg")
     props = {
-        "renderengine.type": "PATHCPU",
+        "renderengine.type": args.engine,
         "renderengine.seed": args.seed,
         "native.threads.count": args.threads,
         "sampler.type": args.sampler,
@@ -56,6 +60,9 @@ def main():
         "film.outputs.0.type": "RGB",
         "film.outputs.0.filename": out,
     }
+    if args.engine == "BIDIRCPU":
+        props["path.maxdepth"] = args.depth
+        props["light.maxdepth"] = args.light_depth or args.depth
     if args.adaptive_strength is not None:
         props["sampler.sobol.adaptive.strength"] = args.adaptive_strength
     if args.width and args.height:
@@ -104,8 +111,12 @@ def main():
         "luxcore_samples_per_second": stats.Get("stats.renderengine.total.samplesec").GetFloat(),
         "rays_per_second": stats.Get("stats.renderengine.total.raysec").GetFloat(),
         "sampler": args.sampler,
+        "engine": args.engine,
         # The value in force (LuxCore's default when not set).
-        "adaptive_strength": config.GetProperty("sampler.sobol.adaptive.strength").GetFloat(),
+        "adaptive_strength": (
+            config.GetProperty("sampler.sobol.adaptive.strength").GetFloat()
+            if args.sampler == "SOBOL" else None
+        ),
         "pyluxcore": pyluxcore.Version(),
     }
     film.SaveOutputs()
