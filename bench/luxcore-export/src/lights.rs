@@ -29,7 +29,10 @@ pub fn write_light(
         }) => {
             set("type", quoted("point"));
             set("position", v3(*position));
-            set("color", v3(*intensity));
+            // LuxCore 2.11's point light sends colour / 4 pi per steradian (measured: a floor
+            // under a point light renders 4 pi = 12.57 times darker than YAT's, which gives
+            // LuxRender 1.x's intensity, colour x gain).
+            set("color", v3(*intensity * (4.0 * std::f32::consts::PI)));
             set("gain", "1 1 1".into());
             set("power", "0".into());
             set("efficency", "0".into());
