@@ -255,3 +255,31 @@ fn a_time_limit_writes_the_last_round_and_the_same_command_goes_on() {
         "round {round}'s image is the final one"
     );
 }
+
+/// Adaptive sampling is refused for a bidirectional render, saying why (its light splats land
+/// outside the blocks a round renders) and what to do instead.
+#[test]
+fn an_adaptive_bidirectional_render_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let overrides = yat_tracer::render::RenderOverrides {
+        transport: Some(yat_tracer::integrator::Transport::Bidirectional),
+        ..SETTINGS_OVERRIDES
+    };
+    let adaptive = AdaptiveSettings {
+        threshold: 0.1,
+        min_spp: 4,
+    };
+    let parsed = yat::scene::ParsedScene::load(&scene, yat::scene::Warnings::Keep).unwrap();
+    let refused = yat::render::RenderRequest::new(
+        parsed,
+        &overrides,
+        Some(adaptive),
+        Some(dir.path().join("out.png")),
+    );
+    let message = format!("{:#}", refused.err().expect("refused"));
+    assert!(
+        message.contains("bidirectional") && message.contains("--integrator path"),
+        "{message}"
+    );
+}

@@ -134,6 +134,48 @@ fn a_killed_or_interrupted_render_resumes_to_the_same_image() {
     );
 }
 
+/// A bidirectional render killed once its checkpoint holds units resumes to the bytes of one
+/// never stopped: the checkpoint keeps the light splats' sums and the light subpaths they are
+/// over as it keeps the camera samples' sums.
+#[test]
+fn a_killed_bidirectional_render_resumes_to_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let bidirectional = ["--integrator", "bidirectional", "--threads", "2"];
+    let fresh = dir.path().join("fresh.png");
+    let output = long_render(
+        &scene,
+        &fresh,
+        &[&bidirectional[..], &["--checkpoint-every", "0"]].concat(),
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    let expected = std::fs::read(fresh.with_extension("exr")).unwrap();
+
+    let out = dir.path().join("stopped.png");
+    let checkpoint = out.with_extension("resume");
+    let every = ["--checkpoint-every", "0.05"];
+    let mut render = long_render(&scene, &out, &[&bidirectional[..], &every[..]].concat())
+        .spawn()
+        .unwrap();
+    wait_for_new_checkpoint(&mut render, &checkpoint, None);
+    render.kill().unwrap();
+    render.wait().unwrap();
+
+    let finished = long_render(&scene, &out, &[&bidirectional[..], &every[..]].concat())
+        .output()
+        .unwrap();
+    assert_success(&finished);
+    let stderr = String::from_utf8_lossy(&finished.stderr);
+    assert!(stderr.contains("resuming from"), "{stderr}");
+    assert_eq!(
+        std::fs::read(out.with_extension("exr")).unwrap(),
+        expected,
+        "resumed bidirectional image differs from the uninterrupted one"
+    );
+}
+
 /// With checkpoints off, SIGTERM stops a render as with them on, and says what that costs: exit
 /// status 130, the signal named, the merged samples lost to the next run and the preview that
 /// shows them; no checkpoint, no final image.
