@@ -13,7 +13,8 @@ use super::media::{travel, Segment, Travel};
 use super::mirror_images::mirror_after;
 use super::mis::power_heuristic;
 use super::roulette::survives;
-use super::scene::{Crossing, PathScene};
+use super::scene::PathScene;
+use super::shadow::goes_straight_on;
 use super::state::{BranchPoint, PathResult, PathState, PrevScatter, MAX_PASS_THROUGH};
 use super::vertex::Vertex;
 use crate::lights::IMAGE_SHARE;
@@ -136,17 +137,7 @@ pub(super) fn walk<S: PathScene>(
         // fixed whatever the material.
         let u = sampler.get_vertex();
         let bsdf = scene.bsdf_at(&hit, u.mix);
-        let straight = if bsdf.is_pass_through() {
-            // Only the mix choice is used: the next vertex's dimensions follow it.
-            sampler.unread_after_mix();
-            Some(Vec3::ONE)
-        } else if panes && scene.crossing(hit.shape) == Crossing::Pane {
-            // A pane that transmits goes on as a shadow ray through it does, so that the light
-            // behind it is weighed against the previous vertex's light sample.
-            bsdf.sample_straight(wo, u.lobe)
-        } else {
-            None
-        };
+        let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
             throughput *= transmittance;
             pass_through += 1;

@@ -7,8 +7,10 @@ use super::scene::{Crossing, PathScene};
 use super::state::MAX_PASS_THROUGH;
 use crate::geometry::SurfaceHit;
 use crate::lanes::Lanes;
+use crate::material::Bsdf;
 use crate::math::{offset_origin, Ray};
 use crate::medium::MediumId;
+use crate::sampler::PixelSampler;
 use crate::vec3_lanes::{dot, V3};
 
 /// What reaches `origin + t dir` from `origin`, for t up to `tmax`, in volume `medium`: 0 when
@@ -82,6 +84,32 @@ fn shadow_walk<S: PathScene>(
         }
     }
     Vec3::ZERO
+}
+
+/// Whether a path that reached `hit` along `-wo` goes straight on through it, and what it
+/// carries on if so: a `null` surface always (its mix number alone read, so the next vertex's
+/// dimensions follow), a pane of architectural glass when its lobe choice `u_lobe` is the
+/// straight transmission (`panes`: the scene has some). Paths cross as shadow rays cross, so
+/// the light behind is weighed against the previous vertex's light sample. The path tracer's
+/// and the bidirectional walks' one rule.
+#[inline(always)]
+pub(super) fn goes_straight_on<S: PathScene>(
+    scene: &S,
+    hit: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    u_lobe: f32,
+    panes: bool,
+    sampler: &mut PixelSampler,
+) -> Option<Vec3> {
+    if bsdf.is_pass_through() {
+        sampler.unread_after_mix();
+        Some(Vec3::ONE)
+    } else if panes && scene.crossing(hit.shape) == Crossing::Pane {
+        bsdf.sample_straight(wo, u_lobe)
+    } else {
+        None
+    }
 }
 
 /// What the pane at `hit` lets straight through along `dir`: its material evaluated there

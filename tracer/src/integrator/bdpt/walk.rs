@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::scene::BidirectionalScene;
 use super::vertex::{shading_correction, Kind, LightVertex, PathVertex, SurfaceVertex};
-use crate::integrator::scene::Crossing;
+use crate::integrator::shadow::goes_straight_on;
 use crate::integrator::state::MAX_PASS_THROUGH;
 use crate::lights::Emitter;
 use crate::math::{luminance, offset_origin, Ray};
@@ -49,6 +49,7 @@ pub(super) fn walk<S: BidirectionalScene>(
     let mut rays = 0;
     let mut pdf_dir = 0.0;
     let mut pass_through = 0;
+    let panes = scene.has_panes();
     while path.len() < max_vertices {
         rays += 1;
         let Some(hit) = scene.geometry().intersect(&ray, f32::INFINITY) else {
@@ -76,14 +77,7 @@ pub(super) fn walk<S: BidirectionalScene>(
         let wo = -ray.dir;
         let u = sampler.get_vertex();
         let bsdf = scene.bsdf_at(&hit, u.mix);
-        let straight = if bsdf.is_pass_through() {
-            sampler.unread_after_mix();
-            Some(Vec3::ONE)
-        } else if scene.has_panes() && scene.crossing(hit.shape) == Crossing::Pane {
-            bsdf.sample_straight(wo, u.lobe)
-        } else {
-            None
-        };
+        let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
             beta *= transmittance;
             pass_through += 1;
