@@ -54,10 +54,10 @@ pub enum Emitter {
     Environment,
 }
 
-/// A ray leaving a light (a light subpath's first vertex and direction).
+/// A ray leaving a light: what each kind's `sample_emission` returns (`pdf_pos` its own), and,
+/// within an [`EmissionSample`], a light subpath's first vertex and direction.
 #[derive(Clone, Copy, Debug)]
-pub struct EmissionSample {
-    pub emitter: Emitter,
+pub struct EmittedRay {
     /// The point the light leaves: on an area light's surface; a point or spot light's
     /// position; for distant lights and the lights at infinity a point of the disc
     /// [`SceneSphere::entry_point`] samples.
@@ -70,9 +70,9 @@ pub struct EmissionSample {
     /// radiance arriving from -dir); intensity for point and spot lights; irradiance for a
     /// distant light.
     pub le: Vec3,
-    /// Area density of `origin` including the probability of choosing the emitter (for the
-    /// mixture at infinity, the sum of its members' choice probabilities); for point and spot
-    /// lights the choice probability alone.
+    /// Area density of `origin` (in an [`EmissionSample`], times the probability of choosing
+    /// the emitter: for the mixture at infinity the sum of its members'); for point and spot
+    /// lights 1 (the choice probability alone in a sample).
     pub pdf_pos: f32,
     /// Solid-angle density of `dir` given `origin` (1 for a distant light's delta direction).
     pub pdf_dir: f32,
@@ -80,18 +80,12 @@ pub struct EmissionSample {
     pub delta_direction: bool,
 }
 
-/// A ray leaving one light before the probability of choosing it is known: what each kind's
-/// `sample_emission` returns, `pdf_pos` its own.
+/// A ray leaving one of the scene's lights, chosen among them: its `pdf_pos` includes the
+/// choice's probability.
 #[derive(Clone, Copy, Debug)]
-pub struct EmittedRay {
-    pub origin: Vec3,
-    pub dir: Vec3,
-    pub normal: Option<Vec3>,
-    pub le: Vec3,
-    pub pdf_pos: f32,
-    pub pdf_dir: f32,
-    pub delta_position: bool,
-    pub delta_direction: bool,
+pub struct EmissionSample {
+    pub emitter: Emitter,
+    pub ray: EmittedRay,
 }
 
 impl EmittedRay {
@@ -99,14 +93,10 @@ impl EmittedRay {
     pub fn chosen(self, emitter: Emitter, pmf: f32) -> EmissionSample {
         EmissionSample {
             emitter,
-            origin: self.origin,
-            dir: self.dir,
-            normal: self.normal,
-            le: self.le,
-            pdf_pos: pmf * self.pdf_pos,
-            pdf_dir: self.pdf_dir,
-            delta_position: self.delta_position,
-            delta_direction: self.delta_direction,
+            ray: EmittedRay {
+                pdf_pos: pmf * self.pdf_pos,
+                ..self
+            },
         }
     }
 }

@@ -310,12 +310,7 @@ impl RenderScene {
                             && index as usize + L::N <= chunk_end as usize
                             && (!adaptive || (index as usize).is_multiple_of(L::N));
                         if !fits {
-                            // An adaptive pixel may stop after any round: its samples are nested.
-                            let mut sampler = if adaptive {
-                                PixelSampler::nested(x, y, index, seed)
-                            } else {
-                                PixelSampler::new(x, y, index, self.settings.spp, seed)
-                            };
+                            let mut sampler = self.sample_stream(unit, (x, y, index));
                             let (u, ray) = self.camera_sample(x, y, &mut sampler);
                             // A sample without a camera ray (outside a fisheye's circle) is black.
                             let path = match ray {
@@ -372,7 +367,6 @@ impl RenderScene {
             .expect("a bidirectional scene has its film mass");
         let mut subpaths = Subpaths::new();
         let mut splats = Vec::with_capacity(crate::integrator::bdpt::MAX_DEPTH as usize + 1);
-        let seed = self.settings.seed;
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
                 if !unit.renders(x, y) {
@@ -384,11 +378,7 @@ impl RenderScene {
                     {
                         return None;
                     }
-                    let mut sampler = if unit.mask.is_some() {
-                        PixelSampler::nested(x, y, index, seed)
-                    } else {
-                        PixelSampler::new(x, y, index, self.settings.spp, seed)
-                    };
+                    let mut sampler = self.sample_stream(unit, (x, y, index));
                     let (u, ray) = self.camera_sample(x, y, &mut sampler);
                     splats.clear();
                     let path =
@@ -427,6 +417,19 @@ impl RenderScene {
                 let weight = wx * wy / mass.at(x, y);
                 splat_sums.add(y * width + x, splat.radiance * weight);
             }
+        }
+    }
+
+    /// The sample stream of sample `index` of pixel (x, y) in `unit`: an adaptive pixel may
+    /// stop after any round, so its samples are nested; a uniform one takes all of the
+    /// render's.
+    #[inline(always)]
+    fn sample_stream(&self, unit: &WorkUnit, (x, y, index): (u32, u32, u32)) -> PixelSampler {
+        let seed = self.settings.seed;
+        if unit.mask.is_some() {
+            PixelSampler::nested(x, y, index, seed)
+        } else {
+            PixelSampler::new(x, y, index, self.settings.spp, seed)
         }
     }
 

@@ -121,24 +121,28 @@ fn light_subpath<S: BidirectionalScene>(
     let lights = scene.lights();
     let u_select = sampler.get_1d();
     let (u_pos, u_dir) = (sampler.get_2d(), sampler.get_2d());
-    let Some(e) = lights.sample_emission(u_select, u_pos, u_dir) else {
+    let Some(sample) = lights.sample_emission(u_select, u_pos, u_dir) else {
         return 0;
     };
+    let e = sample.ray;
     if e.pdf_pos <= 0.0 || e.pdf_dir <= 0.0 || e.le == Vec3::ZERO {
         return 0;
     }
-    let at_infinity = e.delta_direction || matches!(e.emitter, crate::lights::Emitter::Environment);
+    let at_infinity =
+        e.delta_direction || matches!(sample.emitter, crate::lights::Emitter::Environment);
     let normal = e.normal.unwrap_or(Vec3::ZERO);
     let mut start = PathVertex {
         kind: Kind::Light(LightVertex {
-            emitter: e.emitter,
+            emitter: sample.emitter,
             toward: at_infinity.then_some(-e.dir),
             delta_position: e.delta_position,
             delta_direction: e.delta_direction,
         }),
         p: e.origin,
         ng: normal,
-        beta: e.le / e.pdf_pos,
+        // Never read: a light's own point is joined to camera vertices by their light
+        // samples, not by this vertex (the strategies of `connect.rs`).
+        beta: Vec3::ZERO,
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
         delta: false,

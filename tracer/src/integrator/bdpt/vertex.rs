@@ -20,7 +20,7 @@ pub(super) struct PathVertex {
     pub(super) p: Vec3,
     /// Geometric normal (zero off surfaces: the camera, point and spot lights, infinity).
     pub(super) ng: Vec3,
-    /// The subpath's throughput up to here (for a light vertex, its emission over its density).
+    /// The subpath's throughput up to here (unused on a light vertex).
     pub(super) beta: Vec3,
     /// The density of this vertex as its own subpath sampled it.
     pub(super) pdf_fwd: f32,

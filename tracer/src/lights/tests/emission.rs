@@ -32,16 +32,16 @@ fn estimate_emission(lights: &Lights, n: u32, seed: u64) -> Estimate {
             continue;
         };
         samples += 1;
-        assert!((s.dir.length() - 1.0).abs() < 1e-4, "{s:?}");
-        let cos = s.normal.map_or(1.0, |n| n.dot(s.dir).abs());
-        let w = (s.le * cos / (s.pdf_pos * s.pdf_dir)).as_dvec3();
+        assert!((s.ray.dir.length() - 1.0).abs() < 1e-4, "{s:?}");
+        let cos = s.ray.normal.map_or(1.0, |n| n.dot(s.ray.dir).abs());
+        let w = (s.ray.le * cos / (s.ray.pdf_pos * s.ray.pdf_dir)).as_dvec3();
         assert!(w.is_finite(), "{s:?}");
         sum += w;
         sum2 += luminance(w.as_vec3()) as f64 * luminance(w.as_vec3()) as f64;
-        let (pos, dir) = lights.emission_pdf(s.emitter, s.origin, s.normal, s.dir);
+        let (pos, dir) = lights.emission_pdf(s.emitter, s.ray.origin, s.ray.normal, s.ray.dir);
         pdf_err = pdf_err
-            .max(rel_err(pos, s.pdf_pos))
-            .max(rel_err(dir, s.pdf_dir));
+            .max(rel_err(pos, s.ray.pdf_pos))
+            .max(rel_err(dir, s.ray.pdf_dir));
     }
     let mean = sum / f64::from(n);
     let mean_y = f64::from(luminance(mean.as_vec3()));
