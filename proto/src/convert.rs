@@ -78,6 +78,7 @@ impl From<&RenderSettings> for pb::RenderSettings {
             transport: match s.transport {
                 Transport::Path => pb::Transport::Path,
                 Transport::Bidirectional => pb::Transport::Bidirectional,
+                Transport::DirectLighting => pb::Transport::DirectLighting,
             }
             .into(),
         }
@@ -101,6 +102,7 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
         let transport = match pb::Transport::try_from(s.transport) {
             Ok(pb::Transport::Path) => Transport::Path,
             Ok(pb::Transport::Bidirectional) => Transport::Bidirectional,
+            Ok(pb::Transport::DirectLighting) => Transport::DirectLighting,
             Err(_) => {
                 return Err(WireError::Settings(format!(
                     "unknown transport {}",
@@ -530,11 +532,23 @@ mod tests {
     #[test]
     fn settings_round_trip_and_reject_empty_images() {
         let s = settings();
-        assert_eq!(
-            RenderSettings::try_from(&pb::RenderSettings::from(&s)).unwrap(),
-            s
-        );
+        for transport in [
+            Transport::Path,
+            Transport::Bidirectional,
+            Transport::DirectLighting,
+        ] {
+            let s = RenderSettings {
+                transport,
+                ..s.clone()
+            };
+            assert_eq!(
+                RenderSettings::try_from(&pb::RenderSettings::from(&s)).unwrap(),
+                s
+            );
+        }
         let mut wire = pb::RenderSettings::from(&s);
+        wire.transport = 3;
+        assert!(RenderSettings::try_from(&wire).is_err());
         wire.height = 0;
         assert!(RenderSettings::try_from(&wire).is_err());
         wire.height = 1 << 20;

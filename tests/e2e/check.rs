@@ -39,6 +39,10 @@ fn check_summarises_a_seed_scene() {
     assert!(stdout.contains("lights       1 area (shapes)"), "{stdout}");
     assert!(stdout.contains("parse time"), "{stdout}");
     assert!(
+        stdout.contains("integrator   path, max depth 16 (file asks for \"bidirectional\")"),
+        "what will run: {stdout}"
+    );
+    assert!(
         stdout.contains("--integrator bidirectional: eye depth 16, light depth 16"),
         "what the bidirectional integrator would render with: {stdout}"
     );

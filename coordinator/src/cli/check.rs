@@ -14,6 +14,7 @@ use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
 use yat_tracer::diag::{Severity, Warning};
+use yat_tracer::integrator::Transport;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use super::budget::BudgetArgs;
@@ -216,10 +217,17 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         d.filter.xwidth, d.filter.ywidth
     );
     let i = &d.integrator;
+    let runs = match i.transport() {
+        Transport::DirectLighting => format!(
+            "directlighting, {} specular bounces",
+            i.max_depth.saturating_sub(1)
+        ),
+        other => format!("{}, max depth {}", other.name(), i.max_depth),
+    };
     let _ = writeln!(
         s,
-        "integrator   path, max depth {} (file asks for \"{}\"), rr {:?} {}",
-        i.max_depth, i.requested, i.rr_strategy, i.rr_continue_prob
+        "integrator   {runs} (file asks for \"{}\"), rr {:?} {}",
+        i.requested, i.rr_strategy, i.rr_continue_prob
     );
     let _ = writeln!(
         s,

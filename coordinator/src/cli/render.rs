@@ -30,6 +30,7 @@ use crate::status::StatusBoard;
 pub enum IntegratorArg {
     Path,
     Bidirectional,
+    Directlighting,
 }
 
 impl From<IntegratorArg> for Transport {
@@ -37,6 +38,7 @@ impl From<IntegratorArg> for Transport {
         match arg {
             IntegratorArg::Path => Transport::Path,
             IntegratorArg::Bidirectional => Transport::Bidirectional,
+            IntegratorArg::Directlighting => Transport::DirectLighting,
         }
     }
 }
@@ -76,12 +78,14 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PNG", requires = "noise_threshold")]
     pub sample_map: Option<PathBuf>,
     /// Maximum path depth (default: the scene's integrator depth; a bidirectional render's
-    /// camera subpath depth).
+    /// camera subpath depth; a direct-lighting render's vertices that take light, its
+    /// specular maxdepth plus one).
     #[arg(long)]
     pub maxdepth: Option<u32>,
-    /// The light transport: path tracing (what every scene renders with by default, a
-    /// SurfaceIntegrator "bidirectional" included) or bidirectional path tracing (with the
-    /// scene's eyedepth and lightdepth).
+    /// The light transport: path tracing (what scenes render with by default, a
+    /// SurfaceIntegrator "bidirectional" included), bidirectional path tracing (with the
+    /// scene's eyedepth and lightdepth) or direct lighting (LuxRender's: the default of a
+    /// SurfaceIntegrator "directlighting").
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorArg>,
     /// Render threads for an in-process render [default: the CPUs this process may use].

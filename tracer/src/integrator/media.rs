@@ -25,6 +25,9 @@ pub(super) struct Segment<'a> {
     pub(super) id: Option<MediumId>,
     pub(super) ray: Ray,
     pub(super) length: f32,
+    /// The path's last segment (direct lighting's, after its first non-specular vertex): it
+    /// only looks for light beyond, and ends where it would scatter.
+    pub(super) last: bool,
 }
 
 /// What a path does along a [`Segment`].
@@ -43,7 +46,8 @@ pub(super) enum Travel {
 }
 
 /// The path's segment `segment`, reached with `throughput` after `depth` vertices: the light
-/// of a scattering vertex is added to `radiance`, the rays traced counted in `rays`.
+/// of a scattering vertex is added to `radiance`, the rays traced counted in `rays`. A path on
+/// its [`Segment::last`] ends where it would scatter.
 #[inline(always)]
 pub(super) fn travel<S: PathScene>(
     scene: &S,
@@ -67,7 +71,7 @@ pub(super) fn travel<S: PathScene>(
         }
         Flight::Scatter { distance, weight } => {
             throughput *= weight;
-            if depth >= scene.max_depth() {
+            if depth >= scene.max_depth() || segment.last {
                 return Travel::Ended;
             }
             let depth = depth + 1;

@@ -1,9 +1,11 @@
 //! `SurfaceIntegrator "path" ...`: the integrator's settings, LuxRender's defaults and their
-//! reading. Other integrators render as path tracing ("bidirectional" keeps its eye depth).
+//! reading. "bidirectional" renders as path tracing with its eye depth unless the command line
+//! chooses it; "directlighting" renders as LuxRender's direct lighting; others as path tracing.
 //!
 //! | parameter | type | default |
 //! |---|---|---|
 //! | `maxdepth` (path) | integer | 16 |
+//! | `maxdepth` (directlighting) | integer | 5: specular bounces after the camera's first hit |
 //! | `eyedepth`, `lightdepth` (bidirectional) | integer | 8 (LuxRender 1.x's) |
 //! | `eyerrthreshold`, `lightrrthreshold` (bidirectional) | float | 0: the least survival probability of each subpath's roulette |
 //! | `rrstrategy` | string: efficiency, probability, none | efficiency |
@@ -21,6 +23,8 @@ use crate::parse::params::ParamList;
 
 /// Bounces per path when the file does not say.
 pub const DEFAULT_MAX_DEPTH: i32 = 16;
+/// Specular bounces of a direct-lighting path when the file does not say (LuxRender 1.x's).
+pub const DEFAULT_DIRECT_DEPTH: i32 = 5;
 /// Scattering vertices of each bidirectional subpath when the file does not say.
 pub const DEFAULT_SUBPATH_DEPTH: i32 = 8;
 /// Survival probability of `rrstrategy "probability"` when the file does not say.
@@ -72,6 +76,10 @@ pub enum Transport {
     Path,
     /// Bidirectional path tracing ([`crate::integrator::bdpt`]).
     Bidirectional,
+    /// LuxRender's direct lighting: the path tracer's walk through specular vertices only, to
+    /// the first non-specular vertex, which takes the direct light (a light sample and a BSDF
+    /// sample weighed by MIS) and ends the path ([`crate::integrator::PathScene::direct_lighting`]).
+    DirectLighting,
 }
 
 impl Transport {
@@ -79,6 +87,7 @@ impl Transport {
         match self {
             Transport::Path => "path",
             Transport::Bidirectional => "bidirectional",
+            Transport::DirectLighting => "directlighting",
         }
     }
 
@@ -87,12 +96,24 @@ impl Transport {
         match name {
             "path" => Some(Transport::Path),
             "bidirectional" => Some(Transport::Bidirectional),
+            "directlighting" => Some(Transport::DirectLighting),
             _ => None,
         }
     }
 }
 
 impl IntegratorDesc {
+    /// The transport the scene asks for when the command line does not choose: direct
+    /// lighting for "directlighting", path tracing otherwise ("bidirectional" too: see
+    /// docs/architecture.md, "Integrators").
+    pub fn transport(&self) -> Transport {
+        if self.requested == "directlighting" {
+            Transport::DirectLighting
+        } else {
+            Transport::Path
+        }
+    }
+
     /// The path integrator with every default, recorded as `requested`.
     pub fn path_defaults(requested: &str) -> Self {
         Self {
@@ -175,6 +196,20 @@ impl IntegratorDesc {
                     light_depth,
                     eye_rr_threshold,
                     light_rr_threshold,
+                    ..Self::path_defaults(ty)
+                })
+            }
+            "directlighting" => {
+                // LuxRender counts the specular bounces after the first hit; the walk counts
+                // the vertices that take the light: one more.
+                let specular = depth("maxdepth", DEFAULT_DIRECT_DEPTH)?;
+                for name in ["lightstrategy", "shadowraycount"] {
+                    params.ignore(name);
+                }
+                Ok(IntegratorDesc {
+                    max_depth: specular.saturating_add(1),
+                    // LuxRender's direct lighting plays no roulette on its specular chains.
+                    rr_strategy: RussianRoulette::None,
                     ..Self::path_defaults(ty)
                 })
             }

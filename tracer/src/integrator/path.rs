@@ -2,8 +2,10 @@
 //! importance sampling of light and BSDF samples (power heuristic) and Russian roulette,
 //! through participating media ([`super::media`]), with the glossy split
 //! ([`super::glossy_split`]), lamp images in flat mirrors ([`super::mirror_images`]) and the
-//! branching vertex ([`super::branch`]). What a vertex does is [`super::vertex`]'s, shared with
-//! the packets of [`super::packet`]; this file is the loop that strings vertices together.
+//! branching vertex ([`super::branch`]); LuxRender's direct lighting is this walk ended after
+//! the first non-specular vertex ([`PathScene::direct_lighting`]). What a vertex does is
+//! [`super::vertex`]'s, shared with the packets of [`super::packet`]; this file is the loop
+//! that strings vertices together.
 
 use glam::Vec3;
 
@@ -39,6 +41,7 @@ pub(super) fn walk<S: PathScene>(
     let volumes = scene.volumes();
     let has_media = !volumes.media.is_empty();
     let panes = scene.has_panes();
+    let direct_lighting = scene.direct_lighting();
     let PathState {
         mut ray,
         mut traced,
@@ -55,6 +58,8 @@ pub(super) fn walk<S: PathScene>(
 
     loop {
         rays += 1;
+        // Direct lighting's path ends where the ray from its first non-specular vertex ends.
+        let last_segment = direct_lighting && !prev.specular;
         let hit = match traced.take() {
             Some(hit) => hit,
             None => scene.geometry().intersect(&ray, f32::INFINITY),
@@ -77,6 +82,7 @@ pub(super) fn walk<S: PathScene>(
                 id: medium,
                 ray,
                 length: hit.as_ref().map_or(f32::INFINITY, |h| h.t),
+                last: last_segment,
             };
             match travel(
                 scene,
@@ -150,7 +156,7 @@ pub(super) fn walk<S: PathScene>(
         }
         let crossed = pass_through > 0;
         pass_through = 0;
-        if depth >= max_depth {
+        if depth >= max_depth || last_segment {
             break;
         }
         depth += 1;

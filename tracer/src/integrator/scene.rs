@@ -49,4 +49,9 @@ pub trait PathScene {
     /// The continuations a camera path's first broad scattering vertex sends on (see
     /// [`MAX_BRANCHES`](super::branch::MAX_BRANCHES); 1: the path goes on alone).
     fn first_vertex_branches(&self) -> usize;
+    /// Whether a path ends at the surface (or volume event) after its first non-specular
+    /// vertex, with the light it finds there, as LuxRender's direct lighting does
+    /// ([`Transport::DirectLighting`](super::Transport::DirectLighting)): that vertex's light
+    /// sample and BSDF sample are all the light it gathers past its specular chain.
+    fn direct_lighting(&self) -> bool;
 }

@@ -14,7 +14,7 @@ use crate::film::{unit_sum, SampleBuffer, SplatSums};
 use crate::filter::{FilmMass, PixelFilter};
 use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::bdpt::{trace_bidirectional, BidirectionalScene, LightSplat, Subpaths};
-use crate::integrator::options::IntegratorDesc;
+use crate::integrator::options::{IntegratorDesc, Transport};
 use crate::integrator::packet;
 use crate::integrator::{trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES};
 #[cfg(target_arch = "x86_64")]
@@ -135,7 +135,7 @@ impl RenderScene {
             source,
             settings.latlong,
         )?
-        .with_mirror_images(&flat_mirrors(desc), &geometry);
+        .with_mirror_images(&flat_mirrors(desc, settings), &geometry);
         guard.check_cancel()?;
         let mut scene = Self {
             camera: Camera::new(&desc.camera, settings.width, settings.height),
@@ -547,8 +547,13 @@ impl UnitSums {
 /// The shapes whose lamp images the path tracer samples: triangle meshes under a plain
 /// `mirror` (a bump map or a mix would bend the reflection), unless the scene turns that off or
 /// has volumes (the integrator samples images only between surfaces).
-fn flat_mirrors(desc: &SceneDesc) -> Vec<u32> {
-    if !desc.integrator.mirror_images || !desc.volumes.media.is_empty() {
+fn flat_mirrors(desc: &SceneDesc, settings: &RenderSettings) -> Vec<u32> {
+    // A lamp seen in a mirror from a non-specular vertex is indirect light, which direct
+    // lighting leaves out.
+    if !desc.integrator.mirror_images
+        || !desc.volumes.media.is_empty()
+        || settings.transport == Transport::DirectLighting
+    {
         return Vec::new();
     }
     (0..desc.shapes.len() as u32)
@@ -668,6 +673,10 @@ impl PathScene for RenderScene {
 
     fn glossy_split(&self) -> bool {
         self.glossy_split
+    }
+
+    fn direct_lighting(&self) -> bool {
+        self.settings.transport == Transport::DirectLighting
     }
 
     fn first_vertex_branches(&self) -> usize {

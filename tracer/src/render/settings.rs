@@ -134,7 +134,9 @@ impl RenderSettings {
             // A scene's "bidirectional" renders with the path tracer unless the command line
             // chooses: the bidirectional integrator is new, and the course's scenes, which all
             // ask for it, are path tracing's strength (docs/architecture.md, "Integrators").
-            transport: overrides.transport.unwrap_or_default(),
+            transport: overrides
+                .transport
+                .unwrap_or_else(|| desc.integrator.transport()),
         }
     }
 }

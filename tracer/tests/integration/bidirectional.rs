@@ -21,7 +21,7 @@ fn render(text: &str, spp: u32, seed: u64, transport: Transport) -> Vec<Vec3> {
 
 /// A grey room (floor, walls and ceiling of matte quads) lit by a small area lamp under its
 /// ceiling, seen from inside: every path length matters, and every strategy can make them.
-fn room(integrator: &str) -> String {
+pub(super) fn room(integrator: &str) -> String {
     let wall = "Material \"matte\" \"color Kd\" [0.6 0.6 0.6]";
     let red = "Material \"matte\" \"color Kd\" [0.7 0.2 0.2]";
     let lamp = "AreaLightSource \"area\" \"color L\" [8 8 8] \"float power\" [0]";

@@ -7,6 +7,7 @@ mod bidirectional;
 mod branching;
 mod bump_render;
 mod daylight;
+mod direct_lighting;
 mod estimates;
 mod geometry_on_scenes;
 mod glossy_split;

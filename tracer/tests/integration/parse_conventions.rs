@@ -6,11 +6,13 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use yat_tracer::assets::MemorySource;
 use yat_tracer::desc::*;
+use yat_tracer::integrator::Transport;
 use yat_tracer::lights::{DistantLight, InfiniteLight, PointLight, SpotLight};
 use yat_tracer::material::glossy::CoatParams;
 use yat_tracer::material::{self, Glass, Glossy, Matte, Metal, Mirror, Null};
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{metal_preset, parse_scene};
+use yat_tracer::render::{RenderOverrides, RenderSettings};
 use yat_tracer::texture::{Checkerboard, Checkerboard3D, Constant, ImageMap, Mapping3D, Mix};
 
 fn source(files: &[(&str, &[u8])]) -> MemorySource {
@@ -280,6 +282,42 @@ fn bidirectional_reads_luxrenders_depths_and_thresholds() {
         ),
         (8, 8, 0.0, 0.0)
     );
+}
+
+/// LuxRender's direct lighting: its maxdepth counts the specular bounces after the first hit
+/// (5 by default), the walk the vertices that take light (one more); no roulette; the scene's
+/// transport unless the command line chooses another.
+#[test]
+fn directlighting_reads_luxrenders_depth_and_is_the_scenes_transport() {
+    let d = parse("SurfaceIntegrator \"directlighting\"\nWorldBegin\nWorldEnd");
+    let i = &d.integrator;
+    assert_eq!(
+        (i.max_depth, i.rr_strategy, i.transport()),
+        (6, RussianRoulette::None, Transport::DirectLighting)
+    );
+    let about_integrator = |d: &SceneDesc| {
+        d.warnings
+            .iter()
+            .any(|w| w.message.contains("SurfaceIntegrator") || w.message.contains("strategy"))
+    };
+    assert!(!about_integrator(&d), "{:?}", d.warnings);
+    let d = parse(
+        "SurfaceIntegrator \"directlighting\" \"integer maxdepth\" [2] \"string lightstrategy\" \"one\"\nWorldBegin\nWorldEnd",
+    );
+    assert_eq!(d.integrator.max_depth, 3);
+    assert!(!about_integrator(&d), "{:?}", d.warnings);
+    let resolve = |transport| {
+        let overrides = RenderOverrides {
+            transport,
+            ..Default::default()
+        };
+        RenderSettings::resolve(&d, &overrides).transport
+    };
+    assert_eq!(resolve(None), Transport::DirectLighting);
+    assert_eq!(resolve(Some(Transport::Path)), Transport::Path);
+    // "bidirectional" renders with the path tracer unless the command line says.
+    let d = parse("SurfaceIntegrator \"bidirectional\"\nWorldBegin\nWorldEnd");
+    assert_eq!(d.integrator.transport(), Transport::Path);
 }
 
 #[test]

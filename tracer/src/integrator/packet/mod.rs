@@ -35,10 +35,14 @@ use walk::{walk_packet, LanePrevScatter, Packet};
 
 /// Whether `scene`'s camera paths may be traced in packets: no volumes (a packet's lanes all
 /// travel in none) and no panes of architectural glass (a lane's shadow ray is blocked or not,
-/// never dimmed). Any material, light or camera: lanes that meet what a packet does not follow
-/// leave it.
+/// never dimmed), and path tracing's walk (direct lighting's paths end early: one at a time,
+/// they are short). Any material, light or camera: lanes that meet what a packet does not
+/// follow leave it.
 pub fn covers<S: PathScene>(scene: &S) -> bool {
-    scene.volumes().media.is_empty() && scene.volumes().camera.is_none() && !scene.has_panes()
+    scene.volumes().media.is_empty()
+        && scene.volumes().camera.is_none()
+        && !scene.has_panes()
+        && !scene.direct_lighting()
 }
 
 /// Traces the packet's camera rays (`None`: no ray, black) to the end, one [`PathResult`] per
