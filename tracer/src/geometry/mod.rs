@@ -281,6 +281,11 @@ impl SceneGeometry {
         self.crossed.get(shape as usize).copied().unwrap_or(false)
     }
 
+    /// Whether some shape is an infinite plane, which reaches beyond [`Self::bounds`].
+    pub fn has_planes(&self) -> bool {
+        !self.planes.is_empty()
+    }
+
     /// Whether anything blocks the ray within (0, tmax), but the shapes
     /// [`Self::cross_in_occlusion`] named.
     pub fn occluded(&self, ray: &Ray, tmax: f32) -> bool {

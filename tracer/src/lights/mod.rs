@@ -568,6 +568,12 @@ impl Lights {
         (self.sphere.centre, self.sphere.radius)
     }
 
+    /// The density, per area across `dir`, with which emission from a distant light or the
+    /// lights at infinity travelling along `dir` passes `x` ([`SceneSphere::pdf_reaching`]).
+    pub fn pdf_from_infinity(&self, dir: Vec3, x: Vec3) -> f32 {
+        self.sphere.pdf_reaching(dir, x)
+    }
+
     fn area_light(&self, shape: u32) -> Option<(u32, &AreaLight)> {
         let index = (*self.shape_light.get(shape as usize)?)?;
         match &self.lights[index as usize] {

@@ -169,6 +169,21 @@ impl SceneSphere {
     pub fn pdf_area(&self) -> f32 {
         1.0 / (PI * self.radius * self.radius)
     }
+
+    /// The density, per area across `dir`, with which rays from [`Self::entry_point`]'s disc
+    /// along `dir` pass `x`: the disc's within the cylinder the disc sweeps, 0 outside it. The
+    /// sphere bounds the finite shapes only: an infinite plane reaches beyond it, where no
+    /// light from infinity starts.
+    pub fn pdf_reaching(&self, dir: Vec3, x: Vec3) -> f32 {
+        let v = x - self.centre;
+        let along = v.dot(dir);
+        let across = v - along * dir;
+        if along < -self.radius || across.length_squared() > self.radius * self.radius {
+            0.0
+        } else {
+            self.pdf_area()
+        }
+    }
 }
 
 /// A direction uniform over the unit sphere.

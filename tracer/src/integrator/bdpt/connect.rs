@@ -46,14 +46,15 @@ fn densities(path: &[PathVertex]) -> ([Densities; MAX_VERTICES], usize) {
     (out, path.len())
 }
 
-/// `s = 0`: the camera subpath's `t`th vertex is on an area light or at infinity.
+/// `s = 0`: the camera subpath `before` (its first vertices) ends at `pt`, on an area light
+/// or at infinity: `pt` is the subpath's next vertex, or an emitter it crossed there.
 pub(super) fn camera_hits_light<S: BidirectionalScene>(
     scene: &S,
-    camera: &[PathVertex],
-    t: usize,
+    before: &[PathVertex],
+    pt: &PathVertex,
     limits: Limits,
 ) -> Vec3 {
-    let pt = &camera[t - 1];
+    let t = before.len() + 1;
     let le = pt.emitted(scene);
     if le == Vec3::ZERO {
         return Vec3::ZERO;
@@ -61,8 +62,10 @@ pub(super) fn camera_hits_light<S: BidirectionalScene>(
     if t == 2 && pt.at_infinity() && !scene.integrator().include_environment {
         return Vec3::ZERO;
     }
-    let prev = &camera[t - 2];
-    let (mut cam, n) = densities(&camera[..t]);
+    let prev = &before[t - 2];
+    let (mut cam, n) = densities(before);
+    cam[n] = pt.into();
+    let n = n + 1;
     cam[t - 1].rev = pt.pdf_light_origin(scene, prev);
     cam[t - 1].delta = false;
     cam[t - 2].rev = pt.pdf_light(scene, prev);

@@ -27,9 +27,10 @@ use glam::Vec3;
 
 use self::scene::MAX_VERTICES;
 use self::vertex::{Kind, LightVertex, PathVertex};
-use self::walk::{walk, Carries};
+use self::walk::{walk, Carries, CrossedEmitter};
 use self::weight::Limits;
 use super::state::PathResult;
+use crate::integrator::shadow::shadow_transmittance;
 use crate::math::{offset_origin, Ray};
 use crate::sampler::PixelSampler;
 
@@ -38,6 +39,8 @@ use crate::sampler::PixelSampler;
 pub struct Subpaths {
     camera: Vec<PathVertex>,
     light: Vec<PathVertex>,
+    /// The emitters the camera subpath crossed (lamps of null material).
+    crossed: Vec<CrossedEmitter>,
 }
 
 impl Subpaths {
@@ -45,6 +48,7 @@ impl Subpaths {
         Self {
             camera: Vec::with_capacity(MAX_VERTICES),
             light: Vec::with_capacity(MAX_VERTICES),
+            crossed: Vec::with_capacity(MAX_VERTICES),
         }
     }
 }
@@ -65,9 +69,14 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
         max_light: scene.light_depth().min(MAX_DEPTH) as usize + 1,
         only: scene.only_strategy(),
     };
-    let Subpaths { camera, light } = subpaths;
+    let Subpaths {
+        camera,
+        light,
+        crossed,
+    } = subpaths;
     camera.clear();
     light.clear();
+    crossed.clear();
     let mut rays = 0;
     let mut light_sampler = sampler.light_subpath();
     if let Some(ray) = camera_ray {
@@ -83,6 +92,7 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
         rays += walk(
             scene,
             camera,
+            crossed,
             ray,
             Vec3::ONE,
             limits.max_camera,
@@ -95,13 +105,16 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
 
     let mut radiance = Vec3::ZERO;
     for t in 2..=camera.len() {
-        radiance += connect::camera_hits_light(scene, camera, t, limits);
+        radiance += connect::camera_hits_light(scene, &camera[..t - 1], &camera[t - 1], limits);
         if t < camera.len() || !camera[t - 1].at_infinity() {
             radiance += connect::camera_samples_light(scene, camera, t, limits, &mut rays);
         }
         for s in 2..=light.len() {
             radiance += connect::join(scene, light, s, camera, t, limits, &mut rays);
         }
+    }
+    for c in crossed.iter() {
+        radiance += connect::camera_hits_light(scene, &camera[..c.at], &c.vertex, limits);
     }
     for s in 2..=light.len() {
         if let Some(splat) = connect::camera_sees_light_vertex(scene, light, s, limits, &mut rays) {
@@ -150,14 +163,28 @@ fn light_subpath<S: BidirectionalScene>(
     start.pdf_fwd = start.pdf_light_origin(scene, &start);
     light.push(start);
     let cos = e.normal.map_or(1.0, |n| n.dot(e.dir).abs());
-    let beta = e.le * (cos / (e.pdf_pos * e.pdf_dir));
+    let mut beta = e.le * (cos / (e.pdf_pos * e.pdf_dir));
+    let mut rays = 0;
+    // Light from infinity starts on a disc at the edge of the finite shapes' bounds. An
+    // infinite plane reaches past it, between the disc and the light: the light's way from
+    // infinity to the disc is a shadow ray then (else the sky below the horizon would shine
+    // up through the ground onto everything above it).
+    if at_infinity && scene.geometry().has_planes() {
+        beta *= shadow_transmittance(scene, e.origin, -e.dir, f32::INFINITY, None, &mut rays);
+        if beta == Vec3::ZERO {
+            return rays;
+        }
+    }
     // Off the lamp's surface, as any ray leaving a surface (else it may hit the lamp itself).
     let origin = e
         .normal
         .map_or(e.origin, |n| offset_origin(e.origin, n, e.dir));
-    walk(
+    // A light subpath gathers no emission: it keeps no emitter it crosses (and the empty
+    // vector allocates nothing).
+    rays + walk(
         scene,
         light,
+        &mut Vec::new(),
         Ray::new(origin, e.dir),
         beta,
         max_vertices,

@@ -1,18 +1,21 @@
 //! A subpath's random walk: from the camera or from a light, surface to surface, recording a
 //! vertex at every scattering surface with its forward density and its predecessor's reverse
 //! one. Null surfaces and panes of architectural glass are crossed as the path tracer crosses
-//! them (no vertex, the pane's straight transmittance carried), and shadow rays cross them the
-//! same way, so every strategy sees the same light behind them.
+//! them (no vertex, the pane's straight transmittance carried; an emitter crossed is kept
+//! aside for the strategy that ends there), and shadow rays cross them the same way, so every
+//! strategy sees the same light behind them.
 
 use glam::Vec3;
 
-use super::scene::BidirectionalScene;
+use super::scene::{BidirectionalScene, MAX_VERTICES};
 use super::vertex::{shading_correction, Kind, LightVertex, PathVertex, SurfaceVertex};
+use crate::geometry::SurfaceHit;
 use crate::integrator::shadow::goes_straight_on;
 use crate::integrator::state::MAX_PASS_THROUGH;
 use crate::lights::Emitter;
+use crate::material::Bsdf;
 use crate::math::{luminance, offset_origin, Ray};
-use crate::sampler::PixelSampler;
+use crate::sampler::{PixelSampler, VertexSamples};
 
 /// Which way a subpath carries light, which decides the BSDF's adjoint.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -30,15 +33,25 @@ fn survival(threshold: f32, weight: Vec3) -> f32 {
     luminance(weight).max(threshold).min(1.0)
 }
 
+/// An emitter a camera subpath crossed (a lamp of null material, a glowing pane): the vertex
+/// it would have been, after the subpath's first `at` vertices. The path goes on through it,
+/// as the path tracer's does, and the strategy of the camera path ending there (`s = 0`) is
+/// taken from this vertex.
+pub(super) struct CrossedEmitter {
+    pub(super) at: usize,
+    pub(super) vertex: PathVertex,
+}
+
 /// Walks on from `path`'s last vertex along `ray` with throughput `beta`, adding vertices
 /// until `max_vertices` or the path ends; `pdf_dir` is the solid-angle density of `ray`'s
 /// direction (unused after the camera or a light, whose own densities give the first
-/// vertex's). A camera subpath that escapes ends with a vertex at infinity. Returns the rays
-/// traced.
+/// vertex's). A camera subpath that escapes ends with a vertex at infinity; the emitters it
+/// crosses go to `crossed`. Returns the rays traced.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn walk<S: BidirectionalScene>(
     scene: &S,
     path: &mut Vec<PathVertex>,
+    crossed: &mut Vec<CrossedEmitter>,
     mut ray: Ray,
     mut beta: Vec3,
     max_vertices: usize,
@@ -79,6 +92,17 @@ pub(super) fn walk<S: BidirectionalScene>(
         let bsdf = scene.bsdf_at(&hit, u.mix);
         let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
+            if carries == Carries::Radiance
+                && path.len() < max_vertices
+                && crossed.len() < MAX_VERTICES
+                && scene.lights().emitted(&hit, wo) != Vec3::ZERO
+            {
+                let prev = path.last().expect("a walk starts from a vertex");
+                let mut vertex = surface_vertex(hit, bsdf, wo, u, beta);
+                vertex.pdf_fwd = first_or_next(scene, path, prev, pdf_dir, &vertex);
+                let at = path.len();
+                crossed.push(CrossedEmitter { at, vertex });
+            }
             beta *= transmittance;
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
@@ -89,21 +113,7 @@ pub(super) fn walk<S: BidirectionalScene>(
         }
         pass_through = 0;
         let prev = *path.last().expect("a walk starts from a vertex");
-        let mut vertex = PathVertex {
-            kind: Kind::Surface(SurfaceVertex {
-                hit,
-                bsdf,
-                wo,
-                sides: Default::default(),
-                u,
-            }),
-            p: hit.p,
-            ng: hit.ng,
-            beta,
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-            delta: false,
-        };
+        let mut vertex = surface_vertex(hit, bsdf, wo, u, beta);
         vertex.pdf_fwd = first_or_next(scene, path, &prev, pdf_dir, &vertex);
         path.push(vertex);
         if path.len() >= max_vertices {
@@ -151,6 +161,31 @@ pub(super) fn walk<S: BidirectionalScene>(
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
     }
     rays
+}
+
+/// A surface vertex reached with throughput `beta`, its densities not yet known.
+fn surface_vertex(
+    hit: SurfaceHit,
+    bsdf: Bsdf,
+    wo: Vec3,
+    u: VertexSamples,
+    beta: Vec3,
+) -> PathVertex {
+    PathVertex {
+        kind: Kind::Surface(SurfaceVertex {
+            hit,
+            bsdf,
+            wo,
+            sides: Default::default(),
+            u,
+        }),
+        p: hit.p,
+        ng: hit.ng,
+        beta,
+        pdf_fwd: 0.0,
+        pdf_rev: 0.0,
+        delta: false,
+    }
 }
 
 /// The forward density of `next`, reached from `prev` (`path`'s last vertex): the camera's or

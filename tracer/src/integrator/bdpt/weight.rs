@@ -53,13 +53,21 @@ pub(super) fn mis_weight(
     if s + t == 2 {
         return 1.0;
     }
-    // A density of zero (a delta vertex, a delta light's position) counts as one: such
-    // vertices' ratios cancel, and the strategies they would need are skipped below.
+    // A density of zero next to a delta vertex (a specular bounce samples its neighbours with
+    // a delta density, which the vertex records as zero) counts as one: such ratios cancel,
+    // and the strategies that would connect at a delta vertex are skipped below. A reverse
+    // density of zero anywhere else is a vertex the other side cannot make (a light at
+    // infinity beyond its disc: an infinite plane reaches past the scene's bounds; a BSDF's
+    // side that sends nothing back): no strategy past it can make the path.
     let remap = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum = 0.0f32;
     // Moving the connection toward the camera: camera vertex i becomes the light part's last.
     let mut ratio = 1.0f32;
     for i in (1..t).rev() {
+        let after_delta = i + 1 < t && camera[i + 1].delta;
+        if camera[i].rev == 0.0 && !after_delta {
+            break;
+        }
         ratio *= remap(camera[i].rev) / remap(camera[i].fwd);
         let (light_part, camera_part) = (s + t - i, i);
         let possible = light_part <= limits.max_light && !(light_part == 1 && camera_part == 1);
@@ -70,6 +78,10 @@ pub(super) fn mis_weight(
     // Moving it toward the light: light vertex i becomes the camera part's last.
     let mut ratio = 1.0f32;
     for i in (0..s).rev() {
+        let after_delta = i + 1 < s && light[i + 1].delta;
+        if light[i].rev == 0.0 && !after_delta {
+            break;
+        }
         ratio *= remap(light[i].rev) / remap(light[i].fwd);
         let camera_part = s + t - i;
         let before_is_delta = if i > 0 {
@@ -154,13 +166,16 @@ mod tests {
         }
     }
 
-    /// A specular vertex takes no connection: the strategies left still sum to one.
+    /// A specular vertex takes no connection: the strategies left still sum to one. As the
+    /// walk records it, its neighbours' densities of being sampled through it are zero.
     #[test]
     fn a_delta_vertex_leaves_the_other_strategies_summing_to_one() {
         let k = 6;
-        let light_side = [0.7, 1.3, 2.0, 0.4, 3.1, 1.0];
-        let camera_side = [1.1, 0.2, 0.9, 2.2, 0.5, 1.0];
+        let mut light_side = [0.7, 1.3, 2.0, 0.4, 3.1, 1.0];
+        let mut camera_side = [1.1, 0.2, 0.9, 2.2, 0.5, 1.0];
         let specular = 3;
+        light_side[specular + 1] = 0.0;
+        camera_side[specular - 1] = 0.0;
         let limits = Limits {
             max_light: 10,
             max_camera: 10,
@@ -175,23 +190,40 @@ mod tests {
                 continue;
             }
             let (mut light, mut camera) = split(&light_side, &camera_side, s);
-            for (i, d) in light.iter_mut().enumerate() {
-                if i == specular {
-                    *d = Densities {
-                        fwd: 0.0,
-                        rev: 0.0,
-                        delta: true,
-                    };
-                }
+            if let Some(d) = light.get_mut(specular) {
+                d.delta = true;
             }
-            let t_index = k - 1 - specular;
-            if let Some(d) = camera.get_mut(t_index) {
-                *d = Densities {
-                    fwd: 0.0,
-                    rev: 0.0,
-                    delta: true,
-                };
+            if let Some(d) = camera.get_mut(k - 1 - specular) {
+                d.delta = true;
             }
+            total += mis_weight(&light, &camera, false, limits);
+        }
+        assert!((total - 1.0).abs() < 1e-4, "{total}");
+    }
+
+    /// A vertex one side cannot make (its density from that side is zero: a light at infinity
+    /// beyond its disc) leaves the strategies that do not need that side to make it summing to
+    /// one, and gives the others nothing.
+    #[test]
+    fn a_vertex_one_side_cannot_make_leaves_the_others_summing_to_one() {
+        let k = 6;
+        let mut light_side = [0.7, 1.3, 2.0, 0.4, 3.1, 1.0];
+        let camera_side = [1.1, 0.2, 0.9, 2.2, 0.5, 1.0];
+        // No light subpath reaches vertex 2: strategies with s > 2 light vertices need one.
+        let unreachable = 2;
+        light_side[unreachable] = 0.0;
+        let limits = Limits {
+            max_light: 10,
+            max_camera: 10,
+            only: None,
+        };
+        let mut total = 0.0;
+        for s in 0..=unreachable {
+            let t = k - s;
+            if s == 1 && t == 1 {
+                continue;
+            }
+            let (light, camera) = split(&light_side, &camera_side, s);
             total += mis_weight(&light, &camera, false, limits);
         }
         assert!((total - 1.0).abs() < 1e-4, "{total}");
