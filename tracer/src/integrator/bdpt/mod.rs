@@ -13,7 +13,16 @@
 //! LuxRender's parameters: `eyedepth` and `lightdepth` bound the scattering vertices of each
 //! subpath (8 each by default, at most [`MAX_DEPTH`]), `eyerrthreshold` and
 //! `lightrrthreshold` are the least survival probabilities of LuxRender's roulette (0).
-//! Volumes are not walked through (a scene with volumes renders with the path tracer).
+//!
+//! Volumes: both subpaths walk through them as the path tracer's paths do (free flights,
+//! scattering events as vertices with the phase function in place of a BSDF, `walk`), and every
+//! strategy joins at an event as at a surface, its connection carrying the volumes'
+//! transmittance (the path tracer's shadow rays). The camera subpath starts in the camera's
+//! volume. A light subpath starts in the volume its area light's shape names on the side it
+//! leaves into; off an unnamed side, from a point or spot light, or from the lights at infinity,
+//! it starts in no volume, and so takes (LuxRender's rule for a ray in no volume) the volume on
+//! the near side of the first surface it meets: the volume a shadow ray from that surface toward
+//! the light travels in, where the path tracer's light sample finds the same light.
 
 mod connect;
 mod scene;
@@ -26,8 +35,8 @@ pub use self::scene::{BidirectionalScene, LightSplat, MAX_DEPTH};
 use glam::Vec3;
 
 use self::scene::MAX_VERTICES;
-use self::vertex::{Kind, LightVertex, PathVertex};
-use self::walk::{walk, Carries};
+use self::vertex::{Carries, Kind, LightVertex, PathVertex};
+use self::walk::walk;
 use self::weight::Limits;
 use super::state::PathResult;
 use crate::math::{offset_origin, Ray};
@@ -84,6 +93,7 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
             scene,
             camera,
             ray,
+            scene.volumes().camera,
             Vec3::ONE,
             limits.max_camera,
             Carries::Radiance,
@@ -155,10 +165,16 @@ fn light_subpath<S: BidirectionalScene>(
     let origin = e
         .normal
         .map_or(e.origin, |n| offset_origin(e.origin, n, e.dir));
+    // The volume on the side of the lamp's surface the ray leaves into (see the module's doc).
+    let medium = match (lights.shape_of(sample.emitter), e.normal) {
+        (Some(shape), Some(n)) => scene.shape_media(shape).toward(e.dir, n),
+        _ => None,
+    };
     walk(
         scene,
         light,
         Ray::new(origin, e.dir),
+        medium,
         beta,
         max_vertices,
         Carries::Importance,
