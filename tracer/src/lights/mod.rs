@@ -261,6 +261,8 @@ pub struct Lights {
     /// For each area light (the first of `lights`), the shape it lies on: `shape_light`'s
     /// inverse.
     light_shape: Vec<u32>,
+    /// For each light after the area lights, the index of the `LightSource` it came from.
+    light_source: Vec<u32>,
     /// Indices into `lights` of the infinite lights.
     infinite: Vec<u32>,
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
@@ -319,8 +321,10 @@ impl Lights {
             files: source,
             latlong,
         };
-        for desc in descs {
+        let mut light_source = Vec::new();
+        for (index, desc) in descs.iter().enumerate() {
             lights.extend(desc.light(&maps)?);
+            light_source.resize(lights.len() - light_shape.len(), index as u32);
         }
 
         let bounds = geometry.bounds();
@@ -367,6 +371,7 @@ impl Lights {
             selection,
             shape_light,
             light_shape,
+            light_source,
             infinite,
             images: Default::default(),
             sphere,
@@ -572,6 +577,19 @@ impl Lights {
     pub fn shape_of(&self, emitter: Emitter) -> Option<u32> {
         match emitter {
             Emitter::Light(index) => self.light_shape.get(index as usize).copied(),
+            Emitter::Environment => None,
+        }
+    }
+
+    /// The index of the `LightSource` (among the scene description's lights) emitter
+    /// `emitter` came from, when it is not an area light (the lights at infinity together are
+    /// none).
+    pub fn source_of(&self, emitter: Emitter) -> Option<usize> {
+        match emitter {
+            Emitter::Light(index) => {
+                let after_area = (index as usize).checked_sub(self.light_shape.len())?;
+                self.light_source.get(after_area).map(|&i| i as usize)
+            }
             Emitter::Environment => None,
         }
     }

@@ -30,13 +30,17 @@ fn survival(threshold: f32, weight: Vec3) -> f32 {
 
 /// Walks on from `path`'s last vertex along `ray`, in volume `medium`, with throughput `beta`,
 /// adding vertices until `max_vertices` or the path ends. A camera subpath that escapes ends
-/// with a vertex at infinity. Returns the rays traced.
+/// with a vertex at infinity. `from_infinity`: `ray` is light from a light at infinity, which
+/// crossed all of its first segment's volume from there (that volume's transmittance over an
+/// infinite distance, as a shadow ray toward the light finds it; no event in it). Returns the
+/// rays traced.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn walk<S: BidirectionalScene>(
     scene: &S,
     path: &mut Vec<PathVertex>,
     mut ray: Ray,
     mut medium: Option<MediumId>,
+    mut from_infinity: bool,
     mut beta: Vec3,
     max_vertices: usize,
     carries: Carries,
@@ -56,8 +60,14 @@ pub(super) fn walk<S: BidirectionalScene>(
         let hit = scene.geometry().intersect(&ray, f32::INFINITY);
         let sides = meet_surface(scene, hit.as_ref(), ray.dir, &mut medium, has_media);
         if let Some(volume) = medium.and_then(|m| volumes.get(m)) {
-            let length = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
-            match free_flight(volume, length, sampler) {
+            let flight = if from_infinity {
+                Flight::Pass {
+                    weight: volume.transmittance(f32::INFINITY),
+                }
+            } else {
+                free_flight(volume, hit.as_ref().map_or(f32::INFINITY, |h| h.t), sampler)
+            };
+            match flight {
                 Flight::Pass { weight } => {
                     beta *= weight;
                     if beta == Vec3::ZERO {
@@ -95,6 +105,7 @@ pub(super) fn walk<S: BidirectionalScene>(
                 }
             }
         }
+        from_infinity = false;
         let Some(hit) = hit else {
             if carries == Carries::Radiance && !scene.lights().is_empty() {
                 let prev = path.last().expect("a walk starts from a vertex");
