@@ -232,16 +232,8 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
     let _ = writeln!(
         s,
         "             --integrator bidirectional: eye depth {}, light depth {}, rr thresholds \
-         {} (eye) {} (light){}",
-        i.max_depth,
-        i.light_depth,
-        i.eye_rr_threshold,
-        i.light_rr_threshold,
-        if d.volumes.media.is_empty() {
-            ""
-        } else {
-            "; this scene has volumes, which it renders with path tracing"
-        }
+         {} (eye) {} (light)",
+        i.max_depth, i.light_depth, i.eye_rr_threshold, i.light_rr_threshold,
     );
     let spp = d
         .sampler

@@ -8,16 +8,78 @@
 //! the volume on the near side of the surface it hits. A scene without volumes takes none of
 //! these steps and draws no random numbers for them.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::mis::power_heuristic;
 use super::roulette::survives;
 use super::scene::PathScene;
 use super::shadow::{shadow_tmax, shadow_transmittance};
 use super::state::PrevScatter;
+use crate::geometry::SurfaceHit;
 use crate::math::Ray;
-use crate::medium::{Flight, MediumDesc, MediumId, Phase};
+use crate::medium::{Flight, MediumDesc, MediumId, Phase, ShapeMedia};
 use crate::sampler::PixelSampler;
+
+/// The sides of the surface `hit` (if any) as a ray along `dir` in volume `medium` meets
+/// them, and the ray's volume for the segment up to it: a ray in no volume crosses the one on
+/// the near side of what it hits. No volumes in the scene (`has_media` false): no sides, and
+/// `medium` unchanged. The path tracer's and the bidirectional walks' one rule.
+#[inline(always)]
+pub(super) fn meet_surface<S: PathScene>(
+    scene: &S,
+    hit: Option<&SurfaceHit>,
+    dir: Vec3,
+    medium: &mut Option<MediumId>,
+    has_media: bool,
+) -> ShapeMedia {
+    match hit {
+        Some(hit) if has_media => {
+            let sides = scene.shape_media(hit.shape).met_by(dir, hit.ng, *medium);
+            if medium.is_none() {
+                *medium = sides.toward(-dir, hit.ng);
+            }
+            sides
+        }
+        _ => ShapeMedia::default(),
+    }
+}
+
+/// The fate of a ray crossing `length` of `volume`: one random number drawn, only when the
+/// volume scatters.
+#[inline(always)]
+pub(super) fn free_flight(volume: &MediumDesc, length: f32, sampler: &mut PixelSampler) -> Flight {
+    let u = if volume.scatters() {
+        sampler.get_1d()
+    } else {
+        0.0
+    };
+    volume.flight(length, u)
+}
+
+/// A direction drawn from the phase function at a scattering event reached along `-wo`.
+pub(super) struct PhaseSample {
+    pub(super) wi: Vec3,
+    /// The solid-angle density of `wi`.
+    pub(super) pdf: f32,
+    /// The phase function over the density: what the path's throughput is multiplied by.
+    pub(super) weight: Vec3,
+}
+
+/// Draws the direction a path leaves a scattering event with (`u` its two numbers); None when
+/// the density is not positive.
+#[inline(always)]
+pub(super) fn sample_phase(phase: &Phase, wo: Vec3, u: Vec2) -> Option<PhaseSample> {
+    let wi = phase.sample(wo, u);
+    let pdf = phase.pdf(wo, wi);
+    if pdf.is_nan() || pdf <= 0.0 {
+        return None;
+    }
+    Some(PhaseSample {
+        wi,
+        pdf,
+        weight: phase.eval(wo, wi) / pdf,
+    })
+}
 
 /// A path's segment through a volume: the ray, up to `length` (infinite where it hits nothing).
 pub(super) struct Segment<'a> {
@@ -59,8 +121,7 @@ pub(super) fn travel<S: PathScene>(
     rays: &mut u32,
 ) -> Travel {
     let m = segment.volume;
-    let u = if m.scatters() { sampler.get_1d() } else { 0.0 };
-    match m.flight(segment.length, u) {
+    match free_flight(m, segment.length, sampler) {
         Flight::Pass { weight } => {
             throughput *= weight;
             if throughput == Vec3::ZERO {
@@ -81,12 +142,11 @@ pub(super) fn travel<S: PathScene>(
             let phase = m.phase();
             *radiance += throughput
                 * direct_light_in_medium(scene, p, wo, &phase, segment.id, sampler, rays);
-            let wi = phase.sample(wo, sampler.get_2d());
-            let pdf = phase.pdf(wo, wi);
-            if pdf.is_nan() || pdf <= 0.0 {
+            let Some(PhaseSample { wi, pdf, weight }) = sample_phase(&phase, wo, sampler.get_2d())
+            else {
                 return Travel::Ended;
-            }
-            throughput *= phase.eval(wo, wi) / pdf;
+            };
+            throughput *= weight;
             if !survives(
                 scene.integrator(),
                 depth,

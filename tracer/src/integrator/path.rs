@@ -11,7 +11,7 @@ use glam::Vec3;
 
 use super::glossy_split::{split_bsdf_light, splits_at};
 use super::light_draw::BsdfCounts;
-use super::media::{travel, Segment, Travel};
+use super::media::{meet_surface, travel, Segment, Travel};
 use super::mirror_images::mirror_after;
 use super::mis::power_heuristic;
 use super::roulette::survives;
@@ -21,7 +21,6 @@ use super::state::{BranchPoint, PathResult, PathState, PrevScatter, MAX_PASS_THR
 use super::vertex::Vertex;
 use crate::lights::IMAGE_SHARE;
 use crate::math::{offset_origin, Ray};
-use crate::medium::ShapeMedia;
 use crate::sampler::PixelSampler;
 
 /// Traces `state` on, adding its light and rays to `out`, to its end or to the vertex where it
@@ -65,17 +64,7 @@ pub(super) fn walk<S: PathScene>(
             None => scene.geometry().intersect(&ray, f32::INFINITY),
         };
         // The sides of the surface hit as this ray meets them (no volumes: nothing to do).
-        let sides = match &hit {
-            Some(hit) if has_media => {
-                let sides = scene.shape_media(hit.shape).met_by(ray.dir, hit.ng, medium);
-                // A ray in no volume crosses the one on the near side of what it hits.
-                if medium.is_none() {
-                    medium = sides.toward(-ray.dir, hit.ng);
-                }
-                sides
-            }
-            _ => ShapeMedia::default(),
-        };
+        let sides = meet_surface(scene, hit.as_ref(), ray.dir, &mut medium, has_media);
         if let Some(volume) = medium.and_then(|m| volumes.get(m)) {
             let segment = Segment {
                 volume,

@@ -258,6 +258,11 @@ pub struct Lights {
     selection: Distribution1D,
     /// For each shape, the index of its area light in `lights`.
     shape_light: Vec<Option<u32>>,
+    /// For each area light (the first of `lights`), the shape it lies on: `shape_light`'s
+    /// inverse.
+    light_shape: Vec<u32>,
+    /// For each light after the area lights, the index of the `LightSource` it came from.
+    light_source: Vec<u32>,
     /// Indices into `lights` of the infinite lights.
     infinite: Vec<u32>,
     /// The area lights' images in flat mirrors ([`mirrored`]; empty unless the scene adds them).
@@ -287,6 +292,7 @@ impl Lights {
         let descs = lights;
         let mut lights = Vec::new();
         let mut shape_light = Vec::new();
+        let mut light_shape = Vec::new();
         for (index, shape) in shapes.into_iter().enumerate() {
             shape_light.push(None);
             let Some(area_light) = &shape.area_light else {
@@ -306,6 +312,7 @@ impl Lights {
             };
             if light.area() > 0.0 {
                 shape_light[index] = Some(lights.len() as u32);
+                light_shape.push(index as u32);
                 lights.push(Light::Area(light));
             }
         }
@@ -314,8 +321,10 @@ impl Lights {
             files: source,
             latlong,
         };
-        for desc in descs {
+        let mut light_source = Vec::new();
+        for (index, desc) in descs.iter().enumerate() {
             lights.extend(desc.light(&maps)?);
+            light_source.resize(lights.len() - light_shape.len(), index as u32);
         }
 
         let bounds = geometry.bounds();
@@ -361,6 +370,8 @@ impl Lights {
             lights,
             selection,
             shape_light,
+            light_shape,
+            light_source,
             infinite,
             images: Default::default(),
             sphere,
@@ -560,6 +571,27 @@ impl Lights {
     pub fn emitter_of_shape(&self, shape: u32) -> Option<Emitter> {
         self.area_light(shape)
             .map(|(index, _)| Emitter::Light(index))
+    }
+
+    /// The shape emitter `emitter` lies on, when it is an area light.
+    pub fn shape_of(&self, emitter: Emitter) -> Option<u32> {
+        match emitter {
+            Emitter::Light(index) => self.light_shape.get(index as usize).copied(),
+            Emitter::Environment => None,
+        }
+    }
+
+    /// The index of the `LightSource` (among the scene description's lights) emitter
+    /// `emitter` came from, when it is not an area light (the lights at infinity together are
+    /// none).
+    pub fn source_of(&self, emitter: Emitter) -> Option<usize> {
+        match emitter {
+            Emitter::Light(index) => {
+                let after_area = (index as usize).checked_sub(self.light_shape.len())?;
+                self.light_source.get(after_area).map(|&i| i as usize)
+            }
+            Emitter::Environment => None,
+        }
     }
 
     /// The scene's bounding sphere (centre, radius): the discs rays from distant lights and the

@@ -4,7 +4,8 @@
 //! share (ids, the sides of a surface, Beer-Lambert) in the leaf [`common`].
 //!
 //! As in LuxRender, a shape takes the `Interior` and `Exterior` current when it is defined,
-//! the camera sits in the `Exterior` current at `WorldEnd`, and a side with no volume takes
+//! the camera sits in the `Exterior` current at `WorldEnd`, a `LightSource` in the `Exterior`
+//! current at it, and a side with no volume takes
 //! the volume of the ray that reaches it. Only glass2 reads a volume's `fresnel` index (as
 //! the interior's over the exterior's).
 
@@ -31,16 +32,26 @@ pub enum MediumDesc {
     Homogeneous(Homogeneous),
 }
 
-/// The scene's volumes and the one the camera sits in.
+/// The scene's volumes, the one the camera sits in and the ones the lights sit in.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Volumes {
     pub media: Vec<MediumDesc>,
     pub camera: Option<MediumId>,
+    /// For each `LightSource` (`SceneDesc::lights`, in order), the Exterior current at it: as
+    /// in LuxRender, the volume its light leaves into. Read by bidirectional light subpaths
+    /// from point and spot lights; the path tracer's shadow rays find a light in whatever
+    /// volume they reach it in. Missing entries (a description made otherwise) are no volume.
+    pub lights: Vec<Option<MediumId>>,
 }
 
 impl Volumes {
     pub fn get(&self, id: MediumId) -> Option<&MediumDesc> {
         self.media.get(id.0 as usize)
+    }
+
+    /// The volume `LightSource` number `source` sits in.
+    pub fn light(&self, source: usize) -> Option<MediumId> {
+        self.lights.get(source).copied().flatten()
     }
 
     /// The index of refraction of a side of a surface: its volume's `fresnel`, 1 with none.

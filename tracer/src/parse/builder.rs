@@ -474,6 +474,8 @@ impl<'s> Builder<'s> {
                 for _ in 0..skies {
                     self.spend_image(SkyLight::table_cost(), pos)?;
                 }
+                let exterior = self.gs.media.exterior;
+                self.volumes.lights.extend(lights.iter().map(|_| exterior));
                 self.lights.extend(lights);
                 self.warn_unused(&params);
             }

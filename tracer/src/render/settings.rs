@@ -108,10 +108,9 @@ impl RenderSettings {
     }
 
     /// Whether `desc` renders with bidirectional path tracing under these settings: they
-    /// choose it, and the scene has no volumes (the bidirectional walk does not enter them;
-    /// such a scene renders with the path tracer, as `yat check` says).
-    pub fn renders_bidirectional(&self, desc: &SceneDesc) -> bool {
-        self.transport == Transport::Bidirectional && desc.volumes.media.is_empty()
+    /// choose it (any scene can, volumes included: both subpaths walk through them).
+    pub fn renders_bidirectional(&self, _desc: &SceneDesc) -> bool {
+        self.transport == Transport::Bidirectional
     }
 
     pub fn resolve(desc: &SceneDesc, overrides: &RenderOverrides) -> Self {

@@ -73,7 +73,8 @@ fn box_mesh(lo: Vec3, hi: Vec3) -> String {
 }
 
 /// Named volumes with LuxRender's defaults, Interior and Exterior saved and restored by
-/// attribute blocks, the camera in the Exterior current at WorldEnd, and what is not rendered
+/// attribute blocks, the camera in the Exterior current at WorldEnd and a light in the one at
+/// its LightSource, and what is not rendered
 /// (an unknown volume name, a heterogeneous volume, a Volume region) warned about.
 #[test]
 fn volume_statements_follow_the_attribute_state() {
@@ -94,9 +95,13 @@ AttributeBegin
     Interior "smoke"
     Exterior ""
     Shape "sphere" "float radius" [0.5]
+    LightSource "point" "point from" [0 0 0.1]
   AttributeEnd
   Shape "sphere" "float radius" [0.25]
+  Exterior "smoke"
+  LightSource "sunsky" "vector sundir" [0 0 1]
 AttributeEnd
+LightSource "point"
 Interior "nothing"
 Shape "sphere" "float radius" [2]
 Interior "cloud"
@@ -146,6 +151,9 @@ WorldEnd
         ]
     );
     assert_eq!(desc.volumes.camera, air);
+    // Each LightSource in the Exterior current at it (a sunsky is two lights, a sun and a sky).
+    assert_eq!(desc.lights.len(), 4);
+    assert_eq!(desc.volumes.lights, vec![None, smoke, smoke, air]);
     let warnings: Vec<&str> = desc.warnings.iter().map(|w| w.message.as_str()).collect();
     for expected in [
         "heterogeneous",

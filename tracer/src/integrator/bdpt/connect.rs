@@ -2,19 +2,36 @@
 //! `s`, each weighed by [`mis_weight`]. `s = 0`: the camera path's last vertex is on a light;
 //! `s = 1`: its last vertex takes a light sample (the path tracer's next-event estimation);
 //! `t = 1`: a light subpath vertex is seen by the camera (light tracing: a splat anywhere on
-//! the film); otherwise a shadow ray joins two scattering vertices.
+//! the film); otherwise a shadow ray joins two scattering vertices. A scattering vertex is a
+//! surface's or an event in a volume: the phase function takes the BSDF's place there, and no
+//! cosine is taken there (in the geometry term nor in the densities). Every connection
+//! carries the shadow ray's transmittance, through the volumes it crosses from the volume its
+//! start is in ([`PathVertex::leaving`]).
 
 use glam::Vec3;
 
 use super::scene::{BidirectionalScene, LightSplat, MAX_VERTICES};
-use super::vertex::{shading_correction, Kind, LightVertex, PathVertex};
+use super::vertex::{Carries, Kind, LightVertex, PathVertex};
 use super::weight::{mis_weight, Densities, Limits};
 use crate::integrator::shadow::{shadow_tmax, shadow_transmittance};
-use crate::math::offset_origin;
 
-/// What reaches `to` from `from` (two surface points, or a surface point and a lens point or
-/// light point): the shadow ray's transmittance through null surfaces, panes and volumes.
+/// What reaches the point `dist` along unit `dir` from `from` (a scattering vertex, or the
+/// lens): the shadow ray's transmittance through null surfaces, panes and volumes, from the
+/// volume `from` is in.
 fn transmittance<S: BidirectionalScene>(
+    scene: &S,
+    from: &PathVertex,
+    dir: Vec3,
+    dist: f32,
+    rays: &mut u32,
+) -> Vec3 {
+    let (origin, medium) = from.leaving(dir, scene.volumes().camera);
+    let tmax = shadow_tmax(from.p, origin, dist);
+    shadow_transmittance(scene, origin, dir, tmax, medium, rays)
+}
+
+/// [`transmittance`] from `from` to the point `to`.
+fn transmittance_to<S: BidirectionalScene>(
     scene: &S,
     from: &PathVertex,
     to: Vec3,
@@ -25,16 +42,7 @@ fn transmittance<S: BidirectionalScene>(
     if dist <= 0.0 {
         return Vec3::ZERO;
     }
-    let dir = d / dist;
-    let (origin, medium) = match &from.kind {
-        Kind::Surface(s) => (
-            offset_origin(from.p, s.hit.ng, dir),
-            s.sides.toward(dir, s.hit.ng),
-        ),
-        _ => (from.p, scene.volumes().camera),
-    };
-    let tmax = shadow_tmax(from.p, origin, dist);
-    shadow_transmittance(scene, origin, dir, tmax, medium, rays)
+    transmittance(scene, from, d / dist, dist, rays)
 }
 
 /// Copies a subpath's densities for a strategy to change at its connection.
@@ -81,13 +89,12 @@ pub(super) fn camera_samples_light<S: BidirectionalScene>(
     rays: &mut u32,
 ) -> Vec3 {
     let pt = &camera[t - 1];
-    let Some(surface) = pt.surface() else {
+    let Some(u) = pt.samples() else {
         return Vec3::ZERO;
     };
     if pt.delta {
         return Vec3::ZERO;
     }
-    let u = &surface.u;
     let Some((ls, point)) = scene
         .lights()
         .sample_light_point(pt.p, u.light_select, u.light)
@@ -97,18 +104,15 @@ pub(super) fn camera_samples_light<S: BidirectionalScene>(
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let f = surface.bsdf.eval(surface.wo, ls.wi);
+    let f = pt.scatters_toward(ls.wi, Carries::Radiance);
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let origin = offset_origin(pt.p, surface.hit.ng, ls.wi);
-    let tmax = shadow_tmax(pt.p, origin, ls.dist);
-    let medium = surface.sides.toward(ls.wi, surface.hit.ng);
-    let tr = shadow_transmittance(scene, origin, ls.wi, tmax, medium, rays);
+    let tr = transmittance(scene, pt, ls.wi, ls.dist, rays);
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let unweighted = pt.beta * f * ls.li * tr * (ls.wi.dot(surface.hit.ns).abs() / ls.pdf);
+    let unweighted = pt.beta * f * ls.li * tr * (pt.cos_toward(ls.wi) / ls.pdf);
     let light_vertex = PathVertex {
         kind: Kind::Light(LightVertex {
             emitter: point.emitter,
@@ -145,23 +149,23 @@ pub(super) fn camera_sees_light_vertex<S: BidirectionalScene>(
     rays: &mut u32,
 ) -> Option<LightSplat> {
     let qs = &light[s - 1];
-    let surface = qs.surface()?;
+    let u = qs.samples()?;
     if qs.delta {
         return None;
     }
     let camera = scene.camera();
-    let view = camera.view(qs.p, surface.u.light)?;
+    let view = camera.view(qs.p, u.light)?;
     let to_lens = view.lens_point - qs.p;
     let wi = to_lens.normalize_or_zero();
-    let f = surface.bsdf.eval(surface.wo, wi) * shading_correction(surface, surface.wo, wi);
+    let f = qs.scatters_toward(wi, Carries::Importance);
     if f == Vec3::ZERO {
         return None;
     }
-    let tr = transmittance(scene, qs, view.lens_point, rays);
+    let tr = transmittance_to(scene, qs, view.lens_point, rays);
     if tr == Vec3::ZERO {
         return None;
     }
-    let unweighted = qs.beta * f * tr * (wi.dot(surface.hit.ns).abs() * view.density);
+    let unweighted = qs.beta * f * tr * (qs.cos_toward(wi) * view.density);
     let lens = PathVertex {
         kind: Kind::Camera,
         p: view.lens_point,
@@ -195,9 +199,9 @@ pub(super) fn join<S: BidirectionalScene>(
     rays: &mut u32,
 ) -> Vec3 {
     let (qs, pt) = (&light[s - 1], &camera[t - 1]);
-    let (Some(q), Some(p)) = (qs.surface(), pt.surface()) else {
+    if qs.samples().is_none() || pt.samples().is_none() {
         return Vec3::ZERO;
-    };
+    }
     if qs.delta || pt.delta {
         return Vec3::ZERO;
     }
@@ -207,20 +211,20 @@ pub(super) fn join<S: BidirectionalScene>(
         return Vec3::ZERO;
     }
     let dir = d / dist2.sqrt();
-    let f_camera = p.bsdf.eval(p.wo, dir);
+    let f_camera = pt.scatters_toward(dir, Carries::Radiance);
     if f_camera == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let f_light = q.bsdf.eval(q.wo, -dir) * shading_correction(q, q.wo, -dir);
+    let f_light = qs.scatters_toward(-dir, Carries::Importance);
     if f_light == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let g = dir.dot(p.hit.ns).abs() * dir.dot(q.hit.ns).abs() / dist2;
+    let g = pt.cos_toward(dir) * qs.cos_toward(dir) / dist2;
     let unweighted = pt.beta * f_camera * f_light * qs.beta * g;
     if unweighted == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let tr = transmittance(scene, pt, qs.p, rays);
+    let tr = transmittance_to(scene, pt, qs.p, rays);
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }

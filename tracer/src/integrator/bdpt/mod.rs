@@ -13,7 +13,22 @@
 //! LuxRender's parameters: `eyedepth` and `lightdepth` bound the scattering vertices of each
 //! subpath (8 each by default, at most [`MAX_DEPTH`]), `eyerrthreshold` and
 //! `lightrrthreshold` are the least survival probabilities of LuxRender's roulette (0).
-//! Volumes are not walked through (a scene with volumes renders with the path tracer).
+//!
+//! Volumes: both subpaths walk through them as the path tracer's paths do (free flights,
+//! scattering events as vertices with the phase function in place of a BSDF, `walk`), and every
+//! strategy joins at an event as at a surface, its connection carrying the volumes'
+//! transmittance (the path tracer's shadow rays). The camera subpath starts in the camera's
+//! volume. A light subpath starts in the volume its light leaves into: an area light's, the one
+//! its shape names on the emitting side; a point or spot light's, the Exterior current at its
+//! `LightSource` (LuxRender's rule). Off a side that names none, it starts in no volume and so
+//! takes (LuxRender's rule for a ray in no volume) the volume on the near side of the first
+//! surface it meets: the volume a shadow ray from that surface toward the light travels in.
+//! Light from a light at infinity takes that rule too, having crossed its first segment's
+//! volume from infinity (its transmittance over an infinite distance, which is what a shadow
+//! ray toward the light finds: none through a volume that absorbs or scatters).
+//! Where a scene puts a point light in another volume than its Exterior, or names no volume
+//! on the side of a surface a path reaches in one, light subpaths and the path tracer's light
+//! samples may see different volumes; LuxRender's own integrators differ there too.
 
 mod connect;
 mod scene;
@@ -26,8 +41,8 @@ pub use self::scene::{BidirectionalScene, LightSplat, MAX_DEPTH};
 use glam::Vec3;
 
 use self::scene::MAX_VERTICES;
-use self::vertex::{Kind, LightVertex, PathVertex};
-use self::walk::{walk, Carries, CrossedEmitter};
+use self::vertex::{Carries, Kind, LightVertex, PathVertex};
+use self::walk::{walk, CrossedEmitter};
 use self::weight::Limits;
 use super::state::PathResult;
 use crate::integrator::shadow::shadow_transmittance;
@@ -94,6 +109,8 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
             camera,
             crossed,
             ray,
+            scene.volumes().camera,
+            false,
             Vec3::ONE,
             limits.max_camera,
             Carries::Radiance,
@@ -179,6 +196,14 @@ fn light_subpath<S: BidirectionalScene>(
     let origin = e
         .normal
         .map_or(e.origin, |n| offset_origin(e.origin, n, e.dir));
+    // The volume the light leaves into (see the module's doc).
+    let medium = match (lights.shape_of(sample.emitter), e.normal) {
+        (Some(shape), Some(n)) => scene.shape_media(shape).toward(e.dir, n),
+        _ if at_infinity => None,
+        _ => lights
+            .source_of(sample.emitter)
+            .and_then(|source| scene.volumes().light(source)),
+    };
     // A light subpath gathers no emission: it keeps no emitter it crosses (and the empty
     // vector allocates nothing).
     rays + walk(
@@ -186,6 +211,8 @@ fn light_subpath<S: BidirectionalScene>(
         light,
         &mut Vec::new(),
         Ray::new(origin, e.dir),
+        medium,
+        at_infinity,
         beta,
         max_vertices,
         Carries::Importance,

@@ -1,16 +1,34 @@
-//! A vertex of a camera or light subpath, and the densities multiple importance sampling asks
-//! of it: the area density with which one vertex samples the next (pbrt-v4's and Veach's
-//! formulation), the density of a light's own sampling of an emitter point, and of its
-//! emission toward a point.
+//! A vertex of a camera or light subpath, what a scattering one (a surface's BSDF, a volume's
+//! phase function) does to the light it passes on, and the densities multiple importance
+//! sampling asks of it: the area density with which one vertex samples the next (pbrt-v4's
+//! and Veach's formulation; no cosine at a vertex in a volume), the density of a light's own
+//! sampling of an emitter point, and of its emission toward a point.
+//!
+//! The densities are those of the directions alone: like pbrt-v4's, they leave out the
+//! probabilities of the free flights between vertices (of scattering where a vertex in a volume
+//! is, of passing through a volume to a surface). Every strategy that makes a path computes its
+//! weight from the same densities, so the weights still sum to one over the strategies and the
+//! estimate stays unbiased; they are only less well balanced in dense volumes.
 
 use glam::Vec3;
 
 use super::scene::BidirectionalScene;
 use crate::geometry::SurfaceHit;
+use crate::integrator::media::sample_phase;
 use crate::lights::Emitter;
 use crate::material::Bsdf;
-use crate::medium::ShapeMedia;
+use crate::math::offset_origin;
+use crate::medium::{MediumId, Phase, ShapeMedia};
 use crate::sampler::VertexSamples;
+
+/// Which way a subpath carries light, which decides the BSDF's adjoint.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Carries {
+    /// A camera subpath: radiance flows toward its start.
+    Radiance,
+    /// A light subpath: light flows from its start.
+    Importance,
+}
 
 /// A subpath vertex: where it is, what it carries and the densities of reaching it from either
 /// side (area measure; solid angle for a vertex at infinity).
@@ -18,7 +36,8 @@ use crate::sampler::VertexSamples;
 pub(super) struct PathVertex {
     pub(super) kind: Kind,
     pub(super) p: Vec3,
-    /// Geometric normal (zero off surfaces: the camera, point and spot lights, infinity).
+    /// Geometric normal (zero off surfaces: the camera, point and spot lights, infinity, a
+    /// volume's scattering event).
     pub(super) ng: Vec3,
     /// The subpath's throughput up to here (unused on a light vertex).
     pub(super) beta: Vec3,
@@ -40,6 +59,8 @@ pub(super) enum Kind {
     /// A point on a light, or the lights at infinity seen along `toward`.
     Light(LightVertex),
     Surface(SurfaceVertex),
+    /// A scattering event inside a volume.
+    Medium(MediumVertex),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -64,10 +85,122 @@ pub(super) struct SurfaceVertex {
     pub(super) u: VertexSamples,
 }
 
+#[derive(Clone, Copy, Debug)]
+pub(super) struct MediumVertex {
+    pub(super) phase: Phase,
+    /// Unit direction toward the subpath's previous vertex.
+    pub(super) wo: Vec3,
+    /// The volume the event is in: what rays leaving it travel in.
+    pub(super) medium: Option<MediumId>,
+    /// The vertex's random numbers, as a surface vertex's (the phase function's sample in
+    /// `bsdf`, the light sample and lens sample in `light_select` and `light`).
+    pub(super) u: VertexSamples,
+}
+
+/// A direction a scattering vertex sends its subpath on in, with what it carries.
+pub(super) struct Scattered {
+    pub(super) wi: Vec3,
+    /// What the subpath's throughput is multiplied by: `f |cos| / pdf` at a surface (with the
+    /// shading normals' correction for light carried from the lights), the phase function
+    /// over its density in a volume.
+    pub(super) weight: Vec3,
+    /// The solid-angle density of `wi`, and of going back along `-wi` from `wi` (0 both for a
+    /// specular sample).
+    pub(super) pdf: f32,
+    pub(super) pdf_rev: f32,
+    pub(super) specular: bool,
+}
+
 impl PathVertex {
-    pub(super) fn surface(&self) -> Option<&SurfaceVertex> {
+    /// A scattering vertex's random numbers (None for the camera and the lights).
+    pub(super) fn samples(&self) -> Option<&VertexSamples> {
         match &self.kind {
-            Kind::Surface(s) => Some(s),
+            Kind::Surface(s) => Some(&s.u),
+            Kind::Medium(m) => Some(&m.u),
+            _ => None,
+        }
+    }
+
+    /// What a scattering vertex sends toward unit `wi` of the light from its previous vertex
+    /// (`carries` radiance) or of the light reaching it from there (importance, with the
+    /// shading normals' correction): a surface's BSDF, a volume's phase function; 0 for the
+    /// camera and the lights.
+    pub(super) fn scatters_toward(&self, wi: Vec3, carries: Carries) -> Vec3 {
+        match &self.kind {
+            Kind::Surface(s) => {
+                let f = s.bsdf.eval(s.wo, wi);
+                match carries {
+                    Carries::Radiance => f,
+                    Carries::Importance => f * shading_correction(s, s.wo, wi),
+                }
+            }
+            Kind::Medium(m) => m.phase.eval(m.wo, wi),
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// The cosine a connection along unit `w` takes at this vertex: with the shading normal at
+    /// a surface, none (1) in a volume.
+    pub(super) fn cos_toward(&self, w: Vec3) -> f32 {
+        match &self.kind {
+            Kind::Surface(s) => w.dot(s.hit.ns).abs(),
+            _ => 1.0,
+        }
+    }
+
+    /// Where a ray leaving this vertex along unit `dir` starts (off a surface, on the side it
+    /// leaves into) and the volume it travels in: that side's at a surface, the event's in a
+    /// volume, the camera's (`camera_medium`) at the lens.
+    pub(super) fn leaving(
+        &self,
+        dir: Vec3,
+        camera_medium: Option<MediumId>,
+    ) -> (Vec3, Option<MediumId>) {
+        match &self.kind {
+            Kind::Surface(s) => (
+                offset_origin(self.p, s.hit.ng, dir),
+                s.sides.toward(dir, s.hit.ng),
+            ),
+            Kind::Medium(m) => (self.p, m.medium),
+            _ => (self.p, camera_medium),
+        }
+    }
+
+    /// The subpath's next direction from a scattering vertex, drawn from its own numbers.
+    pub(super) fn sample_on(&self, carries: Carries) -> Option<Scattered> {
+        match &self.kind {
+            Kind::Surface(s) => {
+                let bs = s.bsdf.sample(s.wo, s.u.lobe, s.u.bsdf)?;
+                if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
+                    return None;
+                }
+                let mut weight = bs.f * (bs.wi.dot(s.hit.ns).abs() / bs.pdf);
+                if carries == Carries::Importance {
+                    weight *= shading_correction(s, s.wo, bs.wi);
+                }
+                let (pdf, pdf_rev) = if bs.specular {
+                    (0.0, 0.0)
+                } else {
+                    (bs.pdf, s.bsdf.pdf(bs.wi, s.wo))
+                };
+                Some(Scattered {
+                    wi: bs.wi,
+                    weight,
+                    pdf,
+                    pdf_rev,
+                    specular: bs.specular,
+                })
+            }
+            Kind::Medium(m) => {
+                let ps = sample_phase(&m.phase, m.wo, m.u.bsdf)?;
+                Some(Scattered {
+                    wi: ps.wi,
+                    weight: ps.weight,
+                    pdf: ps.pdf,
+                    pdf_rev: m.phase.pdf(ps.wi, m.wo),
+                    specular: false,
+                })
+            }
             _ => None,
         }
     }
@@ -95,7 +228,7 @@ impl PathVertex {
         match &self.kind {
             Kind::Light(l) => Some(l.emitter),
             Kind::Surface(s) => scene.lights().emitter_of_shape(s.hit.shape),
-            Kind::Camera => None,
+            Kind::Camera | Kind::Medium(_) => None,
         }
     }
 
@@ -129,7 +262,7 @@ impl PathVertex {
     }
 
     /// The area density with which this vertex, reached from `prev`, samples `next`: the
-    /// camera's ray density, a light's emission, or the BSDF's sample.
+    /// camera's ray density, a light's emission, the BSDF's or the phase function's sample.
     pub(super) fn pdf_toward<S: BidirectionalScene>(
         &self,
         scene: &S,
@@ -154,6 +287,15 @@ impl PathVertex {
                     return 0.0;
                 };
                 let pdf = s.bsdf.pdf(self.direction_to(prev), self.direction_to(next));
+                self.area_density(pdf, next)
+            }
+            Kind::Medium(m) => {
+                let Some(prev) = prev else {
+                    return 0.0;
+                };
+                let pdf = m
+                    .phase
+                    .pdf(self.direction_to(prev), self.direction_to(next));
                 self.area_density(pdf, next)
             }
         }
