@@ -127,13 +127,12 @@ impl PathVertex {
     /// camera and the lights.
     pub(super) fn scatters_toward(&self, wi: Vec3, carries: Carries) -> Vec3 {
         match &self.kind {
-            Kind::Surface(s) => {
-                let f = s.bsdf.eval(s.wo, wi);
-                match carries {
-                    Carries::Radiance => f,
-                    Carries::Importance => f * shading_correction(s, s.wo, wi),
-                }
-            }
+            Kind::Surface(s) => match carries {
+                Carries::Radiance => s.bsdf.eval(s.wo, wi),
+                // Importance scatters by the adjoint BSDF, f(wi, wo): the same for reciprocal
+                // BSDFs, not for `scatter` (f = R phase / |cos_i|).
+                Carries::Importance => s.bsdf.eval(wi, s.wo) * shading_correction(s, s.wo, wi),
+            },
             Kind::Medium(m) => m.phase.eval(m.wo, wi),
             _ => Vec3::ZERO,
         }
@@ -174,10 +173,16 @@ impl PathVertex {
                 if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
                     return None;
                 }
-                let mut weight = bs.f * (bs.wi.dot(s.hit.ns).abs() / bs.pdf);
-                if carries == Carries::Importance {
-                    weight *= shading_correction(s, s.wo, bs.wi);
-                }
+                // Importance scatters by the adjoint BSDF (see `scatters_toward`); a specular
+                // sample's weight is its own.
+                let f = match carries {
+                    Carries::Importance if !bs.specular => {
+                        s.bsdf.eval(bs.wi, s.wo) * shading_correction(s, s.wo, bs.wi)
+                    }
+                    Carries::Importance => bs.f * shading_correction(s, s.wo, bs.wi),
+                    Carries::Radiance => bs.f,
+                };
+                let weight = f * (bs.wi.dot(s.hit.ns).abs() / bs.pdf);
                 let (pdf, pdf_rev) = if bs.specular {
                     (0.0, 0.0)
                 } else {
