@@ -102,15 +102,18 @@ fn compare(a: &[Vec3], b: &[Vec3]) -> (Vec3, f64) {
     (mb / ma, cov / (va * vb).sqrt())
 }
 
-/// The room's image is the path tracer's: bidirectional subpaths of 3 scattering vertices
-/// each make every path of up to 6, as a path tracer of depth 6 does. The means agree within
-/// 1% (measured: 0.1%), and the pixels correlate.
-#[test]
-fn a_room_renders_as_the_path_tracer_renders_it() {
-    let bidir = room("\"bidirectional\" \"integer eyedepth\" [3] \"integer lightdepth\" [3]");
-    let path = room("\"path\" \"integer maxdepth\" [6]");
-    let path = render(&path, 1024, 1, Transport::Path);
-    let bidir = render(&bidir, 1024, 1, Transport::Bidirectional);
+/// `scene` (a scene's text for a given SurfaceIntegrator) rendered bidirectionally with 3
+/// scattering vertices a subpath and path traced at depth 6, which make the same paths, at
+/// `spp`: asserts their means agree within 1% a channel, and returns (path, bidirectional).
+fn assert_means_agree(scene: impl Fn(&str) -> String, spp: u32) -> (Vec<Vec3>, Vec<Vec3>) {
+    let bidir = scene("\"bidirectional\" \"integer eyedepth\" [3] \"integer lightdepth\" [3]");
+    let path = render(
+        &scene("\"path\" \"integer maxdepth\" [6]"),
+        spp,
+        1,
+        Transport::Path,
+    );
+    let bidir = render(&bidir, spp, 1, Transport::Bidirectional);
     let (p, b) = (mean(&path), mean(&bidir));
     for c in 0..3 {
         assert!(
@@ -118,16 +121,16 @@ fn a_room_renders_as_the_path_tracer_renders_it() {
             "bidirectional {b}, path {p}"
         );
     }
-    let lum = |v: &Vec3| f64::from(v.x + v.y + v.z);
-    let (mp, mb) = (lum(&p), lum(&b));
-    let (mut cov, mut vp, mut vb) = (0.0, 0.0, 0.0);
-    for (x, y) in path.iter().zip(&bidir) {
-        let (dx, dy) = (lum(x) - mp, lum(y) - mb);
-        cov += dx * dy;
-        vp += dx * dx;
-        vb += dy * dy;
-    }
-    let correlation = cov / (vp * vb).sqrt();
+    (path, bidir)
+}
+
+/// The room's image is the path tracer's: bidirectional subpaths of 3 scattering vertices
+/// each make every path of up to 6, as a path tracer of depth 6 does. The means agree within
+/// 1% (measured: 0.1%), and the pixels correlate.
+#[test]
+fn a_room_renders_as_the_path_tracer_renders_it() {
+    let (path, bidir) = assert_means_agree(room, 1024);
+    let (_, correlation) = compare(&path, &bidir);
     assert!(correlation > 0.99, "correlation {correlation}");
 }
 
@@ -144,19 +147,7 @@ fn a_scatter_floor_renders_as_the_path_tracer_renders_it() {
             1,
         )
     };
-    let bidir =
-        scatter_floor("\"bidirectional\" \"integer eyedepth\" [3] \"integer lightdepth\" [3]");
-    let path = scatter_floor("\"path\" \"integer maxdepth\" [6]");
-    let (p, b) = (
-        mean(&render(&path, 512, 1, Transport::Path)),
-        mean(&render(&bidir, 512, 1, Transport::Bidirectional)),
-    );
-    for c in 0..3 {
-        assert!(
-            (b[c] / p[c] - 1.0).abs() < 0.01,
-            "bidirectional {b}, path {p}"
-        );
-    }
+    assert_means_agree(scatter_floor, 512);
 }
 
 /// The room's lamp made of `null` (a LuxBlend habit: the emitter is a light, not a surface)
@@ -170,21 +161,9 @@ fn a_lamp_of_null_material_is_seen_and_lights_the_room() {
             .replace("LookAt 0 -0.95 1  0 1 1", "LookAt 0 -0.95 0.6  0 0.3 1.99")
             .replace("AreaLightSource", "Material \"null\"\nAreaLightSource")
     };
-    let bidir = null_lamp("\"bidirectional\" \"integer eyedepth\" [3] \"integer lightdepth\" [3]");
-    let path = null_lamp("\"path\" \"integer maxdepth\" [6]");
-    let (path, bidir) = (
-        render(&path, 256, 1, Transport::Path),
-        render(&bidir, 256, 1, Transport::Bidirectional),
-    );
+    let (path, _) = assert_means_agree(null_lamp, 256);
     let brightest = path.iter().map(|v| v.x).fold(0.0, f32::max);
     assert!(brightest > 7.0, "the camera sees the lamp: {brightest}");
-    let (p, b) = (mean(&path), mean(&bidir));
-    for c in 0..3 {
-        assert!(
-            (b[c] / p[c] - 1.0).abs() < 0.01,
-            "bidirectional {b}, path {p}"
-        );
-    }
 }
 
 /// A ball on an infinite plane under a uniform sky (the seed's benchmark scenes): light from
@@ -215,18 +194,7 @@ fn an_infinite_plane_under_the_sky_renders_as_the_path_tracer_renders_it() {
              WorldEnd\n"
         )
     };
-    let bidir = scene("\"bidirectional\" \"integer eyedepth\" [3] \"integer lightdepth\" [3]");
-    let path = scene("\"path\" \"integer maxdepth\" [6]");
-    let (p, b) = (
-        mean(&render(&path, 256, 1, Transport::Path)),
-        mean(&render(&bidir, 256, 1, Transport::Bidirectional)),
-    );
-    for c in 0..3 {
-        assert!(
-            (b[c] / p[c] - 1.0).abs() < 0.01,
-            "bidirectional {b}, path {p}"
-        );
-    }
+    assert_means_agree(scene, 256);
 }
 
 /// A point light between a grey floor and a mirror ceiling: the floor gets the light's
