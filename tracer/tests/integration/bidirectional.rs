@@ -197,6 +197,57 @@ fn an_infinite_plane_under_the_sky_renders_as_the_path_tracer_renders_it() {
     assert_means_agree(scene, 256);
 }
 
+/// A point light at `LIGHT_Z` between a grey floor (Kd `KD`) and a mirror ceiling (Kr `KR`) at
+/// `MIRROR_Z`, seen from (0, 0, `camera_z`) looking straight up or down at `look_z`.
+pub(super) fn point_light_under_mirror(integrator: &str, camera_z: f64, look_z: f64) -> String {
+    let (z, m, i) = (LIGHT_Z, MIRROR_Z, INTENSITY);
+    format!(
+        "LookAt 0 0 {camera_z}  0 0 {look_z}  0 1 0\n\
+         Camera \"perspective\" \"float fov\" [50]\n\
+         Film \"fleximage\" \"integer xresolution\" [{SIZE}] \"integer yresolution\" [{SIZE}]\n\
+         PixelFilter \"box\"\n\
+         SurfaceIntegrator {integrator}\n\
+         WorldBegin\n\
+         LightSource \"point\" \"point from\" [0 0 {z}] \"color L\" [{i} {i} {i}]\n\
+         {}{}WorldEnd\n",
+        estimates::quad(
+            &format!("Material \"matte\" \"color Kd\" [{KD} {KD} {KD}]"),
+            ["-20 -20 0", "20 -20 0", "20 20 0", "-20 20 0"]
+        ),
+        estimates::quad(
+            &format!("Material \"mirror\" \"color Kr\" [{KR} {KR} {KR}]"),
+            [
+                &format!("-20 -20 {m}"),
+                &format!("-20 20 {m}"),
+                &format!("20 20 {m}"),
+                &format!("20 -20 {m}"),
+            ]
+        ),
+    )
+}
+
+pub(super) const LIGHT_Z: f64 = 2.0;
+pub(super) const MIRROR_Z: f64 = 3.0;
+pub(super) const INTENSITY: f64 = 10.0;
+pub(super) const KD: f64 = 0.5;
+pub(super) const KR: f64 = 0.8;
+
+/// The floor's radiance under a point light `light_z` above it (Kd / pi I cos / d^2) averaged
+/// over the image of a 50-degree camera whose view is `half` wide at the floor, over 8 x 8
+/// points of each pixel.
+pub(super) fn floor_radiance(half: f64, light_z: f64) -> f64 {
+    let n = SIZE as usize * 8;
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        for j in 0..n {
+            let x = -half + (i as f64 + 0.5) / n as f64 * 2.0 * half;
+            let y = -half + (j as f64 + 0.5) / n as f64 * 2.0 * half;
+            sum += light_z / libm::pow(x * x + y * y + light_z * light_z, 1.5);
+        }
+    }
+    KD / std::f64::consts::PI * INTENSITY * sum / (n * n) as f64
+}
+
 /// A point light between a grey floor and a mirror ceiling: the floor gets the light's
 /// irradiance and its image's in the mirror, Kr times that of a light as far above the
 /// mirror. The path tracer sees the first alone; bidirectional light tracing carries the
@@ -205,47 +256,15 @@ fn an_infinite_plane_under_the_sky_renders_as_the_path_tracer_renders_it() {
 /// side: no other light reaches the camera.
 #[test]
 fn a_point_light_in_a_mirror_lights_the_floor_as_its_image_would() {
-    let (light_z, mirror_z, camera_z) = (2.0f64, 3.0f64, 2.5f64);
-    let (intensity, kd, kr) = (10.0f64, 0.5f64, 0.8f64);
-    let text = format!(
-        "LookAt 0 0 {camera_z}  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" [50]\n\
-         Film \"fleximage\" \"integer xresolution\" [{SIZE}] \"integer yresolution\" [{SIZE}]\n\
-         PixelFilter \"box\"\n\
-         SurfaceIntegrator \"bidirectional\" \"integer eyedepth\" [1] \"integer lightdepth\" [2]\n\
-         WorldBegin\n\
-         LightSource \"point\" \"point from\" [0 0 {light_z}] \"color L\" [{intensity} {intensity} {intensity}]\n\
-         {}{}WorldEnd\n",
-        estimates::quad(
-            &format!("Material \"matte\" \"color Kd\" [{kd} {kd} {kd}]"),
-            ["-20 -20 0", "20 -20 0", "20 20 0", "-20 20 0"]
-        ),
-        estimates::quad(
-            &format!("Material \"mirror\" \"color Kr\" [{kr} {kr} {kr}]"),
-            [
-                &format!("-20 -20 {mirror_z}"),
-                &format!("-20 20 {mirror_z}"),
-                &format!("20 20 {mirror_z}"),
-                &format!("20 -20 {mirror_z}"),
-            ]
-        ),
+    let camera_z = 2.5;
+    let text = point_light_under_mirror(
+        "\"bidirectional\" \"integer eyedepth\" [1] \"integer lightdepth\" [2]",
+        camera_z,
+        0.0,
     );
-    // The floor seen through each pixel, averaged over 8 x 8 points of the pixel.
     let half = libm::tan(25.0f64.to_radians()) * camera_z;
-    let image_z = 2.0 * mirror_z - light_z;
-    let (mut direct, mut mirrored) = (0.0f64, 0.0f64);
-    let n = SIZE as usize * 8;
-    for i in 0..n {
-        for j in 0..n {
-            let x = -half + (i as f64 + 0.5) / n as f64 * 2.0 * half;
-            let y = -half + (j as f64 + 0.5) / n as f64 * 2.0 * half;
-            let r2 = x * x + y * y;
-            direct += light_z / libm::pow(r2 + light_z * light_z, 1.5);
-            mirrored += image_z / libm::pow(r2 + image_z * image_z, 1.5);
-        }
-    }
-    let scale = kd / std::f64::consts::PI * intensity / (n * n) as f64;
-    let (direct, mirrored) = (direct * scale, kr * mirrored * scale);
+    let direct = floor_radiance(half, LIGHT_Z);
+    let mirrored = KR * floor_radiance(half, 2.0 * MIRROR_Z - LIGHT_Z);
 
     let path = f64::from(mean(&render(&text, 16, 1, Transport::Path)).x);
     let bidir = f64::from(mean(&render(&text, 2048, 1, Transport::Bidirectional)).x);

@@ -5,7 +5,7 @@
 use glam::Vec3;
 use yat_tracer::integrator::Transport;
 
-use super::bidirectional::room;
+use super::bidirectional::{floor_radiance, point_light_under_mirror, room, KR, LIGHT_Z, MIRROR_Z};
 use super::estimates;
 
 const SIZE: u32 = 24;
@@ -53,46 +53,11 @@ fn a_matte_room_renders_as_the_path_tracers_first_bounce() {
 /// lighting leaves out: the path tracer's image is brighter by more than 10%.
 #[test]
 fn a_mirror_shows_the_floor_lit_by_the_point_light_alone() {
-    let (light_z, mirror_z, camera_z) = (2.0f64, 3.0f64, 1.0f64);
-    let (intensity, kd, kr) = (10.0f64, 0.5f64, 0.8f64);
-    let scene = |integrator: &str| {
-        format!(
-            "LookAt 0 0 {camera_z}  0 0 {mirror_z}  0 1 0\n\
-             Camera \"perspective\" \"float fov\" [50]\n\
-             Film \"fleximage\" \"integer xresolution\" [{SIZE}] \"integer yresolution\" [{SIZE}]\n\
-             PixelFilter \"box\"\n\
-             SurfaceIntegrator {integrator}\n\
-             WorldBegin\n\
-             LightSource \"point\" \"point from\" [0 0 {light_z}] \"color L\" [{intensity} {intensity} {intensity}]\n\
-             {}{}WorldEnd\n",
-            estimates::quad(
-                &format!("Material \"matte\" \"color Kd\" [{kd} {kd} {kd}]"),
-                ["-20 -20 0", "20 -20 0", "20 20 0", "-20 20 0"]
-            ),
-            estimates::quad(
-                &format!("Material \"mirror\" \"color Kr\" [{kr} {kr} {kr}]"),
-                [
-                    &format!("-20 -20 {mirror_z}"),
-                    &format!("-20 20 {mirror_z}"),
-                    &format!("20 20 {mirror_z}"),
-                    &format!("20 -20 {mirror_z}"),
-                ]
-            ),
-        )
-    };
-    // Unfolded at the mirror, the camera looks down at the floor from 2 mirror_z - camera_z:
-    // the floor seen through each pixel, averaged over 8 x 8 points of the pixel.
-    let half = libm::tan(25.0f64.to_radians()) * (2.0 * mirror_z - camera_z);
-    let mut irradiance = 0.0f64;
-    let n = SIZE as usize * 8;
-    for i in 0..n {
-        for j in 0..n {
-            let x = -half + (i as f64 + 0.5) / n as f64 * 2.0 * half;
-            let y = -half + (j as f64 + 0.5) / n as f64 * 2.0 * half;
-            irradiance += light_z / libm::pow(x * x + y * y + light_z * light_z, 1.5);
-        }
-    }
-    let want = kr * kd / std::f64::consts::PI * intensity * irradiance / (n * n) as f64;
+    let camera_z = 1.0;
+    let scene = |integrator: &str| point_light_under_mirror(integrator, camera_z, MIRROR_Z);
+    // Unfolded at the mirror, the camera looks down at the floor from 2 mirror_z - camera_z.
+    let half = libm::tan(25.0f64.to_radians()) * (2.0 * MIRROR_Z - camera_z);
+    let want = KR * floor_radiance(half, LIGHT_Z);
 
     let direct = scene("\"directlighting\"");
     let direct = f64::from(mean(&render(&direct, 64, Transport::DirectLighting)).x);
