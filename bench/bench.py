@@ -146,16 +146,19 @@ def run_measured(cmd, what, stats):
     return figures
 
 
-def render(scene, spp, depth, threads, out_dir, seed=0, size=None):
-    """One YAT render in-process on `threads` threads (at `size`, else the Film's); writes
-    out_dir/out.png and out.exr. No previews or checkpoints: the figures time rendering, and the
-    other renderers write nothing meanwhile either."""
+def render(scene, spp, depth, threads, out_dir, seed=0, size=None, binary=None, extra=()):
+    """One YAT render in-process on `threads` threads (at `size`, else the Film's; at max depth
+    `depth`, else the scene's; with `binary`, else the release build; `extra` further options);
+    writes out_dir/out.png and out.exr. No previews or checkpoints: the figures time rendering,
+    and the other renderers write nothing meanwhile either."""
     stats = out_dir / "stats.json"
     cmd = [
-        str(YAT), "render", str(scene), "--quiet", "--spp", str(spp), "--maxdepth", str(depth),
+        str(binary or YAT), "render", str(scene), "--quiet", "--spp", str(spp),
         "--threads", str(threads), "--seed", str(seed), "--stats-json", str(stats),
         "-o", str(out_dir / "out.png"), "--exr", "--preview-every", "0", "--checkpoint-every", "0",
-    ] + (["--resolution", f"{size[0]}x{size[1]}"] if size else [])
+        *extra,
+    ] + (["--maxdepth", str(depth)] if depth is not None else []) \
+      + (["--resolution", f"{size[0]}x{size[1]}"] if size else [])
     return run_measured(cmd, f"yat on {scene}", stats)
 
 

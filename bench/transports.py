@@ -78,18 +78,6 @@ def what_runs(binary, scene):
     return (w, h), eye, light
 
 
-def render(binary, scene, size, spp, seed, threads, args, out_dir):
-    stats = out_dir / "stats.json"
-    cmd = [
-        str(binary), "render", str(scene), "--quiet", "--spp", str(spp), "--threads",
-        str(threads), "--seed", str(seed), "--stats-json", str(stats), "--resolution",
-        f"{size[0]}x{size[1]}", "-o", str(out_dir / "out.png"), "--exr", "--preview-every",
-        "0", "--checkpoint-every", "0", *args,
-    ]
-    figures = bench.run_measured(cmd, f"yat on {scene}", stats)
-    return bench.read_exr(out_dir / "out.exr"), figures
-
-
 def compare(binary, name, width, spp, threads):
     import numpy as np
 
@@ -97,14 +85,16 @@ def compare(binary, name, width, spp, threads):
     (fw, fh), eye, light = what_runs(binary, scene)
     size = (width, max(1, round(width * fh / fw)))
     runs = {
-        "path1": (1, ["--integrator", "path", "--maxdepth", str(eye + light)]),
-        "path2": (2, ["--integrator", "path", "--maxdepth", str(eye + light)]),
-        "bidir": (1, ["--integrator", "bidirectional"]),
+        "path1": (1, "path", eye + light),
+        "path2": (2, "path", eye + light),
+        "bidir": (1, "bidirectional", None),
     }
     images, figures = {}, {}
-    for key, (seed, args) in runs.items():
+    for key, (seed, transport, depth) in runs.items():
         with tempfile.TemporaryDirectory() as tmp:
-            images[key], f = render(binary, scene, size, spp, seed, threads, args, Path(tmp))
+            f = bench.render(scene, spp, depth, threads, Path(tmp), seed, size, binary,
+                             ["--integrator", transport])
+            images[key] = bench.read_exr(Path(tmp) / "out.exr")
         figures[key] = {"seconds": f["render_seconds"], "samples_per_second":
                         f["samples_per_second"]}
     path = (images["path1"] + images["path2"]) / 2

@@ -173,12 +173,10 @@ impl PathVertex {
                 if bs.pdf <= 0.0 || bs.f == Vec3::ZERO {
                     return None;
                 }
-                // Importance scatters by the adjoint BSDF (see `scatters_toward`); a specular
-                // sample's weight is its own.
+                // Importance scatters by the adjoint BSDF (`scatters_toward`); a specular
+                // sample's value is its own.
                 let f = match carries {
-                    Carries::Importance if !bs.specular => {
-                        s.bsdf.eval(bs.wi, s.wo) * shading_correction(s, s.wo, bs.wi)
-                    }
+                    Carries::Importance if !bs.specular => self.scatters_toward(bs.wi, carries),
                     Carries::Importance => bs.f * shading_correction(s, s.wo, bs.wi),
                     Carries::Radiance => bs.f,
                 };
