@@ -37,7 +37,14 @@ pub fn grid_mesh(
             for tri in [[a, b, c], [a, c, d]] {
                 let [p0, p1, p2] = tri.map(|k| positions[k as usize]);
                 let cross = (p1 - p0).cross(p2 - p0);
-                if cross.length_squared() <= 0.0 {
+                // A collapsed triangle's corners are one point only up to the rounding of the
+                // surface's formula (sin(acos(-1)) is not 0 in f32): its area, against its
+                // longest edge squared, is that rounding's size, some 1e-6, where the thinnest
+                // real triangle of a grid is 1e-2 or more. Kept, it is degenerate once moved to
+                // world space, and a renderer that samples lights by triangle (LuxCore) stops
+                // sampling the whole light.
+                let longest = [p1 - p0, p2 - p1, p0 - p2].map(Vec3::length_squared);
+                if cross.length() <= 1e-4 * longest.into_iter().fold(0.0, f32::max) {
                     continue;
                 }
                 let outward: Vec3 = tri.iter().map(|&k| normals[k as usize]).sum();

@@ -246,4 +246,27 @@ mod tests {
         let exact = 4.0 * PI * 4.0;
         assert!((area / exact - 1.0).abs() < 1e-3, "area {area} vs {exact}");
     }
+
+    /// The poles' collapsed triangles are left out: moved to where a small lamp hangs, every
+    /// triangle left still has an area (a zero-area one stops LuxCore sampling the light).
+    #[test]
+    fn tessellated_small_sphere_has_no_degenerate_triangle_in_world_space() {
+        let sphere = Sphere {
+            radius: 0.04,
+            zmin: -0.04,
+            zmax: 0.04,
+            phimax: 360.0,
+        };
+        let mesh = sphere.tessellate(256).unwrap();
+        let at = Vec3::new(0.4, -0.3, 1.9);
+        let mut area = 0.0;
+        for tri in &mesh.indices {
+            let [a, b, c] = tri.map(|i| mesh.positions[i as usize] + at);
+            let cross = (b - a).cross(c - a);
+            assert!(cross.length() > 0.0, "triangle {tri:?} has no area");
+            area += 0.5 * cross.length();
+        }
+        let exact = 4.0 * PI * 0.04 * 0.04;
+        assert!((area / exact - 1.0).abs() < 1e-3, "area {area} vs {exact}");
+    }
 }
