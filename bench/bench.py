@@ -162,16 +162,19 @@ def render(scene, spp, depth, threads, out_dir, seed=0, size=None, binary=None, 
     return run_measured(cmd, f"yat on {scene}", stats)
 
 
-def render_luxcore(export_dir, spp, depth, threads, out_dir, seed, size, strength=None):
-    """One LuxCore render of an exported scene at `size`, with its SOBOL sampler's adaptive
+def render_luxcore(export_dir, spp, depth, threads, out_dir, seed, size, strength=None,
+                   engine="PATHCPU", sampler="SOBOL", light_depth=None):
+    """One LuxCore render of an exported scene at `size` with `engine` and `sampler` (BIDIRCPU:
+    `depth` the eye path's, `light_depth` the light path's), with the SOBOL sampler's adaptive
     `strength` (default: LuxCore's); writes out_dir/lux.exr."""
     stats = out_dir / "lux.json"
     cmd = [
         str(VENV_PYTHON), str(ROOT / "bench/luxcore.py"), str(export_dir), "--spp", str(spp),
         "--depth", str(depth), "--threads", str(threads), "--seed", str(seed),
-        "--width", str(size[0]), "--height", str(size[1]),
-        "--out", str(out_dir / "lux.exr"), "--stats", str(stats),
-    ] + (["--adaptive-strength", str(strength)] if strength is not None else [])
+        "--width", str(size[0]), "--height", str(size[1]), "--engine", engine,
+        "--sampler", sampler, "--out", str(out_dir / "lux.exr"), "--stats", str(stats),
+    ] + (["--adaptive-strength", str(strength)] if strength is not None else []) \
+      + (["--light-depth", str(light_depth)] if light_depth is not None else [])
     return run_measured(cmd, f"LuxCore on {export_dir}", stats)
 
 
@@ -213,11 +216,12 @@ def reference_pair(kind, setting, digest, make_half, seeds=(REFERENCE_SEED, REFE
     """A converged reference as the mean of two independent renders (`make_half(dir, seed)`
     renders one into dir/ref.exr; each cached by reference()), and the mean's own noise: the
     expected squared error each pixel of the mean carries, MSE(a, b) / 4 (a and b differ by
-    twice a half's noise; the mean carries half a half's). An MSE against the mean minus that
-    noise is the MSE against the true image, whichever renderer's reference it is."""
+    twice a half's noise; the mean carries half a half's), and the two halves. An MSE against
+    the mean minus that noise is the MSE against the true image, whichever renderer's reference
+    it is."""
     a, b = (reference(kind, f"{setting}-seed{seed}", digest, lambda d, s=seed: make_half(d, s))
             for seed in seeds)
-    return (a + b) / 2, mse(a, b) / 4
+    return (a + b) / 2, mse(a, b) / 4, (a, b)
 
 
 def mse(image, ref):
@@ -229,8 +233,26 @@ def mse(image, ref):
 
 def clean_mse(image, reference):
     """MSE against a reference pair's mean (reference_pair), minus the mean's own noise."""
-    mean, noise = reference
+    mean, noise, _ = reference
     return mse(image, mean) - noise
+
+
+def clean_relmse(image, reference, floor=0.1):
+    """Per-pixel relative MSE, (image - mean)^2 / (mean^2 + (floor x the image mean)^2) over
+    pixels and channels, against a reference pair (reference_pair) less each pixel's share of its
+    noise. Unlike the MSE, a few pixels far brighter than the rest (a lamp seen directly, its
+    highlights) do not decide it: every pixel's error counts relative to its own brightness, the
+    floor keeping the darkest from counting without bound."""
+    import numpy as np
+
+    mean, _, (a, b) = reference
+    # The weight from the reference's 3x3 box mean: weighed by its own noisy value, a pixel's
+    # noise would set its weight and its error together, which biases the difference.
+    h, w = mean.shape[:2]
+    padded = np.pad(mean, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    smooth = sum(padded[i:i + h, j:j + w] for i in range(3) for j in range(3)) / 9
+    weight = 1 / (smooth ** 2 + (floor * mean.mean()) ** 2)
+    return float(np.mean(((image - mean) ** 2 - (a - b) ** 2 / 4) * weight))
 
 
 def block_correlation(a, b, block=16):
