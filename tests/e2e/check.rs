@@ -29,6 +29,24 @@ fn check_with(scene: &Path, flags: &[&str]) -> (bool, String, String) {
 }
 
 #[test]
+fn check_says_a_scene_with_point_light_caustics_renders_bidirectional() {
+    let scene = workspace_root().join("scenes/caustics/caustics.lxs");
+    let (ok, stdout, stderr) = check(&scene);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(
+        stdout
+            .contains("integrator   bidirectional, max depth 8 (file asks for \"bidirectional\")"),
+        "what will run: {stdout}"
+    );
+    assert!(
+        stdout.contains(
+            "bidirectional: the point light's caustics off \"mirror\" need light subpaths"
+        ),
+        "why, and what it costs: {stdout}"
+    );
+}
+
+#[test]
 fn check_summarises_a_seed_scene() {
     let Some(dir) = seed_scenes() else { return };
     let (ok, stdout, stderr) = check(&dir.join("CornellBox/cornell-box.lxs"));
@@ -45,6 +63,10 @@ fn check_summarises_a_seed_scene() {
     assert!(
         stdout.contains("--integrator bidirectional: eye depth 16, light depth 16"),
         "what the bidirectional integrator would render with: {stdout}"
+    );
+    assert!(
+        stdout.contains("path tracing: no caustics of point, spot or distant lights here"),
+        "why path tracing runs: {stdout}"
     );
     assert!(
         stdout.contains("notes (rendered as LuxRender would): 1\n  cornell-box.lxs:11:1: SurfaceIntegrator \"bidirectional\""),

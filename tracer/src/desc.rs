@@ -15,7 +15,7 @@ pub use crate::camera::{CameraDesc, CameraKind};
 pub use crate::diag::{SourcePos, Warning};
 pub use crate::film::{FilmDesc, ToneMap};
 pub use crate::filter::{FilterDesc, FilterKind};
-pub use crate::integrator::options::{IntegratorDesc, RussianRoulette};
+pub use crate::integrator::options::{IntegratorDesc, RussianRoulette, Transport};
 pub use crate::lights::{EnvMapDesc, LatLongConvention, LightDesc};
 pub use crate::material::MaterialDesc;
 pub use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
@@ -44,4 +44,23 @@ pub struct SceneDesc {
     /// What the parse counted against the build budget, figure by figure (the build's memory
     /// estimate among them); nothing for a description made otherwise.
     pub spent: BudgetMeter,
+}
+
+impl SceneDesc {
+    /// The transport the scene renders with when the command line does not choose
+    /// ([`IntegratorDesc::transport`]).
+    pub fn transport(&self) -> Transport {
+        self.integrator.transport(self.delta_caustics().is_some())
+    }
+
+    /// A delta light (point, spot, distant) and a material that scatters into one direction
+    /// (mirror, smooth glass or metal), by their LuxRender names, when the scene has both: light
+    /// that leaves the one and meets the other before a diffuse surface only a light subpath can
+    /// carry, since no light sample finds the lamp through a delta lobe and no BSDF sample finds
+    /// a point. Whether the geometry lets such light reach the camera is left to the render.
+    pub fn delta_caustics(&self) -> Option<(&'static str, &'static str)> {
+        let light = self.lights.iter().find(|l| l.is_delta())?;
+        let material = self.materials.iter().find(|m| m.has_delta_lobe())?;
+        Some((light.name(), material.name()))
+    }
 }

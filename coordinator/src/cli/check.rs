@@ -129,6 +129,33 @@ fn short(v: f32) -> String {
     }
 }
 
+/// Why `transport` runs for a scene asking for `requested`, and what choosing the other costs
+/// (per-sample figures of bench/RESULTS.md, "Bidirectional against path tracing, every
+/// scene"); None where the scene gets what it asks for and loses nothing.
+fn transport_reason(
+    requested: &str,
+    transport: Transport,
+    caustics: Option<(&str, &str)>,
+) -> Option<String> {
+    match (requested, transport, caustics) {
+        ("bidirectional", Transport::Bidirectional, Some((light, material))) => Some(format!(
+            "bidirectional: the {light} light's caustics off \"{material}\" need light subpaths; \
+             a sample costs 2-4x a path-traced one, and --integrator path renders faster \
+             without those caustics"
+        )),
+        ("bidirectional", Transport::Path, None) => Some(
+            "path tracing: no caustics of point, spot or distant lights here, so the same image \
+             as bidirectional at 2-4x the samples a second; --integrator bidirectional chooses it"
+                .to_string(),
+        ),
+        (_, Transport::Path | Transport::DirectLighting, Some((light, material))) => Some(format!(
+            "path tracing misses the {light} light's caustics off \"{material}\": \
+                 --integrator bidirectional renders them"
+        )),
+        _ => None,
+    }
+}
+
 fn counts<'a>(names: impl Iterator<Item = &'a str>) -> String {
     let mut m = BTreeMap::new();
     for n in names {
@@ -217,7 +244,8 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         d.filter.xwidth, d.filter.ywidth
     );
     let i = &d.integrator;
-    let runs = match i.transport() {
+    let transport = d.transport();
+    let runs = match transport {
         Transport::DirectLighting => format!(
             "directlighting, {} specular bounces",
             i.max_depth.saturating_sub(1)
@@ -235,6 +263,9 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
          {} (eye) {} (light)",
         i.max_depth, i.light_depth, i.eye_rr_threshold, i.light_rr_threshold,
     );
+    if let Some(why) = transport_reason(&i.requested, transport, d.delta_caustics()) {
+        let _ = writeln!(s, "             {why}");
+    }
     let spp = d
         .sampler
         .pixel_samples

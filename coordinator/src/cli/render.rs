@@ -82,10 +82,11 @@ pub struct RenderArgs {
     /// specular maxdepth plus one).
     #[arg(long)]
     pub maxdepth: Option<u32>,
-    /// The light transport: path tracing (what scenes render with by default, a
-    /// SurfaceIntegrator "bidirectional" included), bidirectional path tracing (with the
-    /// scene's eyedepth and lightdepth) or direct lighting (LuxRender's: the default of a
-    /// SurfaceIntegrator "directlighting").
+    /// The light transport: path tracing (what scenes render with by default), bidirectional
+    /// path tracing (with the scene's eyedepth and lightdepth; the default of a
+    /// SurfaceIntegrator "bidirectional" whose scene has caustics of point, spot or distant
+    /// lights) or direct lighting (LuxRender's: the default of a SurfaceIntegrator
+    /// "directlighting"). `yat check` says which runs and why.
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorArg>,
     /// Render threads for an in-process render [default: the CPUs this process may use].

@@ -104,13 +104,15 @@ impl Transport {
 
 impl IntegratorDesc {
     /// The transport the scene asks for when the command line does not choose: direct
-    /// lighting for "directlighting", path tracing otherwise ("bidirectional" too: see
-    /// docs/architecture.md, "Integrators").
-    pub fn transport(&self) -> Transport {
-        if self.requested == "directlighting" {
-            Transport::DirectLighting
-        } else {
-            Transport::Path
+    /// lighting for "directlighting"; for "bidirectional", bidirectional path tracing where the
+    /// scene has caustics of delta lights (`delta_caustics`, [`crate::desc::SceneDesc::delta_caustics`]),
+    /// which path tracing cannot carry, and path tracing elsewhere, the same image sooner (see
+    /// docs/architecture.md, "Integrators"); path tracing otherwise.
+    pub fn transport(&self, delta_caustics: bool) -> Transport {
+        match self.requested.as_str() {
+            "directlighting" => Transport::DirectLighting,
+            "bidirectional" if delta_caustics => Transport::Bidirectional,
+            _ => Transport::Path,
         }
     }
 
@@ -189,7 +191,7 @@ impl IntegratorDesc {
                 ctx.note_once(
                     "bidirectional".into(),
                     pos,
-                    format!("SurfaceIntegrator \"bidirectional\" is rendered as path tracing with max depth {max_depth} (its eyedepth) unless --integrator bidirectional is given: the same image once converged, except caustics of point, spot and distant lights, which path tracing cannot carry"),
+                    format!("SurfaceIntegrator \"bidirectional\" is rendered bidirectional where the scene has caustics of point, spot or distant lights (a mirror, smooth glass or metal under one: path tracing cannot carry them), else as path tracing with max depth {max_depth} (its eyedepth), the same image sooner; --integrator chooses (yat check's integrator line says which runs)"),
                 );
                 Ok(IntegratorDesc {
                     max_depth,

@@ -118,6 +118,12 @@ macro_rules! lights {
                 }
             }
 
+            /// Whether the light is at a point or from one direction (point, goniometric, spot,
+            /// distant): no surface a path meets can hit it.
+            pub fn is_delta(&self) -> bool {
+                matches!(self, Self::Point(_) | Self::Spot(_) | Self::Distant(_))
+            }
+
             /// The files the light references (as written; the scene lists them in its assets).
             pub fn files(&self) -> Vec<&str> {
                 match self {

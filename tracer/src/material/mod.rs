@@ -150,6 +150,25 @@ materials! {
     cloth::Cloth { "cloth" => read },
 }
 
+impl MaterialDesc {
+    /// Whether the material scatters light into one direction (a delta lobe: mirror, glass,
+    /// metal or shinymetal with both roughnesses the constant 0), which no light sample finds.
+    pub fn has_delta_lobe(&self) -> bool {
+        let smooth = |u: &ConstOrTexture, v: &ConstOrTexture| {
+            matches!((u, v), (ConstOrTexture::Const(u), ConstOrTexture::Const(v))
+                if u.max_element() <= 0.0 && v.max_element() <= 0.0)
+        };
+        match self {
+            Self::Mirror(_) => true,
+            Self::Glass(g) => smooth(&g.uroughness, &g.vroughness),
+            Self::Metal(m) => smooth(&m.uroughness, &m.vroughness),
+            Self::ShinyMetal(m) => smooth(&m.uroughness, &m.vroughness),
+            Self::Bumped(m, _) => m.has_delta_lobe(),
+            _ => false,
+        }
+    }
+}
+
 /// Reads a material kind from a statement's parameters.
 type MaterialReader =
     fn(&ParamList, &SourcePos, &mut dyn ParseContext) -> Result<MaterialDesc, ParseError>;

@@ -130,12 +130,7 @@ impl RenderSettings {
             max_depth: overrides.max_depth.unwrap_or(desc.integrator.max_depth),
             seed: overrides.seed.unwrap_or(0),
             latlong: overrides.latlong,
-            // A scene's "bidirectional" renders with the path tracer unless the command line
-            // chooses: the bidirectional integrator is new, and the course's scenes, which all
-            // ask for it, are path tracing's strength (docs/architecture.md, "Integrators").
-            transport: overrides
-                .transport
-                .unwrap_or_else(|| desc.integrator.transport()),
+            transport: overrides.transport.unwrap_or_else(|| desc.transport()),
         }
     }
 }

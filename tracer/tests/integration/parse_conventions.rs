@@ -292,7 +292,7 @@ fn directlighting_reads_luxrenders_depth_and_is_the_scenes_transport() {
     let d = parse("SurfaceIntegrator \"directlighting\"\nWorldBegin\nWorldEnd");
     let i = &d.integrator;
     assert_eq!(
-        (i.max_depth, i.rr_strategy, i.transport()),
+        (i.max_depth, i.rr_strategy, d.transport()),
         (6, RussianRoulette::None, Transport::DirectLighting)
     );
     let about_integrator = |d: &SceneDesc| {
@@ -315,9 +315,53 @@ fn directlighting_reads_luxrenders_depth_and_is_the_scenes_transport() {
     };
     assert_eq!(resolve(None), Transport::DirectLighting);
     assert_eq!(resolve(Some(Transport::Path)), Transport::Path);
-    // "bidirectional" renders with the path tracer unless the command line says.
-    let d = parse("SurfaceIntegrator \"bidirectional\"\nWorldBegin\nWorldEnd");
-    assert_eq!(d.integrator.transport(), Transport::Path);
+}
+
+/// A scene's "bidirectional" renders bidirectional where path tracing would lose light (a
+/// delta light and a mirror-like material: its caustics), with the path tracer elsewhere (the
+/// same image sooner); "path" stays path tracing whatever the scene holds.
+#[test]
+fn bidirectional_is_the_transport_where_path_tracing_cannot_carry_the_caustics() {
+    let transport = |integrator: &str, world: &str| {
+        let d = parse(&format!(
+            "SurfaceIntegrator \"{integrator}\"\nWorldBegin\n{world}\nWorldEnd"
+        ));
+        (d.transport(), d.delta_caustics())
+    };
+    let point = "LightSource \"point\" \"point from\" [0 0 2]\n";
+    let area = "AttributeBegin\nAreaLightSource \"area\"\nShape \"sphere\"\nAttributeEnd\n";
+    let glass = "Material \"glass\"\nShape \"sphere\"\n";
+    let rough_metal = "Material \"metal\" \"float uroughness\" [0.1] \"float vroughness\" [0.1]\nShape \"sphere\"\n";
+    let smooth_metal =
+        "Material \"metal\" \"float uroughness\" [0] \"float vroughness\" [0]\nShape \"sphere\"\n";
+    let spot = "LightSource \"spot\"\n";
+    let mirror = "MakeNamedMaterial \"m\" \"string type\" \"mirror\"\nNamedMaterial \"m\"\nShape \"sphere\"\n";
+    assert_eq!(
+        transport("bidirectional", &format!("{point}{glass}")),
+        (Transport::Bidirectional, Some(("point", "glass")))
+    );
+    assert_eq!(
+        transport("bidirectional", &format!("{spot}{mirror}")),
+        (Transport::Bidirectional, Some(("spot", "mirror")))
+    );
+    assert_eq!(
+        transport("bidirectional", &format!("{point}{smooth_metal}")).0,
+        Transport::Bidirectional
+    );
+    // A light sample finds the lamp through a rough lobe; an area light is found by BSDF
+    // samples through glass: path tracing carries both.
+    assert_eq!(
+        transport("bidirectional", &format!("{point}{rough_metal}")),
+        (Transport::Path, None)
+    );
+    assert_eq!(
+        transport("bidirectional", &format!("{area}{glass}")),
+        (Transport::Path, None)
+    );
+    assert_eq!(
+        transport("path", &format!("{point}{glass}")),
+        (Transport::Path, Some(("point", "glass")))
+    );
 }
 
 #[test]

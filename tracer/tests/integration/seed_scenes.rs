@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use yat_tracer::assets::FsSource;
-use yat_tracer::desc::{CameraKind, Geometry, LightDesc, SceneDesc};
+use yat_tracer::desc::{CameraKind, Geometry, LightDesc, SceneDesc, Transport};
 use yat_tracer::lights::InfiniteLight;
 use yat_tracer::math::luminance;
 use yat_tracer::parse::{parse_scene, ParseError};
@@ -90,6 +90,40 @@ fn every_complete_seed_scene_parses() {
         }
     }
 }
+
+/// Every seed scene asks for "bidirectional"; the ones with caustics of a delta light render
+/// so by default, the others with the path tracer (the same image sooner): the list is what
+/// the rule finds in the files, each with the light and the material that make the caustics.
+#[test]
+fn the_seed_scenes_with_delta_light_caustics_render_bidirectional() {
+    let Some(dir) = seed_scenes() else { return };
+    let mut bidirectional = Vec::new();
+    for scene in COMPLETE {
+        let d = load(&dir, scene).unwrap_or_else(|e| panic!("{scene}: {e}"));
+        assert_eq!(d.integrator.requested, "bidirectional", "{scene}");
+        match (d.transport(), d.delta_caustics()) {
+            (Transport::Bidirectional, Some(why)) => bidirectional.push((*scene, why)),
+            (Transport::Path, None) => {}
+            other => panic!("{scene}: {other:?}"),
+        }
+    }
+    assert_eq!(bidirectional, BIDIRECTIONAL_BY_DEFAULT);
+}
+
+const BIDIRECTIONAL_BY_DEFAULT: &[(&str, (&str, &str))] = &[
+    ("Benchmarks/GlassHighIOR.lxs", ("point", "glass")),
+    ("Benchmarks/GlassHighTransparency.lxs", ("point", "glass")),
+    ("Benchmarks/GlassLowTransparency.lxs", ("point", "glass")),
+    ("Benchmarks/GlassMediumTransparency.lxs", ("point", "glass")),
+    ("Benchmarks/MirrorHighReflectivity.lxs", ("point", "mirror")),
+    ("Benchmarks/MirrorLowReflectivity.lxs", ("point", "mirror")),
+    (
+        "Benchmarks/MirrorMediumReflectivity.lxs",
+        ("point", "mirror"),
+    ),
+    ("Benchmarks/Spheres.lxs", ("point", "mirror")),
+    ("Benchmarks/TexturedChannels.lxs", ("point", "mirror")),
+];
 
 #[test]
 fn every_main_file_is_listed() {
