@@ -85,7 +85,7 @@ fn scene_with_differences() -> String {
     let mut text = String::from(
         "Film \"fleximage\" \"integer xresolution\" [8] \"integer yresolution\" [8]\n\
          LookAt 0 -5 1  0 0 1  0 0 1\n\
-         Camera \"perspective\" \"bool autofocus\" [\"true\"]\n\
+         Camera \"realistic\"\n\
          WorldBegin\n\
          Material \"mirror\" \"float index\" [1.5] \"float film\" [200]\n\
          Texture \"t\" \"float\" \"frobnicate\"\n\
@@ -112,7 +112,8 @@ fn check_lists_and_counts_every_difference_at_its_position() {
     let total = 4 + REPEATS;
     for line in [
         format!("not rendered as LuxRender would: {total}"),
-        "  diff.lxs:3:1: Camera: autofocus is not supported".into(),
+        "  diff.lxs:3:1: Camera \"realistic\" is not supported; rendering with a perspective camera"
+            .into(),
         "  diff.lxs:5:39: Material \"mirror\": \"float film\" is not supported".into(),
         "  diff.lxs:6:1: Texture \"t\": type \"frobnicate\" is not supported".into(),
         "  diff.lxs:7:1: unknown LightSource \"laser\" skipped".into(),

@@ -2,6 +2,7 @@
 //! film size and pixel filter).
 
 use glam::Vec3;
+use yat_tracer::camera::aperture::LensDistribution;
 use yat_tracer::desc::{CameraKind, FilterKind, SceneDesc};
 
 use crate::error::ExportError;
@@ -41,7 +42,21 @@ pub fn write_camera(desc: &SceneDesc, p: &mut Props) -> Result<(), ExportError> 
     p.set("scene.camera.screenwindow", format!("{x0} {x1} {y0} {y1}"));
     p.set("scene.camera.lensradius", c.lens_radius);
     p.set("scene.camera.focaldistance", c.focal_distance);
-    p.set("scene.camera.autofocus.enable", 0);
+    p.set("scene.camera.autofocus.enable", u8::from(c.autofocus));
+    if !c.aperture.is_round() {
+        let (kind, power) = match c.aperture.distribution {
+            LensDistribution::Uniform => ("UNIFORM", None),
+            LensDistribution::Exponential { power } => ("EXPONENTIAL", Some(power)),
+            LensDistribution::InverseExponential { power } => ("INVERSEEXPONENTIAL", Some(power)),
+            LensDistribution::Gaussian => ("GAUSSIAN", None),
+            LensDistribution::InverseGaussian => ("INVERSEGAUSSIAN", None),
+        };
+        p.set("scene.camera.bokeh.blades", c.aperture.blades);
+        p.set("scene.camera.bokeh.distribution.type", quoted(kind));
+        if let Some(power) = power {
+            p.set("scene.camera.bokeh.power", power);
+        }
+    }
     p.set("scene.camera.cliphither", c.hither);
     p.set("scene.camera.clipyon", c.yon);
     Ok(())

@@ -10,6 +10,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use yat_tracer::budget::Limit;
+use yat_tracer::camera::aperture::{Aperture, LensDistribution};
+use yat_tracer::camera::MAX_FOCAL_DISTANCE;
 use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
@@ -182,11 +184,35 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         CameraKind::Fisheye { fov } => format!("fisheye fov {fov}"),
     };
     let sw = c.screen_window;
+    let focus = if c.autofocus {
+        "autofocus (the first hit through the screen centre)".to_string()
+    } else if c.focal_distance >= MAX_FOCAL_DISTANCE {
+        format!("{} (infinity)", short(c.focal_distance))
+    } else {
+        short(c.focal_distance)
+    };
+    let aperture = match c.aperture {
+        a if a.is_round() => String::new(),
+        Aperture {
+            blades,
+            distribution,
+        } => {
+            let weighting = match distribution {
+                LensDistribution::Uniform => "uniform".to_string(),
+                LensDistribution::Exponential { power } => format!("exponential, power {power}"),
+                LensDistribution::InverseExponential { power } => {
+                    format!("inverse exponential, power {power}")
+                }
+                LensDistribution::Gaussian => "gaussian".to_string(),
+                LensDistribution::InverseGaussian => "inverse gaussian".to_string(),
+            };
+            format!(", aperture {blades} blades ({weighting})")
+        }
+    };
     let _ = writeln!(
         s,
-        "camera       {camera}, lensradius {}, focaldistance {}, screenwindow [{} {} {} {}]",
+        "camera       {camera}, lensradius {}{aperture}, focaldistance {focus}, screenwindow [{} {} {} {}]",
         c.lens_radius,
-        short(c.focal_distance),
         sw[0],
         sw[1],
         sw[2],

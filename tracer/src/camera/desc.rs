@@ -3,6 +3,7 @@
 
 use glam::Mat4;
 
+use super::aperture::Aperture;
 use crate::diag::SourcePos;
 use crate::film::FilmDesc;
 use crate::parse::context::ParseContext;
@@ -42,7 +43,15 @@ pub struct CameraDesc {
     /// [xmin, xmax, ymin, ymax] in screen space (default follows the film aspect).
     pub screen_window: [f32; 4],
     pub lens_radius: f32,
+    /// The focal plane's distance along the view axis, as the scene gives it (the camera
+    /// reads anything from [`super::rays::MAX_FOCAL_DISTANCE`] on as infinity).
     pub focal_distance: f32,
+    /// Focus on the first hit of the ray through the screen's centre, found once the scene's
+    /// geometry is built ([`super::Camera::autofocus`]), in place of `focal_distance`.
+    pub autofocus: bool,
+    /// The lens's shape and weighting (perspective only: LuxRender's other cameras have the
+    /// round one).
+    pub aperture: Aperture,
     pub hither: f32,
     pub yon: f32,
 }
@@ -86,12 +95,11 @@ impl CameraDesc {
             None if frame > 1.0 => [-frame, frame, -1.0, 1.0],
             None => [-1.0, 1.0, -1.0 / frame, 1.0 / frame],
         };
-        if p.bool("autofocus", false)? {
-            ctx.warn(
-                pos,
-                "Camera: autofocus is not supported; focaldistance is used as given".into(),
-            );
-        }
+        let aperture = if ty == "perspective" {
+            Aperture::read(p)?
+        } else {
+            Aperture::default()
+        };
         let camera_to_world = crate::math::inverse(&world_to_camera);
         if !camera_to_world
             .to_cols_array()
@@ -111,6 +119,8 @@ impl CameraDesc {
             screen_window,
             lens_radius: p.float("lensradius", DEFAULT_LENS_RADIUS)?,
             focal_distance: p.float("focaldistance", DEFAULT_FOCAL_DISTANCE)?,
+            autofocus: p.bool("autofocus", false)?,
+            aperture,
             hither,
             yon: p.float("yon", DEFAULT_YON)?.clamp(hither, DEFAULT_YON),
         })

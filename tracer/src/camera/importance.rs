@@ -26,7 +26,6 @@
 use glam::{Vec2, Vec3};
 
 use super::rays::{Camera, Projection};
-use crate::bxdf::local::sample_disk_concentric;
 
 /// A world point as the camera sees it through a lens point: the light-tracing connection.
 #[derive(Clone, Copy, Debug)]
@@ -49,7 +48,7 @@ impl Camera {
         let c = self.world_to_camera.transform_point3(x);
         let offset =
             if self.lens_radius > 0.0 && !matches!(self.projection, Projection::Fisheye { .. }) {
-                sample_disk_concentric(u_lens) * self.lens_radius
+                self.aperture.sample(u_lens) * self.lens_radius
             } else {
                 Vec2::ZERO
             };
@@ -225,6 +224,8 @@ mod tests {
             screen_window: [-1.7, 1.7, -0.95, 0.95],
             lens_radius,
             focal_distance: 5.0,
+            autofocus: false,
+            aperture: Default::default(),
             hither: 1e-3,
             yon: 1e30,
         };
@@ -232,9 +233,22 @@ mod tests {
     }
 
     fn cameras() -> Vec<Camera> {
+        let hexagonal = Camera {
+            aperture: crate::camera::aperture::Aperture {
+                blades: 6,
+                distribution: crate::camera::aperture::LensDistribution::Gaussian,
+            },
+            ..camera(CameraKind::Perspective { fov: 40.0 }, 0.3)
+        };
+        let at_infinity = Camera {
+            focal_distance: super::super::rays::MAX_FOCAL_DISTANCE,
+            ..camera(CameraKind::Perspective { fov: 40.0 }, 0.3)
+        };
         vec![
             camera(CameraKind::Perspective { fov: 40.0 }, 0.0),
             camera(CameraKind::Perspective { fov: 40.0 }, 0.3),
+            hexagonal,
+            at_infinity,
             camera(CameraKind::Orthographic, 0.0),
             camera(CameraKind::Orthographic, 0.3),
             camera(CameraKind::Fisheye { fov: 60.0 }, 0.0),

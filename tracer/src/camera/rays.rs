@@ -3,10 +3,16 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use super::desc::{CameraDesc, CameraKind};
-use crate::bxdf::local::concentric_disk;
+use super::aperture::Aperture;
+use super::desc::{CameraDesc, CameraKind, MIN_HITHER};
 use crate::lanes::{Lanes, MAX_LANES};
 use crate::math::Ray;
+
+/// The focal distance from which on a thin lens is focused at infinity. A lens offset is below
+/// f32's precision against it, so the rays are the pinhole's directions from the lens point;
+/// it keeps the focal plane's arithmetic in range (LuxRender's default of 1e30, squared,
+/// overflows f32).
+pub const MAX_FOCAL_DISTANCE: f32 = 1e12;
 
 #[derive(Clone, Debug)]
 pub(super) enum Projection {
@@ -34,6 +40,9 @@ pub struct Camera {
     pub(super) height: f32,
     pub(super) lens_radius: f32,
     pub(super) focal_distance: f32,
+    pub(super) aperture: Aperture,
+    /// The hither plane's distance: where LuxRender's autofocus ray starts.
+    pub(super) hither: f32,
 }
 
 impl Camera {
@@ -58,8 +67,61 @@ impl Camera {
             width: width as f32,
             height: height as f32,
             lens_radius: desc.lens_radius,
-            focal_distance: desc.focal_distance,
+            focal_distance: desc.focal_distance.min(MAX_FOCAL_DISTANCE),
+            aperture: desc.aperture,
+            hither: desc.hither,
         }
+    }
+
+    /// The focal distance in use (the scene's, up to [`MAX_FOCAL_DISTANCE`], or autofocus's).
+    pub fn focal_distance(&self) -> f32 {
+        self.focal_distance
+    }
+
+    /// LuxRender 1.x's autofocus: focuses where the pinhole ray through the film's centre,
+    /// starting at the hither plane, first hits something (`first_hit` gives a world ray's
+    /// closest hit distance), and returns that distance; None, the focal distance kept, where
+    /// it hits nothing, and for a fisheye (which has no lens). Computed once from the scene
+    /// alone, so every worker focuses alike.
+    ///
+    /// LuxRender's centre is half its sample extent, which reaches past the film by the pixel
+    /// filter's radius `filter_radius` on the top and left sides: its autofocus point sits
+    /// that many pixels right of and below the film's middle, and so does this one.
+    pub fn autofocus(
+        &mut self,
+        filter_radius: Vec2,
+        first_hit: impl FnOnce(&Ray) -> Option<f32>,
+    ) -> Option<f32> {
+        if matches!(self.projection, Projection::Fisheye { .. }) {
+            return None;
+        }
+        let extent = |size: f32, radius: f32| {
+            let (start, end) = (
+                (0.5 - radius).floor() as i64,
+                (0.5 + size + radius).floor() as i64,
+            );
+            ((end - start) / 2) as f32
+        };
+        let film = Vec2::new(
+            extent(self.width, filter_radius.x),
+            extent(self.height, filter_radius.y),
+        );
+        let pinhole = Camera {
+            lens_radius: 0.0,
+            ..self.clone()
+        };
+        let ray = pinhole.generate_ray(film, Vec2::ZERO)?;
+        let t = first_hit(&ray)?;
+        let origin = self.world_to_camera.transform_point3(ray.origin);
+        let hit = self.world_to_camera.transform_point3(ray.at(t));
+        let towards = hit - origin;
+        let cos = towards.z / towards.length();
+        let distance = towards.length() - self.hither / cos;
+        if !distance.is_finite() {
+            return None;
+        }
+        self.focal_distance = distance.clamp(MIN_HITHER, MAX_FOCAL_DISTANCE);
+        Some(self.focal_distance)
     }
 
     /// The world-space ray through raster position `film`, with `lens` in [0,1)^2 choosing the
@@ -140,7 +202,7 @@ impl Camera {
             (origin, dir)
         } else {
             let radius = L::splat(self.lens_radius);
-            let [lx, ly] = concentric_disk(lens);
+            let [lx, ly] = self.aperture.sample_lanes(lens);
             let to_focus = L::splat(self.focal_distance) / dir[2];
             let lens_point = [
                 origin[0] + lx * radius,
@@ -196,6 +258,8 @@ mod tests {
             screen_window: [-2.0, 2.0, -1.0, 1.0],
             lens_radius,
             focal_distance: 5.0,
+            autofocus: false,
+            aperture: Default::default(),
             hither: 1e-3,
             yon: 1e30,
         }
@@ -329,6 +393,68 @@ mod tests {
             assert!((hit - target).length() < 1e-4, "{hit} vs {target}");
             assert!(ray.origin.length() <= 0.2 + 1e-6);
         }
+    }
+
+    /// LuxRender's default focal distance (1e30) with a lens: rays leave the lens points
+    /// parallel to the pinhole's, so the image is sharp at infinity, not black.
+    #[test]
+    fn a_lens_at_the_default_focal_distance_is_focused_at_infinity() {
+        let kind = CameraKind::Perspective { fov: 60.0 };
+        let far = CameraDesc {
+            focal_distance: crate::camera::DEFAULT_FOCAL_DISTANCE,
+            ..desc(kind.clone(), 0.1)
+        };
+        let (cam, pinhole) = (
+            Camera::new(&far, 64, 32),
+            Camera::new(&desc(kind, 0.0), 64, 32),
+        );
+        let mut rng = fastrand::Rng::with_seed(3);
+        for _ in 0..200 {
+            let film = Vec2::new(rng.f32() * 64.0, rng.f32() * 32.0);
+            let lens = Vec2::new(rng.f32(), rng.f32());
+            let ray = cam.generate_ray(film, lens).unwrap();
+            let straight = pinhole.generate_ray(film, lens).unwrap();
+            assert!(ray.origin.is_finite() && ray.dir.is_finite(), "{ray:?}");
+            assert!(
+                (ray.dir - straight.dir).length() < 1e-6,
+                "{ray:?} vs {straight:?}"
+            );
+            assert!(ray.origin.length() <= 0.1 + 1e-6);
+        }
+    }
+
+    /// Autofocus aims the pinhole ray where LuxRender does (half its sample extent: the
+    /// film's middle moved by the filter radius, floored as it floors it) and focuses at the
+    /// hit's distance from the hither plane along that ray.
+    #[test]
+    fn autofocus_focuses_on_the_centre_rays_first_hit() {
+        let mut cam = Camera::new(&desc(CameraKind::Perspective { fov: 60.0 }, 0.2), 64, 32);
+        let pinhole = Camera::new(&desc(CameraKind::Perspective { fov: 60.0 }, 0.0), 64, 32);
+        let mut aimed = None;
+        // Radius 2: the extent runs from floor(-1.5) = -2 to floor(66.5) = 66 across, so
+        // its half is 34; down, -2 to 34, half 18.
+        let focal = cam.autofocus(Vec2::splat(2.0), |ray| {
+            aimed = Some(*ray);
+            Some(7.0)
+        });
+        let want = pinhole
+            .generate_ray(Vec2::new(34.0, 18.0), Vec2::ZERO)
+            .unwrap();
+        let aimed = aimed.expect("autofocus traced a ray");
+        assert!(
+            (aimed.dir - want.dir).length() < 1e-6,
+            "{aimed:?} vs {want:?}"
+        );
+        let cos = (cam.world_to_camera.transform_vector3(want.dir)).z;
+        let focal = focal.expect("a hit focuses");
+        assert!((focal - (7.0 - 1e-3 / cos)).abs() < 1e-5, "{focal}");
+        assert_eq!(cam.focal_distance(), focal);
+        // Nothing hit: the focal distance stays.
+        let before = cam.focal_distance();
+        assert_eq!(cam.autofocus(Vec2::splat(2.0), |_| None), None);
+        assert_eq!(cam.focal_distance(), before);
+        let mut fisheye = Camera::new(&desc(CameraKind::Fisheye { fov: 90.0 }, 0.0), 64, 32);
+        assert_eq!(fisheye.autofocus(Vec2::ZERO, |_| Some(1.0)), None);
     }
 
     #[test]

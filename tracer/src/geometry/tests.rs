@@ -22,6 +22,8 @@ pub(crate) fn scene_desc(shapes: Vec<ShapeDesc>, lights: Vec<LightDesc>) -> Scen
         screen_window: [-1.0, 1.0, -1.0, 1.0],
         lens_radius: 0.0,
         focal_distance: 1e30,
+        autofocus: false,
+        aperture: Default::default(),
         hither: 1e-3,
         yon: 1e30,
     };

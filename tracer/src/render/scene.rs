@@ -137,8 +137,21 @@ impl RenderScene {
         )?
         .with_mirror_images(&flat_mirrors(desc, settings), &geometry);
         guard.check_cancel()?;
+        let mut camera = Camera::new(&desc.camera, settings.width, settings.height);
+        if desc.camera.autofocus {
+            let filter_radius = Vec2::new(desc.filter.xwidth, desc.filter.ywidth);
+            let first_hit = |ray: &Ray| geometry.closest(ray, f32::INFINITY).map(|hit| hit.t);
+            match camera.autofocus(filter_radius, first_hit) {
+                Some(distance) => tracing::info!("autofocus: focal distance {distance}"),
+                None => tracing::warn!(
+                    "autofocus: the ray through the screen centre hits nothing; focal \
+                     distance {} kept",
+                    camera.focal_distance()
+                ),
+            }
+        }
         let mut scene = Self {
-            camera: Camera::new(&desc.camera, settings.width, settings.height),
+            camera,
             filter: PixelFilter::new(&desc.filter),
             film_mass: settings
                 .renders_bidirectional(desc)

@@ -6,6 +6,7 @@ mod area_texture;
 mod bidirectional;
 mod branching;
 mod bump_render;
+mod camera_lens;
 mod daylight;
 mod direct_lighting;
 mod estimates;

@@ -29,6 +29,8 @@ fn camera(kind: CameraKind, eye: Vec3, lens_radius: f32, focal_distance: f32) ->
         screen_window: [-1.0, 1.0, -1.0, 1.0],
         lens_radius,
         focal_distance,
+        autofocus: false,
+        aperture: Default::default(),
         hither: 1e-3,
         yon: 1e30,
     }
