@@ -28,11 +28,18 @@ impl TrowbridgeReitz {
         if !(u > 0.0 || v > 0.0) {
             return None;
         }
-        let alpha = |r: f32| r.clamp(MIN_ALPHA, 1.0);
-        Some(Self {
+        Some(Self::rough(u, v))
+    }
+
+    /// From LuxRender's u/v roughness, clamped to [MIN_ALPHA, 1] (NaN to MIN_ALPHA): never a
+    /// specular lobe, for the models that have no smooth limit.
+    pub fn rough(u: f32, v: f32) -> Self {
+        // NaN is not below MIN_ALPHA: clamp would keep it; the comparison does not.
+        let alpha = |r: f32| if r >= MIN_ALPHA { r.min(1.0) } else { MIN_ALPHA };
+        Self {
             alpha_x: alpha(u),
             alpha_y: alpha(v),
-        })
+        }
     }
 
     /// The larger of the two alphas: how wide the lobe is at its widest.

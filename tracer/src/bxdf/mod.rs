@@ -7,7 +7,7 @@
 //! implements), [`local`] (local-frame helpers), [`fresnel`], [`microfacet`]
 //! (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the lobes
 //! [`pass_through`], [`diffuse`], [`translucent`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`],
-//! [`cloth`], the glossy [`coat`] layer and [`coat_over_base`] (a coat over any base lobe), and [`bsdf`]
+//! [`cloth`], [`fresnel_blend`], the glossy [`coat`] layer and [`coat_over_base`] (a coat over any base lobe), and [`bsdf`]
 //! (world frame). A new lobe is its file (its struct and [`Lobe`] impl) plus one line in the
 //! lobe list below.
 
@@ -142,4 +142,6 @@ lobes! {
     Velvet(velvet::Velvet),
     Scatter(scatter::Scatter),
     Cloth(cloth::Cloth),
+    /// glossy_lossy (substrate, plastic).
+    FresnelBlend(fresnel_blend::FresnelBlend),
 }

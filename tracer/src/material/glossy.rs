@@ -70,33 +70,7 @@ impl CoatParams {
         roughness_default: f32,
     ) -> Result<Self, ParseError> {
         let name = |n: &str| format!("{prefix}{n}");
-        let ks = ctx.color_param(params, &name("Ks"), ks_default, false)?;
-        let index = ctx.float_param(params, &name("index"), DEFAULT_INDEX)?;
-        let ks = match index {
-            ConstOrTexture::Const(i) if i.x > 0.0 => {
-                let f = ((i.x - 1.0) / (i.x + 1.0)).powi(2);
-                match ks {
-                    ConstOrTexture::Const(c) => ConstOrTexture::Const(c * f),
-                    ConstOrTexture::Texture(id) => ConstOrTexture::Texture(ctx.scaled_texture(id, f)),
-                }
-            }
-            ConstOrTexture::Const(_) => ks,
-            ConstOrTexture::Texture(_) => {
-                ctx.warn(
-                    pos,
-                    format!(
-                        "{}: a textured \"{}\" is not supported; Ks is used as given",
-                        params.statement,
-                        name("index")
-                    ),
-                );
-                ks
-            }
-        };
-        let ks = match ks {
-            ConstOrTexture::Const(c) => ConstOrTexture::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
-            t => t,
-        };
+        let ks = read_ks(params, pos, ctx, prefix, ks_default)?;
         Ok(Self {
             ks,
             ka: ctx.color_param(params, &name("Ka"), DEFAULT_KA, true)?,
@@ -132,6 +106,47 @@ impl CoatParams {
             &self.vroughness,
         ]
     }
+}
+
+/// Glossy2's `{prefix}Ks` with `{prefix}index` folded in (a positive index multiplies it by
+/// ((index-1)/(index+1))^2, a textured Ks through a new scale texture; a textured index warns
+/// and is ignored), a constant clamped to [0, 1]: also the specular reflectance of LuxRender's
+/// older Glossy ([`super::glossy_lossy`]).
+pub fn read_ks(
+    params: &ParamList,
+    pos: &SourcePos,
+    ctx: &mut dyn ParseContext,
+    prefix: &str,
+    ks_default: f32,
+) -> Result<ConstOrTexture, ParseError> {
+    let name = |n: &str| format!("{prefix}{n}");
+    let ks = ctx.color_param(params, &name("Ks"), ks_default, false)?;
+    let index = ctx.float_param(params, &name("index"), DEFAULT_INDEX)?;
+    let ks = match index {
+        ConstOrTexture::Const(i) if i.x > 0.0 => {
+            let f = ((i.x - 1.0) / (i.x + 1.0)).powi(2);
+            match ks {
+                ConstOrTexture::Const(c) => ConstOrTexture::Const(c * f),
+                ConstOrTexture::Texture(id) => ConstOrTexture::Texture(ctx.scaled_texture(id, f)),
+            }
+        }
+        ConstOrTexture::Const(_) => ks,
+        ConstOrTexture::Texture(_) => {
+            ctx.warn(
+                pos,
+                format!(
+                    "{}: a textured \"{}\" is not supported; Ks is used as given",
+                    params.statement,
+                    name("index")
+                ),
+            );
+            ks
+        }
+    };
+    Ok(match ks {
+        ConstOrTexture::Const(c) => ConstOrTexture::Const(c.clamp(Vec3::ZERO, Vec3::ONE)),
+        t => t,
+    })
 }
 
 /// A Lambert base Kd under a [`CoatParams`] coat.

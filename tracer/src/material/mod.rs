@@ -134,6 +134,7 @@ macro_rules! materials {
 materials! {
     matte::Matte { "matte" => read },
     glossy::Glossy { "glossy" => read, "glossy2" => read },
+    glossy_lossy::GlossyLossy { "glossy_lossy" => read, "substrate" => read, "plastic" => read },
     mirror::Mirror { "mirror" => read },
     glass::Glass { "glass" => read, "roughglass" => read_rough, "glass2" => read_glass2 },
     metal::Metal { "metal" => read, "metal2" => read_metal2 },

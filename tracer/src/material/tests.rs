@@ -73,6 +73,17 @@ fn glossy(kd: f32, ks: f32, u: f32, v: f32, multibounce: bool) -> MaterialDesc {
     })
 }
 
+fn glossy_lossy(kd: f32, ks: f32, u: f32, v: f32) -> MaterialDesc {
+    MaterialDesc::GlossyLossy(glossy_lossy::GlossyLossy {
+        kd: c(kd),
+        ks: c(ks),
+        ka: c(0.0),
+        depth: c(0.0),
+        uroughness: c(u),
+        vroughness: c(v),
+    })
+}
+
 fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
     MaterialDesc::Glass(Glass {
         kr: c(1.0),
@@ -341,6 +352,21 @@ fn leaf_cases() -> Vec<(&'static str, MaterialDesc)> {
                 },
             }),
         ),
+        ("substrate ks .04 r .1", glossy_lossy(1.0, 0.04, 0.1, 0.1)),
+        ("substrate ks .5 r .3", glossy_lossy(0.5, 0.5, 0.3, 0.3)),
+        ("substrate aniso .05/.4", glossy_lossy(0.8, 0.1, 0.05, 0.4)),
+        ("substrate smooth", glossy_lossy(1.0, 0.2, 0.0, 0.0)),
+        (
+            "substrate absorbing",
+            MaterialDesc::GlossyLossy(glossy_lossy::GlossyLossy {
+                ka: rgb(0.9, 0.3, 0.0),
+                depth: c(0.5),
+                ..match glossy_lossy(1.0, 0.1, 0.2, 0.2) {
+                    MaterialDesc::GlossyLossy(g) => g,
+                    _ => unreachable!(),
+                }
+            }),
+        ),
         ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) })),
         ("glass 1.5", glass(1.5, 0.0, false)),
         ("glass 2.4", glass(2.4, 0.0, false)),
@@ -458,6 +484,8 @@ fn too_narrow_for_uniform(name: &str) -> bool {
         "gold r .1",
         "roughglass .1",
         "aniso .1/.5",
+        "aniso .05/.4",
+        "substrate smooth",
     ]
     .iter()
     .any(|n| name.contains(n))
@@ -608,6 +636,7 @@ fn reciprocity() {
         ("gold aniso", gold(0.1, 0.6)),
         ("glossy", glossy(0.8, 0.3, 0.2, 0.4, false)),
         ("glossy multibounce", glossy(0.8, 0.3, 0.6, 0.6, true)),
+        ("substrate", glossy_lossy(0.8, 0.3, 0.2, 0.4)),
         (
             "mattetranslucent",
             MaterialDesc::MatteTranslucent(MatteTranslucent {

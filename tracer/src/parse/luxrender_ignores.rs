@@ -11,5 +11,8 @@ pub fn luxrender_ignores(statement: &str, name: &str) -> bool {
         // LuxRender's mirror reads Kr, film, filmindex and bumpmap only; LuxBlend writes a
         // mirror's glass-like index and a diffuse colour anyway.
         ("Material \"mirror\"", "index" | "Kd")
+            // pbrt's plastic and shinymetal had one `roughness`; LuxRender 1.x reads
+            // uroughness and vroughness only (their defaults apply).
+            | ("Material \"plastic\"" | "Material \"shinymetal\"", "roughness")
     )
 }

@@ -11,6 +11,7 @@ mod daylight;
 mod direct_lighting;
 mod estimates;
 mod geometry_on_scenes;
+mod glossy_lossy;
 mod glossy_split;
 #[path = "../../../tests/fixtures/hostile.rs"]
 mod hostile;
