@@ -1,6 +1,8 @@
 //! Generates the binary assets of the project's own scenes (`scenes/`): the LatLong sky
-//! (`scenes/envmap/sky.hdr` and `sky.png`) and the heavy scene's mesh
-//! (`scenes/heavy/heavy.ply`, about 2 M triangles, not committed).
+//! (`scenes/envmap/sky.hdr` and `sky.png`), the picture of the image-format scene in the three
+//! formats LuxBlend writes besides PNG and JPEG (`scenes/textures/formats.tga`, `.tif` and
+//! `.bmp`) and the heavy scene's mesh (`scenes/heavy/heavy.ply`, about 2 M triangles, not
+//! committed).
 //!
 //! `cargo run --release -p yat-tracer --example make_scene_assets [-- SCENES_DIR]`
 
@@ -21,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes"));
     write_sky(&dir.join("envmap"))?;
+    write_formats(&dir.join("textures"))?;
     write_rock(&dir.join("heavy/heavy.ply"))?;
     Ok(())
 }
@@ -71,6 +74,38 @@ fn write_sky(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     image::DynamicImage::ImageRgb32F(hdr).save(dir.join("sky.hdr"))?;
     ldr.save(dir.join("sky.png"))?;
     println!("wrote {}/sky.hdr and sky.png", dir.display());
+    Ok(())
+}
+
+/// Side of the image-format scene's picture, in texels.
+const FORMATS_SIZE: u32 = 64;
+
+/// The image-format scene's picture (`scenes/textures/formats.lxs`): four flat quadrants, top
+/// left to bottom right red, green, blue and yellow, so that a render shows whether each file
+/// is read the right way up and the right way round. `tracer/tests/integration/image_formats.rs`
+/// holds the same colours.
+fn formats_texel(x: u32, y: u32) -> [u8; 3] {
+    let half = FORMATS_SIZE / 2;
+    match (x < half, y < half) {
+        (true, true) => [200, 40, 40],
+        (false, true) => [40, 180, 60],
+        (true, false) => [40, 60, 200],
+        (false, false) => [220, 200, 60],
+    }
+}
+
+/// The picture as 8-bit RGB TGA (run-length encoded, as the `image` crate's encoder and
+/// Blender's "Targa" write it), TIFF and 24-bit BMP.
+fn write_formats(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(dir)?;
+    let picture = image::RgbImage::from_fn(FORMATS_SIZE, FORMATS_SIZE, |x, y| {
+        image::Rgb(formats_texel(x, y))
+    });
+    for extension in ["tga", "tif", "bmp"] {
+        let path = dir.join(format!("formats.{extension}"));
+        picture.save(&path)?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }
 

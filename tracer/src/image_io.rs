@@ -290,7 +290,11 @@ fn palette_indices(codes: &[[u8; 4]]) -> Option<(Vec<[u8; 4]>, Vec<u8>)> {
 }
 
 /// What the decoder's own buffers and the allocator's rounding add while an image decodes, per
-/// texel, rounded up (measured: docs/security.md, "build budget").
+/// texel, rounded up (measured: docs/security.md, "build budget"). TGA, TIFF and BMP files
+/// peak where PNG files of the same texels do (measured with a counting allocator on
+/// 1024x1024 files: 15 bytes a texel for 8-bit RGB, 30 for 16-bit, 36 for float, all under
+/// [`ImageCost::decode`]'s 16, 43 and 49): TIFF's decoder holds the texels in a buffer of its
+/// own too, but frees it before the conversions that make the peak.
 const DECODER_BYTES_PER_TEXEL: u64 = 1;
 
 /// What an image takes in memory: the bytes its texels keep, and the most that making them
@@ -360,8 +364,32 @@ pub struct DecodeError {
     pub source: image::ImageError,
 }
 
-/// Decodes PNG, JPEG, Radiance HDR or OpenEXR. 8- and 16-bit formats are raised to the power
-/// `gamma` (LuxRender's imagemap and infinite-light rule); floating-point formats are already
+/// The format of the image file `bytes`, read from `path`: the one its first bytes announce,
+/// else the one `path`'s extension names, in any case (exported scenes name files such as
+/// `Material__1.JPG`).
+///
+/// The content is asked first because it cannot be wrong where it answers: a file's magic
+/// number is what its decoder will read, while extensions are whatever an exporter or a user
+/// named the file (a JPEG saved as `.png` decodes). TGA has no magic number, so it is found
+/// only by the extension; and a real TGA header does not start like another format's
+/// signature (its second byte, the colour-map type, is 0 or 1: of the signatures with a 0
+/// there, ICO's would make it a colour-mapped TGA without a colour map, which is invalid, and
+/// AVIF's would need `ftypavif` spelt in its origin fields), so the content does not take a
+/// TGA for something else. A file whose content names a format is decoded as that,
+/// and its decoder's error is the one reported: when that decoding fails, trying the
+/// extension's decoder too would only hide the real error behind a second one.
+pub fn format(bytes: &[u8], path: &str) -> image::ImageResult<image::ImageFormat> {
+    image::guess_format(bytes).or_else(|unknown| {
+        std::path::Path::new(path)
+            .extension()
+            .and_then(image::ImageFormat::from_extension)
+            .ok_or(unknown)
+    })
+}
+
+/// Decodes PNG, JPEG, TGA, TIFF, BMP, Radiance HDR or OpenEXR (the format found by
+/// [`format`]). 8- and 16-bit formats are raised to the power `gamma` (LuxRender's imagemap
+/// and infinite-light rule); floating-point formats (EXR, HDR, 32-bit float TIFF) are already
 /// linear and are left alone, but for negative and non-finite values, which become 0 (they
 /// are no radiance or reflectance, and one NaN texel would blacken whatever samples it).
 pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeError> {
@@ -369,7 +397,9 @@ pub fn decode(bytes: &[u8], path: &str, gamma: f32) -> Result<RgbImage, DecodeEr
         path: path.to_string(),
         source,
     };
-    let img = image::load_from_memory(bytes).map_err(err)?;
+    let img = format(bytes, path)
+        .and_then(|format| image::load_from_memory_with_format(bytes, format))
+        .map_err(err)?;
     let linearise = |v: f32| {
         if gamma == 1.0 {
             v
@@ -579,6 +609,207 @@ mod tests {
                 assert_eq!(decoded.get(x, y), want, "texel ({x}, {y})");
             }
         }
+    }
+
+    /// `img` as TGA, uncompressed or run-length encoded.
+    fn tga(img: image::DynamicImage, rle: bool) -> Vec<u8> {
+        use image::ImageEncoder;
+        let mut bytes = Vec::new();
+        let encoder = image::codecs::tga::TgaEncoder::new(&mut bytes);
+        let encoder = if rle { encoder } else { encoder.disable_rle() };
+        let (w, h) = (img.width(), img.height());
+        encoder
+            .write_image(img.as_bytes(), w, h, img.color().into())
+            .unwrap();
+        bytes
+    }
+
+    /// A `w` x `h` 8-bit picture of many colours with runs of one colour in every row (for the
+    /// run-length encoders), different in every row and column, so that a flip or a transpose
+    /// would show.
+    fn picture(w: u32, h: u32) -> image::RgbImage {
+        image::RgbImage::from_fn(w, h, |x, y| {
+            let run = (x / 3) as u8;
+            image::Rgb([
+                run.wrapping_mul(40).wrapping_add(y as u8),
+                250u8.wrapping_sub(17u8.wrapping_mul(y as u8)),
+                (x * y) as u8 ^ 0x5a,
+            ])
+        })
+    }
+
+    /// `decoded` holds the 8-bit texels `want` raised to the power 2.2, exactly.
+    fn assert_gamma_decoded(decoded: &RgbImage, want: &image::RgbImage, what: &str) {
+        assert_eq!((decoded.width, decoded.height), want.dimensions(), "{what}");
+        for (x, y, p) in want.enumerate_pixels() {
+            let texel = Vec3::from_array(p.0.map(|v| libm::powf(f32::from(v) / 255.0, 2.2)));
+            assert_eq!(decoded.get(x, y), texel, "{what}: texel ({x}, {y})");
+        }
+    }
+
+    /// TGA has no magic number: its files are found by their extension (in any case), 8-bit
+    /// RGB and RGBA (the alpha dropped), uncompressed and run-length encoded alike.
+    #[test]
+    fn tga_files_decode_by_their_extension_with_and_without_rle() {
+        let rgb = picture(7, 5);
+        let rgba = image::RgbaImage::from_fn(7, 5, |x, y| {
+            let [r, g, b] = rgb.get_pixel(x, y).0;
+            image::Rgba([r, g, b, (x * 30) as u8])
+        });
+        let images: [(&str, image::DynamicImage); 2] =
+            [("rgb", rgb.clone().into()), ("rgba", rgba.into())];
+        for (name, img) in images {
+            for rle in [false, true] {
+                let bytes = tga(img.clone(), rle);
+                // Image type 2 is uncompressed true colour, 10 run-length encoded; 24 or 32 bits.
+                assert_eq!(bytes[2], if rle { 10 } else { 2 }, "{name}");
+                assert_eq!(bytes[16], if name == "rgb" { 24 } else { 32 }, "{name}");
+                assert!(
+                    image::guess_format(&bytes).is_err(),
+                    "{name}: no magic number"
+                );
+                for path in ["maps/wood.tga", "maps/WOOD.TGA"] {
+                    let decoded = decode(&bytes, path, 2.2).unwrap();
+                    assert_gamma_decoded(&decoded, &rgb, &format!("{name}, rle {rle}, {path}"));
+                }
+                // Without the extension nothing names the format: an error naming the file.
+                let err = decode(&bytes, "maps/wood", 2.2).unwrap_err();
+                assert_eq!(err.path, "maps/wood");
+                assert!(err.to_string().contains("\"maps/wood\""), "{err}");
+            }
+        }
+        let runs = tga(rgb.clone().into(), true).len();
+        let raw = tga(rgb.into(), false).len();
+        assert!(runs < raw, "RLE {runs} bytes, uncompressed {raw}");
+    }
+
+    /// A run-length encoded TGA assembled by hand as Blender writes them (rows bottom to top,
+    /// pixels blue-green-red, a run packet and raw packets) decodes the right way up.
+    #[test]
+    fn a_hand_made_bottom_up_rle_tga_decodes_the_right_way_up() {
+        #[rustfmt::skip]
+        let bytes = [
+            // No id, no colour map, type 10 (RLE true colour), colour-map spec, origin (0, 0),
+            // 3 x 2, 24 bits a pixel, descriptor 0 (no alpha, origin bottom left).
+            0, 0, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 2, 0, 24, 0,
+            // The bottom row: red twice (a run of 2), then green (a raw packet of 1).
+            0x81, 0, 0, 255, 0x00, 0, 255, 0,
+            // The top row: blue, white and (30, 20, 10) (a raw packet of 3).
+            0x02, 255, 0, 0, 255, 255, 255, 10, 20, 30,
+        ];
+        let decoded = decode(&bytes, "blender.tga", 1.0).unwrap();
+        let want = [
+            [[0, 0, 255], [255, 255, 255], [30, 20, 10]],
+            [[255, 0, 0], [255, 0, 0], [0, 255, 0]],
+        ];
+        assert_eq!((decoded.width, decoded.height), (3, 2));
+        for (y, row) in want.iter().enumerate() {
+            for (x, rgb) in row.iter().enumerate() {
+                let texel = Vec3::from_array(rgb.map(|v: u8| f32::from(v) / 255.0));
+                assert_eq!(decoded.get(x as u32, y as u32), texel, "texel ({x}, {y})");
+            }
+        }
+    }
+
+    /// Bytes that are no TGA, and a TGA cut short, are errors naming the file.
+    #[test]
+    fn a_broken_tga_is_an_error_naming_the_file() {
+        let mut truncated = tga(picture(16, 16).into(), false);
+        truncated.truncate(18 + 16 * 8 * 3);
+        let garbage: [&[u8]; 4] = [
+            b"",
+            b"not a TGA",
+            b"\x00\x07\x0b this is not a Targa file at all, nor any other image",
+            &truncated,
+        ];
+        for bytes in garbage {
+            let err = decode(bytes, "textures/broken.tga", 2.2).unwrap_err();
+            assert_eq!(err.path, "textures/broken.tga");
+            assert!(err.to_string().contains("\"textures/broken.tga\""), "{err}");
+        }
+    }
+
+    /// 8-, 16- and 32-bit float TIFFs: 8 and 16 bits go through the gamma curve (16 bits as
+    /// 16-bit PNGs do, to the bit), floats stay linear but for negative and NaN values.
+    #[test]
+    fn tiff_files_of_8_16_and_float_bits_decode_like_png_and_exr() {
+        let rgb = picture(6, 4);
+        let bytes = encode(rgb.clone().into(), image::ImageFormat::Tiff);
+        assert_eq!(&bytes[..4], b"II*\0");
+        // The content names the format: any extension, or none, reads it.
+        for path in ["a.tif", "a.TIFF", "a.png", "a"] {
+            assert_gamma_decoded(&decode(&bytes, path, 2.2).unwrap(), &rgb, path);
+        }
+
+        let deep = image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(5, 3, |x, y| {
+            image::Rgb([(x * 13_000 + y) as u16, 65_535 - (y * 20_000) as u16, 7])
+        });
+        let tiff = encode(deep.clone().into(), image::ImageFormat::Tiff);
+        let png = encode(deep.clone().into(), image::ImageFormat::Png);
+        let (tiff, png) = (
+            decode(&tiff, "deep.tif", 2.2).unwrap(),
+            decode(&png, "deep.png", 2.2).unwrap(),
+        );
+        assert!(matches!(tiff.texels, Texels::Linear(_)));
+        for (x, y, p) in deep.enumerate_pixels() {
+            let want = Vec3::from_array(p.0.map(|v| libm::powf(f32::from(v) / 65_535.0, 2.2)));
+            let got = tiff.get(x, y);
+            assert!(
+                got.abs_diff_eq(want, 1e-6),
+                "({x}, {y}): {got} against {want}"
+            );
+            assert_eq!(got, png.get(x, y), "({x}, {y}) against the PNG");
+        }
+        // 13 000 / 65 535 ^ 2.2, not 13 000 / 65 535 (no gamma) nor 0 (the 8-bit branch).
+        assert!(
+            (tiff.get(1, 0).x - 0.028_473).abs() < 1e-5,
+            "{}",
+            tiff.get(1, 0)
+        );
+
+        let values = [
+            0.25,
+            3.5,
+            -1.0,
+            f32::NAN,
+            f32::INFINITY,
+            1e-3,
+            0.5,
+            12.0,
+            0.0,
+        ];
+        let float = image::Rgb32FImage::from_fn(3, 1, |x, _| {
+            let i = 3 * x as usize;
+            image::Rgb([values[i], values[i + 1], values[i + 2]])
+        });
+        let bytes = encode(float.into(), image::ImageFormat::Tiff);
+        let decoded = decode(&bytes, "float.tif", 2.2).unwrap();
+        assert_eq!(decoded.get(0, 0), Vec3::new(0.25, 3.5, 0.0));
+        assert_eq!(decoded.get(1, 0), Vec3::new(0.0, 0.0, 1e-3));
+        assert_eq!(decoded.get(2, 0), Vec3::new(0.5, 12.0, 0.0));
+    }
+
+    /// 24-bit BMP (rows bottom to top, padded to 4 bytes: 5 texels of 3 bytes are 16 a row).
+    #[test]
+    fn bmp_files_of_24_bits_decode_to_their_gamma_curve() {
+        let rgb = picture(5, 3);
+        let bytes = encode(rgb.clone().into(), image::ImageFormat::Bmp);
+        assert_eq!(&bytes[..2], b"BM");
+        assert_eq!(
+            u16::from_le_bytes([bytes[28], bytes[29]]),
+            24,
+            "bits a pixel"
+        );
+        for path in ["a.bmp", "A.BMP", "a"] {
+            assert_gamma_decoded(&decode(&bytes, path, 2.2).unwrap(), &rgb, path);
+        }
+        // One texel by hand: (0, 0) is red 0, green 250, blue 0x5a.
+        let want = Vec3::new(
+            0.0,
+            libm::powf(250.0 / 255.0, 2.2),
+            libm::powf(90.0 / 255.0, 2.2),
+        );
+        assert_eq!(decode(&bytes, "a.bmp", 2.2).unwrap().get(0, 0), want);
     }
 
     #[test]

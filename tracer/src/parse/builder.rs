@@ -1007,10 +1007,14 @@ impl ParseContext for Builder<'_> {
             Some(&header) => header,
             None => {
                 let bytes = self.read_asset(path, AssetKind::Image, pos)?;
-                let header = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-                    .with_guessed_format()
+                // The format as the decoder will find it (TGA, which has no magic number, by
+                // the extension); its decoder reads the header only, no texel.
+                let header = crate::image_io::format(&bytes, path)
+                    .map(|format| {
+                        image::ImageReader::with_format(std::io::Cursor::new(&bytes[..]), format)
+                    })
+                    .and_then(|r| r.into_decoder())
                     .map_err(|e| e.to_string())
-                    .and_then(|r| r.into_decoder().map_err(|e| e.to_string()))
                     .map(|d| {
                         let (width, height) = d.dimensions();
                         (width, height, d.color_type())

@@ -16,6 +16,7 @@ mod glossy_split;
 #[path = "../../../tests/fixtures/hostile.rs"]
 mod hostile;
 mod hostile_scenes;
+mod image_formats;
 mod luxrender_materials;
 mod mirror_images;
 mod panes;
