@@ -90,6 +90,26 @@ pub fn spectrum_rgb(f: impl Fn(f64) -> f64) -> Vec3 {
 /// The wavelengths a reflectance or a hue is integrated over, in nm.
 const VISIBLE_NM: (f64, f64) = (380.0, 780.0);
 
+/// [`spectrum_rgb`] as weights: each wavelength of the visible range at `step` nm with its
+/// linear sRGB weight, so that a reflectance spectrum's RGB is the sum of weight x value (the
+/// weights of each channel sum to 1). For spectra evaluated many times over, as a thin film's
+/// interference is.
+pub fn spectrum_rgb_weights(step: f64) -> Vec<(f64, Vec3)> {
+    let count = ((VISIBLE_NM.1 - VISIBLE_NM.0) / step).round() as u32;
+    let weights: Vec<(f64, DVec3)> = (0..=count)
+        .map(|i| {
+            let lambda = VISIBLE_NM.0 + f64::from(i) * step;
+            let (x, y, z) = cie_1931(lambda);
+            (lambda, xyz_to_srgb(DVec3::new(x, y, z)))
+        })
+        .collect();
+    let total: DVec3 = weights.iter().map(|&(_, w)| w).sum();
+    weights
+        .into_iter()
+        .map(|(lambda, w)| (lambda, (w / total).as_vec3()))
+        .collect()
+}
+
 /// CIE 1931 XYZ of `spectrum` (nm -> value): the sum of spectrum x the colour matching
 /// functions at `step` nm from `range.0` to `range.1` (both included). The one integration
 /// loop every conversion here shares.

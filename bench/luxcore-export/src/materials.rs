@@ -49,7 +49,7 @@ pub fn write_material(
             set("vroughness", tex_value(vroughness, false));
             set("multibounce", u8::from(*multibounce).to_string());
         }
-        MaterialDesc::Mirror(Mirror { kr }) => {
+        MaterialDesc::Mirror(Mirror { kr, .. }) => {
             set("type", quoted("mirror"));
             set("kr", tex_value(kr, true));
         }

@@ -7,6 +7,7 @@ use super::local::{reflect, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
 use super::lobe::Lobe;
 use super::sample::LocalSample;
+use super::thin_film::ThinFilm;
 
 /// The widest microfacet alpha [`Lobe::glossy_spread`] counts as glossy. A wider lobe sees a
 /// lamp as light sampling does, and more BSDF samples add little (bench/RESULTS.md, "Figures
@@ -39,6 +40,8 @@ pub struct Conductor {
     pub fresnel: ConductorFresnel,
     /// None: a perfect mirror.
     pub distrib: Option<TrowbridgeReitz>,
+    /// Interference on the perfect mirror's reflection (LuxRender has none on rough metals).
+    pub film: Option<ThinFilm>,
 }
 
 impl Conductor {
@@ -102,7 +105,11 @@ impl Lobe for Conductor {
         }
         let Some(distrib) = self.distrib else {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-            return LocalSample::specular(wi, self.fresnel.eval(wi.z) / wi.z.abs(), 1.0);
+            let mut reflected = self.fresnel.eval(wi.z);
+            if let Some(film) = self.film {
+                reflected *= film.weight(wi.z.abs());
+            }
+            return LocalSample::specular(wi, reflected / wi.z.abs(), 1.0);
         };
         let wm = distrib.sample_wm(wo, u);
         let wi = reflect(wo, wm);

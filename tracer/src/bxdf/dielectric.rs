@@ -14,6 +14,7 @@ use super::local::{reflect, refract, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
 use super::lobe::Lobe;
 use super::sample::LocalSample;
+use super::thin_film::ThinFilm;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Surface {
@@ -31,9 +32,20 @@ pub struct Dielectric {
     /// Index of the inside relative to the outside (the side the normal points to).
     pub eta: f32,
     pub surface: Surface,
+    /// Interference on the smooth or thin surface's reflection (LuxRender's glass; its rough
+    /// glass has none).
+    pub film: Option<ThinFilm>,
 }
 
 impl Dielectric {
+    /// The tint of the mirror reflection at `cos` to the normal: Kr, and the film's
+    /// interference over it.
+    fn reflected_tint(&self, cos: f32) -> Vec3 {
+        match self.film {
+            Some(film) => self.kr * film.weight(cos.abs()),
+            None => self.kr,
+        }
+    }
 
     /// Probability of choosing reflection given Fresnel reflectance `r`: in proportion to the
     /// reflected and transmitted energy, so a black tint is never sampled.
@@ -55,7 +67,7 @@ impl Dielectric {
         let p_reflect = self.reflect_probability(r);
         if u_lobe < p_reflect {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-            LocalSample::specular(wi, self.kr * (r / wi.z.abs()), p_reflect)
+            LocalSample::specular(wi, self.reflected_tint(wo.z) * (r / wi.z.abs()), p_reflect)
         } else {
             let (wi, _) = refract(wo, Vec3::Z, self.eta)?;
             if wi.z == 0.0 {
@@ -83,7 +95,7 @@ impl Dielectric {
         let (r, p_reflect) = self.thin_split(wo);
         if u_lobe < p_reflect {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-            LocalSample::specular(wi, self.kr * (r / wi.z.abs()), p_reflect)
+            LocalSample::specular(wi, self.reflected_tint(wo.z) * (r / wi.z.abs()), p_reflect)
         } else {
             let wi = -wo;
             LocalSample::specular(wi, self.kt * ((1.0 - r) / wi.z.abs()), 1.0 - p_reflect)

@@ -35,7 +35,13 @@ impl TrowbridgeReitz {
     /// specular lobe, for the models that have no smooth limit.
     pub fn rough(u: f32, v: f32) -> Self {
         // NaN is not below MIN_ALPHA: clamp would keep it; the comparison does not.
-        let alpha = |r: f32| if r >= MIN_ALPHA { r.min(1.0) } else { MIN_ALPHA };
+        let alpha = |r: f32| {
+            if r >= MIN_ALPHA {
+                r.min(1.0)
+            } else {
+                MIN_ALPHA
+            }
+        };
         Self {
             alpha_x: alpha(u),
             alpha_y: alpha(v),

@@ -5,7 +5,8 @@
 //!
 //! Files: [`sample`] (the shared [`LocalSample`]), [`lobe`] (the [`Lobe`] trait every lobe
 //! implements), [`local`] (local-frame helpers), [`fresnel`], [`microfacet`]
-//! (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), the lobes
+//! (Trowbridge-Reitz/GGX), [`ggx_albedo`] (multiple-scattering tables), [`thin_film`]
+//! (interference on specular reflections), the lobes
 //! [`pass_through`], [`diffuse`], [`translucent`], [`conductor`], [`dielectric`], [`velvet`], [`scatter`],
 //! [`cloth`], [`fresnel_blend`], the glossy [`coat`] layer and [`coat_over_base`] (a coat over any base lobe), and [`bsdf`]
 //! (world frame). A new lobe is its file (its struct and [`Lobe`] impl) plus one line in the
@@ -20,6 +21,7 @@ pub mod lobe;
 pub mod local;
 pub mod microfacet;
 pub mod sample;
+pub mod thin_film;
 
 use glam::{Vec2, Vec3};
 

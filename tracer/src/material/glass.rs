@@ -13,12 +13,14 @@
 //! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 has none: its index is its shape's `Interior` volume's `fresnel` over its `Exterior`'s, 1 for a side with no volume ([`GLASS2_INDEX_WITHOUT_VOLUMES`] when it has neither), set per shape by the parser |
 //! | `architectural` | bool | false: a thin pane (a window) that does not bend light; shadow rays cross it with its straight transmittance, as LuxRender's do ([`crate::integrator::Crossing::Pane`]) |
 //! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
-//! | `film`, `cauchyb` | float | 0; not supported (a warning otherwise) |
+//! | `film`, `filmindex` | float textures, glass only | thin-film interference on the reflection, as LuxRender's ([`super::film`]); LuxRender's roughglass and glass2 have none |
+//! | `cauchyb` | float | 0; not supported (a warning otherwise) |
 //! | `dispersion` | bool, glass2 only | ignored |
 //!
 //! A non-positive index is treated as no interface (index 1).
 
 use super::eval::{texture_ids, HitTextures};
+use super::film::FilmParams;
 use super::kind::MaterialKind;
 use crate::bxdf::dielectric::{Dielectric, Surface};
 use crate::bxdf::Bxdf;
@@ -48,6 +50,7 @@ pub struct Glass {
     pub vroughness: ConstOrTexture,
     /// glass2: `index` is replaced, per shape, by its volumes' (see the table above).
     pub index_from_volumes: bool,
+    pub film: FilmParams,
 }
 
 impl Glass {
@@ -88,7 +91,6 @@ impl Glass {
         } else {
             0.0
         };
-        ctx.unsupported_unless(params, "film", 0.0);
         ctx.unsupported_unless(params, "cauchyb", 0.0);
         let glass2 = ty == "glass2";
         if glass2 {
@@ -114,18 +116,26 @@ impl Glass {
                 ConstOrTexture::float(0.0)
             },
             index_from_volumes: glass2,
+            film: if ty == "glass" {
+                FilmParams::read(params, ctx)?
+            } else {
+                FilmParams::default()
+            },
         })
     }
 }
 
 impl MaterialKind for Glass {
     fn textures(&self) -> Vec<TextureId> {
+        let [film, film_index] = self.film.textures();
         texture_ids(&[
             &self.kr,
             &self.kt,
             &self.index,
             &self.uroughness,
             &self.vroughness,
+            film,
+            film_index,
         ])
     }
 
@@ -145,6 +155,7 @@ impl MaterialKind for Glass {
             // A non-positive index is meaningless; treat it as no interface.
             eta: if eta > 0.0 { eta } else { 1.0 },
             surface,
+            film: self.film.at(eval),
         })
     }
 }

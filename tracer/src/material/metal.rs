@@ -103,6 +103,7 @@ impl MaterialKind for Metal {
         Bxdf::Conductor(Conductor {
             fresnel,
             distrib: eval.roughness(self.uroughness, self.vroughness),
+            film: None,
         })
     }
 }

@@ -7,9 +7,10 @@
 //! | parameter | type | default |
 //! |---|---|---|
 //! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
-//! | `film` | float | 0; thin-film interference is not supported (a warning otherwise) |
+//! | `film`, `filmindex` | float textures | thin-film interference on the reflection ([`super::film`]) |
 
 use super::eval::{texture_ids, HitTextures};
+use super::film::FilmParams;
 use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
@@ -24,6 +25,7 @@ pub const DEFAULT_KR: f32 = 1.0;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mirror {
     pub kr: ConstOrTexture,
+    pub film: FilmParams,
 }
 
 impl Mirror {
@@ -32,22 +34,24 @@ impl Mirror {
         _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        ctx.unsupported_unless(params, "film", 0.0);
         Ok(Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
+            film: FilmParams::read(params, ctx)?,
         })
     }
 }
 
 impl MaterialKind for Mirror {
     fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr])
+        let [film, index] = self.film.textures();
+        texture_ids(&[&self.kr, film, index])
     }
 
     fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
         Bxdf::Conductor(Conductor {
             fresnel: ConductorFresnel::Constant(eval.color(self.kr)),
             distrib: None,
+            film: self.film.at(eval),
         })
     }
 }

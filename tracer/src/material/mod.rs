@@ -19,6 +19,7 @@
 
 pub mod bump;
 pub mod eval;
+pub mod film;
 pub mod kind;
 pub mod nk;
 

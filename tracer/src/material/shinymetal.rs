@@ -11,7 +11,7 @@
 //! | `Kr` | color texture, the mirror reflection's normal-incidence reflectance, clamped to [0, 1] | 1 ([`DEFAULT_KR`]) |
 //! | `Ks` | color texture, the glossy reflection's, clamped to [0, 1] | 1 ([`DEFAULT_KS`]) |
 //! | `uroughness`, `vroughness` | float textures | 0.1 ([`DEFAULT_ROUGHNESS`]) |
-//! | `film`, `filmindex` | thin-film thickness (nm) and index | 0, 1.5; a film is not supported (a warning) |
+//! | `film`, `filmindex` | float textures | thin-film interference on the mirror reflection, as LuxRender's ([`super::film`]) |
 //!
 //! LuxRender adds the two lobes, each with a conductor Fresnel term that tends to 1 at grazing
 //! angles, so the surface reflects up to twice what arrives. Here the lobes are mixed like a
@@ -24,6 +24,7 @@
 use glam::Vec3;
 
 use super::eval::{texture_ids, HitTextures};
+use super::film::FilmParams;
 use super::kind::MaterialKind;
 use crate::bxdf::conductor::{Conductor, ConductorFresnel};
 use crate::bxdf::Bxdf;
@@ -43,6 +44,7 @@ pub struct ShinyMetal {
     pub ks: ConstOrTexture,
     pub uroughness: ConstOrTexture,
     pub vroughness: ConstOrTexture,
+    pub film: FilmParams,
 }
 
 impl ShinyMetal {
@@ -51,25 +53,27 @@ impl ShinyMetal {
         _pos: &SourcePos,
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
-        ctx.unsupported_unless(params, "film", 0.0);
-        if params.find("film").is_none() {
-            // Without a film its index changes nothing.
-            params.ignore("filmindex");
-        } else {
-            ctx.unsupported_unless(params, "filmindex", 1.5);
-        }
         Ok(Self {
             kr: ctx.color_param(params, "Kr", DEFAULT_KR, true)?,
             ks: ctx.color_param(params, "Ks", DEFAULT_KS, true)?,
             uroughness: ctx.float_param(params, "uroughness", DEFAULT_ROUGHNESS)?,
             vroughness: ctx.float_param(params, "vroughness", DEFAULT_ROUGHNESS)?,
+            film: FilmParams::read(params, ctx)?,
         })
     }
 }
 
 impl MaterialKind for ShinyMetal {
     fn textures(&self) -> Vec<TextureId> {
-        texture_ids(&[&self.kr, &self.ks, &self.uroughness, &self.vroughness])
+        let [film, index] = self.film.textures();
+        texture_ids(&[
+            &self.kr,
+            &self.ks,
+            &self.uroughness,
+            &self.vroughness,
+            film,
+            index,
+        ])
     }
 
     /// The lobe chosen by `u` in [0, 1): the mirror or the glossy metal.
@@ -80,6 +84,7 @@ impl MaterialKind for ShinyMetal {
             return Bxdf::Conductor(Conductor {
                 fresnel: ConductorFresnel::Constant(Vec3::ZERO),
                 distrib: None,
+                film: None,
             });
         }
         let total = (sr + ss).max(1.0);
@@ -90,6 +95,7 @@ impl MaterialKind for ShinyMetal {
                     r0: (kr / (total * w_mirror)).min(Vec3::ONE),
                 },
                 distrib: None,
+                film: self.film.at(eval),
             })
         } else {
             Bxdf::Conductor(Conductor {
@@ -97,6 +103,7 @@ impl MaterialKind for ShinyMetal {
                     r0: (ks / (total * (1.0 - w_mirror))).min(Vec3::ONE),
                 },
                 distrib: eval.roughness(self.uroughness, self.vroughness),
+                film: None,
             })
         }
     }

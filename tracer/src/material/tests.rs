@@ -93,7 +93,16 @@ fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
         uroughness: c(roughness),
         vroughness: c(roughness),
         index_from_volumes: false,
+        film: Default::default(),
     })
+}
+
+/// A 300 nm film of index 1.5 (magenta at normal incidence).
+fn film() -> film::FilmParams {
+    film::FilmParams {
+        thickness: c(300.0),
+        index: c(1.5),
+    }
 }
 
 fn gold(u: f32, v: f32) -> MaterialDesc {
@@ -154,6 +163,7 @@ fn shinymetal(kr: f32, ks: f32, r: f32) -> MaterialDesc {
         ks: c(ks),
         uroughness: c(r),
         vroughness: c(r),
+        film: Default::default(),
     })
 }
 
@@ -270,7 +280,10 @@ fn extra_cases() -> Vec<(&'static str, Vec<MaterialDesc>)> {
             "glossycoating over mirror",
             coated(
                 coat(0.3, 0.4, 0.4, false),
-                MaterialDesc::Mirror(Mirror { kr: c(1.0) }),
+                MaterialDesc::Mirror(Mirror {
+                    kr: c(1.0),
+                    film: Default::default(),
+                }),
             ),
         ),
         (
@@ -367,7 +380,27 @@ fn leaf_cases() -> Vec<(&'static str, MaterialDesc)> {
                 }
             }),
         ),
-        ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) })),
+        (
+            "mirror",
+            MaterialDesc::Mirror(Mirror {
+                kr: c(1.0),
+                film: Default::default(),
+            }),
+        ),
+        (
+            "mirror film",
+            MaterialDesc::Mirror(Mirror {
+                kr: c(1.0),
+                film: film(),
+            }),
+        ),
+        (
+            "glass film",
+            match glass(1.5, 0.0, false) {
+                MaterialDesc::Glass(g) => MaterialDesc::Glass(Glass { film: film(), ..g }),
+                _ => unreachable!(),
+            },
+        ),
         ("glass 1.5", glass(1.5, 0.0, false)),
         ("glass 2.4", glass(2.4, 0.0, false)),
         ("architectural", glass(1.5, 0.0, true)),
@@ -512,7 +545,14 @@ fn directional_albedo_never_exceeds_one() {
 fn white_lambert_albedo_is_one_and_lossless_bsdfs_keep_all_energy() {
     for (name, material, expected) in [
         ("lambert", matte(1.0, 0.0), 1.0),
-        ("mirror", MaterialDesc::Mirror(Mirror { kr: c(1.0) }), 1.0),
+        (
+            "mirror",
+            MaterialDesc::Mirror(Mirror {
+                kr: c(1.0),
+                film: Default::default(),
+            }),
+            1.0,
+        ),
         ("glass", glass(1.5, 0.0, false), 1.0),
         ("architectural", glass(1.5, 0.0, true), 1.0),
         ("lambert 0.5", matte(0.5, 0.0), 0.5),

@@ -14,5 +14,7 @@ pub fn luxrender_ignores(statement: &str, name: &str) -> bool {
             // pbrt's plastic and shinymetal had one `roughness`; LuxRender 1.x reads
             // uroughness and vroughness only (their defaults apply).
             | ("Material \"plastic\"" | "Material \"shinymetal\"", "roughness")
+            // Only LuxRender's glass has a thin film; its roughglass and glass2 read neither.
+            | ("Material \"roughglass\"" | "Material \"glass2\"", "film" | "filmindex")
     )
 }

@@ -459,7 +459,8 @@ fn material_defaults_and_rules() {
     assert_eq!(
         d.materials[a.0 as usize],
         MaterialDesc::Mirror(Mirror {
-            kr: ConstOrTexture::float(1.0)
+            kr: ConstOrTexture::float(1.0),
+            film: Default::default(),
         })
     );
     assert!(matches!(
