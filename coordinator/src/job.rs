@@ -9,7 +9,7 @@ use anyhow::Context;
 use yat_tracer::film::Film;
 use yat_tracer::render::adaptive::{self, AdaptiveSettings, Round};
 use yat_tracer::render::unit::FilmFrame;
-use yat_tracer::render::{RenderSettings, UnitStats};
+use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::checkpoint::Checkpoint;
 use crate::interim::InterimOutputs;
@@ -35,15 +35,38 @@ pub struct RenderJob {
     /// Once set (by Ctrl-C, SIGTERM or the caller), the render stops, saving what it can (the
     /// checkpoint, the preview) and saying what is lost.
     pub interrupt: Interrupt,
-    /// `--time-limit`: when an adaptive render stops at a round boundary.
-    pub deadline: Option<Instant>,
+    /// `--time-limit` or the scene's `halttime`: when the render stops (an adaptive one at a
+    /// round boundary).
+    pub deadline: Option<Deadline>,
+}
+
+/// When a render stops, and what set that time (for the messages).
+#[derive(Clone, Debug)]
+pub struct Deadline {
+    pub at: Instant,
+    /// `--time-limit` or the scene's `halttime`.
+    pub set_by: String,
+}
+
+impl Deadline {
+    /// `seconds` from now, set by `set_by`; None for 0 (no limit) or a time too far ahead to
+    /// represent.
+    pub fn after(seconds: Duration, set_by: impl Into<String>) -> Option<Self> {
+        if seconds.is_zero() {
+            return None;
+        }
+        Some(Self {
+            at: Instant::now().checked_add(seconds)?,
+            set_by: set_by.into(),
+        })
+    }
 }
 
 /// What a render that stops short says when nothing was merged.
 const NOTHING_RENDERED: &str = "nothing had been rendered yet";
 
-/// Why a render with `--time-limit` stopped short (its executor's error, turned into an
-/// outcome by [`RenderJob::timed_out`]).
+/// Why a render with a time limit stopped short (its executor's error, turned into an outcome
+/// by [`RenderJob::timed_out`]).
 #[derive(Debug, thiserror::Error)]
 #[error("the time limit was reached")]
 pub struct TimeLimitReached;
@@ -136,7 +159,9 @@ impl RenderJob {
 
     /// Whether the render's time limit has passed.
     pub fn out_of_time(&self) -> bool {
-        self.deadline.is_some_and(|d| Instant::now() >= d)
+        self.deadline
+            .as_ref()
+            .is_some_and(|d| Instant::now() >= d.at)
     }
 
     /// At a round boundary (every unit of the checkpoint's round merged) of a render with a time
@@ -151,7 +176,8 @@ impl RenderJob {
     }
 
     /// The outcome of a render its time limit stopped: the checkpoint saved with everything
-    /// merged, and the image of the last round completed (an error when none was).
+    /// merged, and the image of the last round completed (an error when none was); a uniform
+    /// render's image holds every sample merged, which its message lists.
     pub fn timed_out(
         &self,
         checkpoint: &Checkpoint,
@@ -159,15 +185,37 @@ impl RenderJob {
         stats: UnitStats,
         build: Option<SceneBuild>,
     ) -> anyhow::Result<RenderOutcome> {
-        let kept = self
-            .keep(checkpoint)
-            .unwrap_or_else(|| NOTHING_RENDERED.into());
+        let set_by = self
+            .deadline
+            .as_ref()
+            .map_or("the time limit", |d| d.set_by.as_str());
+        let kept = self.keep(checkpoint);
+        let uniform = checkpoint.round().is_none();
+        if uniform && kept.is_some() {
+            let units = checkpoint.units(&self.settings, None);
+            let held = merged_samples(&units, |u| checkpoint.is_done(u));
+            if !self.quiet {
+                eprintln!(
+                    "{set_by} reached: writing the image of the samples merged: {held}; {}",
+                    kept.as_deref().unwrap_or_default()
+                );
+            }
+            return Ok(RenderOutcome {
+                film: checkpoint.film().clone(),
+                stats,
+                build,
+                round: None,
+                complete: false,
+            });
+        }
+        let kept = kept.unwrap_or_else(|| NOTHING_RENDERED.into());
         let Some(completed) = completed else {
-            anyhow::bail!("--time-limit reached before a round was complete: no image; {kept}");
+            let unit = if uniform { "any unit" } else { "a round" };
+            anyhow::bail!("{set_by} reached before {unit} was complete: no image; {kept}");
         };
         if !self.quiet {
             eprintln!(
-                "--time-limit reached: writing the image of round {} (the render ending there); \
+                "{set_by} reached: writing the image of round {} (the render ending there); \
                  {kept}",
                 completed.round.index
             );
@@ -280,6 +328,39 @@ impl RenderJob {
     }
 }
 
+/// Which samples the merged units of a uniform plan hold, exactly: the sample ranges every
+/// pixel has, then each later range some tiles have, with how many of its tiles ("samples
+/// 0..64 of every pixel; 64..128 in 12 of 40 tiles"). The plan orders units by sample range.
+pub fn merged_samples(units: &[WorkUnit], is_done: impl Fn(&WorkUnit) -> bool) -> String {
+    // (sample range, its tiles, of them merged), in the plan's order.
+    let mut ranges: Vec<((u32, u32), usize, usize)> = Vec::new();
+    for unit in units {
+        let range = (unit.sample_start, unit.sample_end);
+        let merged = usize::from(is_done(unit));
+        match ranges.last_mut() {
+            Some((last, tiles, done)) if *last == range => {
+                *tiles += 1;
+                *done += merged;
+            }
+            _ => ranges.push((range, 1, merged)),
+        }
+    }
+    let whole = ranges
+        .iter()
+        .take_while(|(_, tiles, done)| done == tiles)
+        .count();
+    let mut parts = vec![match whole {
+        0 => "no sample of every pixel".to_string(),
+        n => format!("samples 0..{} of every pixel", ranges[n - 1].0 .1),
+    }];
+    for ((start, end), tiles, done) in &ranges[whole..] {
+        if *done > 0 {
+            parts.push(format!("{start}..{end} in {done} of {tiles} tiles"));
+        }
+    }
+    parts.join("; ")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,5 +391,35 @@ mod tests {
         for nothing in ["", "..", "/", "a/.."] {
             assert!(film_output_path(nothing).is_err(), "{nothing:?}");
         }
+    }
+
+    /// The merged units of a plan of 3 sample ranges over 4 tiles, said exactly: the ranges
+    /// every pixel has, then the tiles of each later range merged.
+    #[test]
+    fn merged_samples_name_the_ranges_and_tiles_held() {
+        let units: Vec<WorkUnit> = (0..12u32)
+            .map(|index| WorkUnit {
+                index,
+                x0: (index % 4) * 16,
+                y0: 0,
+                x1: (index % 4) * 16 + 16,
+                y1: 16,
+                sample_start: index / 4 * 32,
+                sample_end: index / 4 * 32 + 32,
+                mask: None,
+            })
+            .collect();
+        let held = |done: &dyn Fn(u32) -> bool| merged_samples(&units, |u| done(u.index));
+        assert_eq!(held(&|_| false), "no sample of every pixel");
+        assert_eq!(held(&|i| i < 4), "samples 0..32 of every pixel");
+        assert_eq!(
+            held(&|i| i < 5 || (9..12).contains(&i)),
+            "samples 0..32 of every pixel; 32..64 in 1 of 4 tiles; 64..96 in 3 of 4 tiles"
+        );
+        assert_eq!(
+            held(&|i| i != 0),
+            "no sample of every pixel; 0..32 in 3 of 4 tiles; 32..64 in 4 of 4 tiles; 64..96 \
+             in 4 of 4 tiles"
+        );
     }
 }

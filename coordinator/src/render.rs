@@ -16,7 +16,7 @@ use crate::checkpoint::{CheckpointFile, RenderIdentity};
 use crate::exec::distributed::config::DistributedConfig;
 use crate::exec::{distributed, in_process};
 use crate::interim::{InterimOutputs, PreviewFile};
-use crate::job::{check_output_path, film_output_path, RenderJob};
+use crate::job::{check_output_path, film_output_path, Deadline, RenderJob};
 use crate::manifest::SceneManifest;
 use crate::render_report::RenderReport;
 use crate::scene::ParsedScene;
@@ -37,8 +37,9 @@ pub struct RenderRequest {
     pub exr: bool,
     /// Where to write the sample map of an adaptive render, at the end.
     pub sample_map: Option<PathBuf>,
-    /// When an adaptive render stops at a round boundary.
-    pub deadline: Option<Instant>,
+    /// When the render stops (an adaptive one at a round boundary): the scene's `halttime`
+    /// unless the caller sets another (`--time-limit`).
+    pub deadline: Option<Deadline>,
     /// What the caller should tell the user before the render: a folder dropped from the
     /// Film's filename.
     pub warnings: Vec<String>,
@@ -48,8 +49,8 @@ impl RenderRequest {
     /// A render of `scene` with the settings `overrides` resolve from it, checked (and the
     /// film checked against the scene's memory budget), into `output_png`, or, when None, the
     /// PNG the scene's Film names in the current folder (with a warning in
-    /// [`Self::warnings`] when the scene names a folder). No EXR, sample map or deadline: set
-    /// those fields after.
+    /// [`Self::warnings`] when the scene names a folder), stopping at the scene's `halttime`
+    /// from now if it has one. No EXR or sample map: set those fields after.
     pub fn new(
         scene: ParsedScene,
         overrides: &RenderOverrides,
@@ -77,6 +78,10 @@ impl RenderRequest {
             }
         };
         check_output_path(&output_png)?;
+        let deadline = scene.desc.film.halttime.and_then(|seconds| {
+            let after = Duration::try_from_secs_f32(seconds).ok()?;
+            Deadline::after(after, format!("the scene's halttime ({seconds} s)"))
+        });
         Ok(Self {
             scene,
             settings,
@@ -84,7 +89,7 @@ impl RenderRequest {
             output_png,
             exr: false,
             sample_map: None,
-            deadline: None,
+            deadline,
             warnings,
         })
     }

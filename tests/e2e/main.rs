@@ -8,6 +8,7 @@ mod discovery;
 mod distributed;
 mod drain;
 mod files;
+mod halts;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;
 mod hostile_peer;

@@ -18,6 +18,7 @@ use super::budget::BudgetArgs;
 use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
+use crate::job::Deadline;
 use crate::render::{render, Executor, Observers, RenderRequest};
 use crate::scene::{ParsedScene, Warnings};
 use crate::shutdown::Interrupt;
@@ -68,11 +69,13 @@ pub struct RenderArgs {
     /// With --noise-threshold: the samples every pixel gets in the first round (even).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MIN_SPP, requires = "noise_threshold")]
     pub min_spp: u32,
-    /// With --noise-threshold: stop at the first round boundary after this many seconds (from
-    /// the start of the command), writing the image of the last round completed, which is the
-    /// same bytes as the render ending at that round; the checkpoint keeps every sample merged,
-    /// so the same command (with a longer or no limit) goes on from there.
-    #[arg(long, value_name = "SECONDS", requires = "noise_threshold")]
+    /// Stop after this many seconds (from the start of the command; 0: no limit), in place of
+    /// the scene's Film "halttime". A uniform render writes the image of every sample merged
+    /// and says exactly which those are; with --noise-threshold, the render stops at the first
+    /// round boundary after the limit and writes the image of the last round completed (the
+    /// same bytes as the render ending at that round). Either way the checkpoint keeps every
+    /// sample merged, so the same command (with a longer or no limit) goes on from there.
+    #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
     /// With --noise-threshold: write a PNG of the samples each pixel got (grey, log scale).
     #[arg(long, value_name = "PNG", requires = "noise_threshold")]
@@ -180,10 +183,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let checkpoint_every = every("checkpoint-every", args.checkpoint_every)?;
     let preview_every = every("preview-every", args.preview_every)?;
     let status_linger = seconds("status-linger", args.status_linger)?;
-    request.deadline = args
-        .time_limit
-        .map(|t| seconds("time-limit", t).map(|limit| started + limit))
-        .transpose()?;
+    if let Some(limit) = args.time_limit {
+        let limit = seconds("time-limit", limit)?;
+        let left = limit.saturating_sub(started.elapsed());
+        request.deadline = Deadline::after(left.max(Duration::from_nanos(1)), "--time-limit")
+            .filter(|_| !limit.is_zero());
+    }
     request.exr = args.exr;
     request.sample_map = args.sample_map.clone();
     let executor = match args.distributed.config()? {
