@@ -12,6 +12,7 @@ use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
 use crate::checkpoint::Checkpoint;
+use crate::exec::progress_log::ProgressLog;
 use crate::interim::InterimOutputs;
 use crate::scene::ParsedScene;
 use crate::shutdown::{Interrupt, Interrupted};
@@ -30,6 +31,8 @@ pub struct RenderJob {
     /// Also write linear radiance as OpenEXR next to the PNG.
     pub exr: bool,
     pub quiet: bool,
+    /// Progress lines for logs and machines (the bar aside).
+    pub progress_log: ProgressLog,
     /// The preview and the checkpoint, written as the render goes.
     pub interim: InterimOutputs,
     /// Once set (by Ctrl-C, SIGTERM or the caller), the render stops, saving what it can (the

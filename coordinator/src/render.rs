@@ -14,6 +14,7 @@ use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use crate::checkpoint::{CheckpointFile, RenderIdentity};
 use crate::exec::distributed::config::DistributedConfig;
+use crate::exec::progress_log::ProgressLog;
 use crate::exec::{distributed, in_process};
 use crate::interim::{InterimOutputs, PreviewFile};
 use crate::job::{check_output_path, film_output_path, Deadline, RenderJob};
@@ -131,6 +132,8 @@ pub struct Observers {
     pub checkpoint_every: Option<Duration>,
     /// The status page's board: progress, workers, events, the image when it is served.
     pub status: Arc<StatusBoard>,
+    /// Progress lines where there is no terminal, and JSON progress.
+    pub progress_log: ProgressLog,
 }
 
 impl Observers {
@@ -141,6 +144,7 @@ impl Observers {
             preview_every: None,
             checkpoint_every: None,
             status: StatusBoard::unserved(),
+            progress_log: ProgressLog::default(),
         }
     }
 }
@@ -208,6 +212,7 @@ fn render_and_write(
         output_png: request.output_png,
         exr: request.exr,
         quiet: observers.quiet,
+        progress_log: observers.progress_log,
         interrupt,
         deadline: request.deadline,
     };

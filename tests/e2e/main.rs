@@ -17,6 +17,7 @@ mod isa;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;
 mod memory;
+mod progress_log;
 mod resume;
 mod status;
 mod util;

@@ -18,6 +18,7 @@ use super::budget::BudgetArgs;
 use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
+use crate::exec::progress_log::{JsonTarget, ProgressLog, DEFAULT_PROGRESS_EVERY};
 use crate::job::Deadline;
 use crate::render::{render, Executor, Observers, RenderRequest};
 use crate::scene::{ParsedScene, Warnings};
@@ -104,9 +105,18 @@ pub struct RenderArgs {
     /// LatLong environment-map convention.
     #[arg(long, value_enum, default_value = "seed")]
     pub latlong: LatLongArg,
-    /// No progress bar and no summary.
+    /// No progress bar, no progress lines and no summary.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Where standard error is not a terminal (a farm's log), a progress line this often
+    /// (percent, samples/s, ETA, units, workers, requeued units), as --progress-json's objects.
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_PROGRESS_EVERY.as_secs_f64())]
+    pub progress_every: f64,
+    /// Progress as one JSON object a line (state, units and samples done and in all, samples/s,
+    /// ETA, requeued units, round, workers connected), every --progress-every and once at the
+    /// end, to this file, or to standard error with "-".
+    #[arg(long, value_name = "PATH|-")]
+    pub progress_json: Option<PathBuf>,
     /// Write the render's figures (times, samples/s, rays/s, memory) as JSON to this file.
     #[arg(long)]
     pub stats_json: Option<PathBuf>,
@@ -224,10 +234,21 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         None => None,
     };
     let interrupt = Interrupt::install()?;
+    let progress_log = ProgressLog {
+        every: seconds("progress-every", args.progress_every)?,
+        json: args.progress_json.clone().map(|path| {
+            if path.as_os_str() == "-" {
+                JsonTarget::Stderr
+            } else {
+                JsonTarget::File(path)
+            }
+        }),
+    };
     let observers = Observers {
         quiet: args.quiet,
         preview_every,
         checkpoint_every,
+        progress_log,
         status,
     };
     let output_png = request.output_png.clone();

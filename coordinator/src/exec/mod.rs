@@ -4,3 +4,4 @@
 pub mod distributed;
 pub mod in_process;
 pub mod progress;
+pub mod progress_log;

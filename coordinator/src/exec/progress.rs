@@ -1,13 +1,15 @@
 //! A render's progress, the same for every executor: on the terminal, a bar over samples that
 //! starts at what a checkpoint holds (its length an estimate an adaptive render updates each
-//! round), a status after the ETA, and lines printed above it; and the same figures (units,
-//! samples, rounds) on the job's status board.
+//! round), a status after the ETA, and lines printed above it; the same figures (units,
+//! samples, rounds) on the job's status board; and, from the board, the lines of
+//! [`super::progress_log`] where there is no terminal or JSON is asked for.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::progress_log::LogThread;
 use crate::checkpoint::Checkpoint;
 use crate::job::RenderJob;
 use crate::status::StatusBoard;
@@ -16,6 +18,7 @@ pub struct Progress {
     bar: ProgressBar,
     quiet: bool,
     board: Arc<StatusBoard>,
+    log: Mutex<Option<LogThread>>,
 }
 
 impl Progress {
@@ -31,10 +34,15 @@ impl Progress {
             total,
             done,
         );
+        let bar = Self::bar(total, done, job.quiet);
+        // Text lines where the bar cannot be drawn (and the user did not ask for quiet).
+        let lines = !job.quiet && bar.is_hidden();
+        let log = LogThread::start(board.clone(), &job.progress_log, lines);
         let progress = Self {
-            bar: Self::bar(total, done, job.quiet),
+            bar,
             quiet: job.quiet,
             board,
+            log: Mutex::new(log),
         };
         progress.round(job, checkpoint);
         progress
@@ -108,5 +116,9 @@ impl Progress {
 
     pub fn finish(&self) {
         self.bar.finish_and_clear();
+        let log = self.log.lock().ok().and_then(|mut log| log.take());
+        if let Some(log) = log {
+            log.stop();
+        }
     }
 }
