@@ -1,32 +1,15 @@
 //! Files a node keeps for itself (a coordinator's checkpoint and preview, a worker's disk cache
 //! of scene files), safe from what another local user plants in their folder: they are written
-//! to a temporary file created exclusively beside the destination (mode 0600, `O_EXCL |
-//! O_NOFOLLOW`, a random name) and renamed over it, so a crash leaves the previous file whole
-//! and a symlink or a FIFO planted at the name is replaced, never followed; and they are read
-//! only from a regular file of the expected size, not through a link, without blocking on a
-//! FIFO.
+//! to a temporary file the `tempfile` crate creates exclusively beside the destination (mode
+//! 0600, `O_EXCL`, a random name, removed unless kept) and renamed over it, so a crash leaves the
+//! previous file whole and a symlink or a FIFO planted at the name is replaced, never followed;
+//! and they are read only from a regular file of the expected size, not through a link, without
+//! blocking on a FIFO.
 
 use std::fs::File;
-use std::hash::{BuildHasher, Hasher};
 use std::io::{BufWriter, Read, Write};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
-
-/// Attempts at a fresh temporary name before giving up (each collision is a file someone put
-/// there under a name that was random).
-const NAME_ATTEMPTS: u32 = 8;
-
-/// 128 random bits as hex, from the OS-seeded keys of std's hasher.
-pub fn random_hex() -> String {
-    let state = std::collections::hash_map::RandomState::new();
-    (0..2u64)
-        .map(|i| {
-            let mut h = state.build_hasher();
-            h.write_u64(i);
-            format!("{:016x}", h.finish())
-        })
-        .collect()
-}
 
 /// Whether `name` is one of [`StagedFile`]'s temporary names (`.NAME.RANDOM.tmp`): what a crash
 /// in the middle of a write leaves behind.
@@ -37,10 +20,8 @@ pub fn is_staged_name(name: &str) -> bool {
 /// A temporary file beside its destination, created exclusively with mode 0600; removed unless
 /// committed.
 pub struct StagedFile {
-    file: File,
-    temporary: PathBuf,
+    file: tempfile::NamedTempFile,
     path: PathBuf,
-    committed: bool,
 }
 
 impl StagedFile {
@@ -52,37 +33,22 @@ impl StagedFile {
         let name = path
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-        let mut attempt = 0;
-        let (file, temporary) = loop {
-            let temporary = path.with_file_name(format!(".{name}.{}.tmp", random_hex()));
-            let created = File::options()
-                .write(true)
-                .create_new(true)
-                .mode(0o600)
-                .custom_flags(libc::O_NOFOLLOW)
-                .open(&temporary);
-            match created {
-                Ok(file) => break (file, temporary),
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    attempt += 1;
-                    if attempt == NAME_ATTEMPTS {
-                        return Err(e);
-                    }
-                }
-                Err(e) => return Err(e),
-            }
+        let folder = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
         };
-        let staged = Self {
-            file,
-            temporary,
-            path: path.to_path_buf(),
-            committed: false,
-        };
-        let mut out = BufWriter::new(&staged.file);
+        let file = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(folder)?;
+        let mut out = BufWriter::new(file.as_file());
         write(&mut out)?;
         out.flush()?;
         drop(out);
-        Ok(staged)
+        Ok(Self {
+            file,
+            path: path.to_path_buf(),
+        })
     }
 
     /// Where the file goes when committed.
@@ -91,19 +57,10 @@ impl StagedFile {
     }
 
     /// Syncs the file to disk and renames it over the destination.
-    pub fn commit(mut self) -> std::io::Result<()> {
-        self.file.sync_all()?;
-        std::fs::rename(&self.temporary, &self.path)?;
-        self.committed = true;
+    pub fn commit(self) -> std::io::Result<()> {
+        self.file.as_file().sync_all()?;
+        self.file.persist(&self.path).map_err(|e| e.error)?;
         Ok(())
-    }
-}
-
-impl Drop for StagedFile {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_file(&self.temporary);
-        }
     }
 }
 
@@ -160,9 +117,15 @@ mod tests {
         let path = dir.path().join("out.resume");
         std::os::unix::fs::symlink(&target, &path).unwrap();
         let staged = StagedFile::write(&path, |out| out.write_all(b"new")).unwrap();
-        let mode = std::fs::metadata(&staged.temporary).unwrap().mode();
+        let temporary = staged.file.path().to_path_buf();
+        let mode = std::fs::metadata(&temporary).unwrap().mode();
         assert_eq!(mode & 0o777, 0o600);
-        let temporary_name = staged.temporary.file_name().unwrap().to_str().unwrap();
+        assert_eq!(
+            temporary.parent(),
+            Some(dir.path()),
+            "staged beside its destination"
+        );
+        let temporary_name = temporary.file_name().unwrap().to_str().unwrap();
         assert!(is_staged_name(temporary_name), "{temporary_name}");
         staged.commit().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"precious");
@@ -205,9 +168,14 @@ mod tests {
     }
 
     #[test]
-    fn random_names_differ() {
-        let names: std::collections::HashSet<String> = (0..64).map(|_| random_hex()).collect();
+    fn staged_names_differ() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.png");
+        let staged: Vec<StagedFile> = (0..64)
+            .map(|_| StagedFile::write(&path, |out| out.write_all(b"x")).unwrap())
+            .collect();
+        let names: std::collections::HashSet<&Path> =
+            staged.iter().map(|s| s.file.path()).collect();
         assert_eq!(names.len(), 64);
-        assert!(names.iter().all(|n| n.len() == 32));
     }
 }

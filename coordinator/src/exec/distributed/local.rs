@@ -8,7 +8,6 @@ use std::sync::{mpsc, Mutex};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
-use yat_tracer::private_file::random_hex;
 
 /// How long a starting worker may take to print its address.
 const STARTUP_TIMEOUT: Duration = Duration::from_secs(30);
@@ -29,7 +28,7 @@ impl LocalWorker {
         let exe = std::env::current_exe().context("cannot find the yat executable")?;
         let threads = (cores / count).max(1);
         // Loopback ports are open to every local user: each render's workers get a fresh token.
-        let token = random_hex();
+        let token = random_token()?;
         (0..count)
             .map(|i| {
                 let mut child = Command::new(&exe)
@@ -98,5 +97,29 @@ impl Drop for LocalWorker {
         let mut child = self.child.lock().unwrap();
         let _ = child.kill();
         let _ = child.wait();
+    }
+}
+
+/// 128 bits from the operating system's random source, as hex: a secret no other local user
+/// can guess.
+fn random_token() -> anyhow::Result<String> {
+    let mut bytes = [0u8; 16];
+    getrandom::fill(&mut bytes)
+        .map_err(|e| anyhow::anyhow!("cannot draw a token from the system's random source: {e}"))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tokens_are_fresh_hex_secrets() {
+        let tokens: std::collections::HashSet<String> =
+            (0..64).map(|_| random_token().unwrap()).collect();
+        assert_eq!(tokens.len(), 64);
+        assert!(tokens
+            .iter()
+            .all(|t| t.len() == 32 && t.bytes().all(|b| b.is_ascii_hexdigit())));
     }
 }
