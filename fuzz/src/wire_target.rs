@@ -382,6 +382,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 filename: "fuzz".into(),
                 haltspp: None,
                 halttime: None,
+                haltthreshold: None,
             });
             7 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),

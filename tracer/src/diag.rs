@@ -33,6 +33,13 @@ pub enum Severity {
     /// The statement or parameter is not rendered as LuxRender would render it: an
     /// unsupported feature, an approximation, a fallback where LuxRender does something else.
     Differs,
+    /// A difference from LuxRender's image that is documented and accepted (it has a reason
+    /// that a fix would not outweigh): listed apart from [`Severity::Differs`], not counted.
+    Accepted,
+    /// A parameter LuxRender reads that changes nothing in its image (a sampler's, an
+    /// accelerator's or a renderer's choice, which files are written, how often): YAT's image
+    /// is the same without it.
+    NoEffect,
     /// Something about the file that does not change the image compared with LuxRender's: a
     /// parameter LuxRender ignores too, a dangling name both replace by the same default.
     Note,
@@ -84,6 +91,8 @@ impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let label = match self.severity {
             Severity::Differs => "warning",
+            Severity::Accepted => "accepted difference",
+            Severity::NoEffect => "note",
             Severity::Note => "note",
         };
         write!(f, "{}: {label}: {}", self.pos, self.message)?;

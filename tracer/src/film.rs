@@ -15,9 +15,13 @@
 //! | `filename` | string | "luxout" |
 //! | `haltspp` | integer | none |
 //! | `halttime` | float | none |
+//! | `haltthreshold` | float | none (LuxRender's -1): from 0 on, rendering halts once at most this fraction of the pixels still fails LuxRender's convergence test (a perceptual comparison of the image with itself every `convergencestep` samples per pixel); 1 halts at the first test |
 //!
-//! Every film type is read as "fleximage" (with a warning); a scene without a `Film`
-//! statement gets these defaults.
+//! LuxRender 1.x registers "multiimage" (LuxRender 0.x's film) as another name of fleximage:
+//! it is read as fleximage, and the parameters only multiimage had are ignored, as LuxRender
+//! 1.x ignores them. Any other film type fails LuxRender's scene; YAT reads it as fleximage
+//! with a warning. A scene without a `Film` statement gets these defaults. What the other
+//! parameters LuxRender reads do here: [`crate::parse::luxrender_params`].
 
 use std::path::Path;
 
@@ -36,6 +40,8 @@ pub use splats::{FilmSplats, LightSplats, SplatMisfit, SplatSums, MAX_SPLAT_PIXE
 
 /// The film type every `Film` statement is read as.
 pub const FILM_TYPE: &str = "fleximage";
+/// The other name LuxRender 1.x registers fleximage under.
+pub const FILM_ALIAS: &str = "multiimage";
 pub const DEFAULT_XRESOLUTION: i32 = 800;
 pub const DEFAULT_YRESOLUTION: i32 = 600;
 pub const DEFAULT_GAMMA: f32 = 2.2;
@@ -79,6 +85,9 @@ pub struct FilmDesc {
     pub filename: String,
     pub haltspp: Option<u32>,
     pub halttime: Option<f32>,
+    /// The fraction of pixels still failing LuxRender's convergence test at which it halts
+    /// (in [0, 1]; None when the file gives none or a negative one, LuxRender's "off").
+    pub haltthreshold: Option<f32>,
 }
 
 impl FilmDesc {
@@ -100,8 +109,11 @@ impl FilmDesc {
         pos: Option<&SourcePos>,
     ) -> Result<Self, ParseError> {
         if let Some(pos) = pos {
-            if ty != FILM_TYPE {
-                ctx.warn(pos, format!("Film \"{ty}\" is read as \"fleximage\""));
+            if ty != FILM_TYPE && ty != FILM_ALIAS {
+                ctx.warn(
+                    pos,
+                    format!("Film \"{ty}\" is not a LuxRender 1.x film (LuxRender cannot render the scene); read as \"fleximage\""),
+                );
             }
         }
         let resolution = |name: &str, default: i32| -> Result<u32, ParseError> {
@@ -141,21 +153,27 @@ impl FilmDesc {
                 ToneMap::AutoLinear
             }
         };
-        // The parameters of the kernels not chosen are legitimately present in exported files.
+        // The parameters of the kernels not chosen are legitimately present in exported files
+        // (and those of falsecolors, which is reported above where it is chosen). linear_gamma
+        // is left to the table of LuxRender's parameters: YAT's linear kernel does not read it.
         for name in [
             "linear_sensitivity",
             "linear_exposure",
             "linear_fstop",
-            "linear_gamma",
             "reinhard_prescale",
             "reinhard_postscale",
             "reinhard_burn",
             "contrast_ywa",
+            "false_method",
+            "false_colorscale",
+            "false_max",
+            "false_min",
         ] {
             params.ignore(name);
         }
         let haltspp = params.int("haltspp", -1)?;
         let halttime = params.float("halttime", -1.0)?;
+        let haltthreshold = params.float("haltthreshold", -1.0)?;
         Ok(FilmDesc {
             xresolution,
             yresolution,
@@ -164,6 +182,7 @@ impl FilmDesc {
             filename: params.string_or("filename", DEFAULT_FILENAME)?,
             haltspp: (haltspp > 0).then_some(haltspp as u32),
             halttime: (halttime > 0.0).then_some(halttime),
+            haltthreshold: (haltthreshold >= 0.0).then_some(haltthreshold.min(1.0)),
         })
     }
 }

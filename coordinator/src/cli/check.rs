@@ -1,6 +1,8 @@
 //! `yat check`: parse a scene and print a summary, then every statement or parameter that is
-//! not rendered as LuxRender would (each occurrence, with file:line:col), the notes about the
-//! file that leave the image as LuxRender's, and the count of the former.
+//! not rendered as LuxRender would (each occurrence, with file:line:col), the documented
+//! differences YAT accepts, the parameters LuxRender reads that change nothing in its image
+//! (each with why), the notes about the file that leave the image as LuxRender's, and the
+//! count of the first kind only.
 //!
 //! Exit status: 0 when the scene parses (whatever the count), 1 when it does not; with
 //! `--strict`, also 1 when the count is not 0.
@@ -67,12 +69,15 @@ fn differences(warnings: &[Warning]) -> u64 {
         .sum()
 }
 
-/// The differences, then the notes, each occurrence with its position (the first
-/// [`LISTED_PER_WARNING`] of a warning; "and N more" for the rest), then the count.
+/// The differences, the accepted differences, the parameters without effect and the notes,
+/// each occurrence with its position (the first [`LISTED_PER_WARNING`] of a warning; "and N
+/// more" for the rest), then the count of the differences.
 fn listing(warnings: &[Warning], differences: u64) -> String {
     let mut s = String::new();
     for (severity, title) in [
         (Severity::Differs, "not rendered as LuxRender would"),
+        (Severity::Accepted, "documented differences (accepted)"),
+        (Severity::NoEffect, "no effect on the image"),
         (Severity::Note, "notes (rendered as LuxRender would)"),
     ] {
         let of_kind: Vec<&Warning> = warnings.iter().filter(|w| w.severity == severity).collect();
@@ -250,6 +255,10 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         (Some(n), _) => format!(", haltspp {n}"),
         (None, Some(t)) => format!(", halttime {t} s"),
         (None, None) => String::new(),
+    };
+    let halt = match f.haltthreshold {
+        Some(threshold) => format!("{halt}, haltthreshold {threshold}"),
+        None => halt,
     };
     let _ = writeln!(
         s,

@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 
 use super::context::{BoundTexture, ImageUse, ParseContext};
 use super::error::ParseError;
-use super::luxrender_ignores::luxrender_ignores;
+use super::luxrender_params::{verdict, Verdict};
 use super::options::OptionsState;
 use super::params::ParamList;
 use super::reader::Reader;
@@ -130,36 +130,6 @@ pub struct Builder<'s> {
     /// Image textures counted against the memory budget, by (path, gamma's bits): each is
     /// decoded once.
     texture_images: HashSet<(String, u32)>,
-}
-
-/// Exporter parameters the seed scenes (LuxBlend) write everywhere and that change nothing
-/// this renderer does; they are accepted silently.
-fn is_exporter_param(name: &str) -> bool {
-    name.starts_with("write_")
-        || name.starts_with("colorspace_")
-        || matches!(
-            name,
-            "restart_resume_flm"
-                | "ldr_clamp_method"
-                | "displayinterval"
-                | "writeinterval"
-                | "flmwriteinterval"
-                | "outlierrejection_k"
-                | "tilecount"
-                | "premultiplyalpha"
-                | "importance"
-                | "nsamples"
-                | "flipz"
-                | "generatetangents"
-                | "discardmipmaps"
-                | "maxanisotropy"
-                | "filtertype"
-                | "shutteropen"
-                | "shutterclose"
-                | "shutterdistribution"
-                | "separable"
-                | "filmindex"
-        )
 }
 
 impl<'s> Builder<'s> {
@@ -946,24 +916,12 @@ impl ParseContext for Builder<'_> {
     }
 
     fn warn_unused(&mut self, params: &ParamList) {
-        let unused: Vec<(bool, String, Pos)> = params
-            .unused()
-            .filter(|p| !is_exporter_param(&p.name))
-            .map(|p| {
-                let ignored = luxrender_ignores(&params.statement, &p.name);
-                (ignored, p.decl(), p.pos.clone())
-            })
-            .collect();
-        for (luxrender_ignores_it, decl, pos) in unused {
-            let key = format!("param|{}|{decl}", params.statement);
-            let statement = &params.statement;
-            if luxrender_ignores_it {
-                let message =
-                    format!("{statement}: \"{decl}\" is ignored, as LuxRender ignores it");
-                self.note_once(key, &pos, message);
-            } else {
-                let message = format!("{statement}: unknown parameter \"{decl}\" ignored");
-                self.warn_once(key, &pos, message);
+        for p in &params.params {
+            if let Some(Verdict { severity, message }) = verdict(params, p) {
+                // One kind per statement, parameter and verdict: a parameter's later
+                // occurrences are listed as positions of its first.
+                let key = format!("param|{severity:?}|{}|{}", params.statement, p.decl());
+                self.diagnose(severity, key, &p.pos, message);
             }
         }
     }

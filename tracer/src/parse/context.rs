@@ -55,6 +55,12 @@ pub trait ParseContext {
         self.diagnose(Severity::Differs, key, pos, message);
     }
 
+    /// A difference from LuxRender's image that is documented and accepted, of kind `key`:
+    /// listed apart from the differences, and not counted as one.
+    fn accepted_once(&mut self, key: String, pos: &SourcePos, message: String) {
+        self.diagnose(Severity::Accepted, key, pos, message);
+    }
+
     /// Something about the file that leaves the image as LuxRender would render it (the same
     /// fallback, a parameter it ignores too); occurrences with the same message are one kind.
     fn note(&mut self, pos: &SourcePos, message: String) {
@@ -124,8 +130,9 @@ pub trait ParseContext {
         pos: &SourcePos,
     ) -> Result<Vec<f32>, ParseError>;
 
-    /// Warns (once per statement type and parameter) about parameters nothing read, except
-    /// the exporter parameters that change nothing.
+    /// Reports (once per statement type and parameter) what the table of LuxRender's
+    /// parameters says of the statement's ([`super::luxrender_params::verdict`]): parameters
+    /// nothing read, and those read by LuxRender that change nothing in its image.
     fn warn_unused(&mut self, params: &ParamList);
 
     /// Resolves a texture-or-constant parameter; an undefined texture name (or a fresnel

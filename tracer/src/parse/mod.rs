@@ -23,7 +23,7 @@ mod builder;
 pub(crate) mod context;
 pub(crate) mod error;
 mod lexer;
-mod luxrender_ignores;
+pub(crate) mod luxrender_params;
 mod options;
 pub(crate) mod params;
 mod reader;

@@ -83,8 +83,10 @@ impl Blender {
             base: Base::read(decl, params, pos, ctx)?,
             kind,
         };
+        // Accepted, on purpose (see noise_basis): YAT does not copy Blender's tabulated random
+        // numbers, so a pattern has Blender's character but its features sit elsewhere.
         if blender.uses_noise_tables() {
-            ctx.warn_once(
+            ctx.accepted_once(
                 format!("{class} noise"),
                 pos,
                 format!("{class}: YAT's noise bases have Blender's character but not its random tables, so the pattern's features are not where LuxRender puts them"),
