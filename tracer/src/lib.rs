@@ -46,6 +46,7 @@ pub mod shape;
 pub mod spectra;
 pub mod texture;
 pub mod vec3_lanes;
+pub mod wavelength;
 
 /// This build of the renderer: a hash of its sources and of the workspace's manifest and locked
 /// dependencies (tracer/build.rs). Builds with the same name render the same bits on any CPU

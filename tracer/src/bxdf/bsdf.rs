@@ -8,6 +8,7 @@ use super::coat_over_base::Coating;
 use super::sample::LocalSample;
 use super::Bxdf;
 use crate::math::{Cone, Frame};
+use crate::wavelength::Wavelength;
 
 /// A sampled scattering direction.
 #[derive(Clone, Copy, Debug)]
@@ -82,6 +83,36 @@ impl Bsdf {
         };
         let f = d.lambert_value()?;
         (f != Vec3::ZERO && f.is_finite()).then_some((self.frame, self.ng, f))
+    }
+
+    /// Whether the BSDF bends each wavelength its own way ([`Dielectric::is_dispersive`](super::dielectric::Dielectric::is_dispersive)):
+    /// a path takes one wavelength here ([`Self::disperse`]).
+    pub fn is_dispersive(&self) -> bool {
+        matches!(&self.bxdf, Bxdf::Dielectric(d) if d.is_dispersive())
+    }
+
+    /// The BSDF as a path meets it: a dispersive one takes the path's wavelength (`carried`),
+    /// or, at the path's first dispersive vertex, draws it from `number()` and returns the RGB
+    /// weight the path carries from here on ([`crate::wavelength`]). Any other is left as it is.
+    pub fn disperse(
+        &mut self,
+        carried: &mut Option<Wavelength>,
+        number: impl FnOnce() -> f32,
+    ) -> Option<Vec3> {
+        let Bxdf::Dielectric(d) = &mut self.bxdf else {
+            return None;
+        };
+        if !d.is_dispersive() {
+            return None;
+        }
+        let mut drawn = None;
+        let wavelength = *carried.get_or_insert_with(|| {
+            let w = Wavelength::draw(number());
+            drawn = Some(w.weight);
+            w
+        });
+        d.at_wavelength(wavelength.nm);
+        drawn
     }
 
     /// True when every lobe is specular (light sampling is useless here).

@@ -15,6 +15,9 @@ use super::microfacet::TrowbridgeReitz;
 use super::lobe::Lobe;
 use super::sample::LocalSample;
 use super::thin_film::ThinFilm;
+use crate::wavelength::cauchy_index;
+#[cfg(doc)]
+use crate::wavelength::CAUCHY_B_PER_UM2;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Surface {
@@ -35,9 +38,28 @@ pub struct Dielectric {
     /// Interference on the smooth or thin surface's reflection (LuxRender's glass; its rough
     /// glass has none).
     pub film: Option<ThinFilm>,
+    /// Cauchy's B in nm^2 (LuxRender's `cauchyb` times [`CAUCHY_B_PER_UM2`]): the index at a
+    /// path's wavelength is `eta + cauchy_b / nm^2` ([`Self::at_wavelength`]). 0: none.
+    pub cauchy_b: f32,
 }
 
 impl Dielectric {
+    /// Whether the interface bends each wavelength its own way, so a path crossing it takes
+    /// one wavelength ([`crate::wavelength`]). A pane does not bend light: its dispersion
+    /// changes only its faces' reflectance, by a few parts in a thousand, which is left out.
+    pub fn is_dispersive(&self) -> bool {
+        self.cauchy_b != 0.0 && !matches!(self.surface, Surface::Thin)
+    }
+
+    /// The interface as a path of wavelength `nm` meets it: Cauchy's index there.
+    pub fn at_wavelength(&mut self, nm: f32) {
+        let eta = cauchy_index(self.eta, self.cauchy_b, nm);
+        // A negative B can take the index through zero: no interface then, as a non-positive
+        // index is everywhere else.
+        self.eta = if eta > 0.0 && eta.is_finite() { eta } else { 1.0 };
+        self.cauchy_b = 0.0;
+    }
+
     /// The tint of the mirror reflection at `cos` to the normal: Kr, and the film's
     /// interference over it.
     fn reflected_tint(&self, cos: f32) -> Vec3 {

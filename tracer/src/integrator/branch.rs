@@ -100,6 +100,7 @@ fn continuation<S: PathScene>(
         pass_through: 0,
         may_split: point.may_split,
         branches: 1,
+        wavelength: point.wavelength,
         // Counted `count` times against the light sample (the split's way, with the share
         // already in the throughput). A broad BSDF's samples are not specular: no mirror
         // follows.

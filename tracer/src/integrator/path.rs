@@ -52,6 +52,7 @@ pub(super) fn walk<S: PathScene>(
         mut may_split,
         mut branches,
         mut prev,
+        mut wavelength,
     } = state;
     let mut rays = 0u32;
 
@@ -131,7 +132,10 @@ pub(super) fn walk<S: PathScene>(
         // light sample's too (and does not use them): the dimension layout of a vertex stays
         // fixed whatever the material.
         let u = sampler.get_vertex();
-        let bsdf = scene.bsdf_at(&hit, u.mix);
+        let mut bsdf = scene.bsdf_at(&hit, u.mix);
+        if let Some(weight) = bsdf.disperse(&mut wavelength, || sampler.wavelength_number()) {
+            throughput *= weight;
+        }
         let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
             throughput *= transmittance;
@@ -193,6 +197,7 @@ pub(super) fn walk<S: PathScene>(
                 count: branches,
                 radiance,
                 rays,
+                wavelength,
             });
         }
         if !bsdf.is_specular() {

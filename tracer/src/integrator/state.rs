@@ -7,6 +7,7 @@ use crate::geometry::SurfaceHit;
 use crate::material::Bsdf;
 use crate::math::Ray;
 use crate::medium::{MediumId, ShapeMedia};
+use crate::wavelength::Wavelength;
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
 /// null faces).
@@ -40,6 +41,9 @@ pub(super) struct PathState {
     /// specular (1 after that).
     pub(super) branches: usize,
     pub(super) prev: PrevScatter,
+    /// The wavelength the path took at its first dispersive vertex (its weight is in the
+    /// throughput from there on).
+    pub(super) wavelength: Option<Wavelength>,
 }
 
 impl PathState {
@@ -56,6 +60,7 @@ impl PathState {
             branches,
             // The camera ray counts as specular: emitters it sees are taken at full weight.
             prev: PrevScatter::plain(ray.origin, 0.0, true),
+            wavelength: None,
         }
     }
 }
@@ -127,4 +132,5 @@ pub(super) struct BranchPoint {
     /// continuations', as a packet adds its lanes' (the order of float sums is in the bits).
     pub(super) radiance: Vec3,
     pub(super) rays: u32,
+    pub(super) wavelength: Option<Wavelength>,
 }

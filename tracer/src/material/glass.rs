@@ -14,7 +14,7 @@
 //! | `architectural` | bool | false: a thin pane (a window) that does not bend light; shadow rays cross it with its straight transmittance, as LuxRender's do ([`crate::integrator::Crossing::Pane`]) |
 //! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
 //! | `film`, `filmindex` | float textures, glass only | thin-film interference on the reflection, as LuxRender's ([`super::film`]); LuxRender's roughglass and glass2 have none |
-//! | `cauchyb` | float | 0; not supported (a warning otherwise) |
+//! | `cauchyb` | float texture, glass and roughglass | 0: Cauchy's B in um^2, the index at wavelength l being `index + cauchyb / l^2` (LuxRender's formula): a path crossing the interface takes one wavelength there ([`crate::wavelength`]); on architectural glass, which does not bend light, it is left out |
 //! | `dispersion` | bool, glass2 only | ignored |
 //!
 //! A non-positive index is treated as no interface (index 1).
@@ -29,6 +29,7 @@ use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::wavelength::CAUCHY_B_PER_UM2;
 
 pub const DEFAULT_KR: f32 = 1.0;
 pub const DEFAULT_KT: f32 = 1.0;
@@ -45,6 +46,8 @@ pub struct Glass {
     pub kr: ConstOrTexture,
     pub kt: ConstOrTexture,
     pub index: ConstOrTexture,
+    /// Cauchy's B, um^2 (0: no dispersion).
+    pub cauchyb: ConstOrTexture,
     pub architectural: bool,
     pub uroughness: ConstOrTexture,
     pub vroughness: ConstOrTexture,
@@ -91,7 +94,6 @@ impl Glass {
         } else {
             0.0
         };
-        ctx.unsupported_unless(params, "cauchyb", 0.0);
         let glass2 = ty == "glass2";
         if glass2 {
             params.ignore("dispersion");
@@ -115,6 +117,11 @@ impl Glass {
             } else {
                 ConstOrTexture::float(0.0)
             },
+            cauchyb: if glass2 {
+                ConstOrTexture::float(0.0)
+            } else {
+                ctx.float_param(params, "cauchyb", 0.0)?
+            },
             index_from_volumes: glass2,
             film: if ty == "glass" {
                 FilmParams::read(params, ctx)?
@@ -132,6 +139,7 @@ impl MaterialKind for Glass {
             &self.kr,
             &self.kt,
             &self.index,
+            &self.cauchyb,
             &self.uroughness,
             &self.vroughness,
             film,
@@ -156,6 +164,17 @@ impl MaterialKind for Glass {
             eta: if eta > 0.0 { eta } else { 1.0 },
             surface,
             film: self.film.at(eval),
+            cauchy_b: dispersion(eval.float(self.cauchyb)),
         })
+    }
+}
+
+/// `cauchyb` (um^2) as the BxDF's B (nm^2); a value that is not a number is none.
+fn dispersion(cauchyb: f32) -> f32 {
+    let b = cauchyb * CAUCHY_B_PER_UM2;
+    if b.is_finite() {
+        b
+    } else {
+        0.0
     }
 }

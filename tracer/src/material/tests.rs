@@ -89,6 +89,7 @@ fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
         kr: c(1.0),
         kt: c(1.0),
         index: c(index),
+        cauchyb: c(0.0),
         architectural,
         uroughness: c(roughness),
         vroughness: c(roughness),

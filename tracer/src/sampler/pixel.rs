@@ -33,6 +33,10 @@ const BRANCH_KEY: u64 = 0x6272_616e_6368_0000;
 /// camera path's and its branches'.
 const LIGHT_SUBPATH_KEY: u64 = 0x6c69_6768_7470_6174;
 
+/// Keys a sample's wavelength number ([`PixelSampler::wavelength_number`]) apart from its
+/// stream's dimensions.
+const WAVELENGTH_KEY: u64 = 0x7761_7665_6c65_6e67;
+
 /// The first block of [`PixelSampler::nested`]'s indices: the default first round of an
 /// adaptive render, so that rounds of that default are exactly the blocks.
 pub const NESTED_FIRST_BLOCK: u32 = 16;
@@ -126,6 +130,15 @@ impl PixelSampler {
             dimension_key: 0,
             ..self.clone()
         }
+    }
+
+    /// The number this sample's wavelength is drawn from ([`crate::wavelength`]), for a path
+    /// that meets a dispersive interface: a dimension keyed apart from the stream's, so drawing
+    /// it moves no other dimension (and the light subpath's stream, keyed apart itself, sees
+    /// the camera path's wavelength through the caller), stratified over the pixel's samples.
+    pub fn wavelength_number(&self) -> f32 {
+        let hash = mix64(self.pixel_hash ^ WAVELENGTH_KEY);
+        point_1d(self.sobol_index(hash as u32), hash)
     }
 
     /// The stream of branch `k` of this sample's path: the same dimensions, scrambled and

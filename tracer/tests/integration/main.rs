@@ -9,6 +9,7 @@ mod bump_render;
 mod camera_lens;
 mod daylight;
 mod direct_lighting;
+mod dispersion;
 mod estimates;
 mod geometry_on_scenes;
 mod glossy_lossy;

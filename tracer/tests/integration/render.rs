@@ -93,14 +93,21 @@ pub fn render_whole(
     spp: u32,
     resolution: Option<(u32, u32)>,
 ) -> Film {
-    let settings = RenderSettings::resolve(
-        desc,
-        &yat_tracer::render::RenderOverrides {
-            spp: Some(spp),
-            resolution,
-            ..Default::default()
-        },
-    );
+    let overrides = yat_tracer::render::RenderOverrides {
+        spp: Some(spp),
+        resolution,
+        ..Default::default()
+    };
+    render_whole_with(desc, source, &overrides)
+}
+
+/// [`render_whole`] with any overrides (the integrator, the seed, ...).
+pub fn render_whole_with(
+    desc: &SceneDesc,
+    source: &dyn yat_tracer::assets::AssetSource,
+    overrides: &yat_tracer::render::RenderOverrides,
+) -> Film {
+    let settings = RenderSettings::resolve(desc, overrides);
     let scene = RenderScene::build(desc, source, &settings).expect("scene builds");
     let mut film = Film::new(scene.frame());
     for unit in plan_units(&settings) {

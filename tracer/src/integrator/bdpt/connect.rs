@@ -126,6 +126,7 @@ pub(super) fn camera_samples_light<S: BidirectionalScene>(
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
         delta: false,
+        dispersed: false,
     };
     let prev = &camera[t - 2];
     let light = [Densities {
@@ -174,6 +175,7 @@ pub(super) fn camera_sees_light_vertex<S: BidirectionalScene>(
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
         delta: false,
+        dispersed: false,
     };
     let prev = &light[s - 2];
     let (mut lig, n) = densities(&light[..s]);

@@ -42,7 +42,7 @@ use glam::Vec3;
 
 use self::scene::MAX_VERTICES;
 use self::vertex::{Carries, Kind, LightVertex, PathVertex};
-use self::walk::{walk, CrossedEmitter};
+use self::walk::{walk, CrossedEmitter, SampleWavelength};
 use self::weight::Limits;
 use super::state::PathResult;
 use crate::integrator::shadow::shadow_transmittance;
@@ -94,6 +94,10 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
     crossed.clear();
     let mut rays = 0;
     let mut light_sampler = sampler.light_subpath();
+    let mut wavelength = SampleWavelength {
+        number: sampler.wavelength_number(),
+        drawn: None,
+    };
     if let Some(ray) = camera_ray {
         camera.push(PathVertex {
             kind: Kind::Camera,
@@ -103,6 +107,7 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
             delta: false,
+            dispersed: false,
         });
         rays += walk(
             scene,
@@ -115,26 +120,50 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
             limits.max_camera,
             Carries::Radiance,
             integrator.eye_rr_threshold,
+            &mut wavelength,
             sampler,
         );
     }
-    rays += light_subpath(scene, light, limits.max_light, &mut light_sampler);
+    rays += light_subpath(
+        scene,
+        light,
+        limits.max_light,
+        &mut wavelength,
+        &mut light_sampler,
+    );
 
+    let w = &wavelength;
     let mut radiance = Vec3::ZERO;
     for t in 2..=camera.len() {
-        radiance += connect::camera_hits_light(scene, &camera[..t - 1], &camera[t - 1], limits);
-        if t < camera.len() || !camera[t - 1].at_infinity() {
-            radiance += connect::camera_samples_light(scene, camera, t, limits, &mut rays);
+        let pt = &camera[t - 1];
+        radiance += w.weigh(
+            camera[t - 2].dispersed,
+            connect::camera_hits_light(scene, &camera[..t - 1], pt, limits),
+        );
+        if t < camera.len() || !pt.at_infinity() {
+            radiance += w.weigh(
+                pt.dispersed,
+                connect::camera_samples_light(scene, camera, t, limits, &mut rays),
+            );
         }
         for s in 2..=light.len() {
-            radiance += connect::join(scene, light, s, camera, t, limits, &mut rays);
+            radiance += w.weigh(
+                pt.dispersed || light[s - 1].dispersed,
+                connect::join(scene, light, s, camera, t, limits, &mut rays),
+            );
         }
     }
     for c in crossed.iter() {
-        radiance += connect::camera_hits_light(scene, &camera[..c.at], &c.vertex, limits);
+        radiance += w.weigh(
+            camera[c.at - 1].dispersed,
+            connect::camera_hits_light(scene, &camera[..c.at], &c.vertex, limits),
+        );
     }
     for s in 2..=light.len() {
-        if let Some(splat) = connect::camera_sees_light_vertex(scene, light, s, limits, &mut rays) {
+        if let Some(mut splat) =
+            connect::camera_sees_light_vertex(scene, light, s, limits, &mut rays)
+        {
+            splat.radiance = w.weigh(light[s - 1].dispersed, splat.radiance);
             splats.push(splat);
         }
     }
@@ -146,6 +175,7 @@ fn light_subpath<S: BidirectionalScene>(
     scene: &S,
     light: &mut Vec<PathVertex>,
     max_vertices: usize,
+    wavelength: &mut SampleWavelength,
     sampler: &mut PixelSampler,
 ) -> u32 {
     let lights = scene.lights();
@@ -176,6 +206,7 @@ fn light_subpath<S: BidirectionalScene>(
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
         delta: false,
+        dispersed: false,
     };
     start.pdf_fwd = start.pdf_light_origin(scene, &start);
     light.push(start);
@@ -217,6 +248,7 @@ fn light_subpath<S: BidirectionalScene>(
         max_vertices,
         Carries::Importance,
         scene.integrator().light_rr_threshold,
+        wavelength,
         sampler,
     )
 }

@@ -47,6 +47,9 @@ pub(super) struct PathVertex {
     pub(super) pdf_rev: f32,
     /// Whether the subpath scattered specularly here: no strategy connects at such a vertex.
     pub(super) delta: bool,
+    /// Whether the subpath met a dispersive interface here or before: a path joined at this
+    /// vertex carries the sample's wavelength weight ([`super::walk::SampleWavelength`]).
+    pub(super) dispersed: bool,
 }
 
 // Most vertices are surfaces, kept in a subpath's vector allocated once per unit: boxing the

@@ -22,6 +22,7 @@ use crate::material::Bsdf;
 use crate::math::{luminance, offset_origin, Ray};
 use crate::medium::{Flight, MediumId, ShapeMedia};
 use crate::sampler::{PixelSampler, VertexSamples};
+use crate::wavelength::Wavelength;
 
 /// The rule of LuxRender's bidirectional roulette: a subpath goes on past a vertex with
 /// probability `min(1, max(threshold, luminance of the BSDF sample's weight))` (the weight
@@ -29,6 +30,27 @@ use crate::sampler::{PixelSampler, VertexSamples};
 /// its density in a volume). Not at the first vertex.
 fn survival(threshold: f32, weight: Vec3) -> f32 {
     luminance(weight).max(threshold).min(1.0)
+}
+
+/// A sample's wavelength, shared by its camera and light subpaths: drawn from `number` (the
+/// camera stream's [`PixelSampler::wavelength_number`]) at the first dispersive vertex either
+/// subpath meets, so that a path joined from both has one wavelength. Unlike the path tracer's
+/// paths, subpaths do not carry its weight in their throughput (a path joined from two that
+/// both met dispersion would take it twice): the strategies' contributions take it once,
+/// where a vertex they join at is [`PathVertex::dispersed`].
+pub(super) struct SampleWavelength {
+    pub(super) number: f32,
+    pub(super) drawn: Option<Wavelength>,
+}
+
+impl SampleWavelength {
+    /// `contribution` of a path that met dispersion (`dispersed`) or not.
+    pub(super) fn weigh(&self, dispersed: bool, contribution: Vec3) -> Vec3 {
+        match self.drawn {
+            Some(w) if dispersed => contribution * w.weight,
+            _ => contribution,
+        }
+    }
 }
 
 /// An emitter a camera subpath crossed (a lamp of null material, a glowing pane): the vertex
@@ -58,9 +80,11 @@ pub(super) fn walk<S: BidirectionalScene>(
     max_vertices: usize,
     carries: Carries,
     rr_threshold: f32,
+    wavelength: &mut SampleWavelength,
     sampler: &mut PixelSampler,
 ) -> u32 {
     let mut rays = 0;
+    let mut dispersed = path.last().is_some_and(|v| v.dispersed);
     // The solid-angle density of `ray`'s direction (unused after the camera or a light, whose
     // own densities give the first vertex's).
     let mut pdf_dir = 0.0;
@@ -104,6 +128,7 @@ pub(super) fn walk<S: BidirectionalScene>(
                         pdf_fwd: 0.0,
                         pdf_rev: 0.0,
                         delta: false,
+                        dispersed,
                     };
                     vertex.pdf_fwd = first_or_next(scene, path, &prev, pdf_dir, &vertex);
                     path.push(vertex);
@@ -135,6 +160,7 @@ pub(super) fn walk<S: BidirectionalScene>(
                     pdf_fwd: 0.0,
                     pdf_rev: 0.0,
                     delta: false,
+                    dispersed,
                 };
                 vertex.pdf_fwd = first_or_next(scene, path, prev, pdf_dir, &vertex);
                 path.push(vertex);
@@ -143,7 +169,12 @@ pub(super) fn walk<S: BidirectionalScene>(
         };
         let wo = -ray.dir;
         let u = sampler.get_vertex();
-        let bsdf = scene.bsdf_at(&hit, u.mix);
+        let mut bsdf = scene.bsdf_at(&hit, u.mix);
+        if bsdf.is_dispersive() {
+            let number = wavelength.number;
+            bsdf.disperse(&mut wavelength.drawn, || number);
+            dispersed = true;
+        }
         let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
             if carries == Carries::Radiance
@@ -152,7 +183,7 @@ pub(super) fn walk<S: BidirectionalScene>(
                 && scene.lights().emitted(&hit, wo) != Vec3::ZERO
             {
                 let prev = path.last().expect("a walk starts from a vertex");
-                let mut vertex = surface_vertex(hit, bsdf, wo, sides, u, beta);
+                let mut vertex = surface_vertex(hit, bsdf, wo, sides, u, beta, dispersed);
                 vertex.pdf_fwd = first_or_next(scene, path, prev, pdf_dir, &vertex);
                 let at = path.len();
                 crossed.push(CrossedEmitter { at, vertex });
@@ -168,7 +199,7 @@ pub(super) fn walk<S: BidirectionalScene>(
         }
         pass_through = 0;
         let prev = *path.last().expect("a walk starts from a vertex");
-        let mut vertex = surface_vertex(hit, bsdf, wo, sides, u, beta);
+        let mut vertex = surface_vertex(hit, bsdf, wo, sides, u, beta, dispersed);
         vertex.pdf_fwd = first_or_next(scene, path, &prev, pdf_dir, &vertex);
         path.push(vertex);
         let Some((pdf, wi)) = scatter_on(path, max_vertices, carries, rr_threshold, &mut beta)
@@ -190,6 +221,7 @@ fn surface_vertex(
     sides: ShapeMedia,
     u: VertexSamples,
     beta: Vec3,
+    dispersed: bool,
 ) -> PathVertex {
     PathVertex {
         kind: Kind::Surface(SurfaceVertex {
@@ -205,6 +237,7 @@ fn surface_vertex(
         pdf_fwd: 0.0,
         pdf_rev: 0.0,
         delta: false,
+        dispersed,
     }
 }
 

@@ -120,6 +120,8 @@ impl<L: Lanes> Packet<L> {
             may_split: self.may_split,
             branches: self.branches,
             prev: self.prev_scatter(i, parts),
+            // A dispersive vertex is never shaded in lanes: a path takes its wavelength alone.
+            wavelength: None,
         }
     }
 
@@ -486,7 +488,9 @@ pub(super) fn walk_packet<S: PathScene, L: Lanes>(
                         parts: &parts,
                         bsdf_count,
                     };
-                    !bsdf.is_pass_through() && hits.meet(scene, packet, &at, hit, &bsdf, &u)
+                    !bsdf.is_pass_through()
+                        && !bsdf.is_dispersive()
+                        && hits.meet(scene, packet, &at, hit, &bsdf, &u)
                 }
                 _ => false,
             };
