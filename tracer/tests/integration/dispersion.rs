@@ -170,6 +170,7 @@ fn a_prism_spreads_the_spectrum_where_snell_puts_each_wavelength() {
         let film = render(&text, spp, transport);
         let (got_at, got_total) = moments(&measured(&film));
         let spread = (got_at.x - got_at.z, want_at.x - want_at.z);
+        eprintln!("{transport:?}: centroids {got_at}, predicted {want_at} (columns)");
         assert!(
             (got_at - want_at).abs().max_element() < 0.5
                 && (spread.0 / spread.1 - 1.0).abs() < 0.03,
