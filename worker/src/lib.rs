@@ -18,6 +18,8 @@ mod grpc;
 pub mod http;
 mod loaded_scene;
 mod log_limit;
+mod metrics;
+mod metrics_server;
 mod node;
 mod pool;
 pub mod prometheus_text;
