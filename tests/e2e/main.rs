@@ -21,5 +21,6 @@ mod progress_log;
 mod resume;
 mod status;
 mod util;
+mod worker_metrics;
 #[path = "../fixtures/workspace.rs"]
 mod workspace;

@@ -59,6 +59,14 @@ impl BlobStore {
         }
     }
 
+    /// Bytes held in memory, and in the cache folder when there is one.
+    pub fn held_bytes(&self) -> HeldBytes {
+        HeldBytes {
+            memory: self.memory.lock().unwrap().bytes,
+            disk: self.disk.as_ref().map(|d| d.entries.lock().unwrap().bytes),
+        }
+    }
+
     /// The blob's bytes, from memory or from disk. A disk file whose content no longer hashes
     /// to its name is dropped and reported missing.
     pub fn get(&self, hash: &str) -> std::io::Result<Option<Arc<[u8]>>> {
@@ -85,6 +93,14 @@ impl BlobStore {
         self.memory.lock().unwrap().insert(hash, bytes);
         Ok(())
     }
+}
+
+/// What a [`BlobStore`] holds, in bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HeldBytes {
+    pub memory: u64,
+    /// `None` without a cache folder.
+    pub disk: Option<u64>,
 }
 
 /// Blobs in memory, evicted least recently used first beyond a byte budget. A blob larger than

@@ -10,6 +10,10 @@
 //! process or the system (EMFILE, ENFILE, ENOBUFS, ENOMEM) back off from
 //! [`FIRST_BACKOFF`] to [`LAST_BACKOFF`] and report NOT_SERVING until an accept succeeds. Its
 //! warnings are rate-limited, so a flood writes a line per cause per interval.
+//!
+//! Each connection is counted while it is open (and once authenticated), and each one closed
+//! for admission, the handshake deadline or a token check that failed is counted under its
+//! reason (`metrics.rs`).
 
 use std::future::Future;
 use std::io;
@@ -31,6 +35,7 @@ use yat_proto::auth::RequireToken;
 use crate::admission::{Admission, ConnectionStanding};
 use crate::availability::Availability;
 use crate::log_limit::{LogLimit, LOG_INTERVAL};
+use crate::metrics::{Metrics, OpenConnection, Refusal};
 
 /// Idle time before the kernel's TCP keepalive probes a silent peer.
 const TCP_KEEPALIVE: Duration = Duration::from_secs(60);
@@ -56,6 +61,7 @@ pub struct Acceptor {
     pub admission: Arc<Admission>,
     pub timeouts: ConnectionTimeouts,
     pub availability: Arc<Availability>,
+    pub metrics: Arc<Metrics>,
 }
 
 struct AcceptLoop {
@@ -109,6 +115,7 @@ impl AcceptLoop {
             };
             self.backoff = FIRST_BACKOFF;
             self.acceptor.availability.set_accepting(true).await;
+            self.acceptor.metrics.connection_accepted();
             if let Err(error) = configure(&stream) {
                 self.log.warn(
                     "socket options",
@@ -118,12 +125,17 @@ impl AcceptLoop {
             }
             match self.acceptor.admission.admit(peer.ip()) {
                 Ok(standing) => {
-                    return Connection::new(stream, self.acceptor.timeouts, standing, slot);
+                    let metrics = self.acceptor.metrics.clone();
+                    let timeouts = self.acceptor.timeouts;
+                    return Connection::new(stream, timeouts, standing, slot, metrics);
                 }
-                Err(full) => self.log.warn(
-                    "peer over its allowance",
-                    format_args!("connection closed at once: {full}"),
-                ),
+                Err(full) => {
+                    self.acceptor.metrics.refused(Refusal::AddressFull);
+                    self.log.warn(
+                        "peer over its allowance",
+                        format_args!("connection closed at once: {full}"),
+                    )
+                }
             }
         }
     }
@@ -183,8 +195,42 @@ pub struct Connection {
     idle_deadline: Pin<Box<Sleep>>,
     /// Until a request on it passes the token check.
     handshake_deadline: Option<Pin<Box<Sleep>>>,
+    /// Why it is closing, once it is (counted once, reported to every later read).
+    closing: Option<Closing>,
     standing: ConnectionStanding,
+    metrics: Arc<Metrics>,
+    /// Counts the connection as open, and as authenticated once it is.
+    open: OpenConnection,
     _slot: OwnedSemaphorePermit,
+}
+
+/// Why a connection that never authenticated is closed.
+#[derive(Clone, Copy, Debug)]
+enum Closing {
+    Evicted,
+    HandshakeDeadline,
+}
+
+impl Closing {
+    fn refusal(self) -> Refusal {
+        match self {
+            Closing::Evicted => Refusal::UnauthenticatedEvicted,
+            Closing::HandshakeDeadline => Refusal::HandshakeTimeout,
+        }
+    }
+
+    fn error(self) -> io::Error {
+        match self {
+            Closing::Evicted => io::Error::new(
+                io::ErrorKind::ConnectionAborted,
+                "closed before it authenticated, to make room for a newer connection",
+            ),
+            Closing::HandshakeDeadline => io::Error::new(
+                io::ErrorKind::TimedOut,
+                "no authenticated request before the handshake deadline",
+            ),
+        }
+    }
 }
 
 impl Connection {
@@ -193,38 +239,44 @@ impl Connection {
         timeouts: ConnectionTimeouts,
         standing: ConnectionStanding,
         slot: OwnedSemaphorePermit,
+        metrics: Arc<Metrics>,
     ) -> Self {
         Self {
             stream,
             idle: timeouts.idle,
             idle_deadline: Box::pin(tokio::time::sleep(timeouts.idle)),
             handshake_deadline: Some(Box::pin(tokio::time::sleep(timeouts.handshake))),
+            closing: None,
             standing,
+            open: metrics.open_connection(),
+            metrics,
             _slot: slot,
         }
     }
 
     /// Why the connection is to close now, if it is.
     fn poll_closing(&mut self, cx: &mut Context<'_>) -> Option<io::Error> {
+        if let Some(closing) = self.closing {
+            return Some(closing.error());
+        }
         let Some(handshake) = &mut self.handshake_deadline else {
             return None;
         };
         if self.standing.is_authenticated() {
             self.handshake_deadline = None;
+            self.open.authenticated();
             return None;
         }
-        if self.standing.is_evicted(cx.waker()) {
-            return Some(io::Error::new(
-                io::ErrorKind::ConnectionAborted,
-                "closed before it authenticated, to make room for a newer connection",
-            ));
-        }
-        handshake.as_mut().poll(cx).is_ready().then(|| {
-            io::Error::new(
-                io::ErrorKind::TimedOut,
-                "no authenticated request before the handshake deadline",
-            )
-        })
+        let closing = if self.standing.is_evicted(cx.waker()) {
+            Closing::Evicted
+        } else if handshake.as_mut().poll(cx).is_ready() {
+            Closing::HandshakeDeadline
+        } else {
+            return None;
+        };
+        self.metrics.refused(closing.refusal());
+        self.closing = Some(closing);
+        Some(closing.error())
     }
 }
 
@@ -251,13 +303,28 @@ impl Connected for Connection {
 }
 
 /// The token check, which also marks the connection of a request that passes it as
-/// authenticated (no longer subject to the handshake deadline and the pending caps).
+/// authenticated (no longer subject to the handshake deadline and the pending caps), and
+/// counts the requests it refuses.
 #[derive(Clone)]
-pub struct Authenticate(pub RequireToken);
+pub struct Authenticate {
+    pub token: RequireToken,
+    pub metrics: Arc<Metrics>,
+}
 
 impl Interceptor for Authenticate {
     fn call(&mut self, request: Request<()>) -> Result<Request<()>, Status> {
-        let request = self.0.call(request)?;
+        let bearer = request
+            .metadata()
+            .get("authorization")
+            .and_then(|v| v.to_str().ok())
+            .is_some_and(|v| v.starts_with("Bearer "));
+        let request = self.token.call(request).inspect_err(|_| {
+            self.metrics.refused(if bearer {
+                Refusal::TokenWrong
+            } else {
+                Refusal::TokenMissing
+            });
+        })?;
         if let Some(info) = request.extensions().get::<ConnectionInfo>() {
             info.standing.authenticated();
         }

@@ -100,6 +100,12 @@ pub enum ServeError {
          --tls-cert, --tls-key and --tls-client-ca, or --insecure to serve anyway"
     )]
     Exposed { address: SocketAddr },
+    #[error(
+        "refusing to serve metrics on {address} without a token: anyone who reaches this port \
+         could read them. Give --token-file PATH (or YAT_TOKEN), a loopback --metrics-addr, or \
+         --insecure to serve anyway"
+    )]
+    MetricsExposed { address: SocketAddr },
     #[error("cannot read or raise the process's file descriptor limit")]
     DescriptorLimit(#[source] std::io::Error),
     #[error(

@@ -1,5 +1,6 @@
 //! The `RenderNode` gRPC service: requests in to the node, [`NodeError`]s out as the status
-//! codes `render.proto` documents. No logic lives here.
+//! codes `render.proto` documents (each counted on its way out, `metrics.rs`). No logic lives
+//! here.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -27,6 +28,17 @@ impl GrpcNode {
 }
 
 impl GrpcNode {
+    /// The status of `error`, counted.
+    fn refuse(&self, error: NodeError) -> Status {
+        self.node.metrics().failed(&error);
+        error.into()
+    }
+
+    /// The reply, or the status of the error, counted.
+    fn answer<T>(&self, result: Result<T, NodeError>) -> Result<Response<T>, Status> {
+        result.map(Response::new).map_err(|e| self.refuse(e))
+    }
+
     /// The next chunk of blob `hash`, failing the upload when none comes in time.
     async fn next_chunk(
         &self,
@@ -35,11 +47,10 @@ impl GrpcNode {
     ) -> Result<Option<pb::BlobChunk>, Status> {
         match tokio::time::timeout(self.blob_idle, chunks.message()).await {
             Ok(chunk) => chunk,
-            Err(_) => Err(NodeError::BlobStalled {
+            Err(_) => Err(self.refuse(NodeError::BlobStalled {
                 hash: hash.to_string(),
                 seconds: self.blob_idle.as_secs(),
-            }
-            .into()),
+            })),
         }
     }
 }
@@ -79,7 +90,7 @@ impl pb::render_node_server::RenderNode for GrpcNode {
         &self,
         request: Request<pb::HandshakeRequest>,
     ) -> Result<Response<pb::HandshakeReply>, Status> {
-        Ok(Response::new(self.node.handshake(request.get_ref())?))
+        self.answer(self.node.handshake(request.get_ref()))
     }
 
     async fn has_blobs(
@@ -97,31 +108,30 @@ impl pb::render_node_server::RenderNode for GrpcNode {
         let first = self
             .next_chunk(&mut chunks, "(unnamed)")
             .await?
-            .ok_or(NodeError::EmptyBlobStream)?;
-        let mut upload = self.node.begin_blob(first.sha256, first.size)?;
-        upload.push(&first.data)?;
+            .ok_or_else(|| self.refuse(NodeError::EmptyBlobStream))?;
+        let mut upload = self
+            .node
+            .begin_blob(first.sha256, first.size)
+            .map_err(|e| self.refuse(e))?;
+        upload.push(&first.data).map_err(|e| self.refuse(e))?;
         while let Some(chunk) = self.next_chunk(&mut chunks, upload.hash()).await? {
-            upload.push(&chunk.data)?;
+            upload.push(&chunk.data).map_err(|e| self.refuse(e))?;
         }
-        Ok(Response::new(self.node.store_blob(upload).await?))
+        self.answer(self.node.store_blob(upload).await)
     }
 
     async fn load_scene(
         &self,
         request: Request<pb::LoadSceneRequest>,
     ) -> Result<Response<pb::LoadSceneReply>, Status> {
-        Ok(Response::new(
-            self.node.load_scene(request.into_inner()).await?,
-        ))
+        self.answer(self.node.load_scene(request.into_inner()).await)
     }
 
     async fn render_unit(
         &self,
         request: Request<pb::RenderUnitRequest>,
     ) -> Result<Response<pb::RenderUnitReply>, Status> {
-        Ok(Response::new(
-            self.node.render_unit(request.into_inner()).await?,
-        ))
+        self.answer(self.node.render_unit(request.into_inner()).await)
     }
 
     async fn stats(

@@ -1,8 +1,8 @@
 //! The render node's logic on plain types: what a coordinator may ask of a worker (handshake,
 //! blobs, scenes, units, counters) and the state it takes (the blob and scene caches, the render
-//! threads, the counters). The gRPC layer only carries requests in and errors out.
+//! threads, the counters in `metrics.rs`). The gRPC layer only carries requests in and errors
+//! out.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -18,6 +18,7 @@ use crate::blobs::BlobStore;
 use crate::config::WorkerConfig;
 use crate::error::{NodeError, ServeError};
 use crate::loaded_scene::LoadedScene;
+use crate::metrics::{Metrics, NodeGauges};
 use crate::pool::{RenderPool, UnitCounts};
 use crate::scenes::SceneCache;
 use crate::upload::{BlobUpload, UploadBudget};
@@ -33,14 +34,6 @@ pub struct Capabilities {
     pub features: Vec<String>,
 }
 
-#[derive(Default)]
-struct Counters {
-    units_done: AtomicU64,
-    samples_done: AtomicU64,
-    blob_bytes_received: AtomicU64,
-    result_bytes_sent: AtomicU64,
-}
-
 pub struct Node {
     capabilities: Capabilities,
     blobs: Arc<BlobStore>,
@@ -51,7 +44,7 @@ pub struct Node {
     uploads: UploadBudget,
     /// Set once at the shutdown signal: new work is refused, queued units handed back.
     draining: watch::Sender<bool>,
-    counters: Counters,
+    metrics: Arc<Metrics>,
     started: Instant,
 }
 
@@ -95,13 +88,36 @@ impl Node {
             build_budget: config.build_budget,
             uploads: UploadBudget::new(config.upload_budget_bytes),
             draining,
-            counters: Counters::default(),
+            metrics: Arc::default(),
             started: Instant::now(),
         })
     }
 
     pub fn capabilities(&self) -> &Capabilities {
         &self.capabilities
+    }
+
+    /// The worker's counters, which the connections and the gRPC layer count into too.
+    pub fn metrics(&self) -> &Arc<Metrics> {
+        &self.metrics
+    }
+
+    /// The Prometheus text of the counters and the node's state now.
+    pub fn exposition(&self) -> String {
+        let units = self.pool.counts();
+        let cache = self.blobs.held_bytes();
+        self.metrics.render(&NodeGauges {
+            threads: self.capabilities.threads,
+            busy_threads: units.rendering,
+            queued_units: units.waiting,
+            memory_cache_bytes: cache.memory,
+            disk_cache_bytes: cache.disk,
+            blobs_cached: self.blobs.len() as u64,
+            scenes_cached: self.scenes.len() as u64,
+            upload_bytes_held: self.uploads.held(),
+            draining: *self.draining.borrow(),
+            uptime: self.started.elapsed(),
+        })
     }
 
     /// Stops taking work: new blobs, scenes and units are refused from now on and units waiting
@@ -151,11 +167,14 @@ impl Node {
 
     /// The requested blobs this worker does not hold, in request order.
     pub fn missing_blobs(&self, request: pb::HasBlobsRequest) -> pb::HasBlobsReply {
-        let missing = request
+        let asked = request.sha256.len() as u64;
+        let missing: Vec<String> = request
             .sha256
             .into_iter()
             .filter(|h| !self.blobs.contains(h))
             .collect();
+        let missed = missing.len() as u64;
+        self.metrics.blobs_asked(asked - missed, missed);
         pb::HasBlobsReply { missing }
     }
 
@@ -178,9 +197,7 @@ impl Node {
         tokio::task::spawn_blocking(move || blobs.insert(&hash, data.into()))
             .await
             .map_err(NodeError::BlobTask)??;
-        self.counters
-            .blob_bytes_received
-            .fetch_add(stored_bytes, Ordering::Relaxed);
+        self.metrics.blob_stored(stored_bytes);
         Ok(pb::PutBlobReply { stored_bytes })
     }
 
@@ -210,6 +227,7 @@ impl Node {
         let build =
             || LoadedScene::build_blocking(blobs, main, assets, settings, self.build_budget);
         let (loaded, built) = self.scenes.get_or_build(&scene_id, build).await?;
+        self.metrics.scene_loaded(built);
         Ok(pb::LoadSceneReply {
             scene_id,
             triangle_count: loaded.triangle_count,
@@ -238,13 +256,9 @@ impl Node {
         let unit = request.unit.as_ref().ok_or(WireError::Missing("unit"))?;
         let unit = unit_from_wire(unit, &loaded.settings)?;
         let rendered = self.pool.render(loaded, unit).await?;
-        let c = &self.counters;
-        c.units_done.fetch_add(1, Ordering::Relaxed);
-        c.samples_done
-            .fetch_add(rendered.stats.samples, Ordering::Relaxed);
         let sent = rendered.pixels.len() + rendered.splats.len();
-        c.result_bytes_sent
-            .fetch_add(sent as u64, Ordering::Relaxed);
+        self.metrics
+            .unit_rendered(rendered.stats.samples, sent as u64, rendered.elapsed);
         Ok(pb::RenderUnitReply {
             index: unit.index,
             pixels: rendered.pixels,
@@ -256,12 +270,12 @@ impl Node {
 
     /// The worker's counters since it started.
     pub fn stats(&self) -> pb::StatsReply {
-        let c = &self.counters;
+        let c = self.metrics.stats_counters();
         pb::StatsReply {
-            units_done: c.units_done.load(Ordering::Relaxed),
-            samples_done: c.samples_done.load(Ordering::Relaxed),
-            blob_bytes_received: c.blob_bytes_received.load(Ordering::Relaxed),
-            result_bytes_sent: c.result_bytes_sent.load(Ordering::Relaxed),
+            units_done: c.units,
+            samples_done: c.samples,
+            blob_bytes_received: c.upload_bytes,
+            result_bytes_sent: c.result_bytes,
             blobs_cached: self.blobs.len() as u64,
             scenes_cached: self.scenes.len() as u64,
             units_in_flight: {

@@ -5,6 +5,9 @@
 //! The health service (`grpc.health.v1`, for `""` and `yat.render.v1.RenderNode`) is outside
 //! the token check: orchestrators' probes cannot send metadata, and it reveals nothing but
 //! SERVING or NOT_SERVING (`availability.rs`).
+//!
+//! With a metrics listener (`yat worker --metrics-addr`), the worker's Prometheus text is
+//! served beside it (`metrics_server.rs`) until the gRPC server has drained and stopped.
 
 use std::future::Future;
 use std::net::SocketAddr;
@@ -24,6 +27,7 @@ use crate::connection::{self, Acceptor, Authenticate, ConnectionTimeouts};
 use crate::descriptors::{ConnectionCap, DESCRIPTOR_HEADROOM};
 use crate::error::ServeError;
 use crate::grpc::GrpcNode;
+use crate::metrics_server;
 use crate::node::Node;
 
 /// HTTP/2 pings to every peer, so a live peer's connection is never idle and a dead one is
@@ -44,6 +48,8 @@ pub struct Worker {
     tls: Option<Identity>,
     tls_client_ca: Option<Certificate>,
     insecure: bool,
+    /// Where to serve `/metrics`, if anywhere.
+    metrics_listener: Option<TcpListener>,
 }
 
 impl Worker {
@@ -56,7 +62,15 @@ impl Worker {
             tls: config.tls,
             tls_client_ca: config.tls_client_ca,
             insecure: config.insecure,
+            metrics_listener: None,
         })
+    }
+
+    /// Also serves the worker's metrics on `listener` (`GET /metrics`), for as long as the
+    /// worker serves.
+    pub fn with_metrics(mut self, listener: TcpListener) -> Self {
+        self.metrics_listener = Some(listener);
+        self
     }
 
     /// Refuses to serve beyond loopback when anyone reaching the port could use the worker: no
@@ -65,6 +79,16 @@ impl Worker {
         let open = self.token.is_none() && self.tls_client_ca.is_none();
         if open && !address.ip().is_loopback() && !self.insecure {
             return Err(ServeError::Exposed { address });
+        }
+        Ok(())
+    }
+
+    /// Refuses to serve metrics beyond loopback when anyone reaching that port could read
+    /// them: no token (client certificates do not cover the plain-HTTP metrics port), and no
+    /// `--insecure`.
+    pub fn check_metrics_exposure(&self, address: SocketAddr) -> Result<(), ServeError> {
+        if self.token.is_none() && !address.ip().is_loopback() && !self.insecure {
+            return Err(ServeError::MetricsExposed { address });
         }
         Ok(())
     }
@@ -79,6 +103,9 @@ impl Worker {
     ) -> Result<(), ServeError> {
         let address = listener.local_addr().map_err(ServeError::Listener)?;
         self.check_exposure(address)?;
+        if let Some(metrics) = &self.metrics_listener {
+            self.check_metrics_exposure(metrics.local_addr().map_err(ServeError::Listener)?)?;
+        }
         let network = &self.network;
         let cap = ConnectionCap::of_this_process(network.max_connections)
             .map_err(ServeError::DescriptorLimit)?
@@ -127,7 +154,10 @@ impl Worker {
                 .max_encoding_message_size(DEFAULT_MAX_MESSAGE_BYTES);
         let service = InterceptedService::new(
             service,
-            Authenticate(RequireToken::new(self.token.as_deref())),
+            Authenticate {
+                token: RequireToken::new(self.token.as_deref()),
+                metrics: self.node.metrics().clone(),
+            },
         );
         let mut server = Server::builder()
             .http2_keepalive_interval(Some(KEEPALIVE_INTERVAL.min(network.connection_idle / 3)))
@@ -151,6 +181,20 @@ impl Worker {
                 handshake: network.handshake_timeout,
             },
             availability: availability.clone(),
+            metrics: self.node.metrics().clone(),
+        });
+        // Stops when this function returns, whichever way: the sender drops.
+        let (metrics_running, metrics_stop) = tokio::sync::oneshot::channel::<()>();
+        let metrics = self.metrics_listener.map(|listener| {
+            let node = self.node.clone();
+            let token = self.token.clone();
+            tokio::spawn(async move {
+                let stop = async {
+                    let _ = metrics_stop.await;
+                };
+                metrics_server::serve(listener, token.as_deref(), move || node.exposition(), stop)
+                    .await;
+            })
         });
         let (drained, drained_rx) = tokio::sync::oneshot::channel();
         let node = self.node.clone();
@@ -170,13 +214,18 @@ impl Worker {
             }
             tokio::time::sleep(REPLY_GRACE).await;
         };
-        tokio::select! {
+        let served = tokio::select! {
             served = serving => served.map_err(ServeError::Server),
             () = deadline => {
                 tracing::warn!("connections still open {REPLY_GRACE:?} after the drain; stopping");
                 Ok(())
             }
+        };
+        drop(metrics_running);
+        if let Some(metrics) = metrics {
+            let _ = metrics.await;
         }
+        served
     }
 }
 

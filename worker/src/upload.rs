@@ -26,8 +26,7 @@ impl UploadBudget {
     }
 
     /// Bytes held by uploads in progress.
-    #[cfg(test)]
-    fn held(&self) -> u64 {
+    pub fn held(&self) -> u64 {
         self.held.load(Ordering::Relaxed)
     }
 

@@ -1,5 +1,6 @@
-//! `yat worker`: serve renders to coordinators on `--listen` until Ctrl-C or SIGTERM, then
-//! drain (a second signal stops at once).
+//! `yat worker`: serve renders to coordinators on `--listen` (and the worker's Prometheus
+//! metrics on `--metrics-addr`) until Ctrl-C or SIGTERM, then drain (a second signal stops at
+//! once).
 
 use std::io::Write;
 use std::net::SocketAddr;
@@ -20,6 +21,13 @@ pub struct WorkerArgs {
     /// needs a token or TLS client certificates, or --insecure.
     #[arg(long, default_value = "127.0.0.1:7878")]
     pub listen: SocketAddr,
+    /// Serve the worker's Prometheus metrics at http://IP:PORT/metrics (nothing else), e.g.
+    /// 127.0.0.1:7879 or 0.0.0.0:7879 (port 0: any free port; the second line printed on
+    /// stdout, `metrics on http://IP:PORT/metrics`, names it). With a token every request must
+    /// carry `Authorization: Bearer TOKEN`; beyond loopback a token (or --insecure) is
+    /// needed. See docs/status.md.
+    #[arg(long, value_name = "IP:PORT")]
+    pub metrics_addr: Option<SocketAddr>,
     /// Units rendered at the same time [default: the CPUs this process may use, as its
     /// affinity mask and cgroup quota allow].
     #[arg(long)]
@@ -129,6 +137,7 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         build_budget: args.budget.budget(),
     };
     let insecure = config.insecure;
+    let no_token = config.token.is_none();
     // Fails here, before the address is announced, when the cache folder is unusable.
     let worker = Worker::new(config)?;
     worker.check_exposure(args.listen)?;
@@ -138,6 +147,15 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
              reaches this port can use this worker",
             args.listen
         );
+    }
+    if let Some(address) = args.metrics_addr {
+        worker.check_metrics_exposure(address)?;
+        if insecure && no_token && !address.ip().is_loopback() {
+            tracing::warn!(
+                "--insecure: serving metrics on {address} without a token; anyone who reaches \
+                 this port can read them"
+            );
+        }
     }
     if args.exit_with_stdin {
         exit_when_stdin_closes();
@@ -156,6 +174,22 @@ pub fn run(args: WorkerArgs) -> anyhow::Result<()> {
         writeln!(stdout, "listening on {}", listener.local_addr()?)?;
         stdout.flush()?;
         drop(stdout);
+        let worker = match args.metrics_addr {
+            Some(address) => {
+                let metrics = tokio::net::TcpListener::bind(address).await.map_err(|e| {
+                    anyhow::anyhow!("cannot listen on {address} (--metrics-addr): {e}")
+                })?;
+                let mut stdout = std::io::stdout().lock();
+                writeln!(
+                    stdout,
+                    "metrics on http://{}/metrics",
+                    metrics.local_addr()?
+                )?;
+                stdout.flush()?;
+                worker.with_metrics(metrics)
+            }
+            None => worker,
+        };
         worker.serve(listener, first_signal()).await?;
         Ok(())
     })

@@ -1,98 +1,93 @@
 //! `/metrics`: the snapshot in the Prometheus text exposition format (version 0.0.4), the
 //! figures a farm operator graphs: samples and units over time, the progress ratio, and per
-//! worker its state, samples, units, failures and bytes. Written by hand: a dozen families
-//! do not need a registry.
+//! worker its state, samples, units, failures and bytes. Written with the worker crate's
+//! `prometheus_text`, which a worker's own `/metrics` uses too.
 
-use std::fmt::Write;
+use yat_worker::prometheus_text::{labels, Exposition, MetricType};
 
 use super::snapshot::{RenderState, Snapshot, WorkerRow, WorkerState};
 
-pub const CONTENT_TYPE: &str = "text/plain; version=0.0.4; charset=utf-8";
+pub use yat_worker::prometheus_text::CONTENT_TYPE;
+
+use MetricType::{Counter, Gauge};
 
 /// A family with one sample per worker: name, type, help, the value of the worker's row.
 type WorkerFamily = (
     &'static str,
-    &'static str,
+    MetricType,
     &'static str,
     fn(&WorkerRow) -> f64,
 );
 
 /// The exposition of `snap`.
 pub fn render(snap: &Snapshot) -> String {
-    let mut out = String::new();
+    let mut out = Exposition::new();
     let p = &snap.progress;
-    let mut family = |name: &str, kind: &str, help: &str, samples: &[(String, f64)]| {
-        let _ = writeln!(out, "# HELP {name} {help}");
-        let _ = writeln!(out, "# TYPE {name} {kind}");
-        for (labels, value) in samples {
-            let _ = writeln!(out, "{name}{labels} {value}");
-        }
-    };
     // The render's families, one sample each: name, type, help, value.
     let totals = [
         (
             "yat_up",
-            "gauge",
+            Gauge,
             "1 while the render runs, 0 once it has ended.",
             f64::from(u8::from(snap.state == RenderState::Rendering)),
         ),
         (
             "yat_render_failed",
-            "gauge",
+            Gauge,
             "1 if the render ended in an error.",
             f64::from(u8::from(snap.state == RenderState::Failed)),
         ),
         (
             "yat_samples_total",
-            "counter",
+            Counter,
             "Camera samples merged into the image (a resumed checkpoint's included).",
             p.samples_done as f64,
         ),
         (
             "yat_samples_planned",
-            "gauge",
+            Gauge,
             "Camera samples of the whole render.",
             p.samples_total as f64,
         ),
         (
             "yat_units_done_total",
-            "counter",
+            Counter,
             "Work units merged.",
             p.units_done as f64,
         ),
         (
             "yat_units_planned",
-            "gauge",
+            Gauge,
             "Work units of the whole render.",
             p.units_total as f64,
         ),
         (
             "yat_units_requeued_total",
-            "counter",
+            Counter,
             "Work units a worker lost or gave back, sent again.",
             p.units_requeued as f64,
         ),
         (
             "yat_progress_ratio",
-            "gauge",
+            Gauge,
             "Samples merged over samples planned, 0 to 1.",
             p.ratio,
         ),
         (
             "yat_samples_per_second",
-            "gauge",
+            Gauge,
             "Samples this run merged per second so far.",
             p.samples_per_second,
         ),
         (
             "yat_elapsed_seconds",
-            "gauge",
+            Gauge,
             "Seconds since the render started.",
             p.elapsed_seconds,
         ),
     ];
     for (name, kind, help, value) in totals {
-        family(name, kind, help, &[(String::new(), value)]);
+        out.single(name, kind, help, value);
     }
     let per_worker = |value: fn(&WorkerRow) -> f64| -> Vec<(String, f64)> {
         snap.workers
@@ -100,11 +95,11 @@ pub fn render(snap: &Snapshot) -> String {
             .map(|w| (labels(&[("worker", &w.address)]), value(w)))
             .collect()
     };
-    family(
+    out.family(
         "yat_worker_up",
-        "gauge",
+        Gauge,
         "1 while the worker is connected (stalled included).",
-        &per_worker(|w| {
+        per_worker(|w| {
             f64::from(u8::from(matches!(
                 w.state,
                 WorkerState::Connected | WorkerState::Stalled
@@ -127,75 +122,60 @@ pub fn render(snap: &Snapshot) -> String {
             })
         })
         .collect();
-    family(
+    out.family(
         "yat_worker_state",
-        "gauge",
+        Gauge,
         "1 for the worker's state: connecting, connected, stalled, gone or done.",
-        &states,
+        states,
     );
     let worker_families: [WorkerFamily; 7] = [
         (
             "yat_worker_threads",
-            "gauge",
+            Gauge,
             "Render threads the worker reported.",
             |w| f64::from(w.threads),
         ),
         (
             "yat_worker_samples_total",
-            "counter",
+            Counter,
             "Camera samples of the worker's units that were merged.",
             |w| w.samples as f64,
         ),
         (
             "yat_worker_units_total",
-            "counter",
+            Counter,
             "Work units of the worker that were merged.",
             |w| w.units as f64,
         ),
         (
             "yat_worker_failures_total",
-            "counter",
+            Counter,
             "Sessions the worker lost and bad replies it sent.",
             |w| w.failures as f64,
         ),
         (
             "yat_worker_units_requeued_total",
-            "counter",
+            Counter,
             "Work units the worker held that went back to the queue.",
             |w| w.units_requeued as f64,
         ),
         (
             "yat_worker_sent_bytes_total",
-            "counter",
+            Counter,
             "Bytes of every request sent to the worker, scene files included.",
             |w| w.bytes_sent as f64,
         ),
         (
             "yat_worker_received_bytes_total",
-            "counter",
+            Counter,
             "Bytes of every reply received from the worker.",
             |w| w.bytes_received as f64,
         ),
     ];
     for (name, kind, help, value) in worker_families {
-        family(name, kind, help, &per_worker(value));
+        out.family(name, kind, help, per_worker(value));
     }
-    out
-}
-
-/// `{a="x",b="y"}` with the values escaped as the format asks (backslash, quote, newline).
-fn labels(pairs: &[(&str, &str)]) -> String {
-    let body: Vec<String> = pairs
-        .iter()
-        .map(|(name, value)| {
-            let value = value
-                .replace('\\', "\\\\")
-                .replace('"', "\\\"")
-                .replace('\n', "\\n");
-            format!("{name}=\"{value}\"")
-        })
-        .collect();
-    format!("{{{}}}", body.join(","))
+    out.finish()
 }
 
 #[cfg(test)]

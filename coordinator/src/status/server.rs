@@ -9,7 +9,9 @@
 //! sets once. Without it the answer is 401 with the login form and nothing else.
 //!
 //! Bounds: at most [`MAX_CONNECTIONS`] connections at once (more wait to be accepted), the
-//! request head within [`HEADER_TIMEOUT`], a connection at most [`CONNECTION_LIFETIME`] long.
+//! request head within [`HEADER_TIMEOUT`], a connection at most [`CONNECTION_LIFETIME`] long,
+//! applied by the bounded HTTP/1 loop a worker's `/metrics` is served on too
+//! (`yat_worker::http`).
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -22,10 +24,9 @@ use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
 use axum::Router;
-use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::service::TowerToHyperService;
 use tokio::net::TcpListener;
-use tokio::sync::Semaphore;
+use yat_worker::http::HttpBounds;
 
 use super::board::StatusBoard;
 use super::metrics;
@@ -36,6 +37,15 @@ pub const MAX_CONNECTIONS: usize = 32;
 pub const HEADER_TIMEOUT: Duration = Duration::from_secs(5);
 /// A connection (keep-alive included) is closed after this; a browser opens another.
 pub const CONNECTION_LIFETIME: Duration = Duration::from_secs(60);
+/// The bounds above; a request head's size and header count are hyper's defaults (about
+/// 400 KiB, 100 headers: a browser may send every cookie of its host).
+const BOUNDS: HttpBounds = HttpBounds {
+    max_connections: MAX_CONNECTIONS,
+    header_timeout: HEADER_TIMEOUT,
+    connection_lifetime: CONNECTION_LIFETIME,
+    max_head_bytes: None,
+    max_headers: None,
+};
 
 const PAGE: &str = include_str!("page.html");
 const LOGIN: &str = include_str!("login.html");
@@ -97,7 +107,10 @@ impl StatusServer {
             token_digest: token.map(|t| yat_proto::hash::sha256_hex(t.as_bytes())),
             png: tokio::sync::Mutex::new((0, axum::body::Bytes::new())),
         });
-        runtime.spawn(serve(listener, router(state)));
+        let service = TowerToHyperService::new(router(state));
+        // It serves until the runtime is shut down (the server dropped).
+        let serving = yat_worker::http::serve(listener, service, BOUNDS, std::future::pending());
+        runtime.spawn(serving);
         Ok(Self {
             runtime: Some(runtime),
             address: bound,
@@ -128,34 +141,6 @@ fn router(state: Arc<AppState>) -> Router {
         .layer(middleware::from_fn_with_state(state.clone(), require_token))
         .layer(middleware::from_fn(common_headers))
         .with_state(state)
-}
-
-/// Accepts connections while fewer than [`MAX_CONNECTIONS`] are open, each served by hyper
-/// with the head and lifetime bounds.
-async fn serve(listener: TcpListener, app: Router) {
-    let open = Arc::new(Semaphore::new(MAX_CONNECTIONS));
-    loop {
-        let Ok(permit) = open.clone().acquire_owned().await else {
-            return;
-        };
-        let stream = match listener.accept().await {
-            Ok((stream, _)) => stream,
-            // Out of file descriptors and the like: wait rather than spin.
-            Err(_) => {
-                tokio::time::sleep(Duration::from_millis(100)).await;
-                continue;
-            }
-        };
-        let service = TowerToHyperService::new(app.clone());
-        tokio::spawn(async move {
-            let connection = hyper::server::conn::http1::Builder::new()
-                .timer(TokioTimer::new())
-                .header_read_timeout(HEADER_TIMEOUT)
-                .serve_connection(TokioIo::new(stream), service);
-            let _ = tokio::time::timeout(CONNECTION_LIFETIME, connection).await;
-            drop(permit);
-        });
-    }
 }
 
 /// Headers of every answer: nothing cached, nothing sniffed, nothing framed.
