@@ -441,8 +441,17 @@ pub enum OptionError {
         value: String,
         problem: &'static str,
     },
-    #[error("{}", .0.iter().map(|(option, why)| format!("luxconsole option {option} is not supported by YAT: {why}")).collect::<Vec<_>>().join("\n"))]
+    #[error("{}", refusals(.0))]
     Refused(Vec<(String, &'static str)>),
+}
+
+/// One line for each option refused: its name and why.
+fn refusals(refused: &[(String, &'static str)]) -> String {
+    let lines: Vec<String> = refused
+        .iter()
+        .map(|(option, why)| format!("luxconsole option {option} is not supported by YAT: {why}"))
+        .collect();
+    lines.join("\n")
 }
 
 /// How much luxconsole says: its -V, -q and -x (the quietest given wins, as in luxconsole).
