@@ -16,6 +16,7 @@ mod hostile_worker;
 mod isa;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;
+mod luxconsole;
 mod memory;
 mod progress_log;
 mod resume;

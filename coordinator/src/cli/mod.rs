@@ -5,6 +5,7 @@ pub mod check;
 pub mod distributed;
 pub mod export;
 pub mod latlong;
+pub mod luxconsole;
 pub mod render;
 pub mod seconds;
 pub mod worker;
@@ -44,4 +45,10 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Write a scene as LuxCoreRender SDL and PLY meshes (for side-by-side benchmarks).
     ExportLuxcore(export::ExportArgs),
+    /// Read LuxRender 1.x's luxconsole command line (threads, output, servers, verbosity, the
+    /// scene on standard input...) and render as `yat render` does; `yat luxconsole --help`
+    /// lists every luxconsole option and what YAT does with it. The `yat` binary started under
+    /// the name `luxconsole` reads its command line so too.
+    #[command(disable_help_flag = true)]
+    Luxconsole(luxconsole::LuxconsoleArgs),
 }

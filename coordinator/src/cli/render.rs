@@ -162,7 +162,8 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+/// Renders as the flags ask; returns the PNG written (`yat luxconsole -b` reads it back).
+pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
     let started = Instant::now();
     let scene = ParsedScene::load_within(
         &args.scene,
@@ -271,7 +272,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         report.print();
     }
     linger(server, status_linger, &interrupt);
-    Ok(())
+    Ok(output_png)
 }
 
 /// Keeps the status page up for `--status-linger` after the render (or until Ctrl-C), then
