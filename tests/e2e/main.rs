@@ -13,6 +13,7 @@ mod halts;
 mod hostile;
 mod hostile_peer;
 mod hostile_worker;
+mod http;
 mod isa;
 #[path = "../fixtures/lit_sphere.rs"]
 mod lit_sphere;

@@ -3,13 +3,14 @@
 //! (`yat render --workers`) use it; the token rule; the rule beyond loopback; and the metrics
 //! server stopping with the worker.
 
-use std::io::{BufReader, Read, Write};
+use std::io::BufReader;
 use std::net::TcpStream;
 use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use yat_tracer::render::plan_units;
 
+use crate::http::{http, metric, parse_prometheus};
 use crate::util::*;
 
 const TOKEN: &str = "metrics-test-token";
@@ -45,15 +46,14 @@ impl MetricsWorker {
     }
 
     fn get(&self, path: &str, token: Option<&str>) -> (u16, String) {
-        let authorization = token.map(|t| format!("Authorization: Bearer {t}"));
-        http_get(&self.metrics, path, authorization.as_deref())
+        get(&self.metrics, path, token)
     }
 
     /// The samples of `/metrics`, read with the token.
     fn scrape(&self) -> Vec<(String, f64)> {
         let (code, text) = self.get("/metrics", Some(TOKEN));
         assert_eq!(code, 200, "{text}");
-        samples(&text)
+        parse_prometheus(&text)
     }
 
     /// Scrapes until `done` holds of the samples (at most 60 s) and returns them.
@@ -84,50 +84,16 @@ impl Drop for MetricsWorker {
     }
 }
 
-/// One HTTP/1.1 GET on its own connection: the status code and the body.
-fn http_get(address: &str, path: &str, authorization: Option<&str>) -> (u16, String) {
-    let mut stream = TcpStream::connect(address).unwrap();
-    stream
-        .set_read_timeout(Some(Duration::from_secs(20)))
-        .unwrap();
-    let mut request = format!("GET {path} HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n");
-    if let Some(header) = authorization {
-        request.push_str(header);
-        request.push_str("\r\n");
-    }
-    request.push_str("\r\n");
-    stream.write_all(request.as_bytes()).unwrap();
-    let mut raw = String::new();
-    stream.read_to_string(&mut raw).unwrap();
-    let (head, body) = raw.split_once("\r\n\r\n").expect("a response head");
-    let code = head.split(' ').nth(1).unwrap().parse().unwrap();
-    (code, body.to_string())
-}
-
-/// The samples of a Prometheus text: (name with labels, value); every sample's family has a
-/// TYPE line before it.
-fn samples(text: &str) -> Vec<(String, f64)> {
-    let mut typed = std::collections::BTreeSet::new();
-    let mut samples = Vec::new();
-    for line in text.lines() {
-        if let Some(rest) = line.strip_prefix("# TYPE ") {
-            typed.insert(rest.split(' ').next().unwrap().to_string());
-        } else if !line.starts_with('#') {
-            let (series, value) = line.rsplit_once(' ').unwrap_or_else(|| panic!("{line:?}"));
-            let name = series.split('{').next().unwrap();
-            assert!(typed.contains(name), "{name} has no TYPE line before it");
-            samples.push((series.to_string(), value.parse().unwrap()));
-        }
-    }
-    samples
-}
-
-fn metric(samples: &[(String, f64)], series: &str) -> f64 {
-    samples
-        .iter()
-        .find(|(s, _)| s == series)
-        .unwrap_or_else(|| panic!("no {series} in {samples:?}"))
-        .1
+/// A GET of `path` at `address`, with the bearer `token` if any: the status code and the body.
+fn get(address: &str, path: &str, token: Option<&str>) -> (u16, String) {
+    let authorization = token.map(|t| format!("Bearer {t}"));
+    let headers: Vec<(&str, &str)> = authorization
+        .as_deref()
+        .map(|a| ("Authorization", a))
+        .into_iter()
+        .collect();
+    let response = http(address, "GET", path, &headers);
+    (response.code, response.text())
 }
 
 fn refused(samples: &[(String, f64)], reason: &str) -> f64 {
@@ -348,9 +314,9 @@ fn metrics_beyond_loopback_need_a_token_and_stop_with_the_worker() {
     ));
     let port = worker.metrics.rsplit_once(':').unwrap().1.to_string();
     let local = format!("127.0.0.1:{port}");
-    let (code, body) = http_get(&local, "/metrics", None);
+    let (code, body) = get(&local, "/metrics", None);
     assert_eq!(code, 200, "{body}");
-    assert_eq!(metric(&samples(&body), "yat_node_connections"), 0.0);
+    assert_eq!(metric(&parse_prometheus(&body), "yat_node_connections"), 0.0);
     let open = MetricsWorker::spawn(Worker::command(
         "127.0.0.1:0",
         &["--metrics-addr", "127.0.0.1:0"],
