@@ -47,11 +47,45 @@ impl Interceptor for RequireToken {
 }
 
 /// Compares in time independent of where the bytes differ (`subtle`'s), so response timing
-/// does not reveal a matching prefix (the coordinator's status page checks its token with it
-/// too). Only the length may show, which the token's strength does not rest on.
-pub fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
+/// does not reveal a matching prefix (the HTTP servers' [`TokenDigest`] too). Only the length may show, which the token's strength does not rest on.
+fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
     use subtle::ConstantTimeEq;
     a.ct_eq(b).into()
+}
+
+/// The token as the HTTP servers (the status page, a worker's `/metrics`) keep it: its SHA-256
+/// digest in hex, which a cookie may carry in the token's place; every comparison in constant
+/// time.
+#[derive(Clone, Debug)]
+pub struct TokenDigest(String);
+
+impl TokenDigest {
+    pub fn of(token: &str) -> Self {
+        Self(crate::hash::sha256_hex(token.as_bytes()))
+    }
+
+    pub fn hex(&self) -> &str {
+        &self.0
+    }
+
+    pub fn matches_token(&self, token: &str) -> bool {
+        constant_time_eq(
+            crate::hash::sha256_hex(token.as_bytes()).as_bytes(),
+            self.0.as_bytes(),
+        )
+    }
+
+    pub fn matches_digest(&self, digest: &str) -> bool {
+        constant_time_eq(digest.as_bytes(), self.0.as_bytes())
+    }
+
+    /// Whether an `Authorization` header's value is `Bearer <the token>`.
+    pub fn matches_bearer(&self, authorization: Option<&[u8]>) -> bool {
+        authorization
+            .and_then(|v| std::str::from_utf8(v).ok())
+            .and_then(|v| v.strip_prefix(BEARER))
+            .is_some_and(|token| self.matches_token(token))
+    }
 }
 
 #[derive(Debug, thiserror::Error)]

@@ -316,7 +316,10 @@ fn metrics_beyond_loopback_need_a_token_and_stop_with_the_worker() {
     let local = format!("127.0.0.1:{port}");
     let (code, body) = get(&local, "/metrics", None);
     assert_eq!(code, 200, "{body}");
-    assert_eq!(metric(&parse_prometheus(&body), "yat_node_connections"), 0.0);
+    assert_eq!(
+        metric(&parse_prometheus(&body), "yat_node_connections"),
+        0.0
+    );
     let open = MetricsWorker::spawn(Worker::command(
         "127.0.0.1:0",
         &["--metrics-addr", "127.0.0.1:0"],

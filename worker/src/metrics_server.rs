@@ -21,8 +21,7 @@ use hyper::body::Incoming;
 use hyper::header::{self, HeaderValue};
 use hyper::{Method, Request, Response, StatusCode};
 use tokio::net::TcpListener;
-use yat_proto::auth::constant_time_eq;
-use yat_proto::hash::sha256_hex;
+use yat_proto::auth::TokenDigest;
 
 use crate::http::{self, HttpBounds};
 use crate::prometheus_text::CONTENT_TYPE;
@@ -42,7 +41,7 @@ pub const PATH: &str = "/metrics";
 
 struct Endpoint<F> {
     /// SHA-256 (hex) of the token, when one is required.
-    token_digest: Option<String>,
+    token_digest: Option<TokenDigest>,
     exposition: F,
 }
 
@@ -57,7 +56,7 @@ pub async fn serve<F>(
     F: Fn() -> String + Send + Sync + 'static,
 {
     let endpoint = Arc::new(Endpoint {
-        token_digest: token.map(|t| sha256_hex(t.as_bytes())),
+        token_digest: token.map(TokenDigest::of),
         exposition,
     });
     let service = hyper::service::service_fn(move |request| {
@@ -99,14 +98,12 @@ impl<F: Fn() -> String> Endpoint<F> {
         let Some(expected) = &self.token_digest else {
             return true;
         };
-        request
-            .headers()
-            .get(header::AUTHORIZATION)
-            .and_then(|v| v.to_str().ok())
-            .and_then(|v| v.strip_prefix("Bearer "))
-            .is_some_and(|token| {
-                constant_time_eq(sha256_hex(token.as_bytes()).as_bytes(), expected.as_bytes())
-            })
+        expected.matches_bearer(
+            request
+                .headers()
+                .get(header::AUTHORIZATION)
+                .map(|v| v.as_bytes()),
+        )
     }
 }
 

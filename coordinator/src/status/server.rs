@@ -26,6 +26,7 @@ use axum::routing::get;
 use axum::Router;
 use hyper_util::service::TowerToHyperService;
 use tokio::net::TcpListener;
+use yat_proto::auth::TokenDigest;
 use yat_worker::http::HttpBounds;
 
 use super::board::StatusBoard;
@@ -76,7 +77,7 @@ pub struct StatusServer {
 struct AppState {
     board: Arc<StatusBoard>,
     /// SHA-256 (hex) of the token, when one is required.
-    token_digest: Option<String>,
+    token_digest: Option<TokenDigest>,
     /// The newest image encoded: (generation, PNG bytes). Encoding holds the lock, so one
     /// request encodes and the others wait for its bytes.
     png: tokio::sync::Mutex<(u64, axum::body::Bytes)>,
@@ -104,7 +105,7 @@ impl StatusServer {
             .map_err(|source| StatusServerError::Listen { address, source })?;
         let state = Arc::new(AppState {
             board,
-            token_digest: token.map(|t| yat_proto::hash::sha256_hex(t.as_bytes())),
+            token_digest: token.map(TokenDigest::of),
             png: tokio::sync::Mutex::new((0, axum::body::Bytes::new())),
         });
         let service = TowerToHyperService::new(router(state));
@@ -174,21 +175,9 @@ async fn require_token(
     let Some(expected) = &state.token_digest else {
         return next.run(request).await;
     };
-    let matches = |token: &str| {
-        yat_proto::auth::constant_time_eq(
-            yat_proto::hash::sha256_hex(token.as_bytes()).as_bytes(),
-            expected.as_bytes(),
-        )
-    };
     let headers = request.headers();
-    let bearer = headers
-        .get(header::AUTHORIZATION)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.strip_prefix("Bearer "))
-        .is_some_and(matches);
-    let cookie = cookie_value(headers).is_some_and(|digest| {
-        yat_proto::auth::constant_time_eq(digest.as_bytes(), expected.as_bytes())
-    });
+    let bearer = expected.matches_bearer(headers.get(header::AUTHORIZATION).map(|v| v.as_bytes()));
+    let cookie = cookie_value(headers).is_some_and(|digest| expected.matches_digest(digest));
     if bearer || cookie {
         return next.run(request).await;
     }
@@ -197,12 +186,16 @@ async fn require_token(
             .find(|(name, _)| name == "token")
             .map(|(_, value)| value.into_owned())
     });
-    if !from_url.as_deref().is_some_and(matches) {
+    if !from_url
+        .as_deref()
+        .is_some_and(|t| expected.matches_token(t))
+    {
         let challenge = [(header::WWW_AUTHENTICATE, "Bearer realm=\"yat status\"")];
         return (StatusCode::UNAUTHORIZED, challenge, html(LOGIN)).into_response();
     }
     let set_cookie = HeaderValue::try_from(format!(
-        "{COOKIE}={expected}; HttpOnly; SameSite=Strict; Path=/"
+        "{COOKIE}={}; HttpOnly; SameSite=Strict; Path=/",
+        expected.hex()
     ))
     .expect("hex digits make a valid header");
     let mut response = if request.uri().path() == "/" && request.method() == Method::GET {
