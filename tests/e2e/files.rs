@@ -224,11 +224,7 @@ fn planted_symlinks_at_the_side_files_are_not_followed() {
         stderr_of(&output)
     );
     assert_eq!(std::fs::read(&precious).unwrap(), b"do not touch");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".tmp"))
-        .collect();
+    let leftovers = names_in(dir.path(), |n| n.ends_with(".tmp"));
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 

@@ -6,7 +6,7 @@ use std::process::Command;
 
 use yat::isa::{self, ISA_ENV, V3_NAME, V3_SUFFIX};
 
-use crate::util::YAT;
+use crate::util::yat_in;
 
 /// `yat check` of a file that does not exist, run as `exe`: its stdout and stderr.
 fn check_missing(exe: &Path, isa_env: Option<&str>) -> (String, String) {
@@ -26,12 +26,7 @@ fn check_missing(exe: &Path, isa_env: Option<&str>) -> (String, String) {
 #[test]
 fn a_baseline_yat_hands_over_to_the_v3_build_beside_it_where_the_cpu_has_v3() {
     let dir = tempfile::tempdir().unwrap();
-    let exe = dir.path().join("yat");
-    // A hard link where the filesystem allows (the binary is large), else a copy: a symbolic
-    // link would resolve to the build folder, which has no stand-in beside it.
-    if std::fs::hard_link(YAT, &exe).is_err() {
-        std::fs::copy(YAT, &exe).unwrap();
-    }
+    let exe = yat_in(dir.path());
     let stand_in = dir.path().join(format!("yat{V3_SUFFIX}"));
     std::fs::write(&stand_in, "#!/bin/sh\necho \"v3 build: $YAT_ISA $*\"\n").unwrap();
 

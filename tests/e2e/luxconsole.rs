@@ -10,7 +10,7 @@ use std::process::{Command, Output, Stdio};
 
 use yat::isa::{self, ISA_ENV, V3_NAME, V3_SUFFIX};
 
-use crate::util::{assert_success, stderr_of, write_scene, YAT};
+use crate::util::{assert_success, names_in, stderr_of, write_scene, yat_in, YAT};
 
 /// The end-to-end tests' box (an Include'd materials file, PNG textures) at 48x36 and 16
 /// samples per pixel from its Film, since luxconsole's command line sets neither.
@@ -127,11 +127,7 @@ fn the_scene_on_standard_input_renders_against_the_current_folder() {
     assert_success(&output);
     assert_eq!(pixels(&scenes.join("stdin.png")), expected);
     // The staged copy is gone.
-    let left: Vec<String> = std::fs::read_dir(&scenes)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|name| name.starts_with(".yat-stdin-"))
-        .collect();
+    let left = names_in(&scenes, |name| name.starts_with(".yat-stdin-"));
     assert!(left.is_empty(), "{left:?}");
 }
 
@@ -258,12 +254,8 @@ fn unknown_and_unsupported_options_are_named_and_nothing_renders() {
 #[test]
 fn under_the_name_luxconsole_the_v3_build_is_handed_the_subcommand() {
     let dir = tempfile::tempdir().unwrap();
-    let exe = dir.path().join("yat");
-    // A hard link where the filesystem allows (the binary is large), else a copy; the name
-    // luxconsole is a symbolic link to it, which the running binary resolves to `yat`.
-    if std::fs::hard_link(YAT, &exe).is_err() {
-        std::fs::copy(YAT, &exe).unwrap();
-    }
+    // The name luxconsole is a symbolic link to it, which the running binary resolves to `yat`.
+    let exe = yat_in(dir.path());
     let named = dir.path().join("luxconsole");
     std::os::unix::fs::symlink(&exe, &named).unwrap();
     let stand_in = dir.path().join(format!("yat{V3_SUFFIX}"));

@@ -494,3 +494,23 @@ pub fn worker_entry<'a>(report: &'a serde_json::Value, address: &str) -> &'a ser
 pub fn workers_report(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
+
+/// `yat` as a file of its own in `dir` (a hard link where the filesystem allows, the binary
+/// being large, else a copy): a binary that looks beside itself for the x86-64-v3 build finds
+/// `dir`, where a symbolic link would resolve to the build folder.
+pub fn yat_in(dir: &Path) -> PathBuf {
+    let exe = dir.join("yat");
+    if std::fs::hard_link(YAT, &exe).is_err() {
+        std::fs::copy(YAT, &exe).unwrap();
+    }
+    exe
+}
+
+/// The names of the files in `dir` that `keep` accepts (files a test expects gone).
+pub fn names_in(dir: &Path, keep: impl Fn(&str) -> bool) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| keep(name))
+        .collect()
+}

@@ -39,14 +39,13 @@ use clap::Parser;
 use tempfile::NamedTempFile;
 
 use super::render::{self, RenderArgs};
+// A `-u HOST` without a port gets `yat worker`'s default (a LuxRender slave's, 18018, is no
+// YAT worker's).
+use super::worker::DEFAULT_PORT as WORKER_PORT;
 use crate::isa::{self, IsaChoice};
 
 /// The name under which the `yat` binary reads luxconsole's command line.
 pub const LUXCONSOLE: &str = "luxconsole";
-
-/// The port a `-u HOST` without one is given: `yat worker`'s default `--listen` port (a
-/// LuxRender slave's, 18018, is no YAT worker's).
-pub const WORKER_PORT: u16 = 7878;
 
 /// The most bytes of a scene read from standard input: what a scene may parse at most under
 /// the default build budget.

@@ -3,7 +3,7 @@
 //! once).
 
 use std::io::Write;
-use std::net::SocketAddr;
+use std::net::{Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -14,12 +14,16 @@ use super::budget::BudgetArgs;
 use crate::cpus::threads_or_usable_cpus;
 use crate::shutdown::{signalled, INTERRUPTED_EXIT_CODE};
 
+/// The port `yat worker` listens on by default, and the one a worker address without a port
+/// is taken to have (`yat luxconsole -u HOST`).
+pub const DEFAULT_PORT: u16 = 7878;
+
 #[derive(clap::Args, Debug)]
 pub struct WorkerArgs {
     /// Address to listen on, IP:PORT. Port 0 picks a free port; the first line printed on
     /// stdout, `listening on IP:PORT`, names the real address. Beyond loopback the worker
     /// needs a token or TLS client certificates, or --insecure.
-    #[arg(long, default_value = "127.0.0.1:7878")]
+    #[arg(long, default_value_t = SocketAddr::from((Ipv4Addr::LOCALHOST, DEFAULT_PORT)))]
     pub listen: SocketAddr,
     /// Serve the worker's Prometheus metrics at http://IP:PORT/metrics (nothing else), e.g.
     /// 127.0.0.1:7879 or 0.0.0.0:7879 (port 0: any free port; the second line printed on

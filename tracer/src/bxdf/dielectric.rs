@@ -16,8 +16,6 @@ use super::lobe::Lobe;
 use super::sample::LocalSample;
 use super::thin_film::ThinFilm;
 use crate::wavelength::cauchy_index;
-#[cfg(doc)]
-use crate::wavelength::CAUCHY_B_PER_UM2;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Surface {
@@ -38,7 +36,8 @@ pub struct Dielectric {
     /// Interference on the smooth or thin surface's reflection (LuxRender's glass; its rough
     /// glass has none).
     pub film: Option<ThinFilm>,
-    /// Cauchy's B in nm^2 (LuxRender's `cauchyb` times [`CAUCHY_B_PER_UM2`]): the index at a
+    /// Cauchy's B in nm^2 (LuxRender's `cauchyb` times
+    /// [`CAUCHY_B_PER_UM2`](crate::wavelength::CAUCHY_B_PER_UM2)): the index at a
     /// path's wavelength is `eta + cauchy_b / nm^2` ([`Self::at_wavelength`]). 0: none.
     pub cauchy_b: f32,
 }

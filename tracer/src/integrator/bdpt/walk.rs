@@ -170,11 +170,8 @@ pub(super) fn walk<S: BidirectionalScene>(
         let wo = -ray.dir;
         let u = sampler.get_vertex();
         let mut bsdf = scene.bsdf_at(&hit, u.mix);
-        if bsdf.is_dispersive() {
-            let number = wavelength.number;
-            bsdf.disperse(&mut wavelength.drawn, || number);
-            dispersed = true;
-        }
+        dispersed |= bsdf.is_dispersive();
+        bsdf.disperse(&mut wavelength.drawn, || wavelength.number);
         let straight = goes_straight_on(scene, &hit, &bsdf, wo, u.lobe, panes, sampler);
         if let Some(transmittance) = straight {
             if carries == Carries::Radiance
