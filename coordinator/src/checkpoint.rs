@@ -11,7 +11,11 @@
 //! the four sums per pixel once per source plane (`FilmFrame::source_planes`), then come the
 //! half sums (four i64 per pixel), each block's samples so far as the film counted them (u32),
 //! the round's number and each block's planned samples (u32): all the decisions so far, so the
-//! next ones are the same on resume. A render whose units carry light splats
+//! next ones are the same on resume. A converging render (LuxRender's `haltthreshold`, whose
+//! identity says so) keeps its round's units in a bitmap with room for a round's tiles, and
+//! after its sums (and light splats) the round's number (u32), the pixels that failed the last
+//! test (u32, `u32::MAX` before the first) and the last test's image (three f32 per pixel,
+//! zeros before round 1). A render whose units carry light splats
 //! (`FilmFrame::light_splats`, never adaptive) has after its sums the light splats' three i64
 //! sums per pixel and the light paths they are over (u64). Like the adaptive layout, this one
 //! is the render's own, so the format's version stays: checkpoints of every other render read
@@ -30,10 +34,13 @@ use anyhow::Context;
 use prost::Message;
 use yat_proto::hash::Sha256Stream;
 use yat_proto::pb;
+use yat_tracer::film::FilmDesc;
 use yat_tracer::film::{BufferMismatch, Film, FilmSplats, SampleBuffer};
-use yat_tracer::render::adaptive::{self, AdaptiveSettings, BlockGrid, Round};
+use yat_tracer::render::adaptive::{BlockGrid, Round};
+use yat_tracer::render::convergence::{ConvergenceRound, CONVERGENCE_VERSION};
+use yat_tracer::render::sampling::{Rounds, RoundsEnd, Sampling};
 use yat_tracer::render::unit::FilmFrame;
-use yat_tracer::render::{plan_units, RenderSettings, WorkUnit, PLAN_VERSION};
+use yat_tracer::render::{RenderSettings, WorkUnit, PLAN_VERSION};
 
 use yat_tracer::private_file::{read_regular_file, ReadFileError, StagedFile};
 
@@ -45,28 +52,37 @@ const HEADER_LEN: usize = MAGIC.len() + 4 + IDENTITY_LEN + 3 * 4;
 
 /// What a checkpoint belongs to: the SHA-256 of the renderer's version, the unit plan's version
 /// and the scene as a worker is asked to load it (every file by content hash, and the
-/// settings), and for an adaptive render its settings. Anything that changes the image changes
-/// it; threads, workers and output paths do not.
+/// settings), and for an adaptive or converging render its settings. Anything that changes the
+/// image changes it; threads, workers and output paths do not.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RenderIdentity(String);
 
 impl RenderIdentity {
-    pub fn of(load_request: &pb::LoadSceneRequest, adaptive: Option<&AdaptiveSettings>) -> Self {
+    pub fn of(load_request: &pb::LoadSceneRequest, sampling: &Sampling) -> Self {
         let mut digest = Sha256Stream::default();
         digest.update(b"yat render ");
         digest.update(env!("CARGO_PKG_VERSION").as_bytes());
         digest.update(format!(" plan {PLAN_VERSION} ").as_bytes());
         digest.update(&load_request.encode_to_vec());
-        if let Some(a) = adaptive {
-            // A uniform render's identity is what it always was: its checkpoints still resume.
-            digest.update(
+        // A uniform render's identity is what it always was: its checkpoints still resume.
+        match sampling {
+            Sampling::Uniform => {}
+            Sampling::Adaptive(a) => digest.update(
                 format!(
                     " adaptive {ADAPTIVE_VERSION} {:#010x} {}",
                     a.threshold.to_bits(),
                     a.min_spp
                 )
                 .as_bytes(),
-            );
+            ),
+            Sampling::Converging(halt) => digest.update(
+                format!(
+                    " converging {CONVERGENCE_VERSION} {:#010x} {}",
+                    halt.threshold.to_bits(),
+                    halt.step
+                )
+                .as_bytes(),
+            ),
         }
         Self(digest.finish_hex())
     }
@@ -76,16 +92,19 @@ impl RenderIdentity {
 /// the decision, the units of a round): part of an adaptive render's identity.
 const ADAPTIVE_VERSION: u32 = 4;
 
-/// The render so far: the merged film and which units of the plan it holds; for an adaptive
-/// render, the round under way (whose units `done` counts) and the half sums in the film.
+/// The render so far: the merged film and which units of the plan it holds; for a render in
+/// rounds, the round under way (whose units `done` counts), and for an adaptive one the half
+/// sums in the film.
 #[derive(Clone)]
 pub struct Checkpoint {
     film: Film,
     done: Vec<bool>,
     done_count: usize,
-    round: Option<Round>,
+    rounds: Rounds,
+    /// How the last round ended, once the render is done.
+    ended: Option<RoundsEnd>,
     /// Bits of the done bitmap in the file: one per unit of the plan, or room for the largest
-    /// round of an adaptive render.
+    /// round.
     bitmap_bits: usize,
 }
 
@@ -93,68 +112,61 @@ impl Checkpoint {
     /// Nothing rendered yet: the plan's units to do, or an adaptive render's round 0; the film
     /// is of `frame` (`RenderSettings::film_frame`: the settings' size, the scene filter's
     /// border, whether units carry light splats).
-    pub fn new(
-        settings: &RenderSettings,
-        frame: FilmFrame,
-        adaptive: Option<&AdaptiveSettings>,
-    ) -> Self {
-        let (film, round) = match adaptive {
-            Some(a) => (Film::adaptive(frame), Some(Round::first(settings, a))),
-            None => (Film::new(frame), None),
+    pub fn new(settings: &RenderSettings, frame: FilmFrame, sampling: &Sampling) -> Self {
+        let film = match sampling {
+            Sampling::Adaptive(_) => Film::adaptive(frame),
+            _ => Film::new(frame),
         };
-        let mut checkpoint = Self {
+        let rounds = Rounds::first(settings, sampling);
+        Self {
             film,
-            done: Vec::new(),
+            done: vec![false; rounds.units(settings).len()],
             done_count: 0,
-            round,
-            bitmap_bits: 0,
-        };
-        checkpoint.done = vec![false; checkpoint.units(settings, adaptive).len()];
-        checkpoint.bitmap_bits = match adaptive {
-            Some(_) => adaptive::max_round_units(settings),
-            None => checkpoint.done.len(),
-        };
-        checkpoint
+            rounds,
+            ended: None,
+            bitmap_bits: sampling.max_units(settings),
+        }
     }
 
-    /// The units of the plan (uniform) or of the round under way (adaptive).
-    pub fn units(
-        &self,
-        settings: &RenderSettings,
-        adaptive: Option<&AdaptiveSettings>,
-    ) -> Vec<WorkUnit> {
-        match (&self.round, adaptive) {
-            (Some(round), Some(a)) => round.units(settings, a),
-            _ => plan_units(settings),
-        }
+    /// The units of the plan (uniform) or of the round under way.
+    pub fn units(&self, settings: &RenderSettings) -> Vec<WorkUnit> {
+        self.rounds.units(settings)
+    }
+
+    /// Where the render's rounds are.
+    pub fn rounds(&self) -> &Rounds {
+        &self.rounds
     }
 
     /// The adaptive render's round under way.
-    pub fn round(&self) -> Option<&Round> {
-        self.round.as_ref()
+    pub fn adaptive_round(&self) -> Option<&Round> {
+        self.rounds.adaptive_round()
     }
 
-    /// Once every unit is in, moves an adaptive render to its next round, decided from the
-    /// merged film alone ([`adaptive::next_round`]); false when there is none (or the render is
-    /// uniform, or units are missing): the render is done.
-    pub fn advance(
-        &mut self,
-        settings: &RenderSettings,
-        adaptive: Option<&AdaptiveSettings>,
-    ) -> bool {
-        let (Some(round), Some(a)) = (&self.round, adaptive) else {
-            return false;
-        };
+    /// How the render's last round ended, once [`Self::advance`] found no next one.
+    pub fn ended(&self) -> Option<RoundsEnd> {
+        self.ended
+    }
+
+    /// Once every unit is in, moves a render in rounds to its next round, decided from the
+    /// merged film alone (`desc`: the scene's film, as a converging render's images are
+    /// compared displayed); false when there is none (or the render is uniform, or units are
+    /// missing): the render is done, and [`Self::ended`] says how.
+    pub fn advance(&mut self, settings: &RenderSettings, desc: &FilmDesc) -> bool {
         if !self.is_complete() {
             return false;
         }
-        let Some(next) = adaptive::next_round(&self.film, round, settings, a) else {
-            return false;
-        };
-        self.done = vec![false; next.units(settings, a).len()];
-        self.done_count = 0;
-        self.round = Some(next);
-        true
+        match self.rounds.advance(&self.film, desc, settings) {
+            Ok(()) => {
+                self.done = vec![false; self.rounds.units(settings).len()];
+                self.done_count = 0;
+                true
+            }
+            Err(end) => {
+                self.ended = Some(end);
+                false
+            }
+        }
     }
 
     /// Merges a unit's result. A unit already merged is not added again (false); a buffer that
@@ -195,26 +207,12 @@ impl Checkpoint {
         self.done_count == self.done.len()
     }
 
-    /// Camera samples merged, and all the render will take: for an adaptive render, the most
-    /// it may take (as if every block active now stayed so to the end), an estimate that each
-    /// round brings down.
-    pub fn samples(
-        &self,
-        settings: &RenderSettings,
-        adaptive: Option<&AdaptiveSettings>,
-    ) -> (u64, u64) {
-        let units = self.units(settings, adaptive);
-        let this_plan = self.done_samples(&units);
-        match (&self.round, adaptive) {
-            (Some(round), Some(a)) => {
-                let counts = round.samples(settings, a);
-                (
-                    counts.before + this_plan,
-                    counts.before + counts.now + counts.later,
-                )
-            }
-            _ => (this_plan, units.iter().map(WorkUnit::sample_count).sum()),
-        }
+    /// Camera samples merged, and all the render will take: for a render in rounds, the most
+    /// it may take (as if every block active now stayed so to the end, or the image never
+    /// converged), an estimate that each round brings down.
+    pub fn samples(&self, settings: &RenderSettings) -> (u64, u64) {
+        let this_round = self.done_samples(&self.units(settings));
+        self.rounds.samples(settings, this_round)
     }
 
     /// Camera samples of the units merged, out of `units` (the plan).
@@ -279,10 +277,27 @@ impl Checkpoint {
         for samples in self.film.block_samples() {
             out.write_all(&samples.to_le_bytes())?;
         }
-        if let Some(round) = &self.round {
-            out.write_all(&round.index.to_le_bytes())?;
-            for planned in &round.planned {
-                out.write_all(&planned.to_le_bytes())?;
+        match &self.rounds {
+            Rounds::Uniform => {}
+            Rounds::Adaptive(_, round) => {
+                out.write_all(&round.index.to_le_bytes())?;
+                for planned in &round.planned {
+                    out.write_all(&planned.to_le_bytes())?;
+                }
+            }
+            Rounds::Converging(_, round) => {
+                out.write_all(&round.index.to_le_bytes())?;
+                let unconverged = round.unconverged.map_or(u32::MAX, |n| n as u32);
+                out.write_all(&unconverged.to_le_bytes())?;
+                let pixels = self.film.width() as usize * self.film.height() as usize;
+                match &round.reference {
+                    Some(image) => {
+                        for v in image.iter().flatten() {
+                            out.write_all(&v.to_le_bytes())?;
+                        }
+                    }
+                    None => out.write_all(&vec![0u8; pixels * 12])?,
+                }
             }
         }
         let digest = out.digest.finish_hex();
@@ -290,29 +305,22 @@ impl Checkpoint {
     }
 
     /// The size of the file of a checkpoint with these settings.
-    fn file_len(
-        settings: &RenderSettings,
-        frame: FilmFrame,
-        adaptive: Option<&AdaptiveSettings>,
-    ) -> u64 {
+    fn file_len(settings: &RenderSettings, frame: FilmFrame, sampling: &Sampling) -> u64 {
         let pixels = u64::from(settings.width) * u64::from(settings.height);
-        let fixed = (HEADER_LEN + DIGEST_LEN) as u64;
-        match adaptive {
-            None => {
-                fixed
-                    + (plan_units(settings).len() as u64).div_ceil(8)
-                    + pixels * 32
-                    + splats_len(&frame, pixels) as u64
-            }
-            Some(_) => {
+        let fixed =
+            (HEADER_LEN + DIGEST_LEN) as u64 + (sampling.max_units(settings) as u64).div_ceil(8);
+        match sampling {
+            Sampling::Uniform => fixed + pixels * 32 + splats_len(&frame, pixels) as u64,
+            Sampling::Adaptive(_) => {
                 let blocks = BlockGrid::of(settings).len() as u64;
                 let planes = frame.source_planes() as u64;
+                fixed + pixels * 32 * (planes + 1) + adaptive_rounds_len(blocks as usize) as u64
+            }
+            Sampling::Converging(_) => {
                 fixed
-                    + (adaptive::max_round_units(settings) as u64).div_ceil(8)
-                    + pixels * 32 * (planes + 1)
-                    + blocks * 4
-                    + 4
-                    + blocks * 4
+                    + pixels * 32
+                    + splats_len(&frame, pixels) as u64
+                    + converging_rounds_len(pixels as usize) as u64
             }
         }
     }
@@ -323,7 +331,7 @@ impl Checkpoint {
         identity: &RenderIdentity,
         settings: &RenderSettings,
         frame: FilmFrame,
-        adaptive: Option<&AdaptiveSettings>,
+        sampling: &Sampling,
     ) -> Result<Self, CheckpointError> {
         if bytes.len() < HEADER_LEN + DIGEST_LEN || &bytes[..MAGIC.len()] != MAGIC {
             return Err(CheckpointError::NotACheckpoint);
@@ -347,14 +355,15 @@ impl Checkpoint {
         {
             return Err(CheckpointError::OtherRender);
         }
-        let mut checkpoint = Self::new(settings, frame, adaptive);
+        let mut checkpoint = Self::new(settings, frame, sampling);
         let pixels = width as usize * height as usize;
         let bitmap_len = checkpoint.bitmap_bits.div_ceil(8);
         let blocks = BlockGrid::of(settings).len();
         let planes = checkpoint.film.frame().source_planes();
-        let (sum_count, round_len) = match adaptive {
-            Some(_) => ((planes + 1) * pixels, 4 * blocks + 4 + 4 * blocks),
-            None => (pixels, 0),
+        let (sum_count, round_len) = match sampling {
+            Sampling::Uniform => (pixels, 0),
+            Sampling::Adaptive(_) => ((planes + 1) * pixels, adaptive_rounds_len(blocks)),
+            Sampling::Converging(_) => (pixels, converging_rounds_len(pixels)),
         };
         let splat_len = splats_len(&frame, pixels as u64);
         let rest = &body[HEADER_LEN..];
@@ -372,14 +381,14 @@ impl Checkpoint {
             .chunks_exact(4)
             .map(|w| u32::from_le_bytes(w.try_into().expect("4 bytes")))
             .collect();
-        let (block_samples, round_words) = match adaptive {
-            Some(_) => {
+        let (block_samples, round_words) = match sampling {
+            Sampling::Adaptive(_) => {
                 let (samples, round) = words.split_at(blocks);
                 (samples.to_vec(), round)
             }
-            None => (Vec::new(), &words[..]),
+            _ => (Vec::new(), &words[..]),
         };
-        let half = if adaptive.is_some() {
+        let half = if sampling.adaptive().is_some() {
             sums.split_off(planes * pixels)
         } else {
             Vec::new()
@@ -396,18 +405,35 @@ impl Checkpoint {
         });
         checkpoint.film = Film::from_sums(frame, sums, half, block_samples, splats)
             .ok_or(CheckpointError::Corrupt)?;
-        if let (Some(a), Some(_)) = (adaptive, &checkpoint.round) {
-            let round = Round {
-                index: round_words[0],
-                planned: round_words[1..].to_vec(),
-            };
-            // Checked as if hostile: a round no decision makes would plan nonsense units.
-            if !round.fits(settings, a) {
-                return Err(CheckpointError::Corrupt);
+        // Checked as if hostile: a round no decision makes would plan nonsense units.
+        match &mut checkpoint.rounds {
+            Rounds::Uniform => {}
+            Rounds::Adaptive(a, round) => {
+                *round = Round {
+                    index: round_words[0],
+                    planned: round_words[1..].to_vec(),
+                };
+                if !round.fits(settings, a) {
+                    return Err(CheckpointError::Corrupt);
+                }
             }
-            checkpoint.round = Some(round);
+            Rounds::Converging(halt, round) => {
+                let index = round_words[0];
+                let reference: Vec<[f32; 3]> = round_words[2..]
+                    .chunks_exact(3)
+                    .map(|rgb| std::array::from_fn(|c| f32::from_bits(rgb[c])))
+                    .collect();
+                *round = ConvergenceRound {
+                    index,
+                    reference: (index > 0).then_some(reference),
+                    unconverged: (round_words[1] != u32::MAX).then_some(u64::from(round_words[1])),
+                };
+                if !round.fits(settings, halt) {
+                    return Err(CheckpointError::Corrupt);
+                }
+            }
         }
-        let unit_count = checkpoint.units(settings, adaptive).len();
+        let unit_count = checkpoint.units(settings).len();
         if units as usize != unit_count || unit_count > checkpoint.bitmap_bits {
             return Err(CheckpointError::OtherRender);
         }
@@ -417,6 +443,18 @@ impl Checkpoint {
         checkpoint.done_count = checkpoint.done.iter().filter(|&&d| d).count();
         Ok(checkpoint)
     }
+}
+
+/// Bytes of an adaptive checkpoint's round: each block's samples so far, the round's number and
+/// each block's planned samples (u32 each).
+fn adaptive_rounds_len(blocks: usize) -> usize {
+    4 * blocks + 4 + 4 * blocks
+}
+
+/// Bytes of a converging checkpoint's round: its number, the last test's failed pixels (u32
+/// each) and the last test's image (three f32 per pixel).
+fn converging_rounds_len(pixels: usize) -> usize {
+    4 + 4 + 12 * pixels
 }
 
 /// Bytes of a checkpoint's light splats: three i64 sums per pixel and the light paths (u64),
@@ -477,13 +515,13 @@ impl CheckpointFile {
         &self,
         settings: &RenderSettings,
         frame: FilmFrame,
-        adaptive: Option<&AdaptiveSettings>,
+        sampling: &Sampling,
     ) -> Result<Option<Checkpoint>, CheckpointError> {
-        let expected = Checkpoint::file_len(settings, frame, adaptive);
+        let expected = Checkpoint::file_len(settings, frame, sampling);
         let Some(bytes) = read_regular_file(&self.path, expected)? else {
             return Ok(None);
         };
-        Checkpoint::decode(&bytes, &self.identity, settings, frame, adaptive).map(Some)
+        Checkpoint::decode(&bytes, &self.identity, settings, frame, sampling).map(Some)
     }
 
     /// The checkpoint to start from: the one on disk when it belongs to this render, else an
@@ -492,34 +530,35 @@ impl CheckpointFile {
         &self,
         settings: &RenderSettings,
         frame: FilmFrame,
-        adaptive: Option<&AdaptiveSettings>,
+        sampling: &Sampling,
         quiet: bool,
     ) -> Checkpoint {
-        match self.load(settings, frame, adaptive) {
+        match self.load(settings, frame, sampling) {
             Ok(Some(checkpoint)) => {
                 if !quiet {
-                    let (done, total) = checkpoint.samples(settings, adaptive);
+                    let (done, total) = checkpoint.samples(settings);
                     eprintln!(
                         "resuming from {}: {} of {} units{} ({:.1}% of the samples{}) already rendered",
                         self.path.display(),
                         checkpoint.done_count(),
                         checkpoint.done.len(),
                         checkpoint
-                            .round()
-                            .map_or(String::new(), |r| format!(" of round {}", r.index)),
+                            .rounds()
+                            .index()
+                            .map_or(String::new(), |i| format!(" of round {i}")),
                         100.0 * done as f64 / total.max(1) as f64,
-                        if adaptive.is_some() { " at most" } else { "" },
+                        if sampling.has_rounds() { " at most" } else { "" },
                     );
                 }
                 checkpoint
             }
-            Ok(None) => Checkpoint::new(settings, frame, adaptive),
+            Ok(None) => Checkpoint::new(settings, frame, sampling),
             Err(e) => {
                 eprintln!(
                     "not resuming from {}: it is {e}; starting afresh",
                     self.path.display()
                 );
-                Checkpoint::new(settings, frame, adaptive)
+                Checkpoint::new(settings, frame, sampling)
             }
         }
     }
@@ -573,6 +612,8 @@ impl<W: Write> Write for DigestingWriter<W> {
 mod tests {
     use super::*;
     use yat_tracer::desc::LatLongConvention;
+    use yat_tracer::render::adaptive::AdaptiveSettings;
+    use yat_tracer::render::convergence::ConvergenceHalt;
     use yat_tracer::render::plan_units;
 
     fn settings() -> RenderSettings {
@@ -597,6 +638,18 @@ mod tests {
         }
     }
 
+    /// The film of a scene that says nothing of it: LuxRender's defaults.
+    fn film_desc() -> FilmDesc {
+        let mut files = yat_tracer::assets::MemorySource::new();
+        files.insert(
+            "f.lxs",
+            std::sync::Arc::from(&b"WorldBegin\nWorldEnd\n"[..]),
+        );
+        yat_tracer::parse::parse_scene("f.lxs", &files)
+            .unwrap()
+            .film
+    }
+
     fn encode(checkpoint: &Checkpoint, identity: &RenderIdentity) -> Vec<u8> {
         let mut bytes = Vec::new();
         checkpoint.encode_to(identity, &mut bytes).unwrap();
@@ -613,14 +666,14 @@ mod tests {
                 assets: vec![],
                 settings: Some((&settings()).into()),
             },
-            None,
+            &Sampling::Uniform,
         )
     }
 
     /// A checkpoint holding every third unit of the plan, with distinct sums per unit.
     fn partial() -> (Checkpoint, Vec<WorkUnit>) {
         let units = plan_units(&settings());
-        let mut checkpoint = Checkpoint::new(&settings(), frame(), None);
+        let mut checkpoint = Checkpoint::new(&settings(), frame(), &Sampling::Uniform);
         for unit in units.iter().step_by(3) {
             let mut buffer = SampleBuffer::new(*unit, &frame());
             for (i, (rgb, w)) in buffer.rgb.iter_mut().zip(&mut buffer.weight).enumerate() {
@@ -637,8 +690,14 @@ mod tests {
     fn a_checkpoint_reads_back_exactly() {
         let (checkpoint, units) = partial();
         let id = identity("a.lxs");
-        let back = Checkpoint::decode(&encode(&checkpoint, &id), &id, &settings(), frame(), None)
-            .expect("own checkpoint");
+        let back = Checkpoint::decode(
+            &encode(&checkpoint, &id),
+            &id,
+            &settings(),
+            frame(),
+            &Sampling::Uniform,
+        )
+        .expect("own checkpoint");
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.done, checkpoint.done);
         assert_eq!(back.done_count(), units.len().div_ceil(3));
@@ -655,7 +714,7 @@ mod tests {
             ..frame()
         };
         let units = plan_units(&settings());
-        let mut checkpoint = Checkpoint::new(&settings(), splat_frame, None);
+        let mut checkpoint = Checkpoint::new(&settings(), splat_frame, &Sampling::Uniform);
         for unit in units.iter().step_by(2) {
             let mut buffer = SampleBuffer::new(*unit, &splat_frame);
             let pixels: Vec<u32> = (0..40).map(|k| unit.index % 20 * 7 + k * 67).collect();
@@ -674,22 +733,28 @@ mod tests {
         let bytes = encode(&checkpoint, &id);
         assert_eq!(
             bytes.len() as u64,
-            Checkpoint::file_len(&settings(), splat_frame, None)
+            Checkpoint::file_len(&settings(), splat_frame, &Sampling::Uniform)
         );
         let pixels = (settings().width * settings().height) as u64;
         assert_eq!(
-            Checkpoint::file_len(&settings(), splat_frame, None)
-                - Checkpoint::file_len(&settings(), frame(), None),
+            Checkpoint::file_len(&settings(), splat_frame, &Sampling::Uniform)
+                - Checkpoint::file_len(&settings(), frame(), &Sampling::Uniform),
             pixels * 24 + 8
         );
-        let back = Checkpoint::decode(&bytes, &id, &settings(), splat_frame, None).unwrap();
+        let back =
+            Checkpoint::decode(&bytes, &id, &settings(), splat_frame, &Sampling::Uniform).unwrap();
         assert_eq!(back.film().splats(), Some(&splats));
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.film().radiance(), checkpoint.film().radiance());
         // The layout without splats is not read as one with them, nor the reverse.
-        let plain = encode(&Checkpoint::new(&settings(), frame(), None), &id);
-        assert!(Checkpoint::decode(&plain, &id, &settings(), splat_frame, None).is_err());
-        assert!(Checkpoint::decode(&bytes, &id, &settings(), frame(), None).is_err());
+        let plain = encode(
+            &Checkpoint::new(&settings(), frame(), &Sampling::Uniform),
+            &id,
+        );
+        assert!(
+            Checkpoint::decode(&plain, &id, &settings(), splat_frame, &Sampling::Uniform).is_err()
+        );
+        assert!(Checkpoint::decode(&bytes, &id, &settings(), frame(), &Sampling::Uniform).is_err());
     }
 
     #[test]
@@ -699,15 +764,11 @@ mod tests {
             min_spp: 2,
         };
         let s = settings();
-        let mut checkpoint = Checkpoint::new(&s, frame(), Some(&a));
+        let sampling = Sampling::Adaptive(a);
+        let mut checkpoint = Checkpoint::new(&s, frame(), &sampling);
         // Round 0, then round 1 after a noisy film, then part of round 1.
         let fill = |checkpoint: &mut Checkpoint, every: usize| {
-            for (n, unit) in checkpoint
-                .units(&s, Some(&a))
-                .iter()
-                .enumerate()
-                .step_by(every)
-            {
+            for (n, unit) in checkpoint.units(&s).iter().enumerate().step_by(every) {
                 let mut buffer = SampleBuffer::new(*unit, &frame());
                 let value = |i: usize| ((i * 7919 + n * 104_729) % 97) as f32 / 9.0;
                 for i in 0..buffer.weight.len() {
@@ -722,21 +783,22 @@ mod tests {
             }
         };
         fill(&mut checkpoint, 1);
-        assert!(checkpoint.advance(&s, Some(&a)), "a noisy film goes on");
+        let film_desc = film_desc();
+        assert!(checkpoint.advance(&s, &film_desc), "a noisy film goes on");
         fill(&mut checkpoint, 2);
-        let round = checkpoint.round().unwrap().clone();
+        let round = checkpoint.adaptive_round().unwrap().clone();
         assert_eq!(round.index, 1);
-        let id = RenderIdentity::of(&pb::LoadSceneRequest::default(), Some(&a));
+        let id = RenderIdentity::of(&pb::LoadSceneRequest::default(), &sampling);
         assert_ne!(
             id,
-            RenderIdentity::of(&pb::LoadSceneRequest::default(), None)
+            RenderIdentity::of(&pb::LoadSceneRequest::default(), &Sampling::Uniform)
         );
         let bytes = encode(&checkpoint, &id);
         assert_eq!(
             bytes.len() as u64,
-            Checkpoint::file_len(&s, frame(), Some(&a))
+            Checkpoint::file_len(&s, frame(), &sampling)
         );
-        let back = Checkpoint::decode(&bytes, &id, &s, frame(), Some(&a)).unwrap();
+        let back = Checkpoint::decode(&bytes, &id, &s, frame(), &sampling).unwrap();
         assert_eq!(back.film().sums(), checkpoint.film().sums());
         assert_eq!(back.film().half_sums(), checkpoint.film().half_sums());
         assert_eq!(
@@ -744,15 +806,74 @@ mod tests {
             checkpoint.film().block_samples()
         );
         assert!(back.film().block_samples().contains(&4));
-        assert_eq!(back.round(), Some(&round));
+        assert_eq!(back.adaptive_round(), Some(&round));
         assert_eq!(back.done, checkpoint.done);
-        assert_eq!(back.samples(&s, Some(&a)), checkpoint.samples(&s, Some(&a)));
+        assert_eq!(back.samples(&s), checkpoint.samples(&s));
         // A round no decision makes (a block planned for 3 samples) is refused.
         let mut forged = checkpoint.clone();
-        forged.round.as_mut().unwrap().planned[0] = 3;
+        let Rounds::Adaptive(_, forged_round) = &mut forged.rounds else {
+            unreachable!("an adaptive checkpoint")
+        };
+        forged_round.planned[0] = 3;
         let bytes = encode(&forged, &id);
         assert!(matches!(
-            Checkpoint::decode(&bytes, &id, &s, frame(), Some(&a)),
+            Checkpoint::decode(&bytes, &id, &s, frame(), &sampling),
+            Err(CheckpointError::Corrupt)
+        ));
+    }
+
+    /// A converging render's checkpoint keeps its round, the last test's image and result
+    /// exactly; a reference no display shows is refused.
+    #[test]
+    fn a_converging_checkpoint_keeps_its_round_and_reference_exactly() {
+        let s = settings();
+        let halt = ConvergenceHalt::new(0.0, 16.0);
+        let sampling = Sampling::Converging(halt);
+        let mut checkpoint = Checkpoint::new(&s, frame(), &sampling);
+        let fill = |checkpoint: &mut Checkpoint, every: usize, salt: usize| {
+            for unit in checkpoint.units(&s).iter().step_by(every) {
+                let mut buffer = SampleBuffer::new(*unit, &frame());
+                for i in 0..buffer.weight.len() {
+                    let v = ((i * 7919 + salt * 104_729) % 97) as f32 / 50.0;
+                    buffer.rgb[i] = [v, 0.5 * v, 1.0];
+                    buffer.weight[i] = 1.0;
+                }
+                assert!(checkpoint.add(&buffer).unwrap());
+            }
+        };
+        fill(&mut checkpoint, 1, 0);
+        assert!(
+            checkpoint.advance(&s, &film_desc()),
+            "round 0 only sets the reference"
+        );
+        assert_eq!(checkpoint.rounds().index(), Some(1));
+        fill(&mut checkpoint, 2, 1);
+        let id = RenderIdentity::of(&pb::LoadSceneRequest::default(), &sampling);
+        assert_ne!(
+            id,
+            RenderIdentity::of(&pb::LoadSceneRequest::default(), &Sampling::Uniform)
+        );
+        let bytes = encode(&checkpoint, &id);
+        assert_eq!(
+            bytes.len() as u64,
+            Checkpoint::file_len(&s, frame(), &sampling)
+        );
+        let back = Checkpoint::decode(&bytes, &id, &s, frame(), &sampling).unwrap();
+        assert_eq!(back.rounds(), checkpoint.rounds());
+        assert_eq!(back.film().sums(), checkpoint.film().sums());
+        assert_eq!(back.done, checkpoint.done);
+        assert_eq!(back.samples(&s), checkpoint.samples(&s));
+        let Rounds::Converging(_, round) = back.rounds() else {
+            unreachable!("a converging checkpoint")
+        };
+        assert_eq!(round.reference.as_ref().map(Vec::len), Some(70 * 40));
+        let mut forged = checkpoint.clone();
+        let Rounds::Converging(_, forged_round) = &mut forged.rounds else {
+            unreachable!("a converging checkpoint")
+        };
+        forged_round.reference.as_mut().unwrap()[5] = [2.0, 0.0, 0.0];
+        assert!(matches!(
+            Checkpoint::decode(&encode(&forged, &id), &id, &s, frame(), &sampling),
             Err(CheckpointError::Corrupt)
         ));
     }
@@ -763,7 +884,7 @@ mod tests {
         let id = identity("a.lxs");
         let bytes = encode(&checkpoint, &id);
         let decode = |bytes: &[u8], id: &RenderIdentity, settings: &RenderSettings| {
-            Checkpoint::decode(bytes, id, settings, frame(), None).err()
+            Checkpoint::decode(bytes, id, settings, frame(), &Sampling::Uniform).err()
         };
         assert!(matches!(
             decode(&bytes, &identity("b.lxs"), &settings()),
@@ -803,12 +924,15 @@ mod tests {
         let output = dir.path().join("out.png");
         let file = CheckpointFile::beside(&output, identity("a.lxs"), Duration::from_secs(1));
         assert_eq!(file.path(), dir.path().join("out.resume"));
-        assert!(file.load(&settings(), frame(), None).unwrap().is_none());
+        assert!(file
+            .load(&settings(), frame(), &Sampling::Uniform)
+            .unwrap()
+            .is_none());
         let (checkpoint, _) = partial();
-        file.save(&Checkpoint::new(&settings(), frame(), None))
+        file.save(&Checkpoint::new(&settings(), frame(), &Sampling::Uniform))
             .unwrap();
         file.save(&checkpoint).unwrap();
-        let loaded = file.resume(&settings(), frame(), None, true);
+        let loaded = file.resume(&settings(), frame(), &Sampling::Uniform, true);
         assert_eq!(loaded.film().sums(), checkpoint.film().sums());
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
@@ -819,7 +943,7 @@ mod tests {
         let stranger = CheckpointFile::beside(&output, identity("b.lxs"), Duration::ZERO);
         assert_eq!(
             stranger
-                .resume(&settings(), frame(), None, true)
+                .resume(&settings(), frame(), &Sampling::Uniform, true)
                 .done_count(),
             0
         );

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use yat_tracer::film::Film;
-use yat_tracer::render::adaptive::{self, AdaptiveSettings, Round};
+use yat_tracer::render::adaptive::{self, Round};
+use yat_tracer::render::sampling::{RoundsEnd, Sampling};
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
@@ -21,9 +22,9 @@ use crate::shutdown::{Interrupt, Interrupted};
 pub struct RenderJob {
     pub scene: ParsedScene,
     pub settings: RenderSettings,
-    /// Adaptive sampling: rounds until the noise is under the threshold (settings.spp is the
-    /// most any pixel gets); None renders every pixel with spp samples.
-    pub adaptive: Option<AdaptiveSettings>,
+    /// Every pixel spp samples, or rounds until the noise is under a threshold (adaptive) or
+    /// the image stops changing (converging); settings.spp is then the most any pixel gets.
+    pub sampling: Sampling,
     /// Where to write the sample map of an adaptive render, at the end.
     pub sample_map: Option<PathBuf>,
     /// The PNG the render will write; previews and the checkpoint go next to it.
@@ -131,6 +132,8 @@ pub struct RenderOutcome {
     pub build: Option<SceneBuild>,
     /// An adaptive render's last round: each block's samples per pixel.
     pub round: Option<Round>,
+    /// How a complete render's rounds ended (a converging one's last test).
+    pub ended: Option<RoundsEnd>,
     /// False for a render stopped by its time limit: its checkpoint stays for the rest.
     pub complete: bool,
 }
@@ -153,10 +156,10 @@ impl RenderJob {
 
     /// The render to start from: the checkpoint a previous run of this render left, or nothing.
     pub fn resume(&self) -> Checkpoint {
-        let adaptive = self.adaptive.as_ref();
+        let sampling = &self.sampling;
         match &self.interim.checkpoint {
-            Some(file) => file.resume(&self.settings, self.frame(), adaptive, self.quiet),
-            None => Checkpoint::new(&self.settings, self.frame(), adaptive),
+            Some(file) => file.resume(&self.settings, self.frame(), sampling, self.quiet),
+            None => Checkpoint::new(&self.settings, self.frame(), sampling),
         }
     }
 
@@ -171,7 +174,7 @@ impl RenderJob {
     /// limit: the round's film and samples, to write if the limit comes before the next one is
     /// complete.
     pub fn keep_round(&self, checkpoint: &Checkpoint) -> Option<CompletedRound> {
-        let round = checkpoint.round()?;
+        let round = checkpoint.adaptive_round()?;
         (self.deadline.is_some() && checkpoint.is_complete()).then(|| CompletedRound {
             film: checkpoint.film().clone(),
             round: round.clone(),
@@ -193,10 +196,10 @@ impl RenderJob {
             .as_ref()
             .map_or("the time limit", |d| d.set_by.as_str());
         let kept = self.keep(checkpoint);
-        let uniform = checkpoint.round().is_none();
+        // Every pixel alike (one plan, or converging rounds): the image of every sample merged.
+        let uniform = checkpoint.adaptive_round().is_none();
         if uniform && kept.is_some() {
-            let units = checkpoint.units(&self.settings, None);
-            let held = merged_samples(&units, |u| checkpoint.is_done(u));
+            let held = self.merged_samples(checkpoint);
             if !self.quiet {
                 eprintln!(
                     "{set_by} reached: writing the image of the samples merged: {held}; {}",
@@ -208,6 +211,7 @@ impl RenderJob {
                 stats,
                 build,
                 round: None,
+                ended: None,
                 complete: false,
             });
         }
@@ -228,6 +232,7 @@ impl RenderJob {
             stats,
             build,
             round: Some(completed.round),
+            ended: None,
             complete: false,
         })
     }
@@ -253,7 +258,7 @@ impl RenderJob {
     /// when nothing was merged.
     fn keep(&self, checkpoint: &Checkpoint) -> Option<String> {
         let something =
-            checkpoint.done_count() > 0 || checkpoint.round().is_some_and(|r| r.index > 0);
+            checkpoint.done_count() > 0 || checkpoint.rounds().index().is_some_and(|i| i > 0);
         if !something {
             return None;
         }
@@ -271,11 +276,11 @@ impl RenderJob {
         for e in failed {
             eprintln!("{e:#}");
         }
-        let (done, total) = checkpoint.samples(&self.settings, self.adaptive.as_ref());
+        let (done, total) = checkpoint.samples(&self.settings);
         let share = format!(
             "{:.1}% of the samples{}",
             100.0 * done as f64 / total.max(1) as f64,
-            if self.adaptive.is_some() {
+            if self.sampling.has_rounds() {
                 " (at most)"
             } else {
                 ""
@@ -328,6 +333,28 @@ impl RenderJob {
             self.interim.remove();
         }
         Ok(())
+    }
+}
+
+impl RenderJob {
+    /// Which samples the merged units of a render of every pixel alike hold, exactly: of a
+    /// uniform plan, or of the converging rounds before the one under way and its units.
+    fn merged_samples(&self, checkpoint: &Checkpoint) -> String {
+        let units = checkpoint.units(&self.settings);
+        let is_done = |u: &WorkUnit| checkpoint.is_done(u);
+        match (&self.sampling, checkpoint.rounds().index()) {
+            (Sampling::Converging(halt), Some(round)) if round > 0 => {
+                let before = halt
+                    .round_range(round, self.settings.spp)
+                    .map_or(0, |r| r.0);
+                let this_round = merged_samples(&units, is_done);
+                match this_round.strip_prefix("no sample of every pixel") {
+                    Some(rest) => format!("samples 0..{before} of every pixel{rest}"),
+                    None => this_round,
+                }
+            }
+            _ => merged_samples(&units, is_done),
+        }
     }
 }
 

@@ -10,6 +10,8 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use yat_tracer::integrator::Transport;
 use yat_tracer::render::adaptive::AdaptiveSettings;
+use yat_tracer::render::convergence::ConvergenceHalt;
+use yat_tracer::render::sampling::Sampling;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use crate::checkpoint::{CheckpointFile, RenderIdentity};
@@ -29,9 +31,9 @@ use crate::status::StatusBoard;
 pub struct RenderRequest {
     pub scene: ParsedScene,
     pub settings: RenderSettings,
-    /// Adaptive sampling (settings.spp is then the most any pixel gets); None renders every
-    /// pixel with spp samples.
-    pub adaptive: Option<AdaptiveSettings>,
+    /// Every pixel spp samples, adaptive rounds, or rounds until the image stops changing
+    /// (settings.spp then the most any pixel gets).
+    pub sampling: Sampling,
     /// The PNG; the preview, the checkpoint and the EXR go beside it.
     pub output_png: PathBuf,
     /// Also write linear radiance as OpenEXR next to the PNG.
@@ -51,7 +53,9 @@ impl RenderRequest {
     /// film checked against the scene's memory budget), into `output_png`, or, when None, the
     /// PNG the scene's Film names in the current folder (with a warning in
     /// [`Self::warnings`] when the scene names a folder), stopping at the scene's `halttime`
-    /// from now if it has one. No EXR or sample map: set those fields after.
+    /// from now if it has one. With `adaptive` the render is adaptive; else it halts by
+    /// convergence when the scene's `haltthreshold` or the overrides' say so. No EXR or sample
+    /// map: set those fields after.
     pub fn new(
         scene: ParsedScene,
         overrides: &RenderOverrides,
@@ -61,7 +65,15 @@ impl RenderRequest {
         let settings = RenderSettings::resolve(&scene.desc, overrides);
         let cannot_render = || format!("cannot render {}", scene.path.display());
         settings.check().with_context(cannot_render)?;
-        if let Some(a) = &adaptive {
+        let sampling = match (adaptive, ConvergenceHalt::resolve(&scene.desc, overrides)) {
+            (Some(a), _) => Sampling::Adaptive(a),
+            (None, Some(halt)) => {
+                halt.check().with_context(cannot_render)?;
+                Sampling::Converging(halt)
+            }
+            (None, None) => Sampling::Uniform,
+        };
+        if let Sampling::Adaptive(a) = &sampling {
             a.check().with_context(cannot_render)?;
             if settings.transport == Transport::Bidirectional {
                 anyhow::bail!(
@@ -70,7 +82,7 @@ impl RenderRequest {
                 );
             }
         }
-        scene.check_film(&settings, adaptive.is_some())?;
+        scene.check_film(&settings, &sampling)?;
         let (output_png, warnings) = match output_png {
             Some(output) => (output, Vec::new()),
             None => {
@@ -86,7 +98,7 @@ impl RenderRequest {
         Ok(Self {
             scene,
             settings,
-            adaptive,
+            sampling,
             output_png,
             exr: false,
             sample_map: None,
@@ -190,10 +202,8 @@ fn render_and_write(
         .as_ref()
         .zip(observers.checkpoint_every)
         .map(|(m, every)| {
-            let identity = RenderIdentity::of(
-                &m.load_request(&request.settings),
-                request.adaptive.as_ref(),
-            );
+            let identity =
+                RenderIdentity::of(&m.load_request(&request.settings), &request.sampling);
             CheckpointFile::beside(&request.output_png, identity, every)
         });
     let status = observers.status;
@@ -207,7 +217,7 @@ fn render_and_write(
         },
         scene: request.scene,
         settings: request.settings,
-        adaptive: request.adaptive,
+        sampling: request.sampling,
         sample_map: request.sample_map,
         output_png: request.output_png,
         exr: request.exr,

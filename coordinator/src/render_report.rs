@@ -2,6 +2,8 @@
 
 use std::time::Duration;
 
+use yat_tracer::render::sampling::{RoundsEnd, Sampling};
+
 use crate::exec::distributed::report::DistributedReport;
 use crate::job::{RenderJob, RenderOutcome};
 
@@ -27,6 +29,8 @@ pub struct RenderReport {
     pub peak_memory_bytes: Option<u64>,
     /// Rounds of an adaptive render (its spp is then the most a pixel got).
     pub adaptive_rounds: Option<u32>,
+    /// How a render halted by convergence ended (its spp is then the most it could take).
+    pub convergence: Option<ConvergenceEnd>,
     /// The build of the coordinator's process ([`crate::isa::build_name`]), which renders an
     /// in-process render.
     pub instruction_set: &'static str,
@@ -34,6 +38,68 @@ pub struct RenderReport {
     /// writes them, the stats JSON leaves them out).
     #[serde(skip)]
     pub workers: Option<DistributedReport>,
+}
+
+/// The end of a render halted by convergence: the samples every pixel got, and how many pixels
+/// changed visibly in its last test.
+#[derive(serde::Serialize)]
+pub struct ConvergenceEnd {
+    pub spp: u32,
+    pub converged: bool,
+    pub unconverged_pixels: Option<u64>,
+    pub pixels: u64,
+    pub threshold: f32,
+}
+
+impl ConvergenceEnd {
+    fn of(outcome: &RenderOutcome, sampling: &Sampling) -> Option<Self> {
+        let Sampling::Converging(halt) = sampling else {
+            return None;
+        };
+        let (spp, converged, unconverged, pixels) = match outcome.ended? {
+            RoundsEnd::Converged {
+                spp,
+                unconverged,
+                pixels,
+            } => (spp, true, Some(unconverged), pixels),
+            RoundsEnd::SamplesSpent {
+                spp,
+                unconverged,
+                pixels,
+            } => (spp, false, unconverged, pixels),
+            RoundsEnd::Planned => return None,
+        };
+        Some(Self {
+            spp,
+            converged,
+            unconverged_pixels: unconverged,
+            pixels,
+            threshold: halt.threshold,
+        })
+    }
+
+    /// "96 spp (converged: 12 of 1536 pixels, 0.78%, changed visibly in the last test, at
+    /// most 2%)".
+    fn describe(&self) -> String {
+        let changed = match self.unconverged_pixels {
+            Some(n) => format!(
+                "{n} of {} pixels, {:.2}%, changed visibly in the last test",
+                self.pixels,
+                100.0 * n as f64 / self.pixels.max(1) as f64
+            ),
+            None => "no test yet".to_string(),
+        };
+        let how = if self.converged {
+            "converged"
+        } else {
+            "samples spent before converging"
+        };
+        format!(
+            "{} spp ({how}: {changed}, halting at {}% or fewer)",
+            self.spp,
+            self.threshold * 100.0
+        )
+    }
 }
 
 impl RenderReport {
@@ -59,6 +125,7 @@ impl RenderReport {
             rays_per_second: stats.rays as f64 / render_secs,
             peak_memory_bytes: peak_memory_bytes(),
             adaptive_rounds: outcome.round.as_ref().map(|r| r.index + 1),
+            convergence: ConvergenceEnd::of(outcome, &job.sampling),
             instruction_set: crate::isa::build_name(),
             workers: None,
         }
@@ -70,13 +137,14 @@ impl RenderReport {
             "{}x{} at {}, depth {}{}{}",
             self.width,
             self.height,
-            match self.adaptive_rounds {
-                Some(rounds) => format!(
+            match (self.adaptive_rounds, &self.convergence) {
+                (Some(rounds), _) => format!(
                     "{:.1} spp on average (adaptive: {rounds} rounds, at most {})",
                     self.samples as f64 / pixels.max(1) as f64,
                     self.spp
                 ),
-                None => format!("{} spp", self.spp),
+                (None, Some(end)) => end.describe(),
+                (None, None) => format!("{} spp", self.spp),
             },
             self.max_depth,
             self.triangles

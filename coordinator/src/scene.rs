@@ -11,6 +11,8 @@ use yat_tracer::budget::{BuildBudget, BuildGuard, Limit};
 use yat_tracer::desc::SceneDesc;
 use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene_guarded;
+use yat_tracer::render::convergence::ConvergenceHalt;
+use yat_tracer::render::sampling::Sampling;
 use yat_tracer::render::{RenderScene, RenderSettings};
 
 /// A scene file parsed, with where its files come from.
@@ -77,16 +79,22 @@ impl ParsedScene {
         })
     }
 
-    /// Bytes the film of a render of `settings` (an adaptive one's if `adaptive`) takes here:
-    /// the coordinator's, whether it renders in-process or merges workers' units.
-    pub fn film_bytes(&self, settings: &RenderSettings, adaptive: bool) -> u64 {
-        Film::memory_bytes(settings.film_frame(&self.desc), adaptive)
+    /// Bytes the film of a render of `settings` sampled so takes here (a converging render's
+    /// tests included): the coordinator's, whether it renders in-process or merges workers'
+    /// units.
+    pub fn film_bytes(&self, settings: &RenderSettings, sampling: &Sampling) -> u64 {
+        let frame = settings.film_frame(&self.desc);
+        let film = Film::memory_bytes(frame, sampling.adaptive().is_some());
+        match sampling {
+            Sampling::Converging(_) => film + ConvergenceHalt::memory_bytes(settings),
+            _ => film,
+        }
     }
 
     /// Fails unless the film of [`Self::film_bytes`] fits the memory budget with what the
     /// parse estimated for the scene.
-    pub fn check_film(&self, settings: &RenderSettings, adaptive: bool) -> anyhow::Result<()> {
-        let film = self.film_bytes(settings, adaptive);
+    pub fn check_film(&self, settings: &RenderSettings, sampling: &Sampling) -> anyhow::Result<()> {
+        let film = self.film_bytes(settings, sampling);
         self.desc
             .spent
             .clone()

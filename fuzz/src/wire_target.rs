@@ -383,6 +383,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 haltspp: None,
                 halttime: None,
                 haltthreshold: None,
+                convergence_step: yat_tracer::film::DEFAULT_CONVERGENCE_STEP,
             });
             7 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),

@@ -271,7 +271,11 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
     let (ok, stdout, stderr) = check_with(&scene, &["--strict"]);
     assert!(ok, "--strict does not fail on them: {stdout}\n{stderr}");
     for line in [
-        "film         gamma 2.2, tonemap autolinear, output \"luxout\", haltthreshold 0.05",
+        "film         gamma 2.2, tonemap autolinear, output \"luxout\"",
+        "halts        the first met ends the render: 16777216 samples a pixel (the most a render \
+         halted by convergence takes), at most 5% of the pixels changing visibly between tests \
+         every 32 samples (haltthreshold) (--spp, --time-limit and --halt-threshold override \
+         them)",
         "no effect on the image: 6",
         "  quiet.lxs:2:3: Film \"fleximage\": \"bool write_exr\" [\"true\"]: no effect on the image \
          (output settings: which files are written, not what they show)",

@@ -96,3 +96,162 @@ fn a_scenes_halttime_writes_the_samples_merged_and_the_same_command_goes_on() {
         "the halted image is the final one: no halt happened"
     );
 }
+
+/// The test scene with its Film's `extra` parameters.
+fn scene_with_film(dir: &std::path::Path, extra: &str) -> std::path::PathBuf {
+    let scene = write_scene(dir);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let film = "Film \"fleximage\"";
+    assert!(text.contains(film), "the test scene has a Film");
+    std::fs::write(&scene, text.replacen(film, &format!("{film} {extra}"), 1)).unwrap();
+    scene
+}
+
+/// The summary's "N spp (converged: ...)" of a render halted by convergence: (N, the line).
+fn converged_at(output: &std::process::Output) -> (u32, String) {
+    let stdout = String::from_utf8_lossy(&output.stdout).to_string();
+    let line = stdout
+        .lines()
+        .find(|l| l.contains(" spp ("))
+        .unwrap_or_else(|| panic!("no convergence in the summary: {stdout}"))
+        .to_string();
+    let spp = line
+        .split(" spp (")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no spp in {line}"));
+    (spp, line)
+}
+
+const CONVERGING: [&str; 2] = ["--resolution", "32x24"];
+
+/// A scene's `haltthreshold` ends the render at the first round (of `convergencestep`
+/// samples) whose image differs visibly from the last round's in at most that share of the
+/// pixels, long before its haltspp; the round, and so the image, is the same in-process and on
+/// two workers; `--halt-threshold -1` lifts it.
+#[test]
+fn a_scenes_haltthreshold_ends_the_render_at_the_same_round_anywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_with_film(
+        dir.path(),
+        "\"float haltthreshold\" [0.05] \"float convergencestep\" [16] \"integer haltspp\" [4096]",
+    );
+    let here = dir.path().join("here.png");
+    let in_process = render_command_with(&scene, &here, &CONVERGING, &["--threads", "2"])
+        .output()
+        .unwrap();
+    assert_success(&in_process);
+    let (spp, line) = converged_at(&in_process);
+    assert!(line.contains("(converged: "), "{line}");
+    assert!(
+        (32..4096).contains(&spp) && spp % 16 == 0,
+        "ends at a round boundary after the first test, before haltspp: {line}"
+    );
+    let share: f64 = line
+        .split(", ")
+        .find_map(|part| part.strip_suffix("%"))
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no share in {line}"));
+    assert!(share <= 5.0, "{line}");
+
+    let there = dir.path().join("there.png");
+    let distributed = render_command_with(&scene, &there, &CONVERGING, &["--local-workers", "2"])
+        .output()
+        .unwrap();
+    assert_success(&distributed);
+    assert_eq!(
+        converged_at(&distributed).0,
+        spp,
+        "the same round on workers"
+    );
+    assert!(
+        image_bytes(&here) == image_bytes(&there),
+        "a render halted by convergence is the same bytes in-process and on workers"
+    );
+
+    let lifted = dir.path().join("lifted.png");
+    let output = render_command_with(
+        &scene,
+        &lifted,
+        &CONVERGING,
+        &["--threads", "2", "--halt-threshold", "-1", "--spp", "48"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        stdout.contains("32x24 at 48 spp,"),
+        "without the halt the render takes every sample: {stdout}"
+    );
+}
+
+/// A render halted by convergence and stopped by a time limit keeps its round, its last test's
+/// image and every sample merged in its checkpoint: the same command with the limit lifted
+/// ends at the round, and with the bytes, of a render never stopped.
+#[test]
+fn a_converging_render_stopped_by_time_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A threshold of 0 ends on the first round after which no pixel changed visibly.
+    let scene = scene_with_film(
+        dir.path(),
+        "\"float haltthreshold\" [0] \"float convergencestep\" [8]",
+    );
+    let long = ["--resolution", "128x96", "--spp", "512"];
+    let out = dir.path().join("halted.png");
+    let halted = render_command_with(
+        &scene,
+        &out,
+        &long,
+        &[
+            "--threads",
+            "2",
+            "--time-limit",
+            "1",
+            "--checkpoint-every",
+            "1000",
+        ],
+    )
+    .output()
+    .unwrap();
+    assert_success(&halted);
+    let stderr = stderr_of(&halted);
+    assert!(
+        stderr
+            .contains("--time-limit reached: writing the image of the samples merged: samples 0.."),
+        "{stderr}{}",
+        String::from_utf8_lossy(&halted.stdout)
+    );
+    assert!(out.with_extension("resume").exists());
+    let resumed = render_command_with(&scene, &out, &long, &["--threads", "2"])
+        .output()
+        .unwrap();
+    assert_success(&resumed);
+    assert!(
+        stderr_of(&resumed).contains("resuming from"),
+        "{}",
+        stderr_of(&resumed)
+    );
+    let (spp, line) = converged_at(&resumed);
+
+    let whole = dir.path().join("whole.png");
+    let never_stopped = render_command_with(
+        &scene,
+        &whole,
+        &long,
+        &["--threads", "2", "--checkpoint-every", "0"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&never_stopped);
+    assert_eq!(
+        converged_at(&never_stopped).0,
+        spp,
+        "the same round: {line}"
+    );
+    assert!(
+        image_bytes(&out) == image_bytes(&whole),
+        "the resumed render differs from one never stopped"
+    );
+}

@@ -55,6 +55,12 @@ pub const DEFAULT_REINHARD_BURN: f32 = 6.0;
 pub const DEFAULT_CONTRAST_YWA: f32 = 1.0;
 /// Output name without extension.
 pub const DEFAULT_FILENAME: &str = "luxout";
+/// LuxRender 1.x's samples per pixel between convergence tests, and the fewest it takes.
+pub const DEFAULT_CONVERGENCE_STEP: f32 = 32.0;
+pub const MIN_CONVERGENCE_STEP: f32 = 4.0;
+/// The most YAT takes: a round between tests is one unit per tile, and 1024 samples keep such
+/// a unit to seconds.
+pub const MAX_CONVERGENCE_STEP: f32 = 1024.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum ToneMap {
@@ -88,6 +94,9 @@ pub struct FilmDesc {
     /// The fraction of pixels still failing LuxRender's convergence test at which it halts
     /// (in [0, 1]; None when the file gives none or a negative one, LuxRender's "off").
     pub haltthreshold: Option<f32>,
+    /// Samples per pixel between convergence tests (LuxRender's `convergencestep`; at least
+    /// [`MIN_CONVERGENCE_STEP`]).
+    pub convergence_step: f32,
 }
 
 impl FilmDesc {
@@ -174,6 +183,7 @@ impl FilmDesc {
         let haltspp = params.int("haltspp", -1)?;
         let halttime = params.float("halttime", -1.0)?;
         let haltthreshold = params.float("haltthreshold", -1.0)?;
+        let convergence_step = params.float("convergencestep", DEFAULT_CONVERGENCE_STEP)?;
         Ok(FilmDesc {
             xresolution,
             yresolution,
@@ -183,6 +193,11 @@ impl FilmDesc {
             haltspp: (haltspp > 0).then_some(haltspp as u32),
             halttime: (halttime > 0.0).then_some(halttime),
             haltthreshold: (haltthreshold >= 0.0).then_some(haltthreshold.min(1.0)),
+            convergence_step: if convergence_step.is_finite() {
+                convergence_step.clamp(MIN_CONVERGENCE_STEP, MAX_CONVERGENCE_STEP)
+            } else {
+                DEFAULT_CONVERGENCE_STEP
+            },
         })
     }
 }
@@ -569,15 +584,26 @@ impl Film {
             .collect()
     }
 
-    /// Tone maps as the scene's film asks and applies its gamma: 8-bit RGB, rows top to bottom.
-    pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
+    /// Tone mapped as the scene's film asks, its gamma applied, in [0, 1]: the values the 8-bit
+    /// image rounds (and LuxRender's convergence test compares), rows top to bottom.
+    pub fn display_values(&self, film: &FilmDesc) -> Vec<[f32; 3]> {
         let mut mapped = self.radiance();
         tone_map(&mut mapped, &film.tonemap, film.gamma);
         let inv_gamma = 1.0 / film.gamma.max(1e-3);
+        mapped
+            .into_iter()
+            .map(|c| {
+                c.to_array()
+                    .map(|v| libm::powf(v.clamp(0.0, 1.0), inv_gamma))
+            })
+            .collect()
+    }
+
+    /// Tone maps as the scene's film asks and applies its gamma: 8-bit RGB, rows top to bottom.
+    pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
         let mut img = image::RgbImage::new(self.frame.width, self.frame.height);
-        for (px, c) in img.pixels_mut().zip(mapped) {
-            let encode = |v: f32| (libm::powf(v.clamp(0.0, 1.0), inv_gamma) * 255.0 + 0.5) as u8;
-            *px = image::Rgb([encode(c.x), encode(c.y), encode(c.z)]);
+        for (px, c) in img.pixels_mut().zip(self.display_values(film)) {
+            *px = image::Rgb(c.map(|v| (v * 255.0 + 0.5) as u8));
         }
         img
     }

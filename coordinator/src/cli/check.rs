@@ -19,6 +19,8 @@ use yat_tracer::desc::{
 };
 use yat_tracer::diag::{Severity, Warning};
 use yat_tracer::integrator::Transport;
+use yat_tracer::render::convergence::ConvergenceHalt;
+use yat_tracer::render::sampling::Sampling;
 use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 use super::budget::BudgetArgs;
@@ -110,8 +112,11 @@ fn listing(warnings: &[Warning], differences: u64) -> String {
 fn memory(scene: &ParsedScene) -> String {
     let mib = |bytes: u64| Limit::MemoryBytes.amount(bytes);
     let build = scene.desc.spent.spent(Limit::MemoryBytes);
-    let settings = RenderSettings::resolve(&scene.desc, &RenderOverrides::default());
-    let film = scene.film_bytes(&settings, false);
+    let overrides = RenderOverrides::default();
+    let settings = RenderSettings::resolve(&scene.desc, &overrides);
+    let sampling = ConvergenceHalt::resolve(&scene.desc, &overrides)
+        .map_or(Sampling::Uniform, Sampling::Converging);
+    let film = scene.film_bytes(&settings, &sampling);
     let limit = scene.budget.max(Limit::MemoryBytes);
     let limit = if limit == u64::MAX {
         "no limit".to_string()
@@ -124,6 +129,42 @@ fn memory(scene: &ParsedScene) -> String {
         mib(film),
         settings.width,
         settings.height
+    )
+}
+
+/// The halts a render of the scene takes, the first met ending it, and where each comes from.
+fn halts(desc: &SceneDesc) -> String {
+    let overrides = RenderOverrides::default();
+    let settings = RenderSettings::resolve(desc, &overrides);
+    let converging = ConvergenceHalt::resolve(desc, &overrides);
+    let samples_from = if desc.film.haltspp.is_some() {
+        "haltspp"
+    } else if converging.is_some() {
+        "the most a render halted by convergence takes"
+    } else if desc.sampler.pixel_samples.is_some() {
+        "the sampler's pixelsamples"
+    } else {
+        "YAT's default"
+    };
+    let mut halts = vec![format!("{} samples a pixel ({samples_from})", settings.spp)];
+    if let Some(t) = desc.film.halttime {
+        halts.push(format!("{t} s (halttime)"));
+    }
+    if let Some(halt) = converging {
+        halts.push(format!(
+            "at most {}% of the pixels changing visibly between tests every {} samples \
+             (haltthreshold)",
+            halt.threshold * 100.0,
+            halt.step
+        ));
+    }
+    let which = match halts.len() {
+        1 => String::new(),
+        _ => "the first met ends the render: ".to_string(),
+    };
+    format!(
+        "{which}{} (--spp, --time-limit and --halt-threshold override them)",
+        halts.join(", ")
     )
 }
 
@@ -251,20 +292,12 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         }
         ToneMap::Contrast { ywa } => format!("contrast (ywa {ywa})"),
     };
-    let halt = match (f.haltspp, f.halttime) {
-        (Some(n), _) => format!(", haltspp {n}"),
-        (None, Some(t)) => format!(", halttime {t} s"),
-        (None, None) => String::new(),
-    };
-    let halt = match f.haltthreshold {
-        Some(threshold) => format!("{halt}, haltthreshold {threshold}"),
-        None => halt,
-    };
     let _ = writeln!(
         s,
-        "film         gamma {}, tonemap {tonemap}, output \"{}\"{halt}",
+        "film         gamma {}, tonemap {tonemap}, output \"{}\"",
         f.gamma, f.filename
     );
+    let _ = writeln!(s, "halts        {}", halts(d));
     let filter = match d.filter.kind {
         FilterKind::Box => "box".to_string(),
         FilterKind::Triangle => "triangle".to_string(),

@@ -78,6 +78,13 @@ pub struct RenderArgs {
     /// sample merged, so the same command (with a longer or no limit) goes on from there.
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
+    /// Halt once at most this share of the pixels (0 to 1) changed visibly since the last test,
+    /// tested every Film "convergencestep" samples (32) on the merged image, in place of the
+    /// scene's Film "haltthreshold" (a negative share lifts it). The render ends at the same
+    /// round however and wherever it is rendered; --spp (or haltspp) is then the most a pixel
+    /// gets, 16777216 without either.
+    #[arg(long, value_name = "SHARE", allow_negative_numbers = true)]
+    pub halt_threshold: Option<f32>,
     /// With --noise-threshold: write a PNG of the samples each pixel got (grey, log scale).
     #[arg(long, value_name = "PNG", requires = "noise_threshold")]
     pub sample_map: Option<PathBuf>,
@@ -181,6 +188,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         resolution: args.resolution,
         latlong: args.latlong.into(),
         transport: args.integrator.map(Into::into),
+        halt_threshold: args.halt_threshold,
     };
     let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
         threshold,

@@ -39,7 +39,6 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
     };
 
     let settings = &job.settings;
-    let adaptive = job.adaptive.as_ref();
     let start = job.resume();
     let progress = Progress::start(job, &start);
     let status = &job.interim.status;
@@ -59,13 +58,13 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         let todo: Vec<WorkUnit> = {
             let state = state.lock().map_err(|_| poisoned())?;
             let checkpoint = &state.checkpoint;
-            let units = checkpoint.units(settings, adaptive);
+            let units = checkpoint.units(settings);
             let todo: Vec<WorkUnit> = units
                 .into_iter()
                 .filter(|u| !checkpoint.is_done(u))
                 .collect();
-            if let Some(round) = checkpoint.round() {
-                progress.set_status(format!("| round {}", round.index));
+            if let Some(round) = checkpoint.rounds().index() {
+                progress.set_status(format!("| round {round}"));
             }
             todo
         };
@@ -109,7 +108,8 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         if job.out_of_time() {
             break Err(TimeLimitReached.into());
         }
-        if !done.checkpoint.advance(settings, adaptive) {
+        // The next round's decision reads the whole film, as the last unit's thread does.
+        if !done.checkpoint.advance(settings, &job.scene.desc.film) {
             break anyhow::Ok(());
         }
         progress.round(job, &done.checkpoint);
@@ -122,7 +122,8 @@ pub fn render(job: &RenderJob, threads: Option<usize>) -> anyhow::Result<RenderO
         }
         Err(why) => Err(job.stopped(&state.checkpoint, why)),
         Ok(()) => Ok(RenderOutcome {
-            round: state.checkpoint.round().cloned(),
+            round: state.checkpoint.adaptive_round().cloned(),
+            ended: state.checkpoint.ended(),
             film: state.checkpoint.into_film(),
             stats: state.stats,
             build: Some(build),

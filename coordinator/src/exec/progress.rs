@@ -25,11 +25,11 @@ impl Progress {
     /// The bar and the board of `job`, starting from `checkpoint` (what is already rendered
     /// counts as done); the bar is hidden when quiet.
     pub fn start(job: &RenderJob, checkpoint: &Checkpoint) -> Self {
-        let (settings, adaptive) = (&job.settings, job.adaptive.as_ref());
-        let (done, total) = checkpoint.samples(settings, adaptive);
+        let settings = &job.settings;
+        let (done, total) = checkpoint.samples(settings);
         let board = job.interim.status.clone();
         board.plan(
-            checkpoint.units(settings, adaptive).len(),
+            checkpoint.units(settings).len(),
             checkpoint.done_count(),
             total,
             done,
@@ -48,25 +48,21 @@ impl Progress {
         progress
     }
 
-    /// The round under way of an adaptive render (nothing for a uniform one): its number and
+    /// The round under way of a render in rounds (nothing for a uniform one): its number and
     /// units left on the board, and the new estimate of all the samples on both.
     pub fn round(&self, job: &RenderJob, checkpoint: &Checkpoint) {
         let settings = &job.settings;
-        let (Some(round), Some(adaptive)) = (checkpoint.round(), job.adaptive.as_ref()) else {
+        let Some(round) = checkpoint.rounds().index() else {
             return;
         };
         let units_left = checkpoint
-            .units(settings, Some(adaptive))
+            .units(settings)
             .iter()
             .filter(|u| !checkpoint.is_done(u))
             .count();
-        let total = checkpoint.samples(settings, Some(adaptive)).1;
-        self.board.round(
-            round.index,
-            adaptive.round_count(settings.spp),
-            units_left,
-            total,
-        );
+        let total = checkpoint.samples(settings).1;
+        self.board
+            .round(round, job.sampling.round_count(settings), units_left, total);
         self.bar.set_length(total);
     }
 

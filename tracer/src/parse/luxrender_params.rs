@@ -477,7 +477,7 @@ const FLEXIMAGE: &[LuxParam] = &[
     param("haltspp", Int(-1), Rendered),
     param("halttime", Int(-1), Rendered),
     param("haltthreshold", Float(-1.0), Rendered),
-    no_effect("convergencestep", Float(32.0), NoEffect::Progress),
+    param("convergencestep", Float(32.0), Rendered),
     // Set by LuxRender's network slaves: they leave the noise-aware sampling map to the master.
     no_effect("disable_noisemap_update", Bool(false), NoEffect::Sampler),
     no_effect("usersamplingmap_filename", Text(""), NoEffect::Sampler),

@@ -54,23 +54,34 @@ pub fn plan_units(settings: &RenderSettings) -> Vec<WorkUnit> {
         } else {
             TILE_SIZE
         };
-        for y0 in (0..settings.height).step_by(tile as usize) {
-            for x0 in (0..settings.width).step_by(tile as usize) {
-                units.push(WorkUnit {
-                    index: u32::try_from(units.len()).unwrap_or(u32::MAX),
-                    x0,
-                    y0,
-                    x1: x0.saturating_add(tile).min(settings.width),
-                    y1: y0.saturating_add(tile).min(settings.height),
-                    sample_start: start,
-                    sample_end: end,
-                    mask: None,
-                });
-            }
-        }
+        push_pass(&mut units, settings, (start, end), tile);
         start = end;
     }
     units
+}
+
+/// Appends the units of one pass, samples `range` of every pixel, in tiles of side `tile` in
+/// scanline order, indexed on from the units already there.
+pub fn push_pass(
+    units: &mut Vec<WorkUnit>,
+    settings: &RenderSettings,
+    range: (u32, u32),
+    tile: u32,
+) {
+    for y0 in (0..settings.height).step_by(tile as usize) {
+        for x0 in (0..settings.width).step_by(tile as usize) {
+            units.push(WorkUnit {
+                index: u32::try_from(units.len()).unwrap_or(u32::MAX),
+                x0,
+                y0,
+                x1: x0.saturating_add(tile).min(settings.width),
+                y1: y0.saturating_add(tile).min(settings.height),
+                sample_start: range.0,
+                sample_end: range.1,
+                mask: None,
+            });
+        }
+    }
 }
 
 #[cfg(test)]

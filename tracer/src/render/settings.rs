@@ -44,6 +44,21 @@ pub struct RenderOverrides {
     pub resolution: Option<(u32, u32)>,
     pub latlong: LatLongConvention,
     pub transport: Option<Transport>,
+    /// The share of pixels still changing at which the render halts, in place of the scene's
+    /// `haltthreshold`; a negative one lifts the scene's (LuxRender's "off").
+    pub halt_threshold: Option<f32>,
+}
+
+impl RenderOverrides {
+    /// The share of pixels still changing at which the render halts: the command line's, else
+    /// the scene's `haltthreshold`; None when neither sets one or the command line lifts it.
+    pub fn halt_threshold(&self, desc: &SceneDesc) -> Option<f32> {
+        match self.halt_threshold {
+            Some(t) if t < 0.0 => None,
+            Some(t) => Some(t),
+            None => desc.film.haltthreshold,
+        }
+    }
 }
 
 /// Samples per pixel when neither the file nor the command line says.
@@ -117,9 +132,14 @@ impl RenderSettings {
         let (width, height) = overrides
             .resolution
             .unwrap_or((desc.film.xresolution, desc.film.yresolution));
+        // A render halted by convergence goes on until its image stops changing (LuxRender's
+        // sampler has no total of its own): at most MAX_SPP unless the scene or the command
+        // line sets a samples halt.
+        let converging = overrides.halt_threshold(desc).map(|_| MAX_SPP);
         let spp = overrides
             .spp
             .or(desc.film.haltspp)
+            .or(converging)
             .or(desc.sampler.pixel_samples)
             .unwrap_or(DEFAULT_SPP)
             .max(1);

@@ -81,11 +81,11 @@ pub fn render(
         .build()
         .context("cannot start the network runtime")?;
     let start = job.resume();
-    let units = start.units(&job.settings, job.adaptive.as_ref());
+    let units = start.units(&job.settings);
     let (events, event_rx) = mpsc::unbounded_channel();
     let context = Arc::new(SessionContext {
-        // An adaptive render's round is never known to be the last before it is merged.
-        schedule: Schedule::new(units, |u| start.is_done(u), job.adaptive.is_none()),
+        // A round is never known to be the last before it is merged.
+        schedule: Schedule::new(units, |u| start.is_done(u), !job.sampling.has_rounds()),
         deadline: UnitDeadline::new(config.unit_deadline),
         load_request: manifest.load_request(&job.settings),
         frame: start.film().frame(),

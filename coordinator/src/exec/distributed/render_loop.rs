@@ -37,7 +37,7 @@ impl RenderLoop<'_> {
         mut checkpoint: Checkpoint,
         mut events: mpsc::UnboundedReceiver<SessionEvent>,
     ) -> anyhow::Result<RenderOutcome> {
-        let (settings, adaptive) = (&self.job.settings, self.job.adaptive.as_ref());
+        let settings = &self.job.settings;
         let progress = Progress::start(self.job, &checkpoint);
         let mut completed = None;
         let mut stats = UnitStats::default();
@@ -58,13 +58,14 @@ impl RenderLoop<'_> {
                 if self.job.out_of_time() {
                     break Err(TimeLimitReached.into());
                 }
-                if !tokio::task::block_in_place(|| checkpoint.advance(settings, adaptive)) {
+                let film_desc = &self.job.scene.desc.film;
+                if !tokio::task::block_in_place(|| checkpoint.advance(settings, film_desc)) {
                     self.context.schedule.finish();
                     break Ok(());
                 }
                 self.context
                     .schedule
-                    .start_round(checkpoint.units(settings, adaptive));
+                    .start_round(checkpoint.units(settings));
                 progress.round(self.job, &checkpoint);
                 progress.set_status(self.status(&checkpoint));
                 continue;
@@ -133,7 +134,8 @@ impl RenderLoop<'_> {
             }
             Err(why) => Err(self.job.stopped(&checkpoint, why)),
             Ok(()) => Ok(RenderOutcome {
-                round: checkpoint.round().cloned(),
+                round: checkpoint.adaptive_round().cloned(),
+                ended: checkpoint.ended(),
                 film: checkpoint.into_film(),
                 stats,
                 build: None,
@@ -147,8 +149,9 @@ impl RenderLoop<'_> {
         format!(
             "| {}units {}/{}, workers {}/{}",
             checkpoint
-                .round()
-                .map_or(String::new(), |r| format!("round {}, ", r.index)),
+                .rounds()
+                .index()
+                .map_or(String::new(), |i| format!("round {i}, ")),
             checkpoint.done_count(),
             checkpoint.unit_count(),
             self.alive(),
