@@ -255,3 +255,63 @@ fn a_converging_render_stopped_by_time_resumes_to_the_same_bytes() {
         "the resumed render differs from one never stopped"
     );
 }
+
+/// A distributed render stops at its time limit as an in-process one does: the image of every
+/// sample merged, which it names, and the checkpoint kept; the same scene resumed in-process
+/// goes on to the bytes of a render never stopped.
+#[test]
+fn a_distributed_render_stopped_by_time_resumes_in_process_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    // 6 million samples: far more than two workers render in the two seconds.
+    let long = ["--spp", "8192", "--resolution", "32x24"];
+    let out = dir.path().join("halted.png");
+    let halted = render_command_with(
+        &scene,
+        &out,
+        &long,
+        &[
+            "--local-workers",
+            "2",
+            "--time-limit",
+            "2",
+            "--checkpoint-every",
+            "1000",
+        ],
+    )
+    .output()
+    .unwrap();
+    assert_success(&halted);
+    let stderr = stderr_of(&halted);
+    assert!(
+        stderr.contains("--time-limit reached: writing the image of the samples merged: "),
+        "{stderr}"
+    );
+    assert!(
+        out.with_extension("resume").exists(),
+        "the checkpoint is kept"
+    );
+    let resumed = render_command_with(&scene, &out, &long, &["--threads", "2"])
+        .output()
+        .unwrap();
+    assert_success(&resumed);
+    assert!(
+        stderr_of(&resumed).contains("resuming from"),
+        "{}",
+        stderr_of(&resumed)
+    );
+    let whole = dir.path().join("whole.png");
+    let never_stopped = render_command_with(
+        &scene,
+        &whole,
+        &long,
+        &["--threads", "2", "--checkpoint-every", "0"],
+    )
+    .output()
+    .unwrap();
+    assert_success(&never_stopped);
+    assert!(
+        image_bytes(&out) == image_bytes(&whole),
+        "the resumed render differs from one never stopped"
+    );
+}
