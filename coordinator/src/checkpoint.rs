@@ -58,6 +58,11 @@ const HEADER_LEN: usize = MAGIC.len() + 4 + IDENTITY_LEN + 3 * 4;
 pub struct RenderIdentity(String);
 
 impl RenderIdentity {
+    /// The identity as 64 hex digits.
+    pub fn hex(&self) -> &str {
+        &self.0
+    }
+
     pub fn of(load_request: &pb::LoadSceneRequest, sampling: &Sampling) -> Self {
         let mut digest = Sha256Stream::default();
         digest.update(b"yat render ");

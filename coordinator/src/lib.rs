@@ -8,11 +8,13 @@
 //! and returns what it cost ([`render_report`]); [`status`] serves a live page of it.
 //! [`shutdown`] is the caller's stop, which `yat render` wires to Ctrl-C and SIGTERM. [`isa`]
 //! hands the process to a build for the CPU's instruction set when one is installed beside it.
+//! [`frames`] is a sequence of scenes one command renders (their files, images and journal).
 
 pub mod checkpoint;
 pub mod cli;
 pub mod cpus;
 pub mod exec;
+pub mod frames;
 pub mod interim;
 pub mod isa;
 pub mod job;

@@ -108,6 +108,21 @@ impl RenderRequest {
     }
 }
 
+impl RenderRequest {
+    /// What names this render (its checkpoint's identity): the scene's files by content, the
+    /// settings and the sampling.
+    pub fn identity(&self) -> anyhow::Result<RenderIdentity> {
+        Ok(Self::identity_with(
+            &SceneManifest::read(&self.scene)?,
+            self,
+        ))
+    }
+
+    fn identity_with(manifest: &SceneManifest, request: &RenderRequest) -> RenderIdentity {
+        RenderIdentity::of(&manifest.load_request(&request.settings), &request.sampling)
+    }
+}
+
 /// Who renders: this process's threads, or workers over gRPC.
 pub enum Executor {
     /// On this many threads [default: the CPUs this process may use].
@@ -168,7 +183,7 @@ impl Observers {
 /// report says what the render cost. The status board is told how the render ended either way.
 pub fn render(
     request: RenderRequest,
-    executor: Executor,
+    executor: &Executor,
     observers: Observers,
     interrupt: Interrupt,
 ) -> anyhow::Result<RenderReport> {
@@ -183,14 +198,14 @@ pub fn render(
 /// [`render`] but for telling the board of a failure.
 fn render_and_write(
     request: RenderRequest,
-    executor: Executor,
+    executor: &Executor,
     observers: Observers,
     interrupt: Interrupt,
 ) -> anyhow::Result<RenderReport> {
     let started = Instant::now();
     let (distributed, threads) = match executor {
         Executor::Distributed(config) => (Some(config), None),
-        Executor::InProcess { threads } => (None, threads),
+        Executor::InProcess { threads } => (None, *threads),
     };
     // The files by content: what workers receive, and what names the render for its checkpoint.
     let manifest = if distributed.is_some() || observers.checkpoint_every.is_some() {
@@ -202,8 +217,7 @@ fn render_and_write(
         .as_ref()
         .zip(observers.checkpoint_every)
         .map(|(m, every)| {
-            let identity =
-                RenderIdentity::of(&m.load_request(&request.settings), &request.sampling);
+            let identity = RenderRequest::identity_with(m, &request);
             CheckpointFile::beside(&request.output_png, identity, every)
         });
     let status = observers.status;
@@ -229,7 +243,7 @@ fn render_and_write(
 
     let (outcome, workers) = match (distributed, manifest) {
         (Some(config), Some(manifest)) => {
-            let (outcome, workers) = distributed::render(&config, &job, manifest)?;
+            let (outcome, workers) = distributed::render(config, &job, manifest)?;
             (outcome, Some(workers))
         }
         (_, manifest) => {

@@ -11,7 +11,9 @@
 #      resumes from the checkpoint and still equals the in-process render byte for byte; the
 #      job's token is in its processes' environment, on no command line;
 #   5. the same render given the time-limit warning (USR1 to the batch shell) saves, requeues
-#      itself, resumes in the requeued run and equals the in-process render byte for byte.
+#      itself, resumes in the requeued run and equals the in-process render byte for byte;
+#   6. a job array of four frames, two a task, writes each frame's image under its Film
+#      filename, each equal to the frame rendered alone in-process byte for byte.
 #
 # Needs root (it installs Debian's slurm-wlm and munge when missing, and runs the daemons):
 # without root it says so and exits 77, the usual "skipped" code. Exits 0 when every check
@@ -419,6 +421,39 @@ expect_resumed "$tmp/jobs/job-$job.log"
 expect_same_image "$tmp/requeued.png" "$tmp/long-ref.png"
 step_done "resumed with $resumed"
 pass "a render requeued at the time-limit warning resumes and equals the in-process render"
+
+# ---------------------------------------------------------------------------------- 4. frames
+step "a job array of four frames (the repository's Cornell box, its width changed), two a task"
+frames_dir=$tmp/frames
+mkdir -p "$frames_dir"
+cp "$repo"/scenes/cornell/cornell-*.lxo "$frames_dir/"
+for n in 1 2 3 4; do
+    sed -e "s/\"string filename\" \[\"cornell-box\"\]/\"string filename\" [\"frame.000$n\"]/" \
+        -e "s/\"integer xresolution\" \[512\] \"integer yresolution\" \[512\]/\"integer xresolution\" [$((40 + 8 * n))] \"integer yresolution\" [48]/" \
+        "$repo/scenes/cornell/cornell-box.lxs" >"$frames_dir/frame$n.lxs"
+    grep -q "frame.000$n" "$frames_dir/frame$n.lxs" && grep -q "\[$((40 + 8 * n))\]" "$frames_dir/frame$n.lxs" ||
+        fail "frame $n: the Cornell box's Film is not as this test expects"
+    "$yat" render "$frames_dir/frame$n.lxs" -o "$frames_dir/alone$n.png" --spp 16 --quiet \
+        --checkpoint-every 0 --preview-every 0 || fail "in-process render of frame $n failed"
+done
+printf '%s\n' "$frames_dir"/frame{1,2,3,4}.lxs >"$frames_dir/frames.txt"
+job=$(cd "$tmp/work" && YAT_FRAMES_PER_TASK=2 sbatch --parsable --nodes=1 --exclusive --array=0-1 \
+    --output="$tmp/jobs/job-%A_%a.log" "$batch_script" "$frames_dir/frames.txt" "$frames_dir/out" \
+    --spp 16) || fail "sbatch --array failed"
+job=${job%%;*}
+jobs_submitted+=("$job")
+for task in 0 1; do
+    state=$(wait_job_end "${job}_$task" 300) || fail "array task ${job}_$task did not end within 300 s"
+    [[ $state == COMPLETED ]] || fail "array task ${job}_$task ended $state"
+done
+for n in 1 2 3 4; do
+    expect_same_image "$frames_dir/out/frame.000$n.png" "$frames_dir/alone$n.png"
+done
+grep -q "rendering frames 1 to 2 of" "$tmp/jobs/job-${job}_0.log" &&
+    grep -q "rendering frames 3 to 4 of" "$tmp/jobs/job-${job}_1.log" ||
+    fail "the array tasks did not take frames 1-2 and 3-4"
+step_done
+pass "a job array renders each task's frames, each equal to the frame rendered alone byte for byte"
 
 say "all done in $(seconds_since "$test_start") s"
 echo "slurm: $passed passed, 0 failed"

@@ -8,6 +8,7 @@ mod discovery;
 mod distributed;
 mod drain;
 mod files;
+mod frames;
 mod halts;
 #[path = "../fixtures/hostile.rs"]
 mod hostile;

@@ -318,7 +318,7 @@ fn a_render_its_caller_interrupts_resumes_to_the_same_image() {
 
     let report = yat::render::render(
         request_with(&scene, &out, &long, None),
-        two_threads(),
+        &two_threads(),
         checkpointing(),
         Interrupt::default(),
     )

@@ -190,7 +190,7 @@ pub fn two_threads() -> Executor {
 
 /// Renders `request` on `executor` in this process, quiet and writing no interim file.
 pub fn render_here(request: RenderRequest, executor: Executor) -> anyhow::Result<RenderReport> {
-    yat::render::render(request, executor, Observers::none(), Interrupt::default())
+    yat::render::render(request, &executor, Observers::none(), Interrupt::default())
 }
 
 /// The in-process render of `scene` with the test settings, into `dir`/in-process.png: (PNG
@@ -208,7 +208,7 @@ pub fn spawn_render(
     observers: Observers,
     interrupt: Interrupt,
 ) -> JoinHandle<anyhow::Result<RenderReport>> {
-    std::thread::spawn(move || yat::render::render(request, executor, observers, interrupt))
+    std::thread::spawn(move || yat::render::render(request, &executor, observers, interrupt))
 }
 
 /// A `yat worker` process on a loopback port; killed when dropped.

@@ -8,6 +8,7 @@ use yat_proto::flags::{ClientTlsFlags, TokenFlag};
 
 use super::seconds::seconds;
 use crate::exec::distributed::config::DistributedConfig;
+use crate::exec::distributed::local::LocalWorkers;
 
 #[derive(clap::Args, Debug, Default)]
 pub struct DistributedArgs {
@@ -69,7 +70,7 @@ impl DistributedArgs {
             workers: self.workers.clone(),
             resolve_every: resolve_every(self.resolve_every)?,
             dns_server: self.dns_server,
-            local_workers: self.local_workers,
+            local_workers: LocalWorkers::new(self.local_workers),
             token: self.token.resolve()?,
             tls: self.tls.config()?,
             tls_domain_given: self.tls.tls_domain.is_some(),

@@ -42,6 +42,7 @@ use super::render::{self, RenderArgs};
 // A `-u HOST` without a port gets `yat worker`'s default (a LuxRender slave's, 18018, is no
 // YAT worker's).
 use super::worker::DEFAULT_PORT as WORKER_PORT;
+use crate::frames::read_list_file;
 use crate::isa::{self, IsaChoice};
 
 /// The name under which the `yat` binary reads luxconsole's command line.
@@ -50,9 +51,6 @@ pub const LUXCONSOLE: &str = "luxconsole";
 /// The most bytes of a scene read from standard input: what a scene may parse at most under
 /// the default build budget.
 pub const MAX_STDIN_BYTES: u64 = yat_tracer::budget::DEFAULT_MAX_PARSED_BYTES;
-
-/// The longest `-L` list file read (one scene path a line).
-pub const MAX_LIST_FILE_BYTES: u64 = 1 << 20;
 
 /// The file luxconsole reads options from when it is in the current folder (`-C` names
 /// another); YAT does not read it.
@@ -683,7 +681,9 @@ impl Plan {
         }
         let mut names = options.scenes.clone();
         for list in &options.list_files {
-            names.extend(read_list_file(&cwd.join(list))?);
+            let listed =
+                read_list_file(&cwd.join(list)).map_err(|e| anyhow::anyhow!("{e:#} (-L)"))?;
+            names.extend(listed);
         }
         if names.is_empty() {
             anyhow::bail!(
@@ -786,31 +786,6 @@ impl Plan {
 struct RenderCommand {
     #[command(flatten)]
     render: RenderArgs,
-}
-
-/// The scene paths a `-L` file lists: one a line (a Windows line end taken off), blank lines
-/// skipped.
-fn read_list_file(path: &Path) -> anyhow::Result<Vec<OsString>> {
-    let cannot = || format!("cannot read the scene list {} (-L)", path.display());
-    let mut bytes = Vec::new();
-    File::open(path)
-        .with_context(cannot)?
-        .take(MAX_LIST_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .with_context(cannot)?;
-    if bytes.len() as u64 > MAX_LIST_FILE_BYTES {
-        anyhow::bail!(
-            "{}: longer than {} KiB",
-            cannot(),
-            MAX_LIST_FILE_BYTES >> 10
-        );
-    }
-    Ok(bytes
-        .split(|&b| b == b'\n')
-        .map(|line| line.strip_suffix(b"\r").unwrap_or(line))
-        .filter(|line| !line.iter().all(u8::is_ascii_whitespace))
-        .map(|line| OsString::from_vec(line.to_vec()))
-        .collect())
 }
 
 /// `-o NAME` as YAT writes it: NAME with its extension replaced by `.png`, checked to be a file
@@ -1074,7 +1049,7 @@ mod tests {
         ] {
             let render = render_args(args, dir.path());
             assert_eq!(render.threads, Some(2), "{args:?}");
-            assert_eq!(render.scene, dir.path().join("a.lxs"), "{args:?}");
+            assert_eq!(render.scenes, [dir.path().join("a.lxs")], "{args:?}");
         }
         assert_eq!(render_args(&["a.lxs"], dir.path()).threads, None);
     }

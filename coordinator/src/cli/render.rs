@@ -4,7 +4,7 @@
 //! Ctrl-C and SIGTERM stop the render through its interrupt.
 
 use std::net::SocketAddr;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -19,7 +19,8 @@ use super::distributed::DistributedArgs;
 use super::latlong::LatLongArg;
 use super::seconds::seconds;
 use crate::exec::progress_log::{JsonTarget, ProgressLog, DEFAULT_PROGRESS_EVERY};
-use crate::job::Deadline;
+use crate::frames;
+use crate::job::{film_output_path, Deadline};
 use crate::render::{render, Executor, Observers, RenderRequest};
 use crate::scene::{ParsedScene, Warnings};
 use crate::shutdown::Interrupt;
@@ -47,11 +48,27 @@ impl From<IntegratorArg> for Transport {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// The main .lxs file.
-    pub scene: PathBuf,
+    /// The main .lxs file. Several (or a glob pattern, or --frames) render one after another
+    /// as the frames of a sequence, on the same workers (which keep the files they were sent),
+    /// each into its Film filename plus .png; the same command, stopped, goes on at the frame
+    /// and the sample where it stopped.
+    #[arg(required_unless_present = "frames", num_args = 1..)]
+    pub scenes: Vec<PathBuf>,
+    /// A file listing the frames' scene files, one a line, rendered after any given as
+    /// arguments ("-": standard input).
+    #[arg(long, value_name = "FILE")]
+    pub frames: Option<PathBuf>,
+    /// Render only this task's frames of the sequence (from 0): a job array's task or an
+    /// indexed job's pod, each taking --frames-per-task frames in order.
+    #[arg(long, value_name = "N")]
+    pub frames_task: Option<usize>,
+    /// Frames of the sequence each --frames-task renders.
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "frames_task")]
+    pub frames_per_task: usize,
     /// Output PNG (default: the Film's filename plus .png, in the current folder; a folder in
     /// the Film's filename is dropped). Its side files go beside it: X.preview.png, X.resume and
-    /// X.exr, so an output named like one of those is refused.
+    /// X.exr, so an output named like one of those is refused. With several frames, or a path
+    /// ending in "/", the folder the frames' images go to (made if missing).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Also write linear radiance as OpenEXR next to the PNG.
@@ -169,11 +186,82 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// Renders as the flags ask; returns the PNG written (`yat luxconsole -b` reads it back).
+/// Renders as the flags ask; returns the PNG written, the last frame's of a sequence (`yat
+/// luxconsole -b` reads it back).
 pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
+    let slice = args.frames_task.map(|task| frames::FrameSlice {
+        task,
+        per_task: args.frames_per_task,
+    });
+    let scenes = frames::scene_files(&args.scenes, args.frames.as_deref(), slice)?;
+    let executor = match args.distributed.config()? {
+        Some(config) => config.into(),
+        None => Executor::InProcess {
+            threads: args.threads,
+        },
+    };
+    let interrupt = Interrupt::install()?;
+    // One scene into a file is a plain render; into a folder (a job array's task of one
+    // frame), a sequence of one frame.
+    let into_folder = args.output.as_deref().is_some_and(frames::is_folder);
+    if let ([scene], false) = (&scenes[..], into_folder) {
+        let request = frame_request(&args, scene, |_| Ok(args.output.clone()))?;
+        return render_frame(&args, request, &executor, &interrupt, true);
+    }
+    let mut outputs = frames::FrameOutputs::new(args.output.as_deref())?;
+    let mut journal = None;
+    let mut last = PathBuf::new();
+    let count = scenes.len();
+    for (i, scene) in scenes.iter().enumerate() {
+        let which = || format!("frame {} of {count}, {}", i + 1, scene.display());
+        let request = frame_request(&args, scene, |scene| {
+            let (film_output, _) = film_output_path(&scene.desc.film.filename)?;
+            outputs.place(&scene.path, &film_output).map(Some)
+        })
+        .with_context(which)?;
+        let image = request.output_png.clone();
+        let journal = match &mut journal {
+            Some(journal) => journal,
+            None => journal.insert(frames::FrameJournal::beside(&image)?),
+        };
+        let identity = request.identity()?;
+        if journal.is_done(&identity, &image) {
+            if !args.quiet {
+                println!("{}: rendered already ({})", which(), image.display());
+            }
+            last = image;
+            continue;
+        }
+        if !args.quiet {
+            println!("{}", which());
+        }
+        last = render_frame(&args, request, &executor, &interrupt, i + 1 == count).with_context(
+            || {
+                format!(
+                    "{}; the same command goes on from there (frames rendered are in {})",
+                    which(),
+                    journal.path().display()
+                )
+            },
+        )?;
+        journal.record(&identity, &last)?;
+    }
+    if let Some(journal) = journal {
+        journal.remove();
+    }
+    Ok(last)
+}
+
+/// The request of one frame (or of the one scene): its scene loaded, the flags applied, its
+/// image the one `output` chooses for the scene (None: its Film's), its time limit from now.
+fn frame_request(
+    args: &RenderArgs,
+    scene_path: &Path,
+    output: impl FnOnce(&ParsedScene) -> anyhow::Result<Option<PathBuf>>,
+) -> anyhow::Result<RenderRequest> {
     let started = Instant::now();
     let scene = ParsedScene::load_within(
-        &args.scene,
+        scene_path,
         if args.quiet {
             Warnings::Keep
         } else {
@@ -194,14 +282,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         threshold,
         min_spp: args.min_spp,
     });
-    let mut request = RenderRequest::new(scene, &overrides, adaptive, args.output.clone())?;
-    for warning in &request.warnings {
-        eprintln!("warning: {warning}");
-    }
-    let every = |name, value| seconds(name, value).map(|every| (!every.is_zero()).then_some(every));
-    let checkpoint_every = every("checkpoint-every", args.checkpoint_every)?;
-    let preview_every = every("preview-every", args.preview_every)?;
-    let status_linger = seconds("status-linger", args.status_linger)?;
+    let output = output(&scene)?;
+    let mut request = RenderRequest::new(scene, &overrides, adaptive, output)?;
     if let Some(limit) = args.time_limit {
         let limit = seconds("time-limit", limit)?;
         let left = limit.saturating_sub(started.elapsed());
@@ -210,16 +292,33 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
     }
     request.exr = args.exr;
     request.sample_map = args.sample_map.clone();
-    let executor = match args.distributed.config()? {
-        Some(config) => config.into(),
-        None => Executor::InProcess {
-            threads: args.threads,
-        },
+    Ok(request)
+}
+
+/// Renders one frame's request on `executor`, serving its status page as the flags ask
+/// (lingering after the `last` frame), and prints its summary; returns the PNG written.
+fn render_frame(
+    args: &RenderArgs,
+    request: RenderRequest,
+    executor: &Executor,
+    interrupt: &Interrupt,
+    last: bool,
+) -> anyhow::Result<PathBuf> {
+    for warning in &request.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let every = |name, value| seconds(name, value).map(|every| (!every.is_zero()).then_some(every));
+    let checkpoint_every = every("checkpoint-every", args.checkpoint_every)?;
+    let preview_every = every("preview-every", args.preview_every)?;
+    let status_linger = if last {
+        seconds("status-linger", args.status_linger)?
+    } else {
+        Duration::ZERO
     };
     let settings = &request.settings;
     let status = Arc::new(StatusBoard::new(
         SceneInfo {
-            path: args.scene.display().to_string(),
+            path: request.scene.path.display().to_string(),
             name: request.scene.main_name.clone(),
         },
         SettingsInfo {
@@ -242,7 +341,6 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         }
         None => None,
     };
-    let interrupt = Interrupt::install()?;
     let progress_log = ProgressLog {
         every: seconds("progress-every", args.progress_every)?,
         json: args.progress_json.clone().map(|path| {
@@ -264,7 +362,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
     let report = match render(request, executor, observers, interrupt.clone()) {
         Ok(report) => report,
         Err(e) => {
-            linger(server, status_linger, &interrupt);
+            linger(server, status_linger, interrupt);
             return Err(e);
         }
     };
@@ -279,7 +377,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         println!("wrote {}", output_png.display());
         report.print();
     }
-    linger(server, status_linger, &interrupt);
+    linger(server, status_linger, interrupt);
     Ok(output_png)
 }
 

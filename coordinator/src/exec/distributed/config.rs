@@ -6,6 +6,8 @@ use std::time::Duration;
 
 use tonic::transport::ClientTlsConfig;
 
+use super::local::LocalWorkers;
+
 /// The default: no worker, names resolved once, no token, TLS, timeout or report file.
 #[derive(Default)]
 pub struct DistributedConfig {
@@ -18,7 +20,7 @@ pub struct DistributedConfig {
     /// The name server to ask instead of the system's (tests).
     pub dns_server: Option<SocketAddr>,
     /// Workers to start on this machine, sharing its cores.
-    pub local_workers: usize,
+    pub local_workers: LocalWorkers,
     /// The token the (remote) workers were started with.
     pub token: Option<String>,
     /// TLS towards the (remote) workers.

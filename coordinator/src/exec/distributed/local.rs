@@ -4,13 +4,51 @@
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Stdio};
-use std::sync::{mpsc, Mutex};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
 
 /// How long a starting worker may take to print its address.
 const STARTUP_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// The local workers of a configuration: started by its first render and kept for every render
+/// after it (the frames of a sequence), so their caches of the scene's files stay warm; stopped
+/// when the configuration is dropped.
+#[derive(Default)]
+pub struct LocalWorkers {
+    count: usize,
+    started: Mutex<Vec<Arc<LocalWorker>>>,
+}
+
+impl LocalWorkers {
+    pub fn new(count: usize) -> Self {
+        Self {
+            count,
+            started: Mutex::default(),
+        }
+    }
+
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// The workers, started on the first call.
+    pub fn get(&self) -> anyhow::Result<Vec<Arc<LocalWorker>>> {
+        let mut started = self
+            .started
+            .lock()
+            .expect("no panic while starting workers");
+        if started.is_empty() && self.count > 0 {
+            let cores = crate::cpus::threads_or_usable_cpus(None, "local workers");
+            *started = LocalWorker::spawn_all(self.count, cores)?
+                .into_iter()
+                .map(Arc::new)
+                .collect();
+        }
+        Ok(started.clone())
+    }
+}
 
 pub struct LocalWorker {
     pub address: String,

@@ -7,7 +7,7 @@ pub mod config;
 
 mod client;
 mod discovery;
-mod local;
+pub mod local;
 mod node;
 mod render_loop;
 pub mod report;
@@ -28,7 +28,6 @@ use crate::manifest::SceneManifest;
 use client::ClientConfig;
 use config::DistributedConfig;
 use discovery::{ClientTemplate, Discovery, Roster, WorkerTarget};
-use local::LocalWorker;
 use node::Node;
 use render_loop::RenderLoop;
 use report::{process_cpu_time, DistributedReport};
@@ -62,16 +61,13 @@ pub fn render(
             nodes.push(Node::new(client, None));
         }
     }
-    if config.local_workers > 0 {
-        let cores = crate::cpus::threads_or_usable_cpus(None, "local workers");
-        for worker in LocalWorker::spawn_all(config.local_workers, cores)? {
-            let client = ClientConfig {
-                address: worker.address.clone(),
-                token: Some(worker.token.clone()),
-                tls: None,
-            };
-            nodes.push(Node::new(client, Some(worker)));
-        }
+    for worker in config.local_workers.get()? {
+        let client = ClientConfig {
+            address: worker.address.clone(),
+            token: Some(worker.token.clone()),
+            tls: None,
+        };
+        nodes.push(Node::new(client, Some(worker)));
     }
 
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -115,7 +111,7 @@ pub fn render(
         };
         render_loop.run(start, event_rx).await
     });
-    // Ends the node loops and closes connections; then `roster` drops the local workers.
+    // Ends the node loops and closes connections (the local workers live on in `config`).
     drop(runtime);
 
     let mut report = DistributedReport::new(

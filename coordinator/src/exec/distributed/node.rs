@@ -1,7 +1,7 @@
 //! One worker as the coordinator sees it: how to reach it, the process behind it when this
 //! coordinator started it, and what it did in this render.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use super::client::ClientConfig;
 use super::local::LocalWorker;
@@ -73,12 +73,12 @@ pub struct Node {
     /// How to reach it.
     pub config: ClientConfig,
     /// The process, for a worker this coordinator started.
-    pub local: Option<LocalWorker>,
+    pub local: Option<Arc<LocalWorker>>,
     pub report: Mutex<NodeReport>,
 }
 
 impl Node {
-    pub fn new(config: ClientConfig, local: Option<LocalWorker>) -> Self {
+    pub fn new(config: ClientConfig, local: Option<Arc<LocalWorker>>) -> Self {
         let report = NodeReport {
             address: config.address.clone(),
             ..NodeReport::default()
