@@ -9,6 +9,7 @@ use anyhow::Context;
 use yat_tracer::assets::FsSource;
 use yat_tracer::budget::{BuildBudget, BuildGuard, Limit};
 use yat_tracer::desc::SceneDesc;
+use yat_tracer::diag::{Severity, Warning};
 use yat_tracer::film::Film;
 use yat_tracer::parse::parse_scene_guarded;
 use yat_tracer::render::convergence::ConvergenceHalt;
@@ -27,6 +28,28 @@ pub struct ParsedScene {
     pub parse_time: Duration,
     /// What the scene may cost to parse and build here.
     pub budget: BuildBudget,
+}
+
+/// The differences from LuxRender's image on stderr, each at its position; of the warnings that
+/// leave the image as LuxRender's (accepted differences, parameters without effect, notes) only
+/// how many there are, which `yat check` lists.
+fn print_warnings(path: &Path, warnings: &[Warning]) {
+    let mut quiet = 0u64;
+    for w in warnings {
+        if w.severity == Severity::Differs {
+            eprintln!("{w}");
+        } else {
+            quiet += w.occurrences();
+        }
+    }
+    if quiet > 0 {
+        eprintln!(
+            "{}: {quiet} more statements or parameters that render as LuxRender's or are \
+             documented differences: `yat check {}` lists them",
+            path.display(),
+            path.display()
+        );
+    }
 }
 
 /// What loading does with the parser's warnings.
@@ -65,9 +88,7 @@ impl ParsedScene {
             .with_context(|| format!("cannot load scene {}", path.display()))?;
         let parse_time = started.elapsed();
         if warnings == Warnings::Print {
-            for w in &desc.warnings {
-                eprintln!("{w}");
-            }
+            print_warnings(path, &desc.warnings);
         }
         Ok(Self {
             path: path.to_path_buf(),

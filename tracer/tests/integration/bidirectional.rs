@@ -3,6 +3,7 @@
 //! only light tracing carries (a point light reflected by a mirror onto a floor: no camera path
 //! finds a point light behind a mirror).
 
+use crate::statistics::correlation;
 use glam::Vec3;
 use yat_tracer::integrator::Transport;
 
@@ -87,18 +88,10 @@ fn point_lit_room(integrator: &str, at: &str) -> String {
 }
 
 /// The correlation of `a`'s and `b`'s pixels' brightness.
-fn correlation(a: &[Vec3], b: &[Vec3]) -> f64 {
-    let (ma, mb) = (mean(a), mean(b));
-    let lum = |v: &Vec3| f64::from(v.x + v.y + v.z);
-    let (la, lb) = (lum(&ma), lum(&mb));
-    let (mut cov, mut va, mut vb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        let (dx, dy) = (lum(x) - la, lum(y) - lb);
-        cov += dx * dy;
-        va += dx * dx;
-        vb += dy * dy;
-    }
-    cov / (va * vb).sqrt()
+fn brightness_correlation(a: &[Vec3], b: &[Vec3]) -> f64 {
+    let brightness =
+        |v: &[Vec3]| -> Vec<f64> { v.iter().map(|p| f64::from(p.x + p.y + p.z)).collect() };
+    correlation(&brightness(a), &brightness(b))
 }
 
 /// `scene` (a scene's text for a given SurfaceIntegrator) rendered bidirectionally with 3
@@ -130,7 +123,7 @@ fn assert_means_agree(
 #[test]
 fn a_room_renders_as_the_path_tracer_renders_it() {
     let (path, bidir) = assert_means_agree(room, 1024, 0.01);
-    let correlation = correlation(&path, &bidir);
+    let correlation = brightness_correlation(&path, &bidir);
     assert!(correlation > 0.99, "correlation {correlation}");
 }
 
@@ -330,7 +323,7 @@ fn a_room_full_of_fog_renders_as_the_path_tracer_renders_it() {
     let sky = "LightSource \"infinite\" \"color L\" [0.3 0.3 0.3]\nWorldEnd\n";
     let scene = |integrator: &str| in_fog(&room(integrator), 0.6).replacen("WorldEnd\n", sky, 1);
     let (path, bidir) = assert_means_agree(scene, 512, 0.015);
-    let correlation = correlation(&path, &bidir);
+    let correlation = brightness_correlation(&path, &bidir);
     assert!(correlation > 0.98, "correlation {correlation}");
 }
 
@@ -402,6 +395,6 @@ fn a_point_light_in_fog_lights_the_room_as_the_path_tracer_sees_it() {
         )
     };
     let (path, bidir) = assert_means_agree(scene, 512, 0.015);
-    let correlation = correlation(&path, &bidir);
+    let correlation = brightness_correlation(&path, &bidir);
     assert!(correlation > 0.98, "correlation {correlation}");
 }

@@ -3,6 +3,7 @@
 //! polygonal and weighted apertures of `blades`, `distribution` and `power`, each measured on
 //! the rendered image against the pinhole's or the aperture's analytic shape.
 
+use crate::statistics::correlation;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -64,15 +65,6 @@ fn block_means(film: &Film, block: u32) -> Vec<f64> {
         }
     }
     means
-}
-
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt().max(1e-12)
 }
 
 fn mean(v: &[f64]) -> f64 {

@@ -30,6 +30,7 @@ mod seed_renders;
 mod seed_scenes;
 mod shapes;
 mod spectral_textures;
+mod statistics;
 mod thin_film;
 #[path = "../../../tests/fixtures/workspace.rs"]
 mod util;

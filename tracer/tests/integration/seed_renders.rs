@@ -4,6 +4,7 @@
 //! the test compares structure (correlation of the block means: framing, orientation, where the
 //! bright and dark parts are), not absolute values. Skipped when the seed project is absent.
 
+use crate::statistics::correlation;
 use std::path::{Path, PathBuf};
 
 use yat_tracer::assets::FsSource;
@@ -38,15 +39,6 @@ fn block_means(img: &image::RgbImage) -> Vec<f64> {
         sums[cell].1 += 1;
     }
     sums.iter().map(|&(s, n)| s / f64::from(n.max(1))).collect()
-}
-
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt().max(1e-12)
 }
 
 fn render_small(scene: &Path, width: u32, height: u32) -> image::RgbImage {
