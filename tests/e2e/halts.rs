@@ -228,35 +228,12 @@ fn a_converging_render_stopped_by_time_resumes_to_the_same_bytes() {
     let long = ["--resolution", "256x192", "--spp", "2048"];
     let out = dir.path().join("halted.png");
     stop_by_time(&scene, &out, &long, &["--threads", "2"]);
-    let resumed = render_command_with(&scene, &out, &long, &["--threads", "2"])
-        .output()
-        .unwrap();
-    assert_success(&resumed);
-    assert!(
-        stderr_of(&resumed).contains("resuming from"),
-        "{}",
-        stderr_of(&resumed)
-    );
+    let (resumed, never_stopped) = resume_beside_a_render_never_stopped(&scene, &out, &long);
     let (spp, line) = converged_at(&resumed);
-
-    let whole = dir.path().join("whole.png");
-    let never_stopped = render_command_with(
-        &scene,
-        &whole,
-        &long,
-        &["--threads", "2", "--checkpoint-every", "0"],
-    )
-    .output()
-    .unwrap();
-    assert_success(&never_stopped);
     assert_eq!(
         converged_at(&never_stopped).0,
         spp,
         "the same round: {line}"
-    );
-    assert!(
-        image_bytes(&out) == image_bytes(&whole),
-        "the resumed render differs from one never stopped"
     );
 }
 
@@ -271,7 +248,17 @@ fn a_distributed_render_stopped_by_time_resumes_in_process_to_the_same_bytes() {
     let long = ["--spp", "512", "--resolution", "128x96"];
     let out = dir.path().join("halted.png");
     stop_by_time(&scene, &out, &long, &["--local-workers", "2"]);
-    let resumed = render_command_with(&scene, &out, &long, &["--threads", "2"])
+    resume_beside_a_render_never_stopped(&scene, &out, &long);
+}
+
+/// Resumes the render stopped into `out` in-process, renders the same never stopped beside it
+/// and checks the two are the same bytes; returns both runs' output.
+fn resume_beside_a_render_never_stopped(
+    scene: &std::path::Path,
+    out: &std::path::Path,
+    settings: &[&str],
+) -> (std::process::Output, std::process::Output) {
+    let resumed = render_command_with(scene, out, settings, &["--threads", "2"])
         .output()
         .unwrap();
     assert_success(&resumed);
@@ -280,18 +267,19 @@ fn a_distributed_render_stopped_by_time_resumes_in_process_to_the_same_bytes() {
         "{}",
         stderr_of(&resumed)
     );
-    let whole = dir.path().join("whole.png");
+    let whole = out.with_file_name("never-stopped.png");
     let never_stopped = render_command_with(
-        &scene,
+        scene,
         &whole,
-        &long,
+        settings,
         &["--threads", "2", "--checkpoint-every", "0"],
     )
     .output()
     .unwrap();
     assert_success(&never_stopped);
     assert!(
-        image_bytes(&out) == image_bytes(&whole),
+        image_bytes(out) == image_bytes(&whole),
         "the resumed render differs from one never stopped"
     );
+    (resumed, never_stopped)
 }
