@@ -225,7 +225,7 @@ fn a_converging_render_stopped_by_time_resumes_to_the_same_bytes() {
         dir.path(),
         "\"float haltthreshold\" [0] \"float convergencestep\" [8]",
     );
-    let long = ["--resolution", "256x192", "--spp", "2048"];
+    let long = ["--resolution", "160x120", "--spp", "1024"];
     let out = dir.path().join("halted.png");
     stop_by_time(&scene, &out, &long, &["--threads", "2"]);
     let (resumed, never_stopped) = resume_beside_a_render_never_stopped(&scene, &out, &long);
