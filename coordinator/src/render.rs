@@ -32,9 +32,11 @@ pub struct RenderRequest {
     /// Adaptive sampling (settings.spp is then the most any pixel gets); None renders every
     /// pixel with spp samples.
     pub adaptive: Option<AdaptiveSettings>,
-    /// The PNG; the preview, the checkpoint and the EXR go beside it.
+    /// The image's path: the PNG's, when the Film writes one; the preview, the checkpoint and
+    /// the TGA and EXR the Film asks for go beside it.
     pub output_png: PathBuf,
-    /// Also write linear radiance as OpenEXR next to the PNG.
+    /// `--exr`: also write an EXR (the linear radiance in full floats, unless the Film's
+    /// `write_exr_*` say otherwise) where the Film writes none.
     pub exr: bool,
     /// Where to write the sample map of an adaptive render, at the end.
     pub sample_map: Option<PathBuf>,
@@ -176,6 +178,20 @@ fn render_and_write(
     interrupt: Interrupt,
 ) -> anyhow::Result<RenderReport> {
     let started = Instant::now();
+    if request
+        .scene
+        .desc
+        .film
+        .outputs
+        .files(request.exr)
+        .is_empty()
+    {
+        anyhow::bail!(
+            "cannot render {}: its Film writes no file (write_png, write_tga and write_exr are \
+             all false); set one of them, or add --exr",
+            request.scene.path.display()
+        );
+    }
     let (distributed, threads) = match executor {
         Executor::Distributed(config) => (Some(config), None),
         Executor::InProcess { threads } => (None, threads),

@@ -50,11 +50,14 @@ pub struct RenderArgs {
     /// The main .lxs file.
     pub scene: PathBuf,
     /// Output PNG (default: the Film's filename plus .png, in the current folder; a folder in
-    /// the Film's filename is dropped). Its side files go beside it: X.preview.png, X.resume and
-    /// X.exr, so an output named like one of those is refused.
+    /// the Film's filename is dropped). The Film's write_png, write_tga and write_exr choose
+    /// which files are written: the PNG here, the TGA and EXR beside it as X.tga and X.exr, and
+    /// the side files X.preview.png and X.resume, so an output named like one of those is
+    /// refused.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Also write linear radiance as OpenEXR next to the PNG.
+    /// Also write an EXR beside the image where the Film writes none: the linear radiance in
+    /// 32-bit floats, unless the Film's write_exr_* parameters say otherwise.
     #[arg(long)]
     pub exr: bool,
     /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the
@@ -162,8 +165,9 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// Renders as the flags ask; returns the PNG written (`yat luxconsole -b` reads it back).
-pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
+/// Renders as the flags ask; returns the PNG written, if the Film writes one (`yat luxconsole
+/// -b` reads it back).
+pub fn run(args: RenderArgs) -> anyhow::Result<Option<PathBuf>> {
     let started = Instant::now();
     let scene = ParsedScene::load_within(
         &args.scene,
@@ -252,7 +256,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         progress_log,
         status,
     };
-    let output_png = request.output_png.clone();
+    let files = crate::job::output_files(
+        &request.output_png,
+        &request.scene.desc.film.outputs.files(request.exr),
+    );
     let report = match render(request, executor, observers, interrupt.clone()) {
         Ok(report) => report,
         Err(e) => {
@@ -268,11 +275,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
         if let Some(workers) = &report.workers {
             workers.print();
         }
-        println!("wrote {}", output_png.display());
+        for (_, path) in &files {
+            println!("wrote {}", path.display());
+        }
         report.print();
     }
     linger(server, status_linger, &interrupt);
-    Ok(output_png)
+    Ok(files.into_iter().find_map(|(file, path)| {
+        matches!(file, yat_tracer::film::OutputFile::Png { .. }).then_some(path)
+    }))
 }
 
 /// Keeps the status page up for `--status-linger` after the render (or until Ctrl-C), then
