@@ -6,7 +6,7 @@ use std::path::{Component, Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use yat_tracer::film::Film;
+use yat_tracer::film::{Film, OutputFile};
 use yat_tracer::render::adaptive::{self, Round};
 use yat_tracer::render::sampling::{RoundsEnd, Sampling};
 use yat_tracer::render::unit::FilmFrame;
@@ -27,9 +27,10 @@ pub struct RenderJob {
     pub sampling: Sampling,
     /// Where to write the sample map of an adaptive render, at the end.
     pub sample_map: Option<PathBuf>,
-    /// The PNG the render will write; previews and the checkpoint go next to it.
+    /// The image's path: the PNG's, when the Film writes one; the TGA and the EXR it asks for
+    /// go beside it (its extension replaced by theirs), as do the preview and the checkpoint.
     pub output_png: PathBuf,
-    /// Also write linear radiance as OpenEXR next to the PNG.
+    /// `--exr`: also write an EXR where the Film writes none (`FilmOutputs::files`).
     pub exr: bool,
     pub quiet: bool,
     /// Progress lines for logs and machines (the bar aside).
@@ -83,9 +84,9 @@ pub struct CompletedRound {
 }
 
 /// The endings of the files a render writes beside its output `X.png`: `X.preview.png`,
-/// `X.resume`, `X.exr`. An output named so would be overwritten by, or overwrite, the side file
-/// of another output (or its own: `-o x.resume` is its own checkpoint).
-const SIDE_FILE_ENDINGS: [&str; 3] = [".preview.png", ".resume", ".exr"];
+/// `X.resume`, `X.tga`, `X.exr`. An output named so would be overwritten by, or overwrite, the
+/// side file of another output (or its own: `-o x.resume` is its own checkpoint).
+const SIDE_FILE_ENDINGS: [&str; 4] = [".preview.png", ".resume", ".tga", ".exr"];
 
 /// Refuses an output path that collides with the side files of a render.
 pub fn check_output_path(output_png: &Path) -> anyhow::Result<()> {
@@ -96,7 +97,8 @@ pub fn check_output_path(output_png: &Path) -> anyhow::Result<()> {
     if let Some(ending) = SIDE_FILE_ENDINGS.iter().find(|e| name.ends_with(*e)) {
         anyhow::bail!(
             "the output {} ends in \"{ending}\", the name a render gives the preview, the \
-             checkpoint or the EXR it writes beside its image: choose a name ending in .png",
+             checkpoint, the TGA or the EXR it writes beside its image: choose a name ending in \
+             .png",
             output_png.display()
         );
     }
@@ -104,7 +106,8 @@ pub fn check_output_path(output_png: &Path) -> anyhow::Result<()> {
 }
 
 /// The output a scene's `Film "string filename"` asks for when `-o` is absent: its file name
-/// plus `.png`, in the current folder. A scene is not trusted to choose a folder: a filename
+/// plus `.png`, in the current folder (and its TGA and EXR beside it, as LuxRender names them:
+/// the file name plus `.tga`, `.exr`). A scene is not trusted to choose a folder: a filename
 /// with one (`../../x`, `/etc/x`) keeps only its last part, with the warning returned.
 pub fn film_output_path(filename: &str) -> anyhow::Result<(PathBuf, Option<String>)> {
     let path = Path::new(filename);
@@ -305,16 +308,23 @@ impl RenderJob {
         })
     }
 
-    /// Writes the final image, the PNG (and the linear EXR when asked) exactly the same way for
-    /// every executor, and the sample map when asked; then removes the interim outputs they
-    /// replace (but the checkpoint of a render its time limit stopped).
+    /// The files the render writes at the end and where: those the Film's `write_*` ask for
+    /// (and `--exr`'s), the PNG at [`Self::output_png`], the others beside it.
+    pub fn output_files(&self) -> Vec<(OutputFile, PathBuf)> {
+        output_files(
+            &self.output_png,
+            &self.scene.desc.film.outputs.files(self.exr),
+        )
+    }
+
+    /// Writes the final image, every file the Film asks for (and the EXR of `--exr`) exactly
+    /// the same way for every executor, and the sample map when asked; then removes the
+    /// interim outputs they replace (but the checkpoint of a render its time limit stopped).
     pub fn write_final(&self, outcome: &RenderOutcome) -> anyhow::Result<()> {
-        let film = &outcome.film;
-        film.write_png(&self.output_png, &self.scene.desc.film)
-            .with_context(|| format!("cannot write {}", self.output_png.display()))?;
-        if self.exr {
-            let path = self.output_png.with_extension("exr");
-            film.write_exr(&path)
+        let image = outcome.film.image(&self.scene.desc.film);
+        for (file, path) in self.output_files() {
+            image
+                .write(&file, &path)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
         if let (Some(path), Some(round)) = (&self.sample_map, &outcome.round) {
@@ -358,6 +368,21 @@ impl RenderJob {
     }
 }
 
+/// Where each of `files` goes for an image at `output_png`: the PNG there, the others beside
+/// it with their own extensions.
+pub fn output_files(output_png: &Path, files: &[OutputFile]) -> Vec<(OutputFile, PathBuf)> {
+    files
+        .iter()
+        .map(|&file| {
+            let path = match file {
+                OutputFile::Png { .. } => output_png.to_path_buf(),
+                _ => output_png.with_extension(file.extension()),
+            };
+            (file, path)
+        })
+        .collect()
+}
+
 /// Which samples the merged units of a uniform plan hold, exactly: the sample ranges every
 /// pixel has, then each later range some tiles have, with how many of its tiles ("samples
 /// 0..64 of every pixel; 64..128 in 12 of 40 tiles"). The plan orders units by sample range.
@@ -397,7 +422,13 @@ mod tests {
 
     #[test]
     fn outputs_named_like_side_files_are_refused() {
-        for bad in ["x.resume", "a/x.preview.png", "x.exr", "/tmp/y.resume"] {
+        for bad in [
+            "x.resume",
+            "a/x.preview.png",
+            "x.exr",
+            "x.tga",
+            "/tmp/y.resume",
+        ] {
             let err = check_output_path(Path::new(bad)).unwrap_err().to_string();
             assert!(err.contains("choose a name"), "{bad}: {err}");
         }

@@ -34,9 +34,11 @@ pub struct RenderRequest {
     /// Every pixel spp samples, adaptive rounds, or rounds until the image stops changing
     /// (settings.spp then the most any pixel gets).
     pub sampling: Sampling,
-    /// The PNG; the preview, the checkpoint and the EXR go beside it.
+    /// The image's path: the PNG's, when the Film writes one; the preview, the checkpoint and
+    /// the TGA and EXR the Film asks for go beside it.
     pub output_png: PathBuf,
-    /// Also write linear radiance as OpenEXR next to the PNG.
+    /// `--exr`: also write an EXR (the linear radiance in full floats, unless the Film's
+    /// `write_exr_*` say otherwise) where the Film writes none.
     pub exr: bool,
     /// Where to write the sample map of an adaptive render, at the end.
     pub sample_map: Option<PathBuf>,
@@ -203,6 +205,20 @@ fn render_and_write(
     interrupt: Interrupt,
 ) -> anyhow::Result<RenderReport> {
     let started = Instant::now();
+    if request
+        .scene
+        .desc
+        .film
+        .outputs
+        .files(request.exr)
+        .is_empty()
+    {
+        anyhow::bail!(
+            "cannot render {}: its Film writes no file (write_png, write_tga and write_exr are \
+             all false); set one of them, or add --exr",
+            request.scene.path.display()
+        );
+    }
     let (distributed, threads) = match executor {
         Executor::Distributed(config) => (Some(config), None),
         Executor::InProcess { threads } => (None, *threads),

@@ -366,6 +366,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                     sensitivity: 50.0,
                     exposure: 1.0,
                     fstop: 2.8,
+                    gamma: 1.0,
                 },
                 2 => ToneMap::Reinhard {
                     prescale: 1.0,
@@ -384,6 +385,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 halttime: None,
                 haltthreshold: None,
                 convergence_step: yat_tracer::film::DEFAULT_CONVERGENCE_STEP,
+                outputs: Default::default(),
             });
             7 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),

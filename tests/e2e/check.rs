@@ -79,11 +79,11 @@ fn check_summarises_a_seed_scene() {
     );
     // LuxBlend's sampler, light strategy, output and shutter settings, each with why.
     assert!(
-        stdout.contains("\nno effect on the image: 28\n"),
+        stdout.contains("\nno effect on the image: 19\n"),
         "{stdout}"
     );
     assert!(
-        stdout.contains("notes (rendered as LuxRender would): 13\n  cornell-box.lxs:11:1: SurfaceIntegrator \"bidirectional\""),
+        stdout.contains("notes (rendered as LuxRender would): 12\n  cornell-box.lxs:11:1: SurfaceIntegrator \"bidirectional\""),
         "the notes, the integrator's first: {stdout}"
     );
     assert!(
@@ -258,8 +258,8 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
     std::fs::write(
         &scene,
         "Film \"fleximage\" \"integer xresolution\" [8] \"integer yresolution\" [8]\n\
-         \x20 \"bool write_exr\" [\"true\"] \"integer writeinterval\" [30]\n\
-         \x20 \"string ldr_clamp_method\" [\"cut\"] \"float haltthreshold\" [0.05]\n\
+         \x20 \"bool write_resume_flm\" [\"true\"] \"integer writeinterval\" [30]\n\
+         \x20 \"string cameraresponse\" [\"\"] \"float haltthreshold\" [0.05]\n\
          Sampler \"metropolis\" \"float largemutationprob\" [0.400000005960464]\n\
          SurfaceIntegrator \"path\" \"string lightstrategy\" [\"one\"]\n\
          LookAt 0 -5 1  0 0 1  0 0 1\n\
@@ -277,9 +277,9 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
          every 32 samples (haltthreshold) (--spp, --time-limit and --halt-threshold override \
          them)",
         "no effect on the image: 6",
-        "  quiet.lxs:2:3: Film \"fleximage\": \"bool write_exr\" [\"true\"]: no effect on the image \
-         (output settings: which files are written, not what they show)",
-        "  quiet.lxs:2:29: Film \"fleximage\": \"integer writeinterval\" [30]: no effect on the \
+        "  quiet.lxs:2:3: Film \"fleximage\": \"bool write_resume_flm\" [\"true\"]: no effect on \
+         the image (output settings: which files are written, not what they show)",
+        "  quiet.lxs:2:36: Film \"fleximage\": \"integer writeinterval\" [30]: no effect on the \
          image (progress settings: when the image is shown, saved or tested, not what it shows)",
         "  quiet.lxs:4:22: Sampler \"metropolis\": \"float largemutationprob\" [0.4]: no effect on \
          the image (sampler choice: YAT's own samples converge to the same image)",
@@ -290,7 +290,7 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
          motion)",
         "  quiet.lxs:7:46: Camera \"perspective\": \"float shutterclose\" [0.04]: no effect",
         "notes (rendered as LuxRender would): 1",
-        "  quiet.lxs:3:3: Film \"fleximage\": \"string ldr_clamp_method\" [\"cut\"] is LuxRender's \
+        "  quiet.lxs:3:3: Film \"fleximage\": \"string cameraresponse\" [\"\"] is LuxRender's \
          default, which YAT renders",
     ] {
         assert!(
@@ -310,7 +310,7 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
     // Outlier rejection drops samples (fireflies) from LuxRender's image: a difference.
     std::fs::write(
         &scene,
-        "Film \"fleximage\" \"integer outlierrejection_k\" [2] \"bool write_png\" [\"true\"]\n\
+        "Film \"fleximage\" \"integer outlierrejection_k\" [2] \"bool write_flm_direct\" [\"true\"]\n\
          WorldBegin\nWorldEnd\n",
     )
     .unwrap();

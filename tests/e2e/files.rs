@@ -110,7 +110,7 @@ fn an_output_named_like_a_side_file_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let before = std::fs::read_dir(dir.path()).unwrap().count();
-    for name in ["x.resume", "x.preview.png", "x.exr"] {
+    for name in ["x.resume", "x.preview.png", "x.tga", "x.exr"] {
         let output = render(&scene, &dir.path().join(name), &[]);
         let err = stderr_of(&output);
         assert!(!output.status.success(), "{name}: rendered");

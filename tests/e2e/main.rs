@@ -20,6 +20,7 @@ mod isa;
 mod lit_sphere;
 mod luxconsole;
 mod memory;
+mod outputs;
 mod progress_log;
 mod resume;
 mod status;

@@ -1,8 +1,8 @@
 //! `Film "fleximage" "integer xresolution" [800] "integer yresolution" [600] ...`: the film's
 //! description, LuxRender's defaults and their reading; sample buffers and the film: per-pixel
 //! sums from units, merged in an order-independent way (exact fixed-point sums), tone mapped
-//! and written as PNG or linear EXR. A bidirectional render's units carry light splats too,
-//! merged into sums of their own ([`splats`]).
+//! and handed to the writers of the files the Film asks for ([`outputs`]). A bidirectional
+//! render's units carry light splats too, merged into sums of their own ([`splats`]).
 //!
 //! | parameter | type | default |
 //! |---|---|---|
@@ -10,20 +10,20 @@
 //! | `gamma` | float | 2.2 |
 //! | `tonemapkernel` | string: autolinear, linear, reinhard, contrast | autolinear |
 //! | `linear_sensitivity`, `linear_exposure`, `linear_fstop` | float | 50, 1, 2.8 |
+//! | `linear_gamma` | float | 1: the linear kernel aims its exposure at (118/255)^linear_gamma |
 //! | `reinhard_prescale`, `reinhard_postscale`, `reinhard_burn` | float | 1, 1, 6 |
 //! | `contrast_ywa` | float | 1 |
 //! | `filename` | string | "luxout" |
 //! | `haltspp` | integer | none |
 //! | `halttime` | float | none |
 //! | `haltthreshold` | float | none (LuxRender's -1): from 0 on, rendering halts once at most this fraction of the pixels still fails LuxRender's convergence test (a perceptual comparison of the image with itself every `convergencestep` samples per pixel); 1 halts at the first test |
+//! | `write_*`, `ldr_clamp_method` | | the files written: [`outputs`] |
 //!
 //! LuxRender 1.x registers "multiimage" (LuxRender 0.x's film) as another name of fleximage:
 //! it is read as fleximage, and the parameters only multiimage had are ignored, as LuxRender
 //! 1.x ignores them. Any other film type fails LuxRender's scene; YAT reads it as fleximage
 //! with a warning. A scene without a `Film` statement gets these defaults. What the other
 //! parameters LuxRender reads do here: [`crate::parse::luxrender_params`].
-
-use std::path::Path;
 
 use glam::Vec3;
 
@@ -34,8 +34,10 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
 
+pub mod outputs;
 pub mod splats;
 
+pub use outputs::{FilmImage, FilmOutputs, OutputError, OutputFile};
 pub use splats::{FilmSplats, LightSplats, SplatMisfit, SplatSums, MAX_SPLAT_PIXELS};
 
 /// The film type every `Film` statement is read as.
@@ -49,6 +51,7 @@ pub const DEFAULT_TONEMAP_KERNEL: &str = "autolinear";
 pub const DEFAULT_LINEAR_SENSITIVITY: f32 = 50.0;
 pub const DEFAULT_LINEAR_EXPOSURE: f32 = 1.0;
 pub const DEFAULT_LINEAR_FSTOP: f32 = 2.8;
+pub const DEFAULT_LINEAR_GAMMA: f32 = 1.0;
 pub const DEFAULT_REINHARD_PRESCALE: f32 = 1.0;
 pub const DEFAULT_REINHARD_POSTSCALE: f32 = 1.0;
 pub const DEFAULT_REINHARD_BURN: f32 = 6.0;
@@ -66,10 +69,13 @@ pub const MAX_CONVERGENCE_STEP: f32 = 1024.0;
 pub enum ToneMap {
     /// scale = 1.25 / Yavg x (118/255)^gamma over pixels with Y > 0.
     AutoLinear,
+    /// scale = exposure / fstop^2 x sensitivity x 0.65 / 10 x (118/255)^gamma, with the
+    /// kernel's own gamma (`linear_gamma`), not the film's.
     Linear {
         sensitivity: f32,
         exposure: f32,
         fstop: f32,
+        gamma: f32,
     },
     Reinhard {
         prescale: f32,
@@ -97,6 +103,8 @@ pub struct FilmDesc {
     /// Samples per pixel between convergence tests (LuxRender's `convergencestep`; at least
     /// [`MIN_CONVERGENCE_STEP`]).
     pub convergence_step: f32,
+    /// Which files the render writes, and how ([`outputs`]).
+    pub outputs: FilmOutputs,
 }
 
 impl FilmDesc {
@@ -143,6 +151,7 @@ impl FilmDesc {
                 sensitivity: params.float("linear_sensitivity", DEFAULT_LINEAR_SENSITIVITY)?,
                 exposure: params.float("linear_exposure", DEFAULT_LINEAR_EXPOSURE)?,
                 fstop: params.float("linear_fstop", DEFAULT_LINEAR_FSTOP)?,
+                gamma: params.float("linear_gamma", DEFAULT_LINEAR_GAMMA)?,
             },
             "reinhard" => ToneMap::Reinhard {
                 prescale: params.float("reinhard_prescale", DEFAULT_REINHARD_PRESCALE)?,
@@ -163,12 +172,12 @@ impl FilmDesc {
             }
         };
         // The parameters of the kernels not chosen are legitimately present in exported files
-        // (and those of falsecolors, which is reported above where it is chosen). linear_gamma
-        // is left to the table of LuxRender's parameters: YAT's linear kernel does not read it.
+        // (and those of falsecolors, which is reported above where it is chosen).
         for name in [
             "linear_sensitivity",
             "linear_exposure",
             "linear_fstop",
+            "linear_gamma",
             "reinhard_prescale",
             "reinhard_postscale",
             "reinhard_burn",
@@ -198,6 +207,7 @@ impl FilmDesc {
             } else {
                 DEFAULT_CONVERGENCE_STEP
             },
+            outputs: FilmOutputs::read(ctx, params, pos)?,
         })
     }
 }
@@ -315,8 +325,9 @@ impl Film {
     }
 
     /// Bytes a film of `frame` (an adaptive render's if `adaptive`) takes at most: its sums,
-    /// a copy of them while a checkpoint is written, and the radiance and image a file is
-    /// written from.
+    /// a copy of them while a checkpoint is written, and what a file is written from (the
+    /// linear and tone-mapped radiance, alpha, and the file's samples: at most four 32-bit
+    /// floats a pixel).
     pub fn memory_bytes(frame: FilmFrame, adaptive: bool) -> u64 {
         let pixels = u64::from(frame.width) * u64::from(frame.height);
         let sum = std::mem::size_of::<[i64; 4]>() as u64;
@@ -327,7 +338,7 @@ impl Film {
         } else {
             pixels * sum
         } + u64::from(frame.light_splats) * pixels * splat_sum;
-        let output = pixels * 2 * std::mem::size_of::<Vec3>() as u64;
+        let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16);
         2 * sums + output
     }
 
@@ -584,45 +595,38 @@ impl Film {
             .collect()
     }
 
-    /// Tone mapped as the scene's film asks, its gamma applied, in [0, 1]: the values the 8-bit
-    /// image rounds (and LuxRender's convergence test compares), rows top to bottom.
+    /// Tone mapped, limited and gamma encoded as the scene's film asks, in [0, 1]: the values
+    /// an 8- or 16-bit file quantises (and LuxRender's convergence test compares), rows top to
+    /// bottom.
     pub fn display_values(&self, film: &FilmDesc) -> Vec<[f32; 3]> {
-        let mut mapped = self.radiance();
-        tone_map(&mut mapped, &film.tonemap, film.gamma);
-        let inv_gamma = 1.0 / film.gamma.max(1e-3);
-        mapped
-            .into_iter()
-            .map(|c| {
-                c.to_array()
-                    .map(|v| libm::powf(v.clamp(0.0, 1.0), inv_gamma))
-            })
+        let image = self.image(film);
+        (0..image.tone_mapped.len())
+            .map(|i| image.encoded(i).to_array())
             .collect()
     }
 
-    /// Tone maps as the scene's film asks and applies its gamma: 8-bit RGB, rows top to bottom.
-    pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
-        let mut img = image::RgbImage::new(self.frame.width, self.frame.height);
-        for (px, c) in img.pixels_mut().zip(self.display_values(film)) {
-            *px = image::Rgb(c.map(|v| (v * 255.0 + 0.5) as u8));
+    /// The finished image as the scene's film makes it: the linear radiance, the tone-mapped
+    /// radiance, and how an 8- or 16-bit file limits and encodes it; what every file is
+    /// written from ([`FilmImage::write`]).
+    pub fn image(&self, film: &FilmDesc) -> FilmImage {
+        let linear = self.radiance();
+        let mut tone_mapped = linear.clone();
+        tone_map(&mut tone_mapped, &film.tonemap, film.gamma);
+        FilmImage {
+            width: self.frame.width,
+            height: self.frame.height,
+            linear,
+            tone_mapped,
+            alpha: None,
+            gamma: film.gamma,
+            ldr_clamp: film.outputs.ldr_clamp,
         }
-        img
     }
 
-    pub fn write_png(&self, path: &Path, film: &FilmDesc) -> Result<(), image::ImageError> {
-        self.to_display(film)
-            .save_with_format(path, image::ImageFormat::Png)
-    }
-
-    /// Linear radiance as 32-bit float OpenEXR, no tone mapping.
-    pub fn write_exr(&self, path: &Path) -> Result<(), image::ImageError> {
-        let data: Vec<f32> = self
-            .radiance()
-            .into_iter()
-            .flat_map(|c| [c.x, c.y, c.z])
-            .collect();
-        let img = image::Rgb32FImage::from_raw(self.frame.width, self.frame.height, data)
-            .expect("buffer has width x height pixels");
-        image::DynamicImage::ImageRgb32F(img).save_with_format(path, image::ImageFormat::OpenExr)
+    /// Tone maps as the scene's film asks, limits and applies its gamma: 8-bit RGB, rows top
+    /// to bottom, as the PNG has it by default (the preview's and the status page's image).
+    pub fn to_display(&self, film: &FilmDesc) -> image::RgbImage {
+        self.image(film).to_rgb8()
     }
 }
 
@@ -669,7 +673,7 @@ fn mean(&[r, g, b, w]: &[i64; 4]) -> Vec3 {
 
 /// LuxRender's tone mapping kernels, turning radiance in place into values to be gamma encoded.
 pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
-    // The mid-grey LuxRender aims autolinear and linear exposure at.
+    // The mid-grey LuxRender aims autolinear exposure at.
     let middle_grey = libm::powf(118.0f32 / 255.0, gamma);
     match *tonemap {
         ToneMap::AutoLinear => {
@@ -686,7 +690,10 @@ pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
             sensitivity,
             exposure,
             fstop,
+            gamma,
         } => {
+            // LuxRender's linear kernel aims at mid-grey with its own gamma, not the film's.
+            let middle_grey = libm::powf(118.0f32 / 255.0, gamma);
             let scale = exposure / (fstop * fstop) * sensitivity * 0.65 / 10.0 * middle_grey;
             radiance.iter_mut().for_each(|c| *c *= scale);
         }
@@ -1033,6 +1040,42 @@ mod tests {
         tone_map(&mut mapped, &ToneMap::AutoLinear, 2.2);
         let expected = 1.25 * libm::powf(118.0f32 / 255.0, 2.2);
         assert!((mapped[0].x - expected).abs() < 1e-5);
+    }
+
+    /// LuxRender's linear kernel exposes for mid-grey with its own `linear_gamma` (default 1),
+    /// not the film's gamma: radiance 1 at sensitivity 50, exposure 1, f/2.8 becomes
+    /// 50 x 0.065 / 2.8^2 x (118/255)^1 = 0.19183.
+    #[test]
+    fn linear_exposes_with_its_own_gamma() {
+        let mut source = crate::assets::MemorySource::new();
+        let scene =
+            "Film \"fleximage\" \"string tonemapkernel\" [\"linear\"] \"float gamma\" [2.2]\n\
+                     WorldBegin\nWorldEnd\n";
+        source.insert("main.lxs", scene.as_bytes().into());
+        let desc = crate::parse::parse_scene("main.lxs", &source).unwrap();
+        let tonemap = desc.film.tonemap;
+        assert_eq!(
+            tonemap,
+            ToneMap::Linear {
+                sensitivity: 50.0,
+                exposure: 1.0,
+                fstop: 2.8,
+                gamma: DEFAULT_LINEAR_GAMMA,
+            }
+        );
+        let mut mapped = [Vec3::ONE];
+        tone_map(&mut mapped, &tonemap, 2.2);
+        assert!((mapped[0].x - 0.191_83).abs() < 1e-5, "{}", mapped[0].x);
+        // linear_gamma 2.2 whatever the film's: (118/255)^2.2 = 0.18356.
+        let tonemap = ToneMap::Linear {
+            sensitivity: 50.0,
+            exposure: 1.0,
+            fstop: 2.8,
+            gamma: 2.2,
+        };
+        let mut mapped = [Vec3::ONE];
+        tone_map(&mut mapped, &tonemap, 1.0);
+        assert!((mapped[0].x - 0.076_09).abs() < 1e-5, "{}", mapped[0].x);
     }
 
     #[test]

@@ -280,8 +280,12 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
             sensitivity,
             exposure,
             fstop,
+            gamma,
         } => {
-            format!("linear (sensitivity {sensitivity}, exposure {exposure}, fstop {fstop})")
+            format!(
+                "linear (sensitivity {sensitivity}, exposure {exposure}, fstop {fstop}, gamma \
+                 {gamma})"
+            )
         }
         ToneMap::Reinhard {
             prescale,
@@ -298,6 +302,26 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         f.gamma, f.filename
     );
     let _ = writeln!(s, "halts        {}", halts(d));
+    let files: Vec<String> = f
+        .outputs
+        .files(false)
+        .iter()
+        .map(|file| format!("{}.{} ({})", f.filename, file.extension(), file.describe()))
+        .collect();
+    let files = if files.is_empty() {
+        "none (the Film writes no PNG, TGA or EXR)".to_string()
+    } else {
+        files.join(", ")
+    };
+    let limit = if f.outputs.write_png || f.outputs.write_tga {
+        format!(
+            "; PNG and TGA colours limited by \"{}\"",
+            f.outputs.ldr_clamp.name()
+        )
+    } else {
+        String::new()
+    };
+    let _ = writeln!(s, "files        {files}{limit}");
     let filter = match d.filter.kind {
         FilterKind::Box => "box".to_string(),
         FilterKind::Triangle => "triangle".to_string(),

@@ -20,7 +20,8 @@
 //! Where files go, as luxconsole puts them: luxconsole changes into a scene file's folder before
 //! it renders it, so the Film's filename and a relative `-o` land beside the scene; so does
 //! this. LuxRender's `-o NAME` is a base name (it drops NAME's extension and each film output
-//! adds its own); YAT writes one PNG, NAME with its extension replaced by `.png`. A scene on
+//! adds its own); so is YAT's: it passes NAME with its extension replaced by `.png` to
+//! `yat render -o`, which writes the Film's PNG there and its TGA and EXR beside it. A scene on
 //! standard input (`-`) is read as luxconsole reads it, against the current folder: its bytes
 //! (at most [`MAX_STDIN_BYTES`]) are staged in a private temporary file created there (mode
 //! 0600, removed after its render), so its relative Includes and textures resolve there, and
@@ -248,8 +249,9 @@ pub const OPTIONS: &[LuxOption] = &[
         Some('o'),
         Value::Text,
         Effect::Output,
-        "-o NAME with NAME's extension replaced by .png (LuxRender's -o is a base name); a \
-         relative NAME is in the scene's folder, where luxconsole writes it",
+        "-o NAME with NAME's extension replaced by .png (LuxRender's -o is a base name: the \
+         Film's TGA and EXR go beside it as NAME.tga, NAME.exr); a relative NAME is in the \
+         scene's folder, where luxconsole writes it",
     ),
     option(
         "fixedseed",
@@ -1000,6 +1002,12 @@ pub fn run(args: LuxconsoleArgs) -> anyhow::Result<()> {
             }
         })?;
         if let Some(out) = &mut pixels {
+            let Some(png) = png else {
+                anyhow::bail!(
+                    "-b sends the pixels of the PNG a render writes, and the scene's Film writes \
+                     none (write_png false)"
+                );
+            };
             dump_pixels(out, &png)?;
         }
     }

@@ -66,12 +66,15 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 1, requires = "frames_task")]
     pub frames_per_task: usize,
     /// Output PNG (default: the Film's filename plus .png, in the current folder; a folder in
-    /// the Film's filename is dropped). Its side files go beside it: X.preview.png, X.resume and
-    /// X.exr, so an output named like one of those is refused. With several frames, or a path
-    /// ending in "/", the folder the frames' images go to (made if missing).
+    /// the Film's filename is dropped). The Film's write_png, write_tga and write_exr choose
+    /// which files are written: the PNG here, the TGA and EXR beside it as X.tga and X.exr, and
+    /// the side files X.preview.png and X.resume, so an output named like one of those is
+    /// refused. With several frames, or a path ending in "/", the folder the frames' images go
+    /// to (made if missing).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Also write linear radiance as OpenEXR next to the PNG.
+    /// Also write an EXR beside the image where the Film writes none: the linear radiance in
+    /// 32-bit floats, unless the Film's write_exr_* parameters say otherwise.
     #[arg(long)]
     pub exr: bool,
     /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the
@@ -186,9 +189,9 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// Renders as the flags ask; returns the PNG written, the last frame's of a sequence (`yat
-/// luxconsole -b` reads it back).
-pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
+/// Renders as the flags ask; returns the PNG written if the Film writes one, the last frame's
+/// of a sequence (`yat luxconsole -b` reads it back).
+pub fn run(args: RenderArgs) -> anyhow::Result<Option<PathBuf>> {
     let slice = args.frames_task.map(|task| frames::FrameSlice {
         task,
         per_task: args.frames_per_task,
@@ -210,7 +213,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
     }
     let mut outputs = frames::FrameOutputs::new(args.output.as_deref())?;
     let mut journal = None;
-    let mut last = PathBuf::new();
+    let mut last = None;
     let count = scenes.len();
     for (i, scene) in scenes.iter().enumerate() {
         let which = || format!("frame {} of {count}, {}", i + 1, scene.display());
@@ -229,7 +232,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
             if !args.quiet {
                 println!("{}: rendered already ({})", which(), image.display());
             }
-            last = image;
+            last = Some(image);
             continue;
         }
         if !args.quiet {
@@ -244,7 +247,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<PathBuf> {
                 )
             },
         )?;
-        journal.record(&identity, &last)?;
+        journal.record(&identity, &image)?;
     }
     if let Some(journal) = journal {
         journal.remove();
@@ -303,7 +306,7 @@ fn render_frame(
     executor: &Executor,
     interrupt: &Interrupt,
     last: bool,
-) -> anyhow::Result<PathBuf> {
+) -> anyhow::Result<Option<PathBuf>> {
     for warning in &request.warnings {
         eprintln!("warning: {warning}");
     }
@@ -358,7 +361,10 @@ fn render_frame(
         progress_log,
         status,
     };
-    let output_png = request.output_png.clone();
+    let files = crate::job::output_files(
+        &request.output_png,
+        &request.scene.desc.film.outputs.files(request.exr),
+    );
     let report = match render(request, executor, observers, interrupt.clone()) {
         Ok(report) => report,
         Err(e) => {
@@ -374,11 +380,15 @@ fn render_frame(
         if let Some(workers) = &report.workers {
             workers.print();
         }
-        println!("wrote {}", output_png.display());
+        for (_, path) in &files {
+            println!("wrote {}", path.display());
+        }
         report.print();
     }
     linger(server, status_linger, interrupt);
-    Ok(output_png)
+    Ok(files.into_iter().find_map(|(file, path)| {
+        matches!(file, yat_tracer::film::OutputFile::Png { .. }).then_some(path)
+    }))
 }
 
 /// Keeps the status page up for `--status-linger` after the render (or until Ctrl-C), then

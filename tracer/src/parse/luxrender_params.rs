@@ -406,24 +406,18 @@ const FLEXIMAGE: &[LuxParam] = &[
         "LuxRender tabulates the pixel filter in 2^filterquality steps; YAT's table is fixed, \
          finer than the default's 16",
     ),
-    // LuxRender limits out-of-gamut colours of the PNG, TGA and display with it (ColorSystem's
-    // Limit, before the gamma): "cut" clamps each channel to [0, 1] as YAT's PNG does, "lum",
-    // "hue" and "darken" desaturate or scale the colour instead.
-    differs(
-        "ldr_clamp_method",
-        Text("cut"),
-        "LuxRender brings bright colours into the PNG by luminance, hue or darkening; YAT cuts \
-         each channel, as \"cut\" does",
-    ),
-    no_effect("write_exr", Bool(false), NoEffect::Output),
-    no_effect("write_exr_channels", Text("RGB"), NoEffect::Output),
-    no_effect("write_exr_halftype", Bool(true), NoEffect::Output),
+    // The files written and how (`film/outputs.rs`); ldr_clamp_method limits the PNG's and
+    // TGA's bright colours, as LuxRender's ColorSystem::Limit does before the gamma.
+    param("ldr_clamp_method", Text("cut"), Rendered),
+    param("write_exr", Bool(false), Rendered),
+    param("write_exr_channels", Text("RGB"), Rendered),
+    param("write_exr_halftype", Bool(true), Rendered),
     no_effect(
         "write_exr_compressiontype",
         Text("PIZ (lossless)"),
         NoEffect::Output,
     ),
-    no_effect("write_exr_applyimaging", Bool(true), NoEffect::Output),
+    param("write_exr_applyimaging", Bool(true), Rendered),
     // The three gamut clamps are stored by LuxRender 1.x's film and never applied: the PNG's
     // pixels are limited by ldr_clamp_method alone, whatever these say.
     no_effect("write_exr_gamutclamp", Bool(true), NoEffect::Output),
@@ -433,11 +427,10 @@ const FLEXIMAGE: &[LuxParam] = &[
         Text("None"),
         NoEffect::Output,
     ),
-    no_effect("write_exr_straightcolors", Bool(false), NoEffect::Output),
-    no_effect("write_png", Bool(true), NoEffect::Output),
-    // "Y" and "YA" write a grey PNG of the same image: a file format, as the EXR's channels.
-    no_effect("write_png_channels", Text("RGB"), NoEffect::Output),
-    no_effect("write_png_16bit", Bool(false), NoEffect::Output),
+    param("write_exr_straightcolors", Bool(false), Rendered),
+    param("write_png", Bool(true), Rendered),
+    param("write_png_channels", Text("RGB"), Rendered),
+    param("write_png_16bit", Bool(false), Rendered),
     no_effect("write_png_gamutclamp", Bool(true), NoEffect::Output),
     no_effect("write_png_ZBuf", Bool(false), NoEffect::Output),
     no_effect(
@@ -445,8 +438,8 @@ const FLEXIMAGE: &[LuxParam] = &[
         Text("Min/Max"),
         NoEffect::Output,
     ),
-    no_effect("write_tga", Bool(false), NoEffect::Output),
-    no_effect("write_tga_channels", Text("RGB"), NoEffect::Output),
+    param("write_tga", Bool(false), Rendered),
+    param("write_tga_channels", Text("RGB"), Rendered),
     no_effect("write_tga_gamutclamp", Bool(true), NoEffect::Output),
     no_effect("write_tga_ZBuf", Bool(false), NoEffect::Output),
     no_effect(
@@ -509,14 +502,8 @@ const FLEXIMAGE: &[LuxParam] = &[
     param("linear_sensitivity", Float(50.0), Rendered),
     param("linear_exposure", Float(1.0), Rendered),
     param("linear_fstop", Float(2.8), Rendered),
-    // LuxRender's linear kernel exposes for mid-grey with (118/255)^linear_gamma; YAT's with the
-    // film's gamma in its place.
-    differs_with(
-        "linear_gamma",
-        Float(1.0),
-        &[Trigger::Is("tonemapkernel", "linear")],
-        "YAT's linear tone map uses the film's gamma in its place",
-    ),
+    // The linear kernel exposes for mid-grey with (118/255)^linear_gamma.
+    param("linear_gamma", Float(1.0), Rendered),
     param("contrast_ywa", Float(1.0), Rendered),
     // The falsecolors kernel's, which YAT's film reports as unknown where it is chosen.
     param("false_method", Text("linear"), Rendered),

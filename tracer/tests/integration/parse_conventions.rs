@@ -812,7 +812,7 @@ fn includes_are_relative_to_the_main_folder_and_listed_once() {
 fn unknown_statements_and_parameters_warn_once_each() {
     let d = parse(
         "Frobnicate 1 2 \"x\"\nFrobnicate [3]\nCamera \"perspective\" \"float shutteropen\" 0 \"bool autofocus\" \"false\"\n\
-         Film \"fleximage\" \"bool write_png\" \"true\" \"float colorspace_white\" [0.3 0.3] \"integer displayinterval\" 10\n\
+         Film \"fleximage\" \"bool write_resume_flm\" \"true\" \"float colorspace_white\" [0.3 0.3] \"integer displayinterval\" 10\n\
          WorldBegin\nLightGroup \"default\"\nAccelerator \"qbvh\"\n\
          Shape \"sphere\" \"float wobble\" 1 \"bool generatetangents\" \"false\" \"string name\" \"a\"\n\
          Shape \"sphere\" \"float wobble\" 2\nShape \"disk\" \"float wobble\" 2\nWorldEnd",
@@ -838,7 +838,7 @@ fn unknown_statements_and_parameters_warn_once_each() {
     // The exporter's output, display and shutter settings: listed as changing nothing.
     let quiet = of(Severity::NoEffect);
     assert_eq!(quiet.len(), 3, "{quiet:#?}");
-    for name in ["write_png", "displayinterval", "shutteropen"] {
+    for name in ["write_resume_flm", "displayinterval", "shutteropen"] {
         assert!(quiet.iter().any(|m| m.contains(name)), "{name}: {quiet:#?}");
     }
 }
