@@ -74,7 +74,7 @@ pub struct RenderArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Also write an EXR beside the image where the Film writes none: the linear radiance in
-    /// 32-bit floats, unless the Film's write_exr_* parameters say otherwise.
+    /// 32-bit floats (in the Film's write_exr_channels).
     #[arg(long)]
     pub exr: bool,
     /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the

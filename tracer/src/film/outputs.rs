@@ -349,7 +349,9 @@ impl FilmOutputs {
 
     /// The files a render writes, in the order they are written: the PNG, the TGA, the EXR,
     /// each when the Film asks for it; `flag_exr` (`yat render --exr`) adds the EXR where the
-    /// Film writes none, in full floats of the linear radiance unless the Film says otherwise.
+    /// Film writes none: always the linear radiance in full floats (what the benchmarks and
+    /// byte comparisons read), whatever the Film's `write_exr_halftype` and
+    /// `write_exr_applyimaging` say of the EXR it does not write.
     pub fn files(&self, flag_exr: bool) -> Vec<OutputFile> {
         let mut files = Vec::new();
         if self.write_png {
@@ -364,15 +366,18 @@ impl FilmOutputs {
             });
         }
         let (half, tone_mapped) = if self.write_exr {
-            (DEFAULT_EXR_HALFTYPE, DEFAULT_EXR_APPLYIMAGING)
+            (
+                self.exr_halftype.unwrap_or(DEFAULT_EXR_HALFTYPE),
+                self.exr_applyimaging.unwrap_or(DEFAULT_EXR_APPLYIMAGING),
+            )
         } else {
             (FLAG_EXR_HALFTYPE, FLAG_EXR_APPLYIMAGING)
         };
         if self.write_exr || flag_exr {
             files.push(OutputFile::Exr(ExrFormat {
                 channels: self.exr_channels,
-                half: self.exr_halftype.unwrap_or(half),
-                tone_mapped: self.exr_applyimaging.unwrap_or(tone_mapped),
+                half,
+                tone_mapped,
                 straight: self.exr_straight_colors,
             }));
         }
@@ -668,7 +673,7 @@ mod tests {
         assert_eq!(outputs.files(true), [png, OutputFile::Exr(flag_exr)]);
         assert!(!outputs.needs_alpha());
         // The Film's EXR: LuxRender's half floats of the tone-mapped image, with or without
-        // --exr; the parameters it gives win over --exr's defaults.
+        // --exr.
         let (outputs, _) = read("\"bool write_exr\" [\"true\"] \"bool write_png\" [\"false\"]");
         let luxrender = ExrFormat {
             half: true,
@@ -681,9 +686,10 @@ mod tests {
             "\"string write_exr_channels\" [\"YA\"] \"bool write_exr_applyimaging\" [\"true\"] \
              \"bool write_tga\" [\"true\"] \"string write_tga_channels\" [\"Y\"]",
         );
+        // --exr where the Film writes none: linear full floats whatever write_exr_applyimaging
+        // says of the EXR the Film does not write (its channels are the Film's).
         let exr = ExrFormat {
             channels: Channels::Ya,
-            tone_mapped: true,
             ..flag_exr
         };
         assert_eq!(
