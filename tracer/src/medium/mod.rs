@@ -1,7 +1,9 @@
 //! Participating media: LuxRender 1.x's named volumes (`MakeNamedVolume`), the `Interior` and
 //! `Exterior` of each shape, and the camera's volume. One file per kind ([`clear`],
-//! [`homogeneous`]), the phase function in [`phase`], and what shapes and the path tracer
-//! share (ids, the sides of a surface, Beer-Lambert) in the leaf [`common`].
+//! [`homogeneous`]), the phase function in [`phase`], what shapes and the path tracer share
+//! (ids, the sides of a surface, Beer-Lambert) in the leaf [`common`], and the
+//! `VolumeIntegrator` statement (whether volumes scatter, as LuxRender's decides) in
+//! [`integrator`].
 //!
 //! As in LuxRender, a shape takes the `Interior` and `Exterior` current when it is defined,
 //! the camera sits in the `Exterior` current at `WorldEnd`, a `LightSource` in the `Exterior`
@@ -12,6 +14,7 @@
 pub mod clear;
 pub mod common;
 pub mod homogeneous;
+pub mod integrator;
 pub mod phase;
 
 use glam::Vec3;

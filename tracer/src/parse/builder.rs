@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 
 use super::context::{BoundTexture, ImageUse, ParseContext};
 use super::error::ParseError;
-use super::luxrender_params::{verdict, Verdict};
+use super::luxrender_params::{plugin, verdict, Verdict};
 use super::options::OptionsState;
 use super::params::ParamList;
 use super::reader::Reader;
@@ -24,6 +24,7 @@ use crate::geometry::placed_bytes;
 use crate::image_io::ImageCost;
 use crate::lights::{map_cost, AreaLightParams, SkyLight};
 use crate::material::{Glass, Matte};
+use crate::medium::integrator::VolumeIntegrator;
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
 use crate::refs::{ConstOrTexture, MaterialId, TextureId};
@@ -118,6 +119,8 @@ pub struct Builder<'s> {
     /// `MakeNamedVolume` names; None for a kind that is not rendered (a warning).
     named_volumes: HashMap<String, Option<MediumId>>,
     volumes: Volumes,
+    /// The `VolumeIntegrator` statement, if the file has one.
+    volume_integrator: Option<(VolumeIntegrator, Pos)>,
     /// glass2 materials with the index of a shape's volumes, by (glass2, volumes).
     glass2_with_index: HashMap<(MaterialId, ShapeMedia), MaterialId>,
     warnings: Vec<Warning>,
@@ -159,6 +162,7 @@ impl<'s> Builder<'s> {
             lights: Vec::new(),
             named_volumes: HashMap::new(),
             volumes: Volumes::default(),
+            volume_integrator: None,
             glass2_with_index: HashMap::new(),
             warnings: Vec::new(),
             warned: HashMap::new(),
@@ -355,8 +359,25 @@ impl<'s> Builder<'s> {
                 self.options = options;
                 read?;
             }
-            "Accelerator" | "Renderer" | "VolumeIntegrator" | "LightGroup" | "SearchPath"
-            | "PortalShape" => r.skip_statement()?,
+            "Accelerator" | "Renderer" | "VolumeIntegrator" => {
+                let ty = r.string(&format!("the {keyword} type"))?;
+                let params = r.params(format!("{keyword} \"{ty}\""))?;
+                if self.block == Block::World {
+                    self.note(pos, format!("{keyword} inside the world block is ignored (it belongs before WorldBegin)"));
+                    return Ok(());
+                }
+                if keyword == "VolumeIntegrator" {
+                    let integrator = VolumeIntegrator::read(self, &ty, pos);
+                    self.volume_integrator = Some((integrator, pos.clone()));
+                } else if plugin(&params.statement).is_none() {
+                    self.note(
+                        pos,
+                        format!("{keyword} \"{ty}\" is not a LuxRender 1.x {}; YAT renders the same image with its own", keyword.to_lowercase()),
+                    );
+                }
+                self.warn_unused(&params);
+            }
+            "LightGroup" | "SearchPath" | "PortalShape" => r.skip_statement()?,
             "Volume" => {
                 r.skip_statement()?;
                 self.warn_once(
@@ -781,6 +802,13 @@ impl<'s> Builder<'s> {
             // No WorldEnd: the camera's volume is the Exterior current at the end.
             self.volumes.camera = self.gs.media.exterior;
         }
+        let (volume_integrator, at) = self
+            .volume_integrator
+            .take()
+            .unwrap_or_else(|| (VolumeIntegrator::Attenuating, end.clone()));
+        let mut volumes = std::mem::take(&mut self.volumes);
+        volume_integrator.apply(&mut volumes, &mut self, &at);
+        self.volumes = volumes;
         let options = std::mem::take(&mut self.options);
         let (camera, film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
         Ok(SceneDesc {

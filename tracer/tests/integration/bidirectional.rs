@@ -61,7 +61,7 @@ pub(super) fn room(integrator: &str) -> String {
 /// the camera (the Exterior current at WorldEnd) are in it.
 fn in_fog(scene: &str, sigma_s: f32) -> String {
     let fog = format!(
-        "WorldBegin\n\
+        "VolumeIntegrator \"multi\"\nWorldBegin\n\
          MakeNamedVolume \"fog\" \"homogeneous\" \"float fresnel\" [1]\n\
          \"color sigma_a\" [0.02 0.05 0.1] \"color sigma_s\" [{sigma_s} {sigma_s} {sigma_s}] \"float g\" [0.4]\n\
          Interior \"fog\"\n\

@@ -911,3 +911,43 @@ fn unbalanced_blocks_are_warnings() {
     assert!(m[2].contains("AttributeBegin is never closed"));
     assert_eq!(d.shapes.len(), 1);
 }
+
+/// Accelerator, Renderer and VolumeIntegrator statements are read as the other option
+/// statements are: their LuxRender parameters are listed as having no effect, an unknown one
+/// is named as a difference, and a plugin LuxRender 1.x does not have is noted.
+#[test]
+fn accelerator_renderer_and_volume_integrator_parameters_are_judged() {
+    let desc = parse(
+        "Accelerator \"qbvh\" \"integer maxprimsperleaf\" [4] \"integer bogusA\" [1]\n\
+         Renderer \"sampler\" \"bool bogusR\" [\"true\"]\n\
+         VolumeIntegrator \"multi\" \"float stepsize\" [1] \"float bogusV\" [1]\n\
+         Accelerator \"octree\"\n\
+         WorldBegin\nWorldEnd\n",
+    );
+    let with = |severity: Severity, text: &str| {
+        desc.warnings
+            .iter()
+            .any(|w| w.severity == severity && w.message.contains(text))
+    };
+    for bogus in ["bogusA", "bogusR", "bogusV"] {
+        assert!(
+            with(Severity::Differs, bogus),
+            "{bogus}: {:?}",
+            desc.warnings
+        );
+    }
+    assert!(
+        with(Severity::NoEffect, "maxprimsperleaf"),
+        "{:?}",
+        desc.warnings
+    );
+    assert!(with(Severity::NoEffect, "stepsize"), "{:?}", desc.warnings);
+    assert!(
+        with(
+            Severity::Note,
+            "Accelerator \"octree\" is not a LuxRender 1.x accelerator"
+        ),
+        "{:?}",
+        desc.warnings
+    );
+}
