@@ -5,10 +5,12 @@
 //! work unit and its counters: the leaf the film, the plan and the nodes share), [`plan`]
 //! (cutting an image into units), [`adaptive`] (the rounds of an adaptive render and the
 //! decision between them), [`branching`] (how many continuations camera paths take at their
-//! first broad vertex), [`scene`] (the built scene and rendering one unit).
+//! first broad vertex), [`layers`] (what units carry besides radiance: alpha), [`scene`] (the
+//! built scene and rendering one unit).
 
 pub mod adaptive;
 pub mod branching;
+pub mod layers;
 pub mod plan;
 pub mod scene;
 pub mod settings;
