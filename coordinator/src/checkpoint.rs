@@ -17,9 +17,10 @@
 //! test (u32, `u32::MAX` before the first) and the last test's image (three f32 per pixel,
 //! zeros before round 1). A render whose units carry light splats
 //! (`FilmFrame::light_splats`, never adaptive) has after its sums the light splats' three i64
-//! sums per pixel and the light paths they are over (u64). Like the adaptive layout, this one
-//! is the render's own, so the format's version stays: checkpoints of every other render read
-//! as they always did.
+//! sums per pixel and the light paths they are over (u64). A render whose units carry layers
+//! (`FilmFrame::layers`: alpha) has next the layers' sums, one i64 per layer for each pixel of
+//! each plane of the film's sums. Like the adaptive layout, these are the render's own, so the
+//! format's version stays: checkpoints of every other render read as they always did.
 //!
 //! The file is only written through an exclusive temporary file renamed over it, and only read
 //! when it is a regular file of exactly the size this render's checkpoint has
@@ -279,6 +280,9 @@ impl Checkpoint {
             }
             out.write_all(&splats.light_paths.to_le_bytes())?;
         }
+        for sum in self.film.layer_sums() {
+            out.write_all(&sum.to_le_bytes())?;
+        }
         for samples in self.film.block_samples() {
             out.write_all(&samples.to_le_bytes())?;
         }
@@ -314,16 +318,20 @@ impl Checkpoint {
         let pixels = u64::from(settings.width) * u64::from(settings.height);
         let fixed =
             (HEADER_LEN + DIGEST_LEN) as u64 + (sampling.max_units(settings) as u64).div_ceil(8);
+        let layers = frame.layers.len() as u64 * 8;
         match sampling {
-            Sampling::Uniform => fixed + pixels * 32 + splats_len(&frame, pixels) as u64,
+            Sampling::Uniform => fixed + pixels * (32 + layers) + splats_len(&frame, pixels) as u64,
             Sampling::Adaptive(_) => {
                 let blocks = BlockGrid::of(settings).len() as u64;
                 let planes = frame.source_planes() as u64;
-                fixed + pixels * 32 * (planes + 1) + adaptive_rounds_len(blocks as usize) as u64
+                fixed
+                    + pixels * 32 * (planes + 1)
+                    + pixels * layers * planes
+                    + adaptive_rounds_len(blocks as usize) as u64
             }
             Sampling::Converging(_) => {
                 fixed
-                    + pixels * 32
+                    + pixels * (32 + layers)
                     + splats_len(&frame, pixels) as u64
                     + converging_rounds_len(pixels as usize) as u64
             }
@@ -371,13 +379,21 @@ impl Checkpoint {
             Sampling::Converging(_) => (pixels, converging_rounds_len(pixels)),
         };
         let splat_len = splats_len(&frame, pixels as u64);
+        let layer_planes = if sampling.adaptive().is_some() {
+            planes
+        } else {
+            1
+        };
+        let layer_len = layer_planes * pixels * frame.layers.len() * 8;
         let rest = &body[HEADER_LEN..];
-        if rest.len() != bitmap_len + sum_count * 32 + splat_len + round_len {
+        if rest.len() != bitmap_len + sum_count * 32 + splat_len + layer_len + round_len {
             return Err(CheckpointError::Corrupt);
         }
         let (bitmap, rest) = rest.split_at(bitmap_len);
         let (sum_bytes, rest) = rest.split_at(sum_count * 32);
-        let (splat_bytes, round_bytes) = rest.split_at(splat_len);
+        let (splat_bytes, rest) = rest.split_at(splat_len);
+        let (layer_bytes, round_bytes) = rest.split_at(layer_len);
+        let layers = layer_bytes.chunks_exact(8).map(|v| i64_at(v, 0)).collect();
         let mut sums: Vec<[i64; 4]> = sum_bytes
             .chunks_exact(32)
             .map(|pixel| std::array::from_fn(|c| i64_at(pixel, c * 8)))
@@ -408,7 +424,7 @@ impl Checkpoint {
                 light_paths: u64::from_le_bytes(light_paths.try_into().expect("8 bytes")),
             }
         });
-        checkpoint.film = Film::from_sums(frame, sums, half, block_samples, splats)
+        checkpoint.film = Film::from_sums(frame, sums, half, block_samples, splats, layers)
             .ok_or(CheckpointError::Corrupt)?;
         // Checked as if hostile: a round no decision makes would plan nonsense units.
         match &mut checkpoint.rounds {
@@ -619,6 +635,7 @@ mod tests {
     use yat_tracer::desc::LatLongConvention;
     use yat_tracer::render::adaptive::AdaptiveSettings;
     use yat_tracer::render::convergence::ConvergenceHalt;
+    use yat_tracer::render::layers::Layers;
     use yat_tracer::render::plan_units;
 
     fn settings() -> RenderSettings {
@@ -760,6 +777,46 @@ mod tests {
             Checkpoint::decode(&plain, &id, &settings(), splat_frame, &Sampling::Uniform).is_err()
         );
         assert!(Checkpoint::decode(&bytes, &id, &settings(), frame(), &Sampling::Uniform).is_err());
+    }
+
+    /// A render whose units carry alpha keeps its sums exactly, 8 bytes a pixel more (per
+    /// source plane when adaptive); the layout without them is not read as one with them.
+    #[test]
+    fn a_checkpoint_keeps_alpha_exactly() {
+        let alpha_frame = FilmFrame {
+            layers: Layers { alpha: true },
+            ..frame()
+        };
+        let a = AdaptiveSettings {
+            threshold: 0.05,
+            min_spp: 2,
+        };
+        let s = settings();
+        let pixels = u64::from(s.width * s.height);
+        for sampling in [Sampling::Uniform, Sampling::Adaptive(a)] {
+            let mut checkpoint = Checkpoint::new(&s, alpha_frame, &sampling);
+            for unit in checkpoint.units(&s).iter().step_by(2) {
+                let mut buffer = SampleBuffer::new(*unit, &alpha_frame);
+                for (i, w) in buffer.weight.iter_mut().enumerate() {
+                    *w = 2.0;
+                    buffer.layers[i] = (i % 3) as f32 * 0.5;
+                }
+                assert!(checkpoint.add(&buffer).unwrap());
+            }
+            assert!(checkpoint.film().layer_sums().iter().any(|&v| v != 0));
+            let id = RenderIdentity::of(&pb::LoadSceneRequest::default(), &sampling);
+            let bytes = encode(&checkpoint, &id);
+            let len = |frame| Checkpoint::file_len(&s, frame, &sampling);
+            assert_eq!(bytes.len() as u64, len(alpha_frame));
+            let planes = sampling
+                .adaptive()
+                .map_or(1, |_| frame().source_planes() as u64);
+            assert_eq!(len(alpha_frame) - len(frame()), pixels * 8 * planes);
+            let back = Checkpoint::decode(&bytes, &id, &s, alpha_frame, &sampling).unwrap();
+            assert_eq!(back.film().layer_sums(), checkpoint.film().layer_sums());
+            assert_eq!(back.film().alpha(), checkpoint.film().alpha());
+            assert!(Checkpoint::decode(&bytes, &id, &s, frame(), &sampling).is_err());
+        }
     }
 
     #[test]

@@ -5,8 +5,9 @@
 //!   hash of blob chunks, [`RenderSettings::try_from`] and the scene id of a load request,
 //!   [`unit_from_wire`] against the session's settings, the token check ([`RequireToken`])
 //!   on hostile `authorization` metadata;
-//! - a coordinator: [`decode_pixels`] and [`decode_splats`] of a reply for the session's
-//!   unit (a film with light splats when the settings' seed is odd), the buffer merged
+//! - a coordinator: [`decode_pixels`], [`decode_layers`] and [`decode_splats`] of a reply for
+//!   the session's unit (a film with light splats when the settings' seed is odd, with alpha
+//!   when its second bit is set), the buffer merged
 //!   into a [`Film`] and tone mapped for display, [`UnitStats`] from the reply, a drain
 //!   signal ([`is_draining`]) in a status read from hostile trailers.
 //!
@@ -29,7 +30,7 @@ use tonic::service::Interceptor;
 use tonic::{Request, Status};
 use yat_proto::auth::RequireToken;
 use yat_proto::convert::{
-    decode_pixels, decode_splats, encode_splats, unit_from_wire, BYTES_PER_PIXEL,
+    decode_layers, decode_pixels, decode_splats, encode_splats, unit_from_wire, BYTES_PER_PIXEL,
 };
 use yat_proto::drain::{is_draining, DRAINING_KEY};
 use yat_proto::hash::{is_sha256_hex, sha256_hex, Sha256Stream};
@@ -37,6 +38,7 @@ use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::desc::{FilmDesc, ToneMap};
 use yat_tracer::film::{Film, LightSplats};
 use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter, WeightBounds};
+use yat_tracer::render::layers::Layers;
 use yat_tracer::render::unit::FilmFrame;
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
@@ -350,15 +352,18 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
             let Ok(mut buffer) = decode_pixels(unit, &frame, &WEIGHTS, &reply.pixels) else {
                 return 3;
             };
-            let Ok(splats) = decode_splats(unit.index, &frame, &reply.light_splats) else {
+            if decode_layers(&mut buffer, &frame, &WEIGHTS, &reply.layers).is_err() {
                 return 4;
+            }
+            let Ok(splats) = decode_splats(unit.index, &frame, &reply.light_splats) else {
+                return 5;
             };
             buffer.splats = splats;
             let Some(film) = &mut state.film else {
-                return 5;
+                return 6;
             };
             if film.add(&buffer).is_err() {
-                return 6;
+                return 7;
             }
             let tonemap = match reply.pixels.len() / BYTES_PER_PIXEL % 4 {
                 0 => ToneMap::AutoLinear,
@@ -387,7 +392,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 convergence_step: yat_tracer::film::DEFAULT_CONVERGENCE_STEP,
                 outputs: Default::default(),
             });
-            7 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
+            8 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),
         Kind::StatsRequest => decoded(pb::StatsRequest::decode(bytes), |_| 0),
         Kind::StatsReply => decoded(pb::StatsReply::decode(bytes), |r| {
@@ -439,13 +444,17 @@ static WEIGHTS: LazyLock<WeightBounds> =
     LazyLock::new(|| PixelFilter::new(&FILTER).weight_bounds());
 
 /// The frame of the settings' film; an odd seed makes it one whose units carry light splats,
-/// so that inputs reach both kinds of film.
+/// and the seed's second bit one whose units carry alpha, so that inputs reach every kind of
+/// film.
 fn frame_for(settings: &RenderSettings) -> FilmFrame {
     FilmFrame {
         width: settings.width,
         height: settings.height,
         border: FILTER.border(),
         light_splats: settings.seed % 2 == 1,
+        layers: Layers {
+            alpha: settings.seed & 2 != 0,
+        },
     }
 }
 
@@ -715,6 +724,8 @@ fn seed_sessions() -> Vec<Session> {
                 }),
                 _ => Default::default(),
             },
+            // Alpha sums of zero (seeds with the second bit): what every pixel may hold.
+            layers: vec![0u8; if seed & 2 != 0 { pixels * 4 } else { 0 }].into(),
         };
         sessions.push(Session {
             frames: vec![
@@ -827,15 +838,15 @@ mod tests {
     fn the_seed_sessions_take_the_deep_paths() {
         let target = WireTarget::new();
         let first = target.execute(&target.corpus[0]).features;
-        // Settings accepted, unit accepted, reply (with light splats: an odd seed) merged into
-        // the film and displayed.
+        // Settings accepted, unit accepted, reply (with light splats and alpha: seed 7) merged
+        // into the film and displayed.
         let load = Kind::LoadSceneRequest as u64 * 16;
         let unit = Kind::RenderUnitRequest as u64 * 16;
         let reply = Kind::RenderUnitReply as u64 * 16;
         assert!(first.contains(&(load + 4)), "{first:?}");
         assert!(first.contains(&(unit + 3)), "{first:?}");
         assert!(
-            first.contains(&(reply + 9)) || first.contains(&(reply + 8)),
+            first.contains(&(reply + 10)) || first.contains(&(reply + 9)),
             "{first:?}"
         );
         let last = target.execute(target.corpus.last().unwrap()).features;

@@ -19,6 +19,9 @@ pub const BYTES_PER_PIXEL: usize = 16;
 /// Bytes per light splat pixel on the wire: its index (u32) and its RGB sums (three f32).
 pub const BYTES_PER_SPLAT: usize = 16;
 
+/// Bytes per layer sum of a pixel on the wire (alpha's: one f32).
+pub const BYTES_PER_LAYER_SUM: usize = 4;
+
 /// Largest unit a worker renders, in pixels of its tile: its reply (the tile and a border of at
 /// most `MAX_BORDER` pixels) stays under 4.5 MiB, under every message limit.
 pub const MAX_UNIT_PIXELS: u64 = 1 << 18;
@@ -53,6 +56,19 @@ pub enum WireError {
     },
     #[error("unit {index}: {reason}")]
     Stats { index: u32, reason: String },
+    #[error("unit {index}: the layers take {got} bytes, {expected} expected")]
+    LayersLength {
+        index: u32,
+        got: usize,
+        expected: usize,
+    },
+    #[error("unit {index}: layer sum {at} holds {value}, which {reason}")]
+    LayerValue {
+        index: u32,
+        at: usize,
+        value: f32,
+        reason: &'static str,
+    },
     #[error("unit {index}: the light splats take {got} bytes, not a whole number of {BYTES_PER_SPLAT}-byte pixels up to {max} pixels")]
     SplatsLength { index: u32, got: usize, max: usize },
     #[error("unit {index}: {misfit}")]
@@ -225,6 +241,84 @@ pub fn encode_pixels(buffer: &SampleBuffer) -> Bytes {
         }
     }
     out.freeze()
+}
+
+/// The wire form of a sample buffer's layer sums: little-endian f32 in the buffer's order (per
+/// source plane, per pixel of the region, per layer); empty when the film keeps no layer.
+pub fn encode_layers(buffer: &SampleBuffer) -> Bytes {
+    let mut out = BytesMut::with_capacity(buffer.layers.len() * BYTES_PER_LAYER_SUM);
+    buffer.layers.iter().for_each(|&v| out.put_f32_le(v));
+    out.freeze()
+}
+
+/// Bytes of a unit's layer sums on the wire: its region of `frame`, once per source plane for a
+/// masked unit, times the frame's layer sums per pixel (none without layers).
+pub fn layers_len(unit: &WorkUnit, frame: &FilmFrame) -> usize {
+    let planes = if unit.mask.is_some() {
+        frame.source_planes()
+    } else {
+        1
+    };
+    frame.region(unit).pixel_count() * planes * frame.layers.len() * BYTES_PER_LAYER_SUM
+}
+
+/// Reads the layer sums of `buffer`'s unit back from their wire form into it, checking what an
+/// honest render gives: [`layers_len`] bytes; each value finite, no larger in magnitude than
+/// the pixel's weight sum can be (a layer's values lie in [-1, 1]: alpha in [0, 1]), not
+/// negative when the filter weighs no sample negatively, and zero where no sample reaches.
+pub fn decode_layers(
+    buffer: &mut SampleBuffer,
+    frame: &FilmFrame,
+    weights: &WeightBounds,
+    bytes: &[u8],
+) -> Result<(), WireError> {
+    let unit = buffer.unit;
+    let expected = layers_len(&unit, frame);
+    if bytes.len() != expected {
+        return Err(WireError::LayersLength {
+            index: unit.index,
+            got: bytes.len(),
+            expected,
+        });
+    }
+    let k = frame.layers.len();
+    if k == 0 {
+        buffer.layers.clear();
+        return Ok(());
+    }
+    let n = buffer.region.pixel_count();
+    let limits = max_weight_sums(&unit, buffer.region, weights);
+    buffer.layers = Vec::with_capacity(expected / BYTES_PER_LAYER_SUM);
+    for (at, word) in bytes.chunks_exact(BYTES_PER_LAYER_SUM).enumerate() {
+        let value = f32::from_le_bytes(word.try_into().expect("4 bytes"));
+        let limit = limits[at / k % n][0];
+        let refuse = |reason| WireError::LayerValue {
+            index: unit.index,
+            at,
+            value,
+            reason,
+        };
+        if !value.is_finite() {
+            return Err(refuse("is not finite"));
+        }
+        if limit == 0.0 && value != 0.0 {
+            return Err(refuse(
+                "lies beyond the reach of every pixel the unit renders",
+            ));
+        }
+        if value < 0.0 && !weights.negative {
+            return Err(refuse(
+                "is negative, and the scene's filter weighs no sample negatively",
+            ));
+        }
+        if f64::from(value.abs()) > limit {
+            return Err(refuse(
+                "exceeds the weight sum the unit's samples can give the pixel",
+            ));
+        }
+        buffer.layers.push(value);
+    }
+    Ok(())
 }
 
 /// The wire form of a unit's light splats: per pixel, its index as a little-endian u32, then
@@ -439,7 +533,8 @@ fn axis_reach(max: &[f32], pixels: Range<u32>, sources: Range<u32>) -> Vec<(f64,
 }
 
 /// A worker's reply to `unit`, checked: the unit's own index, a sample buffer that
-/// [`decode_pixels`] accepts, light splats that [`decode_splats`] accepts, and counters an honest render of the unit gives (exactly its
+/// [`decode_pixels`] accepts, layers that [`decode_layers`] accepts, light splats that
+/// [`decode_splats`] accepts, and counters an honest render of the unit gives (exactly its
 /// samples, no more dropped than taken, rays within [`MAX_RAYS_PER_SAMPLE`] per sample).
 pub fn result_from_wire(
     unit: WorkUnit,
@@ -454,6 +549,7 @@ pub fn result_from_wire(
         });
     }
     let mut buffer = decode_pixels(unit, frame, weights, &reply.pixels)?;
+    decode_layers(&mut buffer, frame, weights, &reply.layers)?;
     buffer.splats = decode_splats(unit.index, frame, &reply.light_splats)?;
     let stats = UnitStats::from(reply.stats.unwrap_or_default());
     let samples = unit.sample_count();
@@ -491,6 +587,7 @@ mod tests {
         FilterDesc, FilterKind, PixelFilter, DEFAULT_MITCHELL_B, DEFAULT_MITCHELL_C,
     };
     use yat_tracer::parse::parse_scene;
+    use yat_tracer::render::layers::Layers;
     use yat_tracer::render::{plan_units, RenderScene};
 
     use prost::Message;
@@ -613,6 +710,7 @@ mod tests {
             half_rgb: Vec::new(),
             half_weight: Vec::new(),
             splats: LightSplats::default(),
+            layers: Vec::new(),
         };
         let bytes = encode_pixels(&buffer);
         assert_eq!(bytes.len(), 6 * BYTES_PER_PIXEL);
@@ -1016,6 +1114,7 @@ mod tests {
             half_rgb: Vec::new(),
             half_weight: Vec::new(),
             splats: LightSplats::default(),
+            layers: Vec::new(),
         };
         let reply = pb::RenderUnitReply {
             index: unit.index,
@@ -1027,6 +1126,7 @@ mod tests {
             }),
             render_seconds: 0.1,
             light_splats: Bytes::new(),
+            layers: Bytes::new(),
         };
         (unit, reply)
     }
@@ -1158,6 +1258,102 @@ mod tests {
             }),
             render_seconds: 0.5,
             light_splats: encode_splats(&buffer.splats),
+            layers: encode_layers(buffer),
+        }
+    }
+
+    /// The alpha unit of [`bordered_unit`]: alpha sums beside its weights.
+    fn alpha_unit() -> (WorkUnit, FilmFrame, SampleBuffer) {
+        let (unit, plain) = bordered_unit();
+        let frame = FilmFrame {
+            layers: Layers { alpha: true },
+            ..plain
+        };
+        let mut buffer = SampleBuffer::new(unit, &frame);
+        for (i, (w, a)) in buffer.weight.iter_mut().zip(&mut buffer.layers).enumerate() {
+            *w = 4.0;
+            *a = [0.0, 4.0, 1.25, f32::MIN_POSITIVE][i % 4];
+        }
+        (unit, frame, buffer)
+    }
+
+    /// Alpha reads back bit-exactly, 4 bytes a pixel of the buffer's region more on the wire;
+    /// a render without layers sends none (its reply as it always was).
+    #[test]
+    fn alpha_round_trips_bit_exactly_at_4_bytes_a_pixel() {
+        let (unit, frame, buffer) = alpha_unit();
+        let weights = box_weights(frame.border);
+        let reply = reply_of(&buffer);
+        assert_eq!(reply.layers.len(), 64 * BYTES_PER_LAYER_SUM);
+        assert_eq!(layers_len(&unit, &frame), 64 * 4);
+        let wire = pb::RenderUnitReply::decode(reply.encode_to_vec().as_slice()).unwrap();
+        let (back, _) = result_from_wire(unit, &frame, &weights, &wire).unwrap();
+        assert_eq!(back, buffer);
+        let bits = |b: &SampleBuffer| b.layers.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back), bits(&buffer));
+        let without = pb::RenderUnitReply {
+            layers: Bytes::new(),
+            ..reply.clone()
+        };
+        // The field's tag and its length take the bytes beyond 4 a pixel.
+        let added = reply.encoded_len() - without.encoded_len();
+        assert!((256..256 + 4).contains(&added), "{added}");
+        let (_, plain) = bordered_unit();
+        assert_eq!(layers_len(&unit, &plain), 0);
+        let plain_reply = reply_of(&SampleBuffer::new(unit, &plain));
+        assert!(plain_reply.layers.is_empty());
+    }
+
+    /// Hostile alpha is refused naming the unit: bytes for another layout (too few, too many,
+    /// any on a film that keeps none), non-finite values, more than the pixel's weight can
+    /// give, negative under a filter without negative lobes, any beyond the unit's reach.
+    #[test]
+    fn hostile_alpha_is_refused() {
+        let (unit, frame, buffer) = alpha_unit();
+        let (_, plain) = bordered_unit();
+        let weights = box_weights(frame.border);
+        let check = |frame: &FilmFrame, layers: Bytes| {
+            let reply = pb::RenderUnitReply {
+                layers,
+                ..reply_of(&buffer)
+            };
+            result_from_wire(unit, frame, &weights, &reply).map(|_| ())
+        };
+        let honest = encode_layers(&buffer);
+        assert!(check(&frame, honest.clone()).is_ok());
+        for layers in [honest.slice(..honest.len() - 4), Bytes::new()] {
+            assert!(matches!(
+                check(&frame, layers),
+                Err(WireError::LayersLength {
+                    index: 9,
+                    expected: 256,
+                    ..
+                })
+            ));
+        }
+        let longer = [honest.as_ref(), &[0; 4]].concat();
+        assert!(check(&frame, longer.into()).is_err());
+        assert!(matches!(
+            check(&plain, honest.clone()),
+            Err(WireError::LayersLength { expected: 0, .. })
+        ));
+        // The region's pixel (2, 2) is reached by the tile's (4, 4) through a 2-pixel border;
+        // a box filter of that border weighs each sample at most 1 there: 8 samples, 8.
+        for (at, value, reason) in [
+            (0, f32::NAN, "not finite"),
+            (0, f32::INFINITY, "not finite"),
+            (0, 9.0, "exceeds"),
+            (0, -0.5, "negative"),
+        ] {
+            let mut hostile = buffer.clone();
+            hostile.layers[at] = value;
+            let error = check(&frame, encode_layers(&hostile))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.contains(reason) && error.contains("unit 9"),
+                "{error}"
+            );
         }
     }
 

@@ -18,7 +18,7 @@ pub use pb::render_node_client::RenderNodeClient;
 pub use pb::render_node_server::{RenderNode, RenderNodeServer};
 
 /// The version of `render.proto` this build speaks. Bump it on any incompatible change.
-pub const PROTOCOL_VERSION: u32 = 7;
+pub const PROTOCOL_VERSION: u32 = 8;
 
 /// Bytes of a blob sent in one `BlobChunk`.
 pub const BLOB_CHUNK_BYTES: usize = 1 << 20;

@@ -447,3 +447,74 @@ fn a_bidirectional_render_is_the_same_bytes_on_workers_killed_or_not() {
         "the results carry light splats: {report:#}"
     );
 }
+
+/// The PNG, TGA and EXR of `out` (the Film's three files).
+fn three_files(out: &Path) -> [Vec<u8>; 3] {
+    ["png", "tga", "exr"].map(|ext| std::fs::read(out.with_extension(ext)).unwrap())
+}
+
+/// A film that writes alpha (`scenes/exported/film-outputs.lxs`: a 16-bit RGBA PNG, an RGB
+/// TGA, a half RGBA EXR) renders to the same bytes in-process and on two workers, uniform, or
+/// adaptive with one worker killed mid-render; its alpha is 0 on the sky and 1 on the floor,
+/// and each unit's reply carries 4 bytes of alpha a pixel besides its 16 of sums.
+#[test]
+fn alpha_is_the_same_bytes_in_process_and_on_workers() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = crate::workspace::workspace_root().join("scenes/exported/film-outputs.lxs");
+    let overrides = RenderOverrides {
+        spp: Some(16),
+        ..SETTINGS_OVERRIDES
+    };
+    let adaptive = yat_tracer::render::adaptive::AdaptiveSettings {
+        threshold: 0.05,
+        min_spp: 4,
+    };
+    let throttle = ["--throttle-ms", "50"];
+    for (name, adaptive) in [("uniform", None), ("adaptive", Some(adaptive))] {
+        let reference = dir.path().join(format!("{name}-in-process.png"));
+        render_here(
+            request_with(&scene, &reference, &overrides, adaptive),
+            two_threads(),
+        )
+        .unwrap();
+        let expected = three_files(&reference);
+        let png = image::open(&reference).unwrap().to_rgba16();
+        let alphas: std::collections::BTreeSet<u16> = png.pixels().map(|p| p.0[3]).collect();
+        assert!(
+            alphas.contains(&0) && alphas.contains(&65535),
+            "{name}: transparent sky and opaque floor: {alphas:?}"
+        );
+        assert_eq!(png.get_pixel(48, 2).0[3], 0, "{name}: the sky");
+        assert_eq!(png.get_pixel(48, 60).0[3], 65535, "{name}: the floor");
+
+        let (mut a, b) = (Worker::start(&throttle), Worker::start(&throttle));
+        let out = dir.path().join(format!("{name}-workers.png"));
+        let json = dir.path().join(format!("{name}.json"));
+        let coordinator = spawn_render(
+            request_with(&scene, &out, &overrides, adaptive),
+            reporting_to(&json, workers_at(&[&a.address, &b.address])),
+            Observers::none(),
+            Interrupt::default(),
+        );
+        if adaptive.is_some() {
+            wait_for_units(&[&a, &b], 2);
+            a.kill();
+        }
+        coordinator.join().unwrap().unwrap();
+        let got = three_files(&out);
+        for (i, ext) in ["PNG", "TGA", "EXR"].iter().enumerate() {
+            assert!(
+                got[i] == expected[i],
+                "{name}: the {ext} differs from in-process"
+            );
+        }
+        if adaptive.is_none() {
+            // 128x96 in 64-pixel tiles with the 1-pixel border of the scene's mitchell of
+            // half-width 1.5: regions of 65x65, 65x65, 65x33 and 65x33 pixels, 12740 for the
+            // 12288 of the image, 20 bytes each.
+            let report = workers_report(&json);
+            let per_pixel = report["result_bytes_per_unit_pixel"].as_f64().unwrap();
+            assert_eq!(per_pixel, 20.0 * 12740.0 / 12288.0, "{report:#}");
+        }
+    }
+}

@@ -217,6 +217,7 @@ impl yat_proto::RenderNode for FakeNode {
             }),
             render_seconds: 0.0,
             light_splats: Default::default(),
+            layers: Default::default(),
         };
         let reply = match self.0.misbehaviour() {
             Misbehaviour::NeverAnswers => std::future::pending().await,

@@ -218,7 +218,8 @@ impl FilmDesc {
 /// per source plane ([`FilmFrame::source_planes`] regions, plane-major: a sample's sums go to the
 /// plane of the block it was taken in), and the plain sums over its odd-index samples too, the
 /// half the adaptive error estimate compares with the whole. A unit of a film with light splats
-/// carries those as well, wherever on the film they land.
+/// carries those as well, wherever on the film they land; one of a film with layers
+/// ([`FilmFrame::layers`]: alpha) their filter-weighted sums per pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleBuffer {
     pub unit: WorkUnit,
@@ -232,6 +233,9 @@ pub struct SampleBuffer {
     pub half_weight: Vec<f32>,
     /// The unit's light splats; empty unless its film keeps them ([`FilmFrame::light_splats`]).
     pub splats: LightSplats,
+    /// The layers' sums: `frame.layers.len()` per pixel (pixel-major), per source plane as
+    /// `rgb` is; empty when the film keeps no layer.
+    pub layers: Vec<f32>,
 }
 
 impl SampleBuffer {
@@ -251,6 +255,7 @@ impl SampleBuffer {
             half_rgb: vec![[0.0; 3]; half],
             half_weight: vec![0.0; half],
             splats: LightSplats::default(),
+            layers: vec![0.0; planes * n * frame.layers.len()],
         }
     }
 }
@@ -299,6 +304,9 @@ pub struct Film {
     block_samples: Vec<u32>,
     /// The light splats' sums, kept only when the frame has light splats.
     splats: Option<FilmSplats>,
+    /// The layers' sums in fixed point, `frame.layers.len()` per pixel, per source plane as
+    /// `sums`; empty when the frame has no layer.
+    layers: Vec<i64>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -321,6 +329,7 @@ impl Film {
             half: Vec::new(),
             block_samples: Vec::new(),
             splats: frame.light_splats.then(|| FilmSplats::new(pixels)),
+            layers: vec![0; pixels * frame.layers.len()],
         }
     }
 
@@ -332,12 +341,18 @@ impl Film {
         let pixels = u64::from(frame.width) * u64::from(frame.height);
         let sum = std::mem::size_of::<[i64; 4]>() as u64;
         let splat_sum = std::mem::size_of::<[i64; 3]>() as u64;
+        let planes = if adaptive {
+            frame.source_planes() as u64
+        } else {
+            1
+        };
         let sums = if adaptive {
-            pixels * sum * (frame.source_planes() as u64 + 1)
+            pixels * sum * (planes + 1)
                 + block_count(&frame) as u64 * std::mem::size_of::<u32>() as u64
         } else {
             pixels * sum
-        } + u64::from(frame.light_splats) * pixels * splat_sum;
+        } + u64::from(frame.light_splats) * pixels * splat_sum
+            + planes * pixels * 8 * frame.layers.len() as u64;
         let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16);
         2 * sums + output
     }
@@ -362,6 +377,7 @@ impl Film {
             half: vec![[0; 4]; pixels],
             block_samples: vec![0; block_count(&frame)],
             splats: None,
+            layers: vec![0; frame.source_planes() * pixels * frame.layers.len()],
         }
     }
 
@@ -405,16 +421,24 @@ impl Film {
         self.splats.as_ref()
     }
 
+    /// The layers' sums (`frame.layers.len()` per pixel, per source plane), as
+    /// [`Film::sums`]; empty when the frame has no layer.
+    pub fn layer_sums(&self) -> &[i64] {
+        &self.layers
+    }
+
     /// A film of `frame` holding these sums: a uniform film's (width x height sums, no half
     /// sums, no block samples) or an adaptive one's (as [`Film::adaptive`] has them), with
     /// light splat sums over width x height pixels exactly when the frame has light splats
-    /// (and is not adaptive); None otherwise.
+    /// (and is not adaptive), and the layers' sums per pixel of every plane the sums have;
+    /// None otherwise.
     pub fn from_sums(
         frame: FilmFrame,
         sums: Vec<[i64; 4]>,
         half: Vec<[i64; 4]>,
         block_samples: Vec<u32>,
         splats: Option<FilmSplats>,
+        layers: Vec<i64>,
     ) -> Option<Self> {
         let pixels = frame.width as usize * frame.height as usize;
         let fits = if half.is_empty() {
@@ -429,20 +453,22 @@ impl Film {
             Some(splats) => frame.light_splats && splats.sums.len() == pixels,
             None => !frame.light_splats,
         };
-        (fits && splats_fit).then_some(Self {
+        let layers_fit = layers.len() == sums.len() * frame.layers.len();
+        (fits && splats_fit && layers_fit).then_some(Self {
             frame,
             sums,
             half,
             block_samples,
             splats,
+            layers,
         })
     }
 
     /// Adds a unit's buffer. Exact and order-independent: adding the same buffers in any order
     /// gives the same bits, overlapping borders included. A buffer that does not fit (a tile
     /// outside the film, another region than the film's border gives the tile, a length not
-    /// the region's, half sums where the film keeps none or none where it does, light splats
-    /// that fail [`LightSplats::check`]) is refused. The unit's light paths (one per camera
+    /// the region's, half sums where the film keeps none or none where it does, layer sums not
+    /// those of the film's layers, light splats that fail [`LightSplats::check`]) is refused. The unit's light paths (one per camera
     /// sample) count toward the film's when it keeps light splats, whether or not any of them
     /// reached the camera.
     pub fn add(&mut self, buffer: &SampleBuffer) -> Result<(), BufferMismatch> {
@@ -465,7 +491,8 @@ impl Film {
             && buffer.rgb.len() == planes * n
             && buffer.weight.len() == planes * n
             && buffer.half_rgb.len() == half_len
-            && buffer.half_weight.len() == half_len;
+            && buffer.half_weight.len() == half_len
+            && buffer.layers.len() == planes * n * self.frame.layers.len();
         let misfit = |reason: String| BufferMismatch {
             index: u.index,
             width: self.frame.width,
@@ -491,6 +518,13 @@ impl Film {
             .zip(buffer.weight.chunks_exact(n));
         for (sums, (rgb, weight)) in planes.zip(buffer_planes) {
             add_region(sums, width, &region, rgb, weight);
+        }
+        let k = self.frame.layers.len();
+        if k > 0 {
+            let film_planes = self.layers.chunks_exact_mut(pixels * k);
+            for (sums, values) in film_planes.zip(buffer.layers.chunks_exact(n * k)) {
+                add_layer_region(sums, width, &region, k, values);
+            }
         }
         if half_len > 0 {
             let columns = self.frame.width.div_ceil(BLOCK_SIZE);
@@ -535,32 +569,76 @@ impl Film {
             return self.with_splats(i, mean(&self.sums[i]));
         }
         let pixels = self.frame.width as usize * self.frame.height as usize;
-        let [bx, by] = self.frame.border;
-        // The blocks the filter reaches from (x, y): at most one per source plane.
-        let span = |v: u32, border: u32, size: u32| {
-            v.saturating_sub(border) / BLOCK_SIZE..=(v + border).min(size - 1) / BLOCK_SIZE
-        };
-        let columns = self.frame.width.div_ceil(BLOCK_SIZE);
         let mut total = [0.0f64; 4];
-        for row in span(y, by, self.frame.height) {
-            for column in span(x, bx, self.frame.width) {
-                let n = self.block_samples[(row * columns + column) as usize];
-                let plane = self
-                    .frame
-                    .source_plane(column * BLOCK_SIZE, row * BLOCK_SIZE);
-                if n > 0 {
-                    let sums = &self.sums[plane * pixels + i];
-                    for (t, &s) in total.iter_mut().zip(sums) {
-                        *t += s as f64 / f64::from(n);
-                    }
-                }
+        self.reached_planes(x, y, |plane, n| {
+            let sums = &self.sums[plane * pixels + i];
+            for (t, &s) in total.iter_mut().zip(sums) {
+                *t += s as f64 / f64::from(n);
             }
-        }
+        });
         let [r, g, b, w] = total;
         if w <= 0.0 {
             return Vec3::ZERO;
         }
         Vec3::new((r / w) as f32, (g / w) as f32, (b / w) as f32)
+    }
+
+    /// For an adaptive film, `f(plane, n)` for each block with samples the filter reaches from
+    /// pixel (x, y) (at most one per source plane), `n` its samples per pixel.
+    fn reached_planes(&self, x: u32, y: u32, mut f: impl FnMut(usize, u32)) {
+        let [bx, by] = self.frame.border;
+        let span = |v: u32, border: u32, size: u32| {
+            v.saturating_sub(border) / BLOCK_SIZE..=(v + border).min(size - 1) / BLOCK_SIZE
+        };
+        let columns = self.frame.width.div_ceil(BLOCK_SIZE);
+        for row in span(y, by, self.frame.height) {
+            for column in span(x, bx, self.frame.width) {
+                let n = self.block_samples[(row * columns + column) as usize];
+                if n > 0 {
+                    let plane = self
+                        .frame
+                        .source_plane(column * BLOCK_SIZE, row * BLOCK_SIZE);
+                    f(plane, n);
+                }
+            }
+        }
+    }
+
+    /// The pixel's value of layer sum `k` (of the frame's [`crate::render::layers::Layers`]):
+    /// the weighted mean of its samples' values, as [`Film::pixel`] takes the colour's (each
+    /// block's samples weighed alike in an adaptive film); 0 without samples.
+    pub fn layer_pixel(&self, x: u32, y: u32, k: usize) -> f32 {
+        let count = self.frame.layers.len();
+        assert!(k < count, "layer sum {k} of {count}");
+        let i = (y * self.frame.width + x) as usize;
+        if !self.has_half() {
+            let w = self.sums[i][3];
+            if w <= 0 {
+                return 0.0;
+            }
+            return (self.layers[i * count + k] as f64 / w as f64) as f32;
+        }
+        let pixels = self.frame.width as usize * self.frame.height as usize;
+        let (mut sum, mut weight) = (0.0f64, 0.0f64);
+        self.reached_planes(x, y, |plane, n| {
+            let at = plane * pixels + i;
+            sum += self.layers[at * count + k] as f64 / f64::from(n);
+            weight += self.sums[at][3] as f64 / f64::from(n);
+        });
+        if weight <= 0.0 {
+            return 0.0;
+        }
+        (sum / weight) as f32
+    }
+
+    /// Every pixel's alpha (rows top to bottom), when the frame keeps it.
+    pub fn alpha(&self) -> Option<Vec<f32>> {
+        self.frame.layers.alpha.then(|| {
+            (0..self.frame.height)
+                .flat_map(|y| (0..self.frame.width).map(move |x| (x, y)))
+                .map(|(x, y)| self.layer_pixel(x, y, 0))
+                .collect()
+        })
     }
 
     /// The plain weighted mean of all the samples that reach pixel `i` (row-major), whatever
@@ -617,7 +695,7 @@ impl Film {
             height: self.frame.height,
             linear,
             tone_mapped,
-            alpha: None,
+            alpha: self.alpha(),
             gamma: film.gamma,
             ldr_clamp: film.outputs.ldr_clamp,
         }
@@ -649,6 +727,17 @@ fn add_region(
             for (s, v) in sum.iter_mut().zip([r, g, b, w]) {
                 *s = s.saturating_add(to_fixed(v));
             }
+        }
+    }
+}
+
+/// Adds a region's f32 layer sums (`k` per pixel) into rows of fixed-point sums.
+fn add_layer_region(sums: &mut [i64], width: u32, region: &PixelRect, k: usize, values: &[f32]) {
+    let region_row = region.width() as usize * k;
+    for (row, y) in values.chunks_exact(region_row).zip(region.y0..region.y1) {
+        let start = (y as usize * width as usize + region.x0 as usize) * k;
+        for (sum, &v) in sums[start..start + region_row].iter_mut().zip(row) {
+            *sum = sum.saturating_add(to_fixed(v));
         }
     }
 }
@@ -740,6 +829,7 @@ pub fn tone_map(radiance: &mut [Vec3], tonemap: &ToneMap, gamma: f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::layers::Layers;
 
     fn unit(index: u32, x0: u32, y0: u32, x1: u32, y1: u32) -> WorkUnit {
         WorkUnit {
@@ -909,17 +999,28 @@ mod tests {
             Vec::new(),
             Vec::new(),
             film.splats().cloned(),
+            Vec::new(),
         )
         .unwrap();
         assert_eq!(back.splats(), film.splats());
         assert_eq!(back.radiance(), film.radiance());
         let sums = || film.sums().to_vec();
-        assert!(Film::from_sums(frame, sums(), Vec::new(), Vec::new(), None).is_none());
+        assert!(Film::from_sums(frame, sums(), Vec::new(), Vec::new(), None, Vec::new()).is_none());
         let short = FilmSplats::new(7);
-        assert!(Film::from_sums(frame, sums(), Vec::new(), Vec::new(), Some(short)).is_none());
+        assert!(Film::from_sums(
+            frame,
+            sums(),
+            Vec::new(),
+            Vec::new(),
+            Some(short),
+            Vec::new()
+        )
+        .is_none());
         let plain = FilmFrame::unbordered(4, 2);
         let splats = film.splats().cloned();
-        assert!(Film::from_sums(plain, sums(), Vec::new(), Vec::new(), splats).is_none());
+        assert!(
+            Film::from_sums(plain, sums(), Vec::new(), Vec::new(), splats, Vec::new()).is_none()
+        );
     }
 
     fn buffer(u: WorkUnit, frame: &FilmFrame, seed: u32) -> SampleBuffer {
@@ -930,6 +1031,43 @@ mod tests {
             *w = 3.0;
         }
         b
+    }
+
+    /// Alpha is the weighted mean of its samples' values, as the colour is, in any order of
+    /// merging; a buffer whose layer sums are not its frame's is refused.
+    #[test]
+    fn alpha_is_a_weighted_mean_and_misfit_layers_are_refused() {
+        let frame = FilmFrame {
+            layers: Layers { alpha: true },
+            ..FilmFrame::unbordered(4, 2)
+        };
+        let u = unit(0, 0, 0, 4, 2);
+        let mut a = SampleBuffer::new(u, &frame);
+        let mut b = SampleBuffer::new(WorkUnit { index: 1, ..u }, &frame);
+        assert_eq!((a.layers.len(), a.weight.len()), (8, 8));
+        (a.weight[1], a.layers[1]) = (2.0, 0.5);
+        (b.weight[1], b.layers[1]) = (2.0, 2.0);
+        (b.weight[6], b.layers[6]) = (0.75, 0.75);
+        let mut films = [Film::new(frame), Film::new(frame)];
+        films[0].add(&a).unwrap();
+        films[0].add(&b).unwrap();
+        films[1].add(&b).unwrap();
+        films[1].add(&a).unwrap();
+        assert_eq!(films[0].layer_sums(), films[1].layer_sums());
+        let alpha = films[0].alpha().unwrap();
+        assert_eq!(alpha, [0.0, 0.625, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        let mut short = a.clone();
+        short.layers.pop();
+        assert!(Film::new(frame).add(&short).is_err());
+        let mut none = a.clone();
+        none.layers.clear();
+        assert!(Film::new(frame).add(&none).is_err());
+        let plain = FilmFrame::unbordered(4, 2);
+        assert!(
+            Film::new(plain).add(&a).is_err(),
+            "alpha the film keeps none of"
+        );
+        assert!(Film::new(plain).alpha().is_none());
     }
 
     #[test]

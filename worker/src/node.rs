@@ -256,7 +256,7 @@ impl Node {
         let unit = request.unit.as_ref().ok_or(WireError::Missing("unit"))?;
         let unit = unit_from_wire(unit, &loaded.settings)?;
         let rendered = self.pool.render(loaded, unit).await?;
-        let sent = rendered.pixels.len() + rendered.splats.len();
+        let sent = rendered.pixels.len() + rendered.layers.len() + rendered.splats.len();
         self.metrics
             .unit_rendered(rendered.stats.samples, sent as u64, rendered.elapsed);
         Ok(pb::RenderUnitReply {
@@ -265,6 +265,7 @@ impl Node {
             stats: Some(rendered.stats.into()),
             render_seconds: rendered.elapsed.as_secs_f64(),
             light_splats: rendered.splats,
+            layers: rendered.layers,
         })
     }
 

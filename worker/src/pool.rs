@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use prost::bytes::Bytes;
 use tokio::sync::{watch, Semaphore};
-use yat_proto::convert::{encode_pixels, encode_splats};
+use yat_proto::convert::{encode_layers, encode_pixels, encode_splats};
 use yat_tracer::render::{UnitStats, WorkUnit};
 
 use crate::error::NodeError;
@@ -34,6 +34,8 @@ pub struct RenderPool {
 /// render took (not counting the wait for a thread).
 pub struct RenderedUnit {
     pub pixels: Bytes,
+    /// The layers' sums (empty unless the render keeps layers).
+    pub layers: Bytes,
     pub splats: Bytes,
     pub stats: UnitStats,
     pub elapsed: Duration,
@@ -118,7 +120,12 @@ impl RenderPool {
             // A renderer bug fails this unit, not the whole worker.
             let rendered = std::panic::catch_unwind(AssertUnwindSafe(|| {
                 let (buffer, stats) = loaded.scene.render_unit_cancellable(&unit, &cancel)?;
-                Some((encode_pixels(&buffer), encode_splats(&buffer.splats), stats))
+                let encoded = [
+                    encode_pixels(&buffer),
+                    encode_layers(&buffer),
+                    encode_splats(&buffer.splats),
+                ];
+                Some((encoded, stats))
             }));
             let _ = done.send(rendered.map(|r| r.map(|r| (r, started.elapsed()))));
         });
@@ -126,10 +133,11 @@ impl RenderPool {
             .await
             .map_err(|_| NodeError::RenderThreadVanished)?
             .map_err(|_| NodeError::UnitPanicked(unit.index))?;
-        let ((pixels, splats, stats), elapsed) =
+        let (([pixels, layers, splats], stats), elapsed) =
             rendered.ok_or(NodeError::UnitCancelled(unit.index))?;
         Ok(RenderedUnit {
             pixels,
+            layers,
             splats,
             stats,
             elapsed,

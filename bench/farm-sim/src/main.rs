@@ -170,6 +170,7 @@ impl RenderNode for FakeWorker {
             }),
             render_seconds: took.as_secs_f64(),
             light_splats: Default::default(),
+            layers: Default::default(),
         }))
     }
 

@@ -111,6 +111,7 @@ pub(super) fn walk<S: PathScene>(
                 };
                 radiance += throughput * le * weight;
             }
+            out.escaped |= depth == 0;
             break;
         };
         let wo = -ray.dir;
@@ -141,6 +142,7 @@ pub(super) fn walk<S: PathScene>(
             throughput *= transmittance;
             pass_through += 1;
             if pass_through > MAX_PASS_THROUGH {
+                out.escaped |= depth == 0;
                 break;
             }
             medium = sides.toward(ray.dir, hit.ng);

@@ -13,11 +13,16 @@ use crate::wavelength::Wavelength;
 /// null faces).
 pub(super) const MAX_PASS_THROUGH: u32 = 64;
 
-/// Radiance along a camera ray, and the number of rays traced for it.
+/// Radiance along a camera ray, the number of rays traced for it, and whether it escaped.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PathResult {
     pub radiance: Vec3,
     pub rays: u32,
+    /// The camera ray escaped (to the environment, or lost among more than
+    /// [`MAX_PASS_THROUGH`] null surfaces) before any vertex, having met only surfaces it
+    /// crosses straight on: LuxRender's alpha 0 (its path integrator's `vertexIndex == 0` at
+    /// the escape).
+    pub escaped: bool,
 }
 
 /// A path between two vertices: the ray to the next one and what the path carries.

@@ -6,12 +6,14 @@
 //! (cutting an image into units), [`adaptive`] (the rounds of an adaptive render and the
 //! decision between them), [`convergence`] (rounds until the image stops changing, LuxRender's
 //! `haltthreshold`) with [`perceptual_diff`] (Yee's metric it tests with), [`sampling`] (which
-//! of those a render is, and where its rounds are), [`branching`] (how many continuations camera paths take at their
-//! first broad vertex), [`scene`] (the built scene and rendering one unit).
+//! of those a render is, and where its rounds are), [`branching`] (how many continuations
+//! camera paths take at their first broad vertex), [`layers`] (what units carry besides
+//! radiance: alpha), [`scene`] (the built scene and rendering one unit).
 
 pub mod adaptive;
 pub mod branching;
 pub mod convergence;
+pub mod layers;
 pub mod perceptual_diff;
 pub mod plan;
 pub mod sampling;

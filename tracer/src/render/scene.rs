@@ -29,6 +29,7 @@ use crate::sampler::{PacketSampler, PixelSampler};
 use crate::texture::Textures;
 
 use super::branching::{self, PilotScene};
+use super::layers::LayerSample;
 use super::settings::RenderSettings;
 use super::unit::{FilmFrame, UnitStats, WorkUnit};
 
@@ -325,9 +326,13 @@ impl RenderScene {
                         if !fits {
                             let mut sampler = self.sample_stream(unit, (x, y, index));
                             let (u, ray) = self.camera_sample(x, y, &mut sampler);
-                            // A sample without a camera ray (outside a fisheye's circle) is black.
+                            // A sample without a camera ray (outside a fisheye's circle) is black
+                            // and sees nothing.
                             let path = match ray {
-                                None => PathResult::default(),
+                                None => PathResult {
+                                    escaped: true,
+                                    ..PathResult::default()
+                                },
                                 Some(ray) => trace_path(self, ray, &mut sampler),
                             };
                             self.add_sample(&mut sums, &mut stats, (x, y, index), u, path);
@@ -446,8 +451,8 @@ impl RenderScene {
         }
     }
 
-    /// Counts sample `index` of pixel (x, y), at `u` in the pixel, and splats its light (a
-    /// sample whose light is not finite is dropped).
+    /// Counts sample `index` of pixel (x, y), at `u` in the pixel, and splats its light and its
+    /// layers' values (a sample whose light is not finite is dropped, layers and all).
     #[inline(always)]
     fn add_sample(
         &self,
@@ -464,13 +469,24 @@ impl RenderScene {
             return;
         }
         let half = sums.buffer.unit.mask.is_some() && index % 2 == 1;
-        self.splat(sums, (x, y), u, path.radiance, half);
+        let layers = LayerSample {
+            alpha: if path.escaped { 0.0 } else { 1.0 },
+        };
+        self.splat(sums, (x, y), u, (path.radiance, layers), half);
     }
 
-    /// Adds a sample at `pixel + u` with `radiance` to every pixel of the buffer's region its
-    /// filter reaches (in the source plane of its block when the unit is adaptive), and to the
-    /// half sums too when `half`.
-    fn splat(&self, sums: &mut UnitSums, (x, y): (u32, u32), u: Vec2, radiance: Vec3, half: bool) {
+    /// Adds a sample at `pixel + u` with `radiance` (and its layers' values, where the frame
+    /// keeps layers) to every pixel of the buffer's region its filter reaches (in the source
+    /// plane of its block when the unit is adaptive), and to the half sums too when `half`
+    /// (which keep no layers).
+    fn splat(
+        &self,
+        sums: &mut UnitSums,
+        (x, y): (u32, u32),
+        u: Vec2,
+        (radiance, layers): (Vec3, LayerSample),
+        half: bool,
+    ) {
         let region = sums.buffer.region;
         let columns = self.filter.taps_x(x, u.x, region.x0, region.x1);
         let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
@@ -501,6 +517,21 @@ impl RenderScene {
                 add(&mut sums.half);
             }
         }
+        let k = self.frame.layers.len();
+        if k > 0 {
+            let values = layers.values(self.frame.layers);
+            let values = &values[..k];
+            for (row, &wy) in rows.weights().iter().enumerate() {
+                let start = (rows.first - region.y0) as usize * width + row * width + first_column;
+                let run = &mut sums.layers[(plane + start) * k..(plane + start + taps) * k];
+                for (pixel, &wx) in run.chunks_exact_mut(k).zip(columns.weights()) {
+                    let w = wx * wy;
+                    for (sum, &v) in pixel.iter_mut().zip(values) {
+                        *sum += v * w;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -529,13 +560,16 @@ struct UnitSums {
     buffer: SampleBuffer,
     all: Vec<Vec4>,
     half: Vec<Vec4>,
+    /// The layers' sums, laid out as the buffer's.
+    layers: Vec<f32>,
 }
 
 impl UnitSums {
-    fn new(buffer: SampleBuffer) -> Self {
+    fn new(mut buffer: SampleBuffer) -> Self {
         Self {
             all: vec![Vec4::ZERO; buffer.weight.len()],
             half: vec![Vec4::ZERO; buffer.half_weight.len()],
+            layers: std::mem::take(&mut buffer.layers),
             buffer,
         }
     }
@@ -553,6 +587,7 @@ impl UnitSums {
                 *weight = sum.w;
             }
         }
+        buffer.layers = self.layers;
         buffer
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::desc::{LatLongConvention, SceneDesc};
 use crate::integrator::options::Transport;
+use crate::render::layers::Layers;
 use crate::render::unit::FilmFrame;
 
 /// Everything besides the scene that decides the image. Identical settings and scene give
@@ -110,15 +111,19 @@ impl RenderSettings {
     }
 
     /// The frame of this render's film: the image size, the border the scene's pixel filter
-    /// gives every unit's buffer, and whether units carry light splats (a bidirectional
-    /// render's, [`Self::renders_bidirectional`]). Every node makes its frame with this, so a
-    /// peer's buffer is checked against the same frame everywhere.
+    /// gives every unit's buffer, whether units carry light splats (a bidirectional render's,
+    /// [`Self::renders_bidirectional`]) and the layers they carry (alpha where a file the
+    /// Film writes has an alpha channel, `FilmOutputs::needs_alpha`). Every node makes its
+    /// frame with this, so a peer's buffer is checked against the same frame everywhere.
     pub fn film_frame(&self, desc: &SceneDesc) -> FilmFrame {
         FilmFrame {
             width: self.width,
             height: self.height,
             border: desc.filter.border(),
             light_splats: self.renders_bidirectional(desc),
+            layers: Layers {
+                alpha: desc.film.outputs.needs_alpha(),
+            },
         }
     }
 

@@ -1,5 +1,7 @@
 //! What a unit of work is and what rendering it reports: the types the film, the unit plan and
-//! every node share. A leaf: it imports nothing from the crate.
+//! every node share. It imports only the leaf [`Layers`].
+
+use super::layers::Layers;
 
 /// Side in pixels of the square blocks an adaptive unit's mask switches on and off: blocks
 /// start at multiples of it from the unit's corner. (Why 4, not 8: bench/RESULTS.md, "Session
@@ -121,17 +123,21 @@ pub struct FilmFrame {
     /// render until that integrator derives it from the scene in `RenderSettings::film_frame`,
     /// the one place every node's frame comes from.
     pub light_splats: bool,
+    /// The layers the units carry besides radiance and weight ([`Layers`]): alpha when a file
+    /// the scene's Film writes has an alpha channel.
+    pub layers: Layers,
 }
 
 impl FilmFrame {
     /// A frame whose filter reaches no neighbour (a box of half-width 0.5, or a synthetic
-    /// film in tests), without light splats.
+    /// film in tests), without light splats or layers.
     pub fn unbordered(width: u32, height: u32) -> Self {
         Self {
             width,
             height,
             border: [0, 0],
             light_splats: false,
+            layers: Layers::NONE,
         }
     }
 

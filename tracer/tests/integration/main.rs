@@ -2,6 +2,7 @@
 //! malformed input, whole renders with numbers, and the seed scenes when they are present.
 
 mod adaptive;
+mod alpha;
 mod area_texture;
 mod bidirectional;
 mod branching;

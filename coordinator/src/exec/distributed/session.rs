@@ -12,10 +12,11 @@ use prost::bytes::Bytes;
 use prost::Message;
 use tokio::sync::watch;
 use tokio::task::JoinSet;
-use yat_proto::convert::{result_from_wire, BYTES_PER_PIXEL, BYTES_PER_SPLAT};
+use yat_proto::convert::{result_from_wire, BYTES_PER_LAYER_SUM, BYTES_PER_PIXEL, BYTES_PER_SPLAT};
 use yat_proto::{pb, PROTOCOL_VERSION};
 use yat_tracer::film::MAX_SPLAT_PIXELS;
 use yat_tracer::filter::MAX_BORDER;
+use yat_tracer::render::layers::MAX_LAYER_SUMS;
 use yat_tracer::render::unit::{FilmFrame, MAX_MASKED_SIDE};
 use yat_tracer::render::{WorkUnit, TILE_SIZE};
 
@@ -52,19 +53,22 @@ const MAX_SCENE_ID_BYTES: usize = 256;
 const REPLY_OVERHEAD_BYTES: u64 = 1024;
 
 /// The smallest message limit a worker may advertise: two of the smallest blob chunk, and the
-/// reply to the largest unit of any plan: a uniform unit's sums over its tile and the widest
-/// filter's border with the most light splats a unit reports (4 MiB), or an adaptive unit's
-/// (which has none) sums per source plane and its half sums over its (smaller) tile and that
-/// border.
+/// reply to the largest unit of any plan: a uniform unit's sums and the most layers' over its
+/// tile and the widest filter's border with the most light splats a unit reports (4 MiB), or
+/// an adaptive unit's (which has none) sums and layers per source plane and its half sums over
+/// its (smaller) tile and that border.
 pub fn min_message_bytes() -> u64 {
-    let region = |tile: u32| u64::from(tile + 2 * MAX_BORDER).pow(2) * BYTES_PER_PIXEL as u64;
+    let region = |tile: u32| u64::from(tile + 2 * MAX_BORDER).pow(2);
+    let sums = BYTES_PER_PIXEL as u64;
+    let layers = (MAX_LAYER_SUMS * BYTES_PER_LAYER_SUM) as u64;
     let splats = (MAX_SPLAT_PIXELS * BYTES_PER_SPLAT) as u64;
     let widest = FilmFrame {
         border: [MAX_BORDER; 2],
         ..FilmFrame::unbordered(u32::MAX, u32::MAX)
     };
-    let adaptive = (widest.source_planes() as u64 + 1) * region(MAX_MASKED_SIDE);
-    let unit_reply = (region(TILE_SIZE) + splats).max(adaptive);
+    let planes = widest.source_planes() as u64;
+    let adaptive = ((planes + 1) * sums + planes * layers) * region(MAX_MASKED_SIDE);
+    let unit_reply = ((sums + layers) * region(TILE_SIZE) + splats).max(adaptive);
     (2 * MIN_CHUNK_BYTES as u64).max(unit_reply + REPLY_OVERHEAD_BYTES)
 }
 
@@ -509,7 +513,8 @@ fn accept(
         if first {
             r.units += 1;
             r.samples += stats.samples;
-            r.result_bytes += (reply.pixels.len() + reply.light_splats.len()) as u64;
+            r.result_bytes +=
+                (reply.pixels.len() + reply.layers.len() + reply.light_splats.len()) as u64;
             r.result_pixels += unit.pixel_count() as u64;
         }
     });

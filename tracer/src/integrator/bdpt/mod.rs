@@ -167,7 +167,16 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
             splats.push(splat);
         }
     }
-    PathResult { radiance, rays }
+    // The camera ray escaped where its subpath ends at infinity straight after the camera
+    // (crossed surfaces make no vertex), or has no vertex but the camera's (it escaped in a
+    // scene without lights; or there is no camera ray, or a depth of 0 traces none): LuxRender's
+    // alpha 0.
+    let escaped = camera.get(1).is_none_or(PathVertex::at_infinity);
+    PathResult {
+        radiance,
+        rays,
+        escaped,
+    }
 }
 
 /// Samples a light subpath into `light`: a ray leaving a light, then its walk.
