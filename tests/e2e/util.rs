@@ -146,6 +146,7 @@ pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
     resolution: Some((128, 96)),
     latlong: yat_tracer::desc::LatLongConvention::Seed,
     transport: None,
+    aovs: yat_tracer::render::layers::Aovs::NONE,
 };
 
 /// [`SETTINGS_OVERRIDES`] with `spp` samples per pixel.

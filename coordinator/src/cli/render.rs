@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use yat_tracer::integrator::Transport;
 use yat_tracer::render::adaptive::{AdaptiveSettings, DEFAULT_MIN_SPP};
+use yat_tracer::render::layers::Aovs;
 use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::RenderOverrides;
 
@@ -60,6 +61,13 @@ pub struct RenderArgs {
     /// 32-bit floats, unless the Film's write_exr_* parameters say otherwise.
     #[arg(long)]
     pub exr: bool,
+    /// AOVs to add to the EXR as extra channels (and the EXR, as --exr, where the Film writes
+    /// none), a comma-separated list of: albedo (albedo.R/G/B: the first surface's
+    /// reflectance), normal (N.X/Y/Z: its shading normal), depth (Z: its distance from the
+    /// camera), samples (the camera samples each pixel got). The same bytes in-process and on
+    /// workers.
+    #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
+    pub aovs: Option<Aovs>,
     /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the
     /// most any pixel gets.
     #[arg(long)]
@@ -151,6 +159,10 @@ pub struct RenderArgs {
     pub distributed: DistributedArgs,
 }
 
+fn parse_aovs(s: &str) -> Result<Aovs, String> {
+    Aovs::from_names(s)
+}
+
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -185,6 +197,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Option<PathBuf>> {
         resolution: args.resolution,
         latlong: args.latlong.into(),
         transport: args.integrator.map(Into::into),
+        aovs: args.aovs.unwrap_or_default(),
     };
     let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
         threshold,
@@ -204,7 +217,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Option<PathBuf>> {
         request.deadline = Deadline::after(left.max(Duration::from_nanos(1)), "--time-limit")
             .filter(|_| !limit.is_zero());
     }
-    request.exr = args.exr;
+    request.exr = args.exr || args.aovs.is_some_and(|a| !a.is_empty());
     request.sample_map = args.sample_map.clone();
     let executor = match args.distributed.config()? {
         Some(config) => config.into(),
