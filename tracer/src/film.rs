@@ -321,7 +321,8 @@ impl Film {
     /// Bytes a film of `frame` (an adaptive render's if `adaptive`) takes at most: its sums,
     /// a copy of them while a checkpoint is written, and what a file is written from (the
     /// linear and tone-mapped radiance, alpha, and the file's samples: at most four 32-bit
-    /// floats a pixel).
+    /// floats a pixel; and each layer's values, twice: the AOVs' images and the EXR's
+    /// channels).
     pub fn memory_bytes(frame: FilmFrame, adaptive: bool) -> u64 {
         let pixels = u64::from(frame.width) * u64::from(frame.height);
         let sum = std::mem::size_of::<[i64; 4]>() as u64;
@@ -338,7 +339,8 @@ impl Film {
             pixels * sum
         } + u64::from(frame.light_splats) * pixels * splat_sum
             + planes * pixels * 8 * frame.layers.len() as u64;
-        let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16);
+        let layers = 2 * 4 * frame.layers.len() as u64;
+        let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16 + layers);
         2 * sums + output
     }
 
