@@ -647,6 +647,7 @@ mod tests {
             seed: 0,
             latlong: LatLongConvention::Seed,
             transport: Default::default(),
+            aovs: Default::default(),
         }
     }
 
@@ -784,7 +785,10 @@ mod tests {
     #[test]
     fn a_checkpoint_keeps_alpha_exactly() {
         let alpha_frame = FilmFrame {
-            layers: Layers { alpha: true },
+            layers: Layers {
+                alpha: true,
+                ..Layers::NONE
+            },
             ..frame()
         };
         let a = AdaptiveSettings {

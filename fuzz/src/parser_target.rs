@@ -60,6 +60,7 @@ pub(crate) fn render_settings() -> RenderSettings {
         seed: 1,
         latlong: LatLongConvention::LuxRender,
         transport: Default::default(),
+        aovs: Default::default(),
     }
 }
 

@@ -454,6 +454,7 @@ fn frame_for(settings: &RenderSettings) -> FilmFrame {
         light_splats: settings.seed % 2 == 1,
         layers: Layers {
             alpha: settings.seed & 2 != 0,
+            aovs: settings.aovs,
         },
     }
 }
@@ -670,6 +671,7 @@ fn seed_sessions() -> Vec<Session> {
             seed,
             latlong: pb::LatLongConvention::LatlongLuxrender.into(),
             transport: pb::Transport::Path.into(),
+            aovs: 0,
         };
         let hash = sha256_hex(b"WorldBegin\nWorldEnd\n");
         let load = pb::LoadSceneRequest {

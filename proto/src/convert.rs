@@ -8,6 +8,7 @@ use yat_tracer::desc::LatLongConvention;
 use yat_tracer::film::{LightSplats, SampleBuffer, MAX_SPLAT_PIXELS, MAX_SUM};
 use yat_tracer::filter::WeightBounds;
 use yat_tracer::integrator::Transport;
+use yat_tracer::render::layers::{Aovs, SumKind};
 use yat_tracer::render::unit::{FilmFrame, PixelRect, BLOCK_SIZE, MAX_MASKED_SIDE};
 use yat_tracer::render::{RenderSettings, UnitStats, WorkUnit};
 
@@ -97,6 +98,7 @@ impl From<&RenderSettings> for pb::RenderSettings {
                 Transport::DirectLighting => pb::Transport::DirectLighting,
             }
             .into(),
+            aovs: s.aovs.bits(),
         }
     }
 }
@@ -126,6 +128,8 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
                 )))
             }
         };
+        let aovs = Aovs::from_bits(s.aovs)
+            .ok_or_else(|| WireError::Settings(format!("unknown AOV bits {:#x}", s.aovs)))?;
         let settings = Self {
             width: s.width,
             height: s.height,
@@ -134,6 +138,7 @@ impl TryFrom<&pb::RenderSettings> for RenderSettings {
             seed: s.seed,
             latlong,
             transport,
+            aovs,
         };
         settings
             .check()
@@ -263,9 +268,13 @@ pub fn layers_len(unit: &WorkUnit, frame: &FilmFrame) -> usize {
 }
 
 /// Reads the layer sums of `buffer`'s unit back from their wire form into it, checking what an
-/// honest render gives: [`layers_len`] bytes; each value finite, no larger in magnitude than
-/// the pixel's weight sum can be (a layer's values lie in [-1, 1]: alpha in [0, 1]), not
-/// negative when the filter weighs no sample negatively, and zero where no sample reaches.
+/// honest render gives: [`layers_len`] bytes; each value finite; a weighted one (a value in
+/// [-1, 1] per sample, [`SumKind::Weighted`]) no larger in magnitude than the pixel's weight sum
+/// can be, not negative when the filter weighs no sample negatively (alpha, albedo and the
+/// depth's count never are; a normal's may be), and zero where no sample reaches; a distance
+/// sum below [`MAX_SUM`] and zero where no sample reaches; a sample count exactly the unit's
+/// samples per pixel in the pixels it renders (in the plane of the pixel's block) and 0
+/// elsewhere.
 pub fn decode_layers(
     buffer: &mut SampleBuffer,
     frame: &FilmFrame,
@@ -286,12 +295,16 @@ pub fn decode_layers(
         buffer.layers.clear();
         return Ok(());
     }
-    let n = buffer.region.pixel_count();
-    let limits = max_weight_sums(&unit, buffer.region, weights);
+    let region = buffer.region;
+    let n = region.pixel_count();
+    let limits = max_weight_sums(&unit, region, weights);
+    let signed = frame.layers.offsets().normal;
+    let samples = (unit.sample_end - unit.sample_start) as f32;
     buffer.layers = Vec::with_capacity(expected / BYTES_PER_LAYER_SUM);
     for (at, word) in bytes.chunks_exact(BYTES_PER_LAYER_SUM).enumerate() {
         let value = f32::from_le_bytes(word.try_into().expect("4 bytes"));
-        let limit = limits[at / k % n][0];
+        let (pixel, sum) = (at / k, at % k);
+        let limit = limits[pixel % n][0];
         let refuse = |reason| WireError::LayerValue {
             index: unit.index,
             at,
@@ -306,15 +319,41 @@ pub fn decode_layers(
                 "lies beyond the reach of every pixel the unit renders",
             ));
         }
-        if value < 0.0 && !weights.negative {
-            return Err(refuse(
-                "is negative, and the scene's filter weighs no sample negatively",
-            ));
-        }
-        if f64::from(value.abs()) > limit {
-            return Err(refuse(
-                "exceeds the weight sum the unit's samples can give the pixel",
-            ));
+        match frame.layers.kind(sum) {
+            SumKind::Weighted => {
+                let may_be_negative =
+                    weights.negative || signed.is_some_and(|o| (o..o + 3).contains(&sum));
+                if value < 0.0 && !may_be_negative {
+                    return Err(refuse(
+                        "is negative, and the scene's filter weighs no sample negatively",
+                    ));
+                }
+                if f64::from(value.abs()) > limit {
+                    return Err(refuse(
+                        "exceeds the weight sum the unit's samples can give the pixel",
+                    ));
+                }
+            }
+            SumKind::Unbounded => {
+                if value.abs() >= MAX_SUM {
+                    return Err(refuse("exceeds what the film holds"));
+                }
+            }
+            SumKind::Count => {
+                let plane = pixel / n;
+                let (x, y) = (
+                    region.x0 + (pixel % n) as u32 % region.width(),
+                    region.y0 + (pixel % n) as u32 / region.width(),
+                );
+                let own = (unit.x0..unit.x1).contains(&x)
+                    && (unit.y0..unit.y1).contains(&y)
+                    && unit.renders(x, y)
+                    && (unit.mask.is_none() || frame.source_plane(x, y) == plane);
+                let expected = if own { samples } else { 0.0 };
+                if value != expected {
+                    return Err(refuse("is not the samples the unit takes in the pixel"));
+                }
+            }
         }
         buffer.layers.push(value);
     }
@@ -623,6 +662,7 @@ mod tests {
             seed: 7,
             latlong: LatLongConvention::LuxRender,
             transport: Default::default(),
+            aovs: Default::default(),
         }
     }
 
@@ -1014,6 +1054,7 @@ mod tests {
             seed: 3,
             latlong: LatLongConvention::LuxRender,
             transport: Default::default(),
+            aovs: Default::default(),
         };
         let scene = RenderScene::build(&desc, &source, &settings).unwrap();
         (scene, settings)
@@ -1266,7 +1307,10 @@ mod tests {
     fn alpha_unit() -> (WorkUnit, FilmFrame, SampleBuffer) {
         let (unit, plain) = bordered_unit();
         let frame = FilmFrame {
-            layers: Layers { alpha: true },
+            layers: Layers {
+                alpha: true,
+                ..Layers::NONE
+            },
             ..plain
         };
         let mut buffer = SampleBuffer::new(unit, &frame);
@@ -1355,6 +1399,76 @@ mod tests {
                 "{error}"
             );
         }
+    }
+
+    /// The AOVs travel in the settings as bits; an unknown bit is refused, and settings
+    /// without AOVs encode as they always did (so a render's identity stays).
+    #[test]
+    fn aovs_travel_in_the_settings() {
+        let with = RenderSettings {
+            aovs: Aovs::from_names("normal,samples").unwrap(),
+            ..settings()
+        };
+        let wire = pb::RenderSettings::from(&with);
+        assert_eq!(wire.aovs, 0b1010);
+        assert_eq!(RenderSettings::try_from(&wire).unwrap(), with);
+        let unknown = pb::RenderSettings { aovs: 16, ..wire };
+        assert!(RenderSettings::try_from(&unknown).is_err());
+        let plain = pb::RenderSettings::from(&settings());
+        let old = pb::RenderSettings { aovs: 0, ..plain };
+        assert_eq!(plain.encode_to_vec(), old.encode_to_vec());
+    }
+
+    /// Every AOV's sums are checked for what they hold: a normal may be negative where alpha
+    /// and albedo may not, a distance sum may be large but under the film's range, and the
+    /// sample count must be exactly the unit's samples in its own pixels and 0 in the border.
+    #[test]
+    fn aov_sums_are_checked_by_kind() {
+        let (unit, plain) = bordered_unit();
+        let frame = FilmFrame {
+            layers: Layers {
+                alpha: true,
+                aovs: Aovs::from_bits(15).unwrap(),
+            },
+            ..plain
+        };
+        let k = frame.layers.len();
+        assert_eq!(k, 10);
+        let mut buffer = SampleBuffer::new(unit, &frame);
+        let region = buffer.region;
+        for (i, w) in buffer.weight.iter_mut().enumerate() {
+            *w = 4.0;
+            let (x, y) = (region.x0 + i as u32 % 8, region.y0 + i as u32 / 8);
+            let own = (4..8).contains(&x) && (4..8).contains(&y);
+            let sums = [4.0, 1.0, 2.0, 3.0, -4.0, 0.0, 4.0, 1e6, 4.0, 0.0];
+            buffer.layers[i * k..(i + 1) * k].copy_from_slice(&sums);
+            buffer.layers[i * k + 9] = if own { 8.0 } else { 0.0 };
+        }
+        let weights = box_weights(frame.border);
+        let check = |b: &SampleBuffer| {
+            let reply = reply_of(b);
+            result_from_wire(unit, &frame, &weights, &reply).map(|_| ())
+        };
+        check(&buffer).unwrap();
+        // Pixel (4, 4) is the region's 18th (row 2, column 2).
+        let own = 2 * 8 + 2;
+        for (sum, value, reason) in [
+            (9, 7.0, "not the samples"),
+            (2, -1.0, "negative"),
+            (7, 1e12, "exceeds what the film holds"),
+            (5, 100.0, "exceeds the weight sum"),
+        ] {
+            let mut hostile = buffer.clone();
+            hostile.layers[own * k + sum] = value;
+            let error = check(&hostile).unwrap_err().to_string();
+            assert!(error.contains(reason), "sum {sum}: {error}");
+        }
+        let mut border = buffer.clone();
+        border.layers[9] = 8.0;
+        assert!(check(&border)
+            .unwrap_err()
+            .to_string()
+            .contains("not the samples"));
     }
 
     /// A reply with light splats reads back bit-exactly, splats included.

@@ -79,11 +79,11 @@ fn check_summarises_a_seed_scene() {
     );
     // LuxBlend's sampler, light strategy, output and shutter settings, each with why.
     assert!(
-        stdout.contains("\nno effect on the image: 19\n"),
+        stdout.contains("\nno effect on the image: 17\n"),
         "{stdout}"
     );
     assert!(
-        stdout.contains("notes (rendered as LuxRender would): 12\n  cornell-box.lxs:11:1: SurfaceIntegrator \"bidirectional\""),
+        stdout.contains("notes (rendered as LuxRender would): 13\n  cornell-box.lxs:11:1: SurfaceIntegrator \"bidirectional\""),
         "the notes, the integrator's first: {stdout}"
     );
     assert!(

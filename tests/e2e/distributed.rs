@@ -454,15 +454,18 @@ fn three_files(out: &Path) -> [Vec<u8>; 3] {
 }
 
 /// A film that writes alpha (`scenes/exported/film-outputs.lxs`: a 16-bit RGBA PNG, an RGB
-/// TGA, a half RGBA EXR) renders to the same bytes in-process and on two workers, uniform, or
-/// adaptive with one worker killed mid-render; its alpha is 0 on the sky and 1 on the floor,
-/// and each unit's reply carries 4 bytes of alpha a pixel besides its 16 of sums.
+/// TGA, a half RGBA EXR), with every AOV asked for, renders to the same bytes in-process and on
+/// two workers, uniform, or adaptive with one worker killed mid-render; its alpha is 0 on the
+/// sky and 1 on the floor, the EXR has the AOVs' channels, and each unit's reply carries 40
+/// bytes of layers a pixel (alpha, albedo, normal, depth's two sums, samples) besides its 16
+/// of sums.
 #[test]
-fn alpha_is_the_same_bytes_in_process_and_on_workers() {
+fn alpha_and_aovs_are_the_same_bytes_in_process_and_on_workers() {
     let dir = tempfile::tempdir().unwrap();
     let scene = crate::workspace::workspace_root().join("scenes/exported/film-outputs.lxs");
     let overrides = RenderOverrides {
         spp: Some(16),
+        aovs: yat_tracer::render::layers::Aovs::from_names("albedo,normal,depth,samples").unwrap(),
         ..SETTINGS_OVERRIDES
     };
     let adaptive = yat_tracer::render::adaptive::AdaptiveSettings {
@@ -486,6 +489,16 @@ fn alpha_is_the_same_bytes_in_process_and_on_workers() {
         );
         assert_eq!(png.get_pixel(48, 2).0[3], 0, "{name}: the sky");
         assert_eq!(png.get_pixel(48, 60).0[3], 65535, "{name}: the floor");
+        let exr = exr::meta::MetaData::read_from_file(reference.with_extension("exr"), false);
+        let channels: Vec<String> = exr.unwrap().headers[0]
+            .channels
+            .list
+            .iter()
+            .map(|c| c.name.to_string())
+            .collect();
+        for aov in ["albedo.R", "N.Z", "Z", "samples"] {
+            assert!(channels.iter().any(|c| c == aov), "{name}: {channels:?}");
+        }
 
         let (mut a, b) = (Worker::start(&throttle), Worker::start(&throttle));
         let out = dir.path().join(format!("{name}-workers.png"));
@@ -511,10 +524,10 @@ fn alpha_is_the_same_bytes_in_process_and_on_workers() {
         if adaptive.is_none() {
             // 128x96 in 64-pixel tiles with the 1-pixel border of the scene's mitchell of
             // half-width 1.5: regions of 65x65, 65x65, 65x33 and 65x33 pixels, 12740 for the
-            // 12288 of the image, 20 bytes each.
+            // 12288 of the image, 16 + 40 bytes each.
             let report = workers_report(&json);
             let per_pixel = report["result_bytes_per_unit_pixel"].as_f64().unwrap();
-            assert_eq!(per_pixel, 20.0 * 12740.0 / 12288.0, "{report:#}");
+            assert_eq!(per_pixel, 56.0 * 12740.0 / 12288.0, "{report:#}");
         }
     }
 }

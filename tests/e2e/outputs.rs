@@ -149,3 +149,38 @@ fn a_films_write_flags_choose_the_files_written() {
         "{err}"
     );
 }
+
+/// `--aovs` adds the AOVs' channels to the EXR, and the EXR itself where the Film writes none;
+/// an unknown AOV is refused, naming it.
+#[test]
+fn aovs_go_into_the_exr() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let out = dir.path().join("x.png");
+    let output = render_in(
+        dir.path(),
+        &scene,
+        &[
+            "-o",
+            out.to_str().unwrap(),
+            "--resolution",
+            "32x24",
+            "--aovs",
+            "depth,samples",
+        ],
+    );
+    assert_success(&output);
+    let channels: Vec<String> = exr_channels(&out.with_extension("exr"))
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect();
+    assert_eq!(channels, ["B", "G", "R", "Z", "samples"]);
+    let output = render_in(
+        dir.path(),
+        &scene,
+        &["-o", out.to_str().unwrap(), "--aovs", "albedo,zbuf"],
+    );
+    assert!(!output.status.success());
+    let err = stderr_of(&output);
+    assert!(err.contains("unknown AOV \"zbuf\""), "{err}");
+}

@@ -147,6 +147,7 @@ pub const SETTINGS_OVERRIDES: RenderOverrides = RenderOverrides {
     latlong: yat_tracer::desc::LatLongConvention::Seed,
     transport: None,
     halt_threshold: None,
+    aovs: yat_tracer::render::layers::Aovs::NONE,
 };
 
 /// [`SETTINGS_OVERRIDES`] with `spp` samples per pixel.

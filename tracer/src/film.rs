@@ -37,7 +37,7 @@ use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
 pub mod outputs;
 pub mod splats;
 
-pub use outputs::{FilmImage, FilmOutputs, OutputError, OutputFile};
+pub use outputs::{AovImages, FilmImage, FilmOutputs, OutputError, OutputFile};
 pub use splats::{FilmSplats, LightSplats, SplatMisfit, SplatSums, MAX_SPLAT_PIXELS};
 
 /// The film type every `Film` statement is read as.
@@ -336,7 +336,8 @@ impl Film {
     /// Bytes a film of `frame` (an adaptive render's if `adaptive`) takes at most: its sums,
     /// a copy of them while a checkpoint is written, and what a file is written from (the
     /// linear and tone-mapped radiance, alpha, and the file's samples: at most four 32-bit
-    /// floats a pixel).
+    /// floats a pixel; and each layer's values, twice: the AOVs' images and the EXR's
+    /// channels).
     pub fn memory_bytes(frame: FilmFrame, adaptive: bool) -> u64 {
         let pixels = u64::from(frame.width) * u64::from(frame.height);
         let sum = std::mem::size_of::<[i64; 4]>() as u64;
@@ -353,7 +354,8 @@ impl Film {
             pixels * sum
         } + u64::from(frame.light_splats) * pixels * splat_sum
             + planes * pixels * 8 * frame.layers.len() as u64;
-        let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16);
+        let layers = 2 * 4 * frame.layers.len() as u64;
+        let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16 + layers);
         2 * sums + output
     }
 
@@ -604,19 +606,15 @@ impl Film {
         }
     }
 
-    /// The pixel's value of layer sum `k` (of the frame's [`crate::render::layers::Layers`]):
-    /// the weighted mean of its samples' values, as [`Film::pixel`] takes the colour's (each
-    /// block's samples weighed alike in an adaptive film); 0 without samples.
-    pub fn layer_pixel(&self, x: u32, y: u32, k: usize) -> f32 {
+    /// Layer sum `k` of the pixel and its weight sum, in fixed-point units: a uniform film's
+    /// own; an adaptive film's over the planes with samples ([`Film::pixel`]'s weighing), each
+    /// divided by its block's samples per pixel.
+    fn layer_and_weight(&self, x: u32, y: u32, k: usize) -> (f64, f64) {
         let count = self.frame.layers.len();
         assert!(k < count, "layer sum {k} of {count}");
         let i = (y * self.frame.width + x) as usize;
         if !self.has_half() {
-            let w = self.sums[i][3];
-            if w <= 0 {
-                return 0.0;
-            }
-            return (self.layers[i * count + k] as f64 / w as f64) as f32;
+            return (self.layers[i * count + k] as f64, self.sums[i][3] as f64);
         }
         let pixels = self.frame.width as usize * self.frame.height as usize;
         let (mut sum, mut weight) = (0.0f64, 0.0f64);
@@ -625,20 +623,80 @@ impl Film {
             sum += self.layers[at * count + k] as f64 / f64::from(n);
             weight += self.sums[at][3] as f64 / f64::from(n);
         });
+        (sum, weight)
+    }
+
+    /// The samples taken in the pixel, as the count sum `k` holds them (an adaptive film's in
+    /// the plane of the pixel's block).
+    fn layer_count(&self, x: u32, y: u32, k: usize) -> f32 {
+        let count = self.frame.layers.len();
+        let i = (y * self.frame.width + x) as usize;
+        let pixels = self.frame.width as usize * self.frame.height as usize;
+        let planes = self.sums.len() / pixels;
+        let total: i64 = (0..planes)
+            .map(|plane| self.layers[(plane * pixels + i) * count + k])
+            .sum();
+        (total as f64 / FIXED_ONE) as f32
+    }
+
+    /// The pixel's value of the filtered layer sum `k` (of the frame's
+    /// [`crate::render::layers::Layers`]): the weighted mean of its samples' values, as
+    /// [`Film::pixel`] takes the colour's (each block's samples weighed alike in an adaptive
+    /// film); 0 without samples.
+    pub fn layer_pixel(&self, x: u32, y: u32, k: usize) -> f32 {
+        let (sum, weight) = self.layer_and_weight(x, y, k);
         if weight <= 0.0 {
             return 0.0;
         }
         (sum / weight) as f32
     }
 
+    /// Every pixel's value of `f(x, y)`, rows top to bottom.
+    fn per_pixel<T>(&self, f: impl Fn(u32, u32) -> T) -> Vec<T> {
+        (0..self.frame.height)
+            .flat_map(|y| (0..self.frame.width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect()
+    }
+
+    /// The AOVs the frame keeps, per pixel: albedo and normal as weighted means; depth as the
+    /// mean distance of the samples that hit (infinite where none did); the samples taken in
+    /// the pixel.
+    pub fn aovs(&self) -> AovImages {
+        let o = self.frame.layers.offsets();
+        let vector = |at: usize| {
+            self.per_pixel(|x, y| {
+                Vec3::new(
+                    self.layer_pixel(x, y, at),
+                    self.layer_pixel(x, y, at + 1),
+                    self.layer_pixel(x, y, at + 2),
+                )
+            })
+        };
+        AovImages {
+            albedo: o.albedo.map(vector),
+            normal: o.normal.map(vector),
+            depth: o.depth.map(|at| {
+                self.per_pixel(|x, y| {
+                    let (distance, _) = self.layer_and_weight(x, y, at);
+                    let (hits, _) = self.layer_and_weight(x, y, at + 1);
+                    if hits > 0.0 {
+                        (distance / hits) as f32
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+            }),
+            samples: o
+                .samples
+                .map(|at| self.per_pixel(|x, y| self.layer_count(x, y, at))),
+        }
+    }
+
     /// Every pixel's alpha (rows top to bottom), when the frame keeps it.
     pub fn alpha(&self) -> Option<Vec<f32>> {
-        self.frame.layers.alpha.then(|| {
-            (0..self.frame.height)
-                .flat_map(|y| (0..self.frame.width).map(move |x| (x, y)))
-                .map(|(x, y)| self.layer_pixel(x, y, 0))
-                .collect()
-        })
+        let at = self.frame.layers.offsets().alpha?;
+        Some(self.per_pixel(|x, y| self.layer_pixel(x, y, at)))
     }
 
     /// The plain weighted mean of all the samples that reach pixel `i` (row-major), whatever
@@ -696,6 +754,7 @@ impl Film {
             linear,
             tone_mapped,
             alpha: self.alpha(),
+            aovs: self.aovs(),
             gamma: film.gamma,
             ldr_clamp: film.outputs.ldr_clamp,
         }
@@ -1038,7 +1097,10 @@ mod tests {
     #[test]
     fn alpha_is_a_weighted_mean_and_misfit_layers_are_refused() {
         let frame = FilmFrame {
-            layers: Layers { alpha: true },
+            layers: Layers {
+                alpha: true,
+                ..Layers::NONE
+            },
             ..FilmFrame::unbordered(4, 2)
         };
         let u = unit(0, 0, 0, 4, 2);

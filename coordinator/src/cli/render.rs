@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use yat_tracer::integrator::Transport;
 use yat_tracer::render::adaptive::{AdaptiveSettings, DEFAULT_MIN_SPP};
+use yat_tracer::render::layers::Aovs;
 use yat_tracer::render::settings::MAX_SIDE;
 use yat_tracer::render::RenderOverrides;
 
@@ -77,6 +78,13 @@ pub struct RenderArgs {
     /// 32-bit floats (in the Film's write_exr_channels).
     #[arg(long)]
     pub exr: bool,
+    /// AOVs to add to the EXR as extra channels (and the EXR, as --exr, where the Film writes
+    /// none), a comma-separated list of: albedo (albedo.R/G/B: the first surface's
+    /// reflectance), normal (N.X/Y/Z: its shading normal), depth (Z: its distance from the
+    /// camera), samples (the camera samples each pixel got). The same bytes in-process and on
+    /// workers.
+    #[arg(long, value_name = "LIST", value_parser = parse_aovs)]
+    pub aovs: Option<Aovs>,
     /// Samples per pixel (default: the Film's haltspp, else 64); with --noise-threshold, the
     /// most any pixel gets.
     #[arg(long)]
@@ -173,6 +181,10 @@ pub struct RenderArgs {
     pub budget: BudgetArgs,
     #[command(flatten)]
     pub distributed: DistributedArgs,
+}
+
+fn parse_aovs(s: &str) -> Result<Aovs, String> {
+    Aovs::from_names(s)
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -280,6 +292,7 @@ fn frame_request(
         latlong: args.latlong.into(),
         transport: args.integrator.map(Into::into),
         halt_threshold: args.halt_threshold,
+        aovs: args.aovs.unwrap_or_default(),
     };
     let adaptive = args.noise_threshold.map(|threshold| AdaptiveSettings {
         threshold,
@@ -293,7 +306,7 @@ fn frame_request(
         request.deadline = Deadline::after(left.max(Duration::from_nanos(1)), "--time-limit")
             .filter(|_| !limit.is_zero());
     }
-    request.exr = args.exr;
+    request.exr = args.exr || args.aovs.is_some_and(|a| !a.is_empty());
     request.sample_map = args.sample_map.clone();
     Ok(request)
 }

@@ -138,6 +138,22 @@ impl Bsdf {
         })
     }
 
+    /// Roughly what the surface reflects and transmits of light leaving along `wo` (its lobe's
+    /// albedo hint, a coating left out): the albedo AOV's value.
+    pub fn albedo(&self, wo: Vec3) -> Vec3 {
+        self.bxdf.albedo_hint(self.frame.to_local(wo).z.abs())
+    }
+
+    /// The shading normal (world space) on `wo`'s side.
+    pub fn shading_normal_toward(&self, wo: Vec3) -> Vec3 {
+        let n = self.frame.n;
+        if wo.dot(n) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    }
+
     /// The cone around `wo`'s mirror direction about the shading normal (world space) that
     /// holds most of a bare glossy lobe ([`Bxdf::glossy_spread`]; a coated one is not counted).
     pub fn glossy_cone(&self, wo: Vec3) -> Option<Cone> {

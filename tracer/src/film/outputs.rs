@@ -17,6 +17,7 @@
 //! | `write_exr_halftype` | bool | true (`--exr` alone: false) |
 //! | `write_exr_applyimaging` | bool | true (`--exr` alone: false) |
 //! | `write_exr_straightcolors` | bool | false |
+//! | `write_exr_ZBuf` | bool | false: a Z channel of each pixel's depth in the EXR |
 //! | `ldr_clamp_method` | string: lum, hue, cut, darken | cut |
 //!
 //! The 8- and 16-bit files (PNG, TGA) hold the tone-mapped image brought into range by
@@ -33,7 +34,12 @@
 //! colours are multiplied by alpha, as OpenEXR's are, unless `write_exr_straightcolors`. Its Y
 //! is LuxRender's EXR luminance, 0.3 R + 0.59 G + 0.11 B. `yat render --exr` adds an EXR where
 //! the Film writes none: the linear radiance in full floats (YAT's EXR before it read these
-//! parameters), unless the Film's own `write_exr_*` parameters say otherwise.
+//! parameters), unless the Film's own `write_exr_*` parameters say otherwise. The AOVs a
+//! render keeps (`--aovs`, and depth for `write_exr_ZBuf`: `render/layers.rs`) are extra
+//! channels of the EXR: `albedo.R`, `albedo.G`, `albedo.B`, `N.X`, `N.Y`, `N.Z` in the EXR's
+//! precision, `Z` (depth: the mean camera distance of the pixel's samples that hit a surface,
+//! infinite where none did) and `samples` (the camera samples taken in the pixel) in full
+//! floats, as LuxRender writes its Z.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -56,6 +62,7 @@ pub const DEFAULT_EXR_CHANNELS: Channels = Channels::Rgb;
 pub const DEFAULT_EXR_HALFTYPE: bool = true;
 pub const DEFAULT_EXR_APPLYIMAGING: bool = true;
 pub const DEFAULT_EXR_STRAIGHT_COLORS: bool = false;
+pub const DEFAULT_EXR_ZBUF: bool = false;
 pub const DEFAULT_LDR_CLAMP: LdrClamp = LdrClamp::Cut;
 /// The EXR `--exr` adds where the Film writes none: full floats...
 pub const FLAG_EXR_HALFTYPE: bool = false;
@@ -180,6 +187,8 @@ pub struct FilmOutputs {
     /// None when the file does not say (LuxRender's default, or `--exr`'s).
     pub exr_applyimaging: Option<bool>,
     pub exr_straight_colors: bool,
+    /// The EXR has a Z channel (`write_exr_ZBuf`).
+    pub exr_zbuf: bool,
     pub ldr_clamp: LdrClamp,
 }
 
@@ -196,6 +205,7 @@ impl Default for FilmOutputs {
             exr_halftype: None,
             exr_applyimaging: None,
             exr_straight_colors: DEFAULT_EXR_STRAIGHT_COLORS,
+            exr_zbuf: DEFAULT_EXR_ZBUF,
             ldr_clamp: DEFAULT_LDR_CLAMP,
         }
     }
@@ -343,6 +353,7 @@ impl FilmOutputs {
             exr_applyimaging: given_bool("write_exr_applyimaging")?,
             exr_straight_colors: params
                 .bool("write_exr_straightcolors", DEFAULT_EXR_STRAIGHT_COLORS)?,
+            exr_zbuf: params.bool("write_exr_ZBuf", DEFAULT_EXR_ZBUF)?,
             ldr_clamp,
         })
     }
@@ -405,9 +416,27 @@ pub struct FilmImage {
     pub tone_mapped: Vec<Vec3>,
     /// Each pixel's alpha; None when the render kept none (every pixel is then opaque).
     pub alpha: Option<Vec<f32>>,
+    /// The AOVs the render kept, each None when it kept none.
+    pub aovs: AovImages,
     /// The Film's gamma.
     pub gamma: f32,
     pub ldr_clamp: LdrClamp,
+}
+
+/// A render's AOVs, per pixel, rows top to bottom (`render/layers.rs`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AovImages {
+    pub albedo: Option<Vec<Vec3>>,
+    pub normal: Option<Vec<Vec3>>,
+    /// Infinite where no sample hit a surface.
+    pub depth: Option<Vec<f32>>,
+    pub samples: Option<Vec<f32>>,
+}
+
+impl AovImages {
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// Why a file could not be written (the caller names the file).
@@ -566,7 +595,7 @@ impl FilmImage {
                 source[i]
             }
         };
-        if format.channels == Channels::Rgb && !format.half {
+        if format.channels == Channels::Rgb && !format.half && self.aovs.is_empty() {
             // The layout `image` writes (and YAT's EXR always had): the same bytes.
             Image::from_channels(
                 size,
@@ -598,6 +627,25 @@ impl FilmImage {
         }
         if format.channels.has_alpha() {
             list.push(AnyChannel::new("A", plane(&|i| self.alpha_at(i))));
+        }
+        let aovs = &self.aovs;
+        let vectors = [
+            (&aovs.albedo, ["albedo.R", "albedo.G", "albedo.B"]),
+            (&aovs.normal, ["N.X", "N.Y", "N.Z"]),
+        ];
+        for (values, names) in vectors {
+            if let Some(values) = values {
+                for (c, name) in names.into_iter().enumerate() {
+                    list.push(AnyChannel::new(name, plane(&|i| values[i][c])));
+                }
+            }
+        }
+        let full = |values: &[f32]| FlatSamples::F32(values.to_vec());
+        if let Some(depth) = &aovs.depth {
+            list.push(AnyChannel::new("Z", full(depth)));
+        }
+        if let Some(samples) = &aovs.samples {
+            list.push(AnyChannel::new("samples", full(samples)));
         }
         let layer = Layer::new(
             size,
@@ -648,6 +696,7 @@ mod tests {
             tone_mapped: linear.iter().map(|&c| c * 0.8).collect(),
             linear,
             alpha: Some((0..n).map(|i| i as f32 / (n - 1) as f32).collect()),
+            aovs: AovImages::default(),
             gamma: 2.2,
             ldr_clamp,
         }
@@ -949,6 +998,71 @@ mod tests {
             let c = image.tone_mapped[i];
             assert_eq!(y, 0.3 * c.x + 0.59 * c.y + 0.11 * c.z, "{i}");
         }
+    }
+
+    /// The AOVs are extra channels of the EXR: albedo and normal in its precision, Z and
+    /// samples in full floats (Z infinite where no sample hit), values as given.
+    #[test]
+    fn aovs_are_extra_exr_channels() {
+        let mut image = image(LdrClamp::Cut);
+        let n = 15;
+        image.aovs = AovImages {
+            albedo: Some((0..n).map(|i| Vec3::splat(i as f32 / 16.0)).collect()),
+            normal: Some(vec![Vec3::new(0.0, -0.6, 0.8); n]),
+            depth: Some(
+                (0..n)
+                    .map(|i| {
+                        if i == 3 {
+                            f32::INFINITY
+                        } else {
+                            1.0 + i as f32 / 3.0
+                        }
+                    })
+                    .collect(),
+            ),
+            samples: Some(vec![4097.0; n]),
+        };
+        let format = ExrFormat {
+            channels: Channels::Rgb,
+            half: true,
+            tone_mapped: false,
+            straight: false,
+        };
+        let (_dir, path) = write(&image, OutputFile::Exr(format));
+        let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+        let types: Vec<(String, bool)> = meta.headers[0]
+            .channels
+            .list
+            .iter()
+            .map(|c| {
+                (
+                    c.name.to_string(),
+                    c.sample_type == exr::meta::attribute::SampleType::F16,
+                )
+            })
+            .collect();
+        let names: Vec<&str> = types.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "B", "G", "N.X", "N.Y", "N.Z", "R", "Z", "albedo.B", "albedo.G", "albedo.R",
+                "samples"
+            ]
+        );
+        for (name, half) in &types {
+            assert_eq!(*half, !matches!(name.as_str(), "Z" | "samples"), "{name}");
+        }
+        let read = exr_channels(&path);
+        let channel = |name: &str| &read.iter().find(|(n, _)| n == name).unwrap().1;
+        assert_eq!(channel("samples")[0], 4097.0, "exact in full floats");
+        assert_eq!(channel("Z")[3], f32::INFINITY);
+        assert_eq!(channel("Z")[6], 3.0);
+        assert_eq!(channel("N.Y")[0], f16_of(-0.6));
+        assert_eq!(channel("albedo.G")[5], 5.0 / 16.0);
+    }
+
+    fn f16_of(v: f32) -> f32 {
+        exr::prelude::f16::from_f32(v).to_f32()
     }
 
     /// The RGB full-float EXR is the file `image`'s OpenEXR encoder writes: `--exr` keeps its

@@ -35,7 +35,7 @@ pub use branch::MAX_BRANCHES;
 pub use glossy_split::GLOSSY_SPLIT;
 pub use options::{IntegratorDesc, RussianRoulette, Transport};
 pub use scene::{Crossing, PathScene};
-pub use state::PathResult;
+pub use state::{PathResult, MAX_PASS_THROUGH};
 
 /// Radiance along the camera ray `ray`, drawn from `sampler`.
 // Inlined into the unit loop: a call away, it costs measurable speed (bench/RESULTS.md, "The

@@ -11,7 +11,7 @@ use crate::wavelength::Wavelength;
 
 /// Null surfaces crossed in a row before a path gives up (guards against stacked coplanar
 /// null faces).
-pub(super) const MAX_PASS_THROUGH: u32 = 64;
+pub const MAX_PASS_THROUGH: u32 = 64;
 
 /// Radiance along a camera ray, the number of rays traced for it, and whether it escaped.
 #[derive(Clone, Copy, Debug, Default)]

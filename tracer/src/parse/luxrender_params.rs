@@ -421,11 +421,12 @@ const FLEXIMAGE: &[LuxParam] = &[
     // The three gamut clamps are stored by LuxRender 1.x's film and never applied: the PNG's
     // pixels are limited by ldr_clamp_method alone, whatever these say.
     no_effect("write_exr_gamutclamp", Bool(true), NoEffect::Output),
-    no_effect("write_exr_ZBuf", Bool(false), NoEffect::Output),
-    no_effect(
+    param("write_exr_ZBuf", Bool(false), Rendered),
+    differs(
         "write_exr_zbuf_normalizationtype",
         Text("None"),
-        NoEffect::Output,
+        "LuxRender rescales the EXR's Z channel to the camera's clipping range or the depths' \
+         range; YAT writes the camera distances, as \"None\" does",
     ),
     param("write_exr_straightcolors", Bool(false), Rendered),
     param("write_png", Bool(true), Rendered),

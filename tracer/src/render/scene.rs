@@ -16,7 +16,9 @@ use crate::geometry::{placed_bytes, SceneGeometry, SurfaceHit};
 use crate::integrator::bdpt::{trace_bidirectional, BidirectionalScene, LightSplat, Subpaths};
 use crate::integrator::options::{IntegratorDesc, Transport};
 use crate::integrator::packet;
-use crate::integrator::{trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES};
+use crate::integrator::{
+    trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES, MAX_PASS_THROUGH,
+};
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::Avx2Cpu;
 use crate::lanes::{Lanes, OnLanes};
@@ -464,15 +466,71 @@ impl RenderScene {
     ) {
         stats.samples += 1;
         stats.rays += u64::from(path.rays);
+        let offsets = self.frame.layers.offsets();
+        if let Some(at) = offsets.samples {
+            // Every sample taken counts, dropped or not: the count is the plan's.
+            let region = sums.buffer.region;
+            let pixel = ((y - region.y0) * region.width() + x - region.x0) as usize;
+            let plane = self.plane_offset(&sums.buffer, (x, y));
+            sums.layers[(plane + pixel) * self.frame.layers.len() + at] += 1.0;
+        }
         if !path.radiance.is_finite() {
             stats.dropped += 1;
             return;
         }
         let half = sums.buffer.unit.mask.is_some() && index % 2 == 1;
-        let layers = LayerSample {
-            alpha: if path.escaped { 0.0 } else { 1.0 },
+        let alpha = if path.escaped { 0.0 } else { 1.0 };
+        let layers = if self.frame.layers.aovs.need_first_surface() {
+            let mut layers = self.first_surface(&sums.buffer.unit, (x, y, index));
+            layers.alpha = alpha;
+            stats.rays += 1;
+            layers
+        } else {
+            LayerSample::alpha(alpha)
         };
         self.splat(sums, (x, y), u, (path.radiance, layers), half);
+    }
+
+    /// Where the source plane of the block of pixel (x, y) starts in `buffer`'s sums (0 for a
+    /// uniform unit), in pixels.
+    fn plane_offset(&self, buffer: &SampleBuffer, (x, y): (u32, u32)) -> usize {
+        if buffer.unit.mask.is_some() {
+            self.frame.source_plane(x, y) * buffer.region.pixel_count()
+        } else {
+            0
+        }
+    }
+
+    /// The AOVs' values of sample `index` of pixel (x, y) (its alpha left 0): the sample's
+    /// camera ray, drawn again as the sample drew it, to the first surface that is not
+    /// `null`; its BSDF (a mix resolved at its middle) gives the albedo and the shading normal
+    /// on the camera's side, the distance from the ray's origin the depth. Nothing where the
+    /// ray escapes (or has none).
+    fn first_surface(&self, unit: &WorkUnit, sample: (u32, u32, u32)) -> LayerSample {
+        let nothing = LayerSample::alpha(0.0);
+        let mut sampler = self.sample_stream(unit, sample);
+        let Some(camera_ray) = self.camera_sample(sample.0, sample.1, &mut sampler).1 else {
+            return nothing;
+        };
+        let mut ray = camera_ray;
+        for _ in 0..=MAX_PASS_THROUGH {
+            let Some(hit) = self.geometry.intersect(&ray, f32::INFINITY) else {
+                return nothing;
+            };
+            if PathScene::crossing(self, hit.shape) == Crossing::Null {
+                ray = Ray::new(crate::math::offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+                continue;
+            }
+            let bsdf = self.bsdf_at(&hit, 0.5);
+            let wo = -ray.dir;
+            return LayerSample {
+                alpha: 0.0,
+                albedo: bsdf.albedo(wo).clamp(Vec3::ZERO, Vec3::ONE),
+                normal: bsdf.shading_normal_toward(wo),
+                depth: Some(hit.p.distance(camera_ray.origin)),
+            };
+        }
+        nothing
     }
 
     /// Adds a sample at `pixel + u` with `radiance` (and its layers' values, where the frame
@@ -492,11 +550,7 @@ impl RenderScene {
         let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
         let width = region.width() as usize;
         let plane_len = region.pixel_count();
-        let plane = if sums.buffer.unit.mask.is_some() {
-            self.frame.source_plane(x, y) * plane_len
-        } else {
-            0
-        };
+        let plane = self.plane_offset(&sums.buffer, (x, y));
         let first_column = (columns.first - region.x0) as usize;
         let taps = columns.weights().len();
         let sample = radiance.extend(1.0);
@@ -520,6 +574,7 @@ impl RenderScene {
         let k = self.frame.layers.len();
         if k > 0 {
             let values = layers.values(self.frame.layers);
+            // The sample count's value is 0 here: it is counted in its own pixel alone.
             let values = &values[..k];
             for (row, &wy) in rows.weights().iter().enumerate() {
                 let start = (rows.first - region.y0) as usize * width + row * width + first_column;

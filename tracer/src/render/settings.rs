@@ -3,7 +3,7 @@
 
 use crate::desc::{LatLongConvention, SceneDesc};
 use crate::integrator::options::Transport;
-use crate::render::layers::Layers;
+use crate::render::layers::{Aovs, Layers};
 use crate::render::unit::FilmFrame;
 
 /// Everything besides the scene that decides the image. Identical settings and scene give
@@ -17,6 +17,8 @@ pub struct RenderSettings {
     pub seed: u64,
     pub latlong: LatLongConvention,
     pub transport: Transport,
+    /// The AOVs asked for (`--aovs`), written as the EXR's extra channels.
+    pub aovs: Aovs,
 }
 
 #[cfg(test)]
@@ -32,6 +34,7 @@ impl RenderSettings {
             seed: 0,
             latlong: LatLongConvention::Seed,
             transport: Transport::Path,
+            aovs: Aovs::NONE,
         }
     }
 }
@@ -48,6 +51,7 @@ pub struct RenderOverrides {
     /// The share of pixels still changing at which the render halts, in place of the scene's
     /// `haltthreshold`; a negative one lifts the scene's (LuxRender's "off").
     pub halt_threshold: Option<f32>,
+    pub aovs: Aovs,
 }
 
 impl RenderOverrides {
@@ -113,8 +117,9 @@ impl RenderSettings {
     /// The frame of this render's film: the image size, the border the scene's pixel filter
     /// gives every unit's buffer, whether units carry light splats (a bidirectional render's,
     /// [`Self::renders_bidirectional`]) and the layers they carry (alpha where a file the
-    /// Film writes has an alpha channel, `FilmOutputs::needs_alpha`). Every node makes its
-    /// frame with this, so a peer's buffer is checked against the same frame everywhere.
+    /// Film writes has an alpha channel, `FilmOutputs::needs_alpha`; the AOVs asked for, and
+    /// depth where the Film's EXR has a Z channel). Every node makes its frame with this, so a
+    /// peer's buffer is checked against the same frame everywhere.
     pub fn film_frame(&self, desc: &SceneDesc) -> FilmFrame {
         FilmFrame {
             width: self.width,
@@ -123,6 +128,10 @@ impl RenderSettings {
             light_splats: self.renders_bidirectional(desc),
             layers: Layers {
                 alpha: desc.film.outputs.needs_alpha(),
+                aovs: self.aovs.or(Aovs {
+                    depth: desc.film.outputs.exr_zbuf,
+                    ..Aovs::NONE
+                }),
             },
         }
     }
@@ -156,6 +165,7 @@ impl RenderSettings {
             seed: overrides.seed.unwrap_or(0),
             latlong: overrides.latlong,
             transport: overrides.transport.unwrap_or_else(|| desc.transport()),
+            aovs: overrides.aovs,
         }
     }
 }
@@ -173,6 +183,7 @@ mod tests {
             seed: 0,
             latlong: LatLongConvention::Seed,
             transport: Transport::Path,
+            aovs: Default::default(),
         }
     }
 

@@ -48,6 +48,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         seed,
         latlong: LatLongConvention::Seed,
         transport: Default::default(),
+        aovs: Default::default(),
     }
 }
 

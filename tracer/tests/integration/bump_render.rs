@@ -21,6 +21,7 @@ fn render(text: &str, spp: u32) -> Film {
         seed: 1,
         latlong: Default::default(),
         transport: Default::default(),
+        aovs: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     let mut film = Film::new(scene.frame());

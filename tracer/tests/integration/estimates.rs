@@ -86,6 +86,7 @@ pub fn build_for(
         seed,
         latlong: Default::default(),
         transport,
+        aovs: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     (scene, settings)

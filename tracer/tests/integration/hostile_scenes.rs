@@ -264,6 +264,7 @@ fn settings(desc: &SceneDesc) -> RenderSettings {
         seed: 0,
         latlong: LatLongConvention::Seed,
         transport: Default::default(),
+        aovs: Default::default(),
     }
 }
 

@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod alpha;
+mod aovs;
 mod area_texture;
 mod bidirectional;
 mod branching;

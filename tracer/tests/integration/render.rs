@@ -71,6 +71,7 @@ fn settings(desc: &SceneDesc, spp: u32) -> RenderSettings {
         seed: 1,
         latlong: LatLongConvention::Seed,
         transport: Default::default(),
+        aovs: Default::default(),
     }
 }
 

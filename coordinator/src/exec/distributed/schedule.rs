@@ -280,6 +280,7 @@ mod tests {
             seed: 0,
             latlong: LatLongConvention::Seed,
             transport: Default::default(),
+            aovs: Default::default(),
         })
     }
 

@@ -75,6 +75,7 @@ fn scene(spp: u32, branches: usize, light: &str) -> (RenderScene, RenderSettings
         seed: 3,
         latlong: Default::default(),
         transport: Default::default(),
+        aovs: Default::default(),
     };
     let scene = RenderScene::build(&desc, &source, &settings).expect("scene builds");
     assert!(super::covers(&scene), "packets cover the scene");
