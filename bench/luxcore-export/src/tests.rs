@@ -27,7 +27,13 @@ fn parse(world: &str, camera: &str) -> SceneDesc {
 }
 
 fn export_world(world: &str) -> LuxCoreScene {
-    let desc = parse(world, "Camera \"perspective\" \"float fov\" [40]");
+    export_world_with("", world)
+}
+
+/// `options` are statements before WorldBegin besides the camera and film.
+fn export_world_with(options: &str, world: &str) -> LuxCoreScene {
+    let camera = format!("Camera \"perspective\" \"float fov\" [40]\n{options}");
+    let desc = parse(world, &camera);
     export(&desc, Path::new("/scenes"), &ExportOptions::default()).expect("exports")
 }
 
@@ -288,10 +294,11 @@ fn sun_and_sky_become_luxcores_sun_and_sky2() {
 
 /// Clear and homogeneous volumes become LuxCore's, the camera's volume is set, and a shape
 /// with volumes gets its own copy of its material carrying them (a shape without keeps the
-/// shared material).
+/// shared material). The scene asks for the "multi" volume integrator, so the smoke scatters.
 #[test]
 fn volumes_map_to_luxcore_volumes() {
-    let scene = export_world(
+    let scene = export_world_with(
+        "VolumeIntegrator \"multi\"",
         r#"MakeNamedVolume "air" "clear" "float fresnel" [1.0002926]
 MakeNamedVolume "ink" "clear" "float fresnel" [1.2] "color absorption" [0.5 1 2]
 MakeNamedVolume "smoke" "homogeneous" "color sigma_a" [0.1 0.2 0.3] "color sigma_s" [2 2 2] "float g" [0.4]
@@ -348,6 +355,25 @@ AttributeEnd"#,
         !scn.contains(&format!("scene.materials.{plain}.volume")),
         "{scn}"
     );
+}
+
+/// Under LuxRender's default volume integrator ("emission") a homogeneous volume only
+/// attenuates, so YAT renders it, and exports it, as a clear volume absorbing its extinction.
+#[test]
+fn homogeneous_volume_under_the_default_integrator_exports_as_clear_extinction() {
+    let scene = export_world(
+        r#"MakeNamedVolume "smoke" "homogeneous" "color sigma_a" [0.1 0.2 0.3] "color sigma_s" [2 2 2]
+Material "null"
+Interior "smoke"
+Shape "sphere" "float radius" [0.5]"#,
+    );
+    let scn = &scene.scene;
+    assert_eq!(value(scn, "scene.volumes.vol0.type"), "\"clear\"");
+    let absorption = floats(value(scn, "scene.volumes.vol0.absorption"));
+    for (got, want) in absorption.iter().zip([2.1f32, 2.2, 2.3]) {
+        assert!((got - want).abs() < 1e-6, "{absorption:?}");
+    }
+    assert!(!scn.contains("scene.volumes.vol0.scattering"), "{scn}");
 }
 
 #[test]
