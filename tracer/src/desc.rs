@@ -16,7 +16,7 @@ pub use crate::diag::{SourcePos, Warning};
 pub use crate::film::{FilmDesc, ToneMap};
 pub use crate::filter::{FilterDesc, FilterKind};
 pub use crate::integrator::options::{IntegratorDesc, RussianRoulette, Transport};
-pub use crate::lights::{EnvMapDesc, LatLongConvention, LightDesc};
+pub use crate::lights::{EnvMapDesc, LatLongConvention, LightDesc, PortalDesc};
 pub use crate::material::MaterialDesc;
 pub use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 pub use crate::mesh::TriangleMesh;
@@ -35,6 +35,8 @@ pub struct SceneDesc {
     pub textures: Vec<TextureDesc>,
     pub materials: Vec<MaterialDesc>,
     pub shapes: Vec<ShapeDesc>,
+    /// `PortalShape`s: not shapes of the scene, but where light from a direction enters.
+    pub portals: Vec<PortalDesc>,
     pub lights: Vec<LightDesc>,
     /// Named volumes (`MakeNamedVolume`) and the camera's.
     pub volumes: Volumes,

@@ -323,6 +323,33 @@ impl SceneGeometry {
     }
 }
 
+/// The world-space triangles of a shape that is not part of the scene's geometry (a portal):
+/// a mesh's (its valid ones, front sides as a shape's), an exact shape's tessellation in
+/// `segments`, none for an infinite plane.
+pub(crate) fn world_triangles(
+    geometry: &crate::shape::Geometry,
+    object_to_world: &glam::Mat4,
+    reverse_orientation: bool,
+    segments: u32,
+) -> Vec<TriangleSurface> {
+    let tessellated;
+    let mesh = match geometry.placement() {
+        Placement::Triangles(mesh) => mesh,
+        Placement::Exact(_) => match geometry.tessellate(segments) {
+            Some(mesh) => {
+                tessellated = mesh;
+                &tessellated
+            }
+            None => return Vec::new(),
+        },
+        Placement::Unbounded(_) => return Vec::new(),
+    };
+    let (world, _) = triangle::WorldMesh::new(0, mesh, object_to_world, reverse_orientation);
+    (0..world.triangle_count() as u32)
+        .map(|tri| world.surface(tri))
+        .collect()
+}
+
 /// The ray direction with -0.0 components turned into +0.0, so that a zero component has one
 /// sign whatever produced it (the slab test picks near and far planes by the sign).
 #[inline(always)]

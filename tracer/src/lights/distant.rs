@@ -25,7 +25,8 @@ use crate::parse::params::ParamList;
 use super::emission::{emits, Emission};
 use super::error::LightError;
 use super::kind::{LightKind, MapSource};
-use super::sample::{DeltaSample, EmittedRay, SceneSphere};
+use super::portals::Entry;
+use super::sample::{DeltaSample, EmittedRay};
 
 /// `from`.
 pub const DEFAULT_FROM: Vec3 = Vec3::ZERO;
@@ -78,27 +79,29 @@ impl DistantLight {
         PI * scene_radius * scene_radius * luminance(self.radiance)
     }
 
-    /// A ray of the light entering the scene `sphere` bounds, from a point uniform on the
-    /// disc it crosses (so its flux, irradiance x disc area, is what the rays carry).
-    pub fn sample_emission(&self, sphere: &SceneSphere, u: Vec2) -> EmittedRay {
+    /// A ray of the light entering the scene by `entry` (the disc of the scene's sphere, or
+    /// the light's portals), from a point uniform on the disc or the portals as the light
+    /// sees them (so its flux, irradiance x area, is what the rays carry). None when no portal
+    /// faces the light.
+    pub fn sample_emission(&self, entry: Entry<'_>, u: Vec2) -> Option<EmittedRay> {
         let dir = -self.to_light;
-        let (pdf_pos, pdf_dir) = self.emission_pdf(sphere);
-        EmittedRay {
-            origin: sphere.entry_point(dir, u),
+        let (origin, pdf_pos) = entry.sample(dir, u)?;
+        Some(EmittedRay {
+            origin,
             dir,
             normal: None,
             le: self.radiance,
             pdf_pos,
-            pdf_dir,
+            pdf_dir: 1.0,
             delta_position: false,
             delta_direction: true,
-        }
+        })
     }
 
-    /// The (position, direction) densities of [`Self::sample_emission`]: the disc's area
-    /// density, and 1 for the delta direction.
-    pub fn emission_pdf(&self, sphere: &SceneSphere) -> (f32, f32) {
-        (sphere.pdf_area(), 1.0)
+    /// The (position, direction) densities of [`Self::sample_emission`] for the ray from
+    /// `origin` along the light: the entry's, and 1 for the delta direction.
+    pub fn emission_pdf(&self, entry: Entry<'_>, origin: Vec3) -> (f32, f32) {
+        (entry.pdf_start(-self.to_light, origin), 1.0)
     }
 }
 

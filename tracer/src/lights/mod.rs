@@ -45,6 +45,7 @@ mod facing;
 mod kind;
 mod lamp_spheres;
 mod mirrored;
+mod portals;
 mod sample;
 mod triangle_lamps;
 
@@ -58,7 +59,7 @@ use glam::{Vec2, Vec3};
 
 use crate::assets::AssetSource;
 use crate::diag::SourcePos;
-use crate::geometry::{SceneGeometry, SurfaceHit};
+use crate::geometry::{SceneGeometry, SurfaceHit, TriangleSurface};
 use crate::math::Cone;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
@@ -71,6 +72,7 @@ pub use error::LightError;
 pub use infinite::{map_cost, EnvMapDesc};
 pub use kind::{LatLongConvention, LightKind, MapSource};
 pub use mirrored::{follows_plane, ImageSample, ImageWeights, IMAGE_SHARE};
+pub use portals::{PortalDesc, MAX_PORTAL_TRIANGLES};
 pub use sample::{EmissionSample, Emitter, LightPoint, LightSample};
 pub use sky::SkyModel;
 pub use sun::sun_rgb;
@@ -81,6 +83,7 @@ use distribution::Distribution1D;
 use infinite::Environment;
 use lamp_spheres::LampSpheres;
 use mirrored::MirrorImages;
+use portals::{Entry, Portals};
 use sample::{EmittedRay, SceneSphere};
 use spot::SpotCone;
 use sun::SunDisc;
@@ -151,6 +154,14 @@ lights! {
     sun::SunLight as Sun { "sun" => read } => |l| Light::Infinite(AtInfinity::Sun(l)),
     sky::SkyLight as Sky { "sky" => read_preetham, "sky2" => read_hosek }
         => |l| Light::Infinite(AtInfinity::Sky(l)),
+}
+
+impl LightDesc {
+    /// Whether the light comes from a direction (distant, or at infinity: infinite, sun, sky),
+    /// the lights that have portals.
+    pub fn enters_from_a_direction(&self) -> bool {
+        !matches!(self, Self::Point(_) | Self::Spot(_))
+    }
 }
 
 /// Reads a light of type `T` from a statement's parameters.
@@ -279,6 +290,11 @@ pub struct Lights {
     triangle_lamps: Option<TriangleLamps>,
     /// Around the geometry: what rays from distant lights and the lights at infinity enter by.
     sphere: SceneSphere,
+    /// The portals light subpaths of the lights at infinity enter by, when they have any
+    /// ([`portals`]; [`Self::with_portals`]).
+    environment_portals: Option<Portals>,
+    /// The portals of distant lights that have them, by index into `lights`.
+    distant_portals: Vec<(u32, Portals)>,
     /// The probability of choosing one of the lights at infinity, the mixture they form.
     environment_pmf: f32,
 }
@@ -381,6 +397,8 @@ impl Lights {
             infinite,
             images: Default::default(),
             sphere,
+            environment_portals: None,
+            distant_portals: Vec::new(),
             environment_pmf,
         })
     }
@@ -494,7 +512,9 @@ impl Lights {
             Light::Area(light) => light.sample_emission(u_pos, u_dir)?,
             Light::Point(light) => light.sample_emission(u_dir),
             Light::Spot(light) => light.sample_emission(u_dir)?,
-            Light::Distant(light) => light.sample_emission(&self.sphere, u_pos),
+            Light::Distant(light) => {
+                light.sample_emission(self.entry(Emitter::Light(index as u32)), u_pos)?
+            }
             Light::Infinite(light) => {
                 let ray = self.sample_environment_emission(light, u_pos, u_dir)?;
                 return Some(ray.chosen(Emitter::Environment, self.environment_pmf));
@@ -515,12 +535,16 @@ impl Lights {
         let (wi, _, _) = light.sample(u_dir, None)?;
         let dir = -wi;
         let (le, pdf_dir) = self.environment_emission(dir);
-        (pdf_dir > 0.0).then(|| EmittedRay {
-            origin: self.sphere.entry_point(dir, u_pos),
+        if pdf_dir.is_nan() || pdf_dir <= 0.0 {
+            return None;
+        }
+        let (origin, pdf_pos) = self.entry(Emitter::Environment).sample(dir, u_pos)?;
+        Some(EmittedRay {
+            origin,
             dir,
             normal: None,
             le,
-            pdf_pos: self.sphere.pdf_area(),
+            pdf_pos,
             pdf_dir,
             delta_position: false,
             delta_direction: false,
@@ -538,38 +562,39 @@ impl Lights {
     /// The (pdf_pos, pdf_dir) [`Self::sample_emission`] has for a ray leaving `emitter` along
     /// unit `dir` (front normal `normal` for an area light): for an area light hit by a camera
     /// path, for a light point [`Self::sample_light_point`] reached, for an escaping ray
-    /// (`Emitter::Environment`, `dir` minus the escaping ray's direction). `_origin` is the
-    /// ray's start, which no density needs (an area light's depends on its normal only, the
-    /// discs' are uniform). pdf_dir is zero where sampling could not have produced the ray
+    /// (`Emitter::Environment`, `dir` minus the escaping ray's direction). `origin` is the
+    /// ray's start, which only portals' densities need (an area light's depends on its normal
+    /// only, the discs' are uniform). pdf_dir is zero where sampling could not have produced the ray
     /// (behind an area light, outside a spot's cone); both are zero for an emitter that is
     /// not one, and for an area light given no normal.
     pub fn emission_pdf(
         &self,
         emitter: Emitter,
-        _origin: Vec3,
+        origin: Vec3,
         normal: Option<Vec3>,
         dir: Vec3,
     ) -> (f32, f32) {
         let index = match emitter {
             Emitter::Light(index) => index as usize,
-            Emitter::Environment => return self.environment_emission_pdf(dir),
+            Emitter::Environment => return self.environment_emission_pdf(origin, dir),
         };
         let (pdf_pos, pdf_dir) = match (self.lights.get(index), normal) {
             (Some(Light::Area(light)), Some(n)) => light.emission_pdf(n, dir),
             (Some(Light::Point(light)), _) => light.emission_pdf(),
             (Some(Light::Spot(light)), _) => light.emission_pdf(dir),
-            (Some(Light::Distant(light)), _) => light.emission_pdf(&self.sphere),
-            (Some(Light::Infinite(_)), _) => return self.environment_emission_pdf(dir),
+            (Some(Light::Distant(light)), _) => light.emission_pdf(self.entry(emitter), origin),
+            (Some(Light::Infinite(_)), _) => return self.environment_emission_pdf(origin, dir),
             (Some(Light::Area(_)), None) | (None, _) => return (0.0, 0.0),
         };
         (self.selection.pmf(index) * pdf_pos, pdf_dir)
     }
 
-    fn environment_emission_pdf(&self, dir: Vec3) -> (f32, f32) {
+    fn environment_emission_pdf(&self, origin: Vec3, dir: Vec3) -> (f32, f32) {
         if self.environment_pmf <= 0.0 {
             return (0.0, 0.0);
         }
-        let pdf_pos = self.environment_pmf * self.sphere.pdf_area();
+        let pdf_pos =
+            self.environment_pmf * self.entry(Emitter::Environment).pdf_start(dir, origin);
         (pdf_pos, self.environment_emission(dir).1)
     }
 
@@ -606,10 +631,61 @@ impl Lights {
         (self.sphere.centre, self.sphere.radius)
     }
 
-    /// The density, per area across `dir`, with which emission from a distant light or the
-    /// lights at infinity travelling along `dir` passes `x` ([`SceneSphere::pdf_reaching`]).
-    pub fn pdf_from_infinity(&self, dir: Vec3, x: Vec3) -> f32 {
-        self.sphere.pdf_reaching(dir, x)
+    /// The density, per area across `dir`, with which emission from `emitter` (a distant light
+    /// or the lights at infinity) travelling along `dir` passes `x`: the disc's
+    /// ([`SceneSphere::pdf_reaching`]) or its portals' ([`Portals::pdf_reaching`]).
+    pub fn pdf_from_infinity(&self, emitter: Emitter, dir: Vec3, x: Vec3) -> f32 {
+        self.entry(emitter).pdf_reaching(dir, x)
+    }
+
+    /// What emission from `emitter`, a distant light or the lights at infinity, enters the
+    /// scene by: its portals, or the disc of the scene's sphere.
+    fn entry(&self, emitter: Emitter) -> Entry<'_> {
+        let portals = match emitter {
+            Emitter::Environment => self.environment_portals.as_ref(),
+            Emitter::Light(index) => self
+                .distant_portals
+                .iter()
+                .find(|(light, _)| *light == index)
+                .map(|(_, portals)| portals),
+        };
+        match portals {
+            Some(portals) => Entry::Portals(portals, &self.sphere),
+            None => Entry::Disc(&self.sphere),
+        }
+    }
+
+    /// The lights with the scene's portals: each portal lets in the lights of the
+    /// `LightSource` it follows (`portals`' light indices are into the scene description's
+    /// lights) where they are distant or at infinity (the lights at infinity share their
+    /// portals, being one mixture); point and spot lights have none, as in LuxRender.
+    pub fn with_portals(mut self, portals: &[PortalDesc]) -> Self {
+        let area_lights = self.light_shape.len();
+        let mut environment = Vec::new();
+        let mut distant: Vec<(u32, Vec<TriangleSurface>)> = Vec::new();
+        for portal in portals {
+            let triangles = portal.triangles();
+            for (after_area, &source) in self.light_source.iter().enumerate() {
+                if !portal.lights.contains(&source) {
+                    continue;
+                }
+                let index = (area_lights + after_area) as u32;
+                match &self.lights[index as usize] {
+                    Light::Infinite(_) => environment.extend_from_slice(&triangles),
+                    Light::Distant(_) => match distant.iter_mut().find(|(l, _)| *l == index) {
+                        Some((_, tris)) => tris.extend_from_slice(&triangles),
+                        None => distant.push((index, triangles.clone())),
+                    },
+                    _ => {}
+                }
+            }
+        }
+        self.environment_portals = Portals::new(environment);
+        self.distant_portals = distant
+            .into_iter()
+            .filter_map(|(index, tris)| Some((index, Portals::new(tris)?)))
+            .collect();
+        self
     }
 
     fn area_light(&self, shape: u32) -> Option<(u32, &AreaLight)> {

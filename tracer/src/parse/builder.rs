@@ -22,7 +22,7 @@ use crate::diag::SourcePos as Pos;
 use crate::diag::{Severity, Warning};
 use crate::geometry::placed_bytes;
 use crate::image_io::ImageCost;
-use crate::lights::{map_cost, AreaLightParams, SkyLight};
+use crate::lights::{map_cost, AreaLightParams, PortalDesc, SkyLight, MAX_PORTAL_TRIANGLES};
 use crate::material::{Glass, Matte};
 use crate::medium::integrator::VolumeIntegrator;
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
@@ -42,6 +42,9 @@ struct GraphicsState {
     reverse_orientation: bool,
     /// `Interior` and `Exterior`.
     media: ShapeMedia,
+    /// The lights (indices into `lights`) of the last `LightSource` of this attribute block:
+    /// what a `PortalShape` lets in (LuxRender's `currentLight`).
+    current_lights: Option<std::ops::Range<u32>>,
 }
 
 #[derive(Clone, Debug)]
@@ -115,6 +118,7 @@ pub struct Builder<'s> {
     pub(super) textures: Vec<TextureDesc>,
     pub(super) materials: Vec<MaterialDesc>,
     shapes: Vec<ShapeDesc>,
+    portals: Vec<PortalDesc>,
     pub(super) lights: Vec<LightDesc>,
     /// `MakeNamedVolume` names; None for a kind that is not rendered (a warning).
     named_volumes: HashMap<String, Option<MediumId>>,
@@ -159,6 +163,7 @@ impl<'s> Builder<'s> {
             textures: Vec::new(),
             materials: Vec::new(),
             shapes: Vec::new(),
+            portals: Vec::new(),
             lights: Vec::new(),
             named_volumes: HashMap::new(),
             volumes: Volumes::default(),
@@ -377,7 +382,7 @@ impl<'s> Builder<'s> {
                 }
                 self.warn_unused(&params);
             }
-            "LightGroup" | "SearchPath" | "PortalShape" => r.skip_statement()?,
+            "LightGroup" | "SearchPath" => r.skip_statement()?,
             "Volume" => {
                 r.skip_statement()?;
                 self.warn_once(
@@ -388,7 +393,7 @@ impl<'s> Builder<'s> {
             }
             "Texture" | "Material" | "MakeNamedMaterial" | "NamedMaterial" | "LightSource"
             | "AreaLightSource" | "Shape" | "ReverseOrientation" | "ObjectBegin" | "ObjectEnd"
-            | "ObjectInstance" | "MakeNamedVolume" | "Interior" | "Exterior" => {
+            | "ObjectInstance" | "MakeNamedVolume" | "Interior" | "Exterior" | "PortalShape" => {
                 if self.block == Block::Options {
                     r.skip_statement()?;
                     self.note(pos, format!("{keyword} before WorldBegin is ignored"));
@@ -467,7 +472,9 @@ impl<'s> Builder<'s> {
                 }
                 let exterior = self.gs.media.exterior;
                 self.volumes.lights.extend(lights.iter().map(|_| exterior));
+                let first = self.lights.len() as u32;
                 self.lights.extend(lights);
+                self.gs.current_lights = Some(first..self.lights.len() as u32);
                 self.warn_unused(&params);
             }
             "AreaLightSource" => {
@@ -480,6 +487,12 @@ impl<'s> Builder<'s> {
                 let ty = r.string("the shape type")?;
                 let params = r.params(format!("Shape \"{ty}\""))?;
                 self.shape_statement(&ty, &params, pos)?;
+                self.warn_unused(&params);
+            }
+            "PortalShape" => {
+                let ty = r.string("the shape type")?;
+                let params = r.params(format!("PortalShape \"{ty}\""))?;
+                self.portal_statement(&ty, &params, pos)?;
                 self.warn_unused(&params);
             }
             "ReverseOrientation" => self.gs.reverse_orientation = !self.gs.reverse_orientation,
@@ -717,6 +730,86 @@ impl<'s> Builder<'s> {
         Ok(())
     }
 
+    /// A `PortalShape`: read as a shape is, kept for the lights of the block's last
+    /// `LightSource` when some of them are distant or at infinity ([`crate::lights`]'s
+    /// portals), within the scene's [`MAX_PORTAL_TRIANGLES`].
+    fn portal_statement(
+        &mut self,
+        ty: &str,
+        params: &ParamList,
+        pos: &Pos,
+    ) -> Result<(), ParseError> {
+        let Some(geometry) = Geometry::read(self, ty, params, pos)? else {
+            return Ok(());
+        };
+        params.ignore("name");
+        let Some(lights) = self.gs.current_lights.clone() else {
+            self.note(
+                pos,
+                "PortalShape with no LightSource before it in its attribute block lets no \
+                 light in, as in LuxRender; ignored"
+                    .into(),
+            );
+            return Ok(());
+        };
+        let from_a_direction = self.lights[lights.start as usize..lights.end as usize]
+            .iter()
+            .any(LightDesc::enters_from_a_direction);
+        if !from_a_direction {
+            self.note(
+                pos,
+                "PortalShape of a point or spot light: only distant lights and the lights at \
+                 infinity have portals, as in LuxRender; ignored"
+                    .into(),
+            );
+            return Ok(());
+        }
+        if self.current_object.is_some() {
+            self.note(
+                pos,
+                "PortalShape inside ObjectBegin is placed where it is defined, not instanced"
+                    .into(),
+            );
+        }
+        let portal = PortalDesc {
+            geometry,
+            object_to_world: self.ctm,
+            reverse_orientation: self.gs.reverse_orientation,
+            lights,
+        };
+        let triangles = portal.triangle_count();
+        if triangles == 0 {
+            self.warn(
+                pos,
+                format!("PortalShape \"{ty}\": an unbounded or empty shape has no surface light can enter through; ignored"),
+            );
+            return Ok(());
+        }
+        let held: u64 = self.portals.iter().map(PortalDesc::triangle_count).sum();
+        if held + triangles > MAX_PORTAL_TRIANGLES {
+            self.warn(
+                pos,
+                format!(
+                    "PortalShape: the scene's portals would hold {} triangles, more than the \
+                     {MAX_PORTAL_TRIANGLES} they may; this portal is ignored (its light still \
+                     enters, found by camera paths)",
+                    held + triangles
+                ),
+            );
+            return Ok(());
+        }
+        self.diagnose(
+            Severity::NoEffect,
+            "PortalShape".into(),
+            pos,
+            "PortalShape: light subpaths of its light start on it (bidirectional transport); \
+             the image is the same, its noise lower where light enters an interior through it"
+                .into(),
+        );
+        self.portals.push(portal);
+        Ok(())
+    }
+
     /// Places a shape in the world (`instance` is the ObjectInstance transform; `pos` the
     /// statement that places it) and sets its area light's radiance from its world-space area.
     fn emit_shape(
@@ -820,6 +913,7 @@ impl<'s> Builder<'s> {
             textures: self.textures,
             materials: self.materials,
             shapes: self.shapes,
+            portals: self.portals,
             lights: self.lights,
             volumes: self.volumes,
             warnings: self.warnings,

@@ -138,6 +138,7 @@ impl RenderScene {
             source,
             settings.latlong,
         )?
+        .with_portals(&desc.portals)
         .with_mirror_images(&flat_mirrors(desc, settings), &geometry);
         guard.check_cancel()?;
         let mut camera = Camera::new(&desc.camera, settings.width, settings.height);

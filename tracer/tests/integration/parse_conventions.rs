@@ -951,3 +951,47 @@ fn accelerator_renderer_and_volume_integrator_parameters_are_judged() {
         desc.warnings
     );
 }
+
+/// A PortalShape belongs to the lights of the last LightSource of its attribute block, as
+/// LuxRender's currentLight: kept for a sunsky (both its lights), with a "no effect" verdict;
+/// ignored with a note after a point light or with no light in the block; placed by the
+/// current transform.
+#[test]
+fn portal_shapes_follow_the_light_of_their_block() {
+    let quad = "\"integer indices\" [0 1 2 0 2 3] \"point P\" [0 0 0 1 0 0 1 1 0 0 1 0]";
+    let desc = world(&format!(
+        "AttributeBegin\nLightSource \"sunsky\" \"vector sundir\" [0 0 1]\n\
+         Translate 0 0 2\nPortalShape \"trianglemesh\" {quad}\nAttributeEnd\n\
+         PortalShape \"trianglemesh\" {quad}\n\
+         AttributeBegin\nLightSource \"point\"\nPortalShape \"trianglemesh\" {quad}\nAttributeEnd"
+    ));
+    assert_eq!(desc.portals.len(), 1, "{:?}", desc.warnings);
+    let portal = &desc.portals[0];
+    assert_eq!(portal.lights, 0..2);
+    let triangles = portal.triangles();
+    assert_eq!(triangles.len(), 2);
+    assert!(triangles
+        .iter()
+        .all(|t| t.vertices.iter().all(|p| p.z == 2.0)));
+    assert!(desc.shapes.is_empty(), "a portal is not a shape");
+    let with = |severity: Severity, text: &str| {
+        desc.warnings
+            .iter()
+            .any(|w| w.severity == severity && w.message.contains(text))
+    };
+    assert!(
+        with(Severity::NoEffect, "PortalShape: light subpaths"),
+        "{:?}",
+        desc.warnings
+    );
+    assert!(
+        with(Severity::Note, "no LightSource before it"),
+        "{:?}",
+        desc.warnings
+    );
+    assert!(
+        with(Severity::Note, "point or spot light"),
+        "{:?}",
+        desc.warnings
+    );
+}

@@ -328,7 +328,7 @@ impl PathVertex {
         {
             // Light from infinity leaves a disc as wide as the scene: its density is the
             // disc's, per area across the light's direction (none beyond it).
-            return cos_next(toward) * lights.pdf_from_infinity(-toward, next.p);
+            return cos_next(toward) * lights.pdf_from_infinity(emitter, -toward, next.p);
         }
         let dir = self.direction_to(next);
         let normal = (self.ng != Vec3::ZERO).then_some(self.ng);

@@ -508,3 +508,103 @@ fn a_textured_lamp_emits_its_texture_where_its_rays_start() {
     }
     assert!(e.pdf_err < 1e-4);
 }
+
+/// A portal: the unit square facing down at height `z` (light passes it going down), for the
+/// lights of `lights`.
+fn portal_facing_down(z: f32, lights: std::ops::Range<u32>) -> PortalDesc {
+    PortalDesc {
+        geometry: square_facing_down(1.0),
+        object_to_world: Mat4::from_translation(Vec3::new(1.0, 0.0, z)),
+        reverse_orientation: false,
+        lights,
+    }
+}
+
+/// With a portal, light from a direction starts its rays behind the portal: every ray crosses
+/// it going the way its front faces, the weights estimate the flux through the portal alone
+/// (pi L A for a constant environment of radiance L, E A cos for a distant light and a sun of
+/// irradiance E), and `emission_pdf` and `pdf_from_infinity` anywhere along the ray give the
+/// density the sample had. Light that crosses no portal has no density; a portal facing away
+/// from a distant light lets none of it start.
+#[test]
+fn portals_start_light_from_a_direction_behind_them() {
+    let to_light = Vec3::new(0.2, 0.3, 1.0).normalize();
+    let radiance = Vec3::new(2.0, 1.0, 0.5);
+    let (sun, sun_flux) = sun_to(Vec3::new(0.3, -0.4, 0.8).normalize());
+    let cases = [
+        (
+            "constant infinite",
+            constant_sky(0.5),
+            DVec3::splat(0.5 * PI64),
+        ),
+        (
+            "distant",
+            LightDesc::Distant(DistantLight { to_light, radiance }),
+            radiance.as_dvec3() * f64::from(to_light.z),
+        ),
+        (
+            "sun",
+            LightDesc::Sun(sun),
+            sun_flux * f64::from(Vec3::new(0.3, -0.4, 0.8).normalize().z),
+        ),
+    ];
+    for (name, light, expected) in cases {
+        let emitter = if matches!(light, LightDesc::Distant(_)) {
+            Emitter::Light(0)
+        } else {
+            Emitter::Environment
+        };
+        let (_, lights) = build(vec![bystander()], vec![light.clone()]);
+        let lights = lights.with_portals(&[portal_facing_down(0.5, 0..1)]);
+        let e = estimate_emission(&lights, 200_000, 23);
+        println!(
+            "{name} through a portal: flux {} expected {expected} (stderr {:.2e}), pdf rel err \
+             {:.2e}, {} sampled",
+            e.mean, e.stderr, e.pdf_err, e.samples
+        );
+        for c in 0..3 {
+            assert!(
+                (e.mean[c] / expected[c] - 1.0).abs() < 0.01,
+                "{name}: flux {} expected {expected}",
+                e.mean
+            );
+        }
+        assert!(e.pdf_err < 1e-4, "{name}: {}", e.pdf_err);
+        let mut rng = fastrand::Rng::with_seed(3);
+        for _ in 0..2000 {
+            let u = |rng: &mut fastrand::Rng| Vec2::new(rng.f32(), rng.f32());
+            let Some(s) = lights.sample_emission(rng.f32(), u(&mut rng), u(&mut rng)) else {
+                continue;
+            };
+            let ray = s.ray;
+            assert!(ray.dir.z < 0.0, "{name}: {ray:?}");
+            let t = (0.5 - ray.origin.z) / ray.dir.z;
+            let at = ray.origin + ray.dir * t;
+            assert!(
+                t > 0.0 && (at.x - 1.0).abs() <= 0.5 + 1e-4 && at.y.abs() <= 0.5 + 1e-4,
+                "{name}: the ray crosses the portal at {at}"
+            );
+            // Behind the scene's sphere: the ray crosses everything between.
+            assert!(ray.origin.distance(Vec3::X) >= 2.0 * 3f32.sqrt() - 1e-3);
+            // The light alone is chosen with probability 1.
+            let beyond = lights.pdf_from_infinity(emitter, ray.dir, at + ray.dir * 2.0);
+            assert!(
+                rel_err(beyond, ray.pdf_pos) < 1e-4,
+                "{name}: {beyond} against {}",
+                ray.pdf_pos
+            );
+            let beside = at + Vec3::new(3.0, 0.0, 0.0);
+            assert_eq!(lights.pdf_from_infinity(emitter, ray.dir, beside), 0.0);
+        }
+    }
+    // A portal that faces up: no light of a distant light going down starts there.
+    let (_, lights) = build(
+        vec![bystander()],
+        vec![LightDesc::Distant(DistantLight { to_light, radiance })],
+    );
+    let mut up = portal_facing_down(0.5, 0..1);
+    up.reverse_orientation = true;
+    let lights = lights.with_portals(&[up]);
+    let e = estimate_emission(&lights, 1000, 1);
+    assert_eq!(e.samples, 0);
+}
