@@ -33,7 +33,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::sample::SceneSphere;
 use crate::geometry::TriangleSurface;
-use crate::shape::Geometry;
+use crate::shape::{Geometry, Placement};
 
 /// The most triangles a scene's portals hold: each density of light from a direction visits
 /// all of them.
@@ -67,12 +67,12 @@ impl PortalDesc {
     /// checks against [`MAX_PORTAL_TRIANGLES`]).
     pub fn triangle_count(&self) -> u64 {
         match self.geometry.placement() {
-            crate::shape::Placement::Triangles(mesh) => mesh.indices.len() as u64,
-            crate::shape::Placement::Exact(_) => self
+            Placement::Triangles(mesh) => mesh.indices.len() as u64,
+            Placement::Exact(_) => self
                 .geometry
                 .tessellate(PORTAL_SEGMENTS)
                 .map_or(0, |m| m.indices.len() as u64),
-            crate::shape::Placement::Unbounded(_) => 0,
+            Placement::Unbounded(_) => 0,
         }
     }
 }
