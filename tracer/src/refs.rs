@@ -1,9 +1,11 @@
 //! The values scene descriptions refer to each other with, once the parser has resolved names:
-//! texture and material ids, texture-or-constant parameters, and a conductor's Fresnel term
+//! texture and material ids, texture-or-constant parameters, and a metal's Fresnel term
 //! (shared by the `fresnel` textures that define it and the metal materials that use it).
 //! A leaf module: the descriptions of every family and the parser's context import it.
 
 use glam::Vec3;
+
+use crate::wavelength::IndexCurve;
 
 /// Index into [`SceneDesc::textures`](crate::desc::SceneDesc::textures).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -30,7 +32,7 @@ impl ConstOrTexture {
     }
 }
 
-/// How a metal material gets its Fresnel term.
+/// How a metal material (or a volume's `fresnel`) gets its Fresnel term.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Fresnel {
     /// Normal-incidence reflectance colour (a `fresnelcolor` texture, or the course's
@@ -40,4 +42,7 @@ pub enum Fresnel {
     Index(ConstOrTexture),
     /// Complex index of refraction per RGB channel (metal presets, `fresnelname`).
     Conductor { eta: Vec3, k: Vec3 },
+    /// A real index that varies with wavelength (the `cauchy`, `abbe`, `sellmeier`, `sopra`
+    /// and `luxpop` fresnel textures): glass2's volumes refract with it, metal2 with its mean.
+    Dispersive(IndexCurve),
 }

@@ -104,6 +104,12 @@ pub fn write_material(
                     p.set(format!("{fprefix}.n"), v3(*eta));
                     p.set(format!("{fprefix}.k"), v3(*k));
                 }
+                // As YAT renders metal2 with it: at its mean index.
+                Fresnel::Dispersive(curve) => {
+                    p.set(format!("{fprefix}.type"), quoted("fresnelconst"));
+                    p.set(format!("{fprefix}.n"), v3(Vec3::splat(curve.mean())));
+                    p.set(format!("{fprefix}.k"), "0 0 0");
+                }
             }
         }
         MaterialDesc::MatteTranslucent(MatteTranslucent { kr, kt, .. }) => {

@@ -15,7 +15,7 @@ use super::microfacet::TrowbridgeReitz;
 use super::lobe::Lobe;
 use super::sample::LocalSample;
 use super::thin_film::ThinFilm;
-use crate::wavelength::cauchy_index;
+use crate::wavelength::Dispersion;
 
 #[derive(Clone, Copy, Debug)]
 pub enum Surface {
@@ -36,10 +36,9 @@ pub struct Dielectric {
     /// Interference on the smooth or thin surface's reflection (LuxRender's glass; its rough
     /// glass has none).
     pub film: Option<ThinFilm>,
-    /// Cauchy's B in nm^2 (LuxRender's `cauchyb` times
-    /// [`CAUCHY_B_PER_UM2`](crate::wavelength::CAUCHY_B_PER_UM2)): the index at a
-    /// path's wavelength is `eta + cauchy_b / nm^2` ([`Self::at_wavelength`]). 0: none.
-    pub cauchy_b: f32,
+    /// How the index depends on a path's wavelength ([`Self::at_wavelength`]): glass's
+    /// `cauchyb` (`eta + b / nm^2`), glass2's volumes' indices, or not at all.
+    pub dispersion: Dispersion,
 }
 
 impl Dielectric {
@@ -47,16 +46,16 @@ impl Dielectric {
     /// one wavelength ([`crate::wavelength`]). A pane does not bend light: its dispersion
     /// changes only its faces' reflectance, by a few parts in a thousand, which is left out.
     pub fn is_dispersive(&self) -> bool {
-        self.cauchy_b != 0.0 && !matches!(self.surface, Surface::Thin)
+        self.dispersion.varies() && !matches!(self.surface, Surface::Thin)
     }
 
-    /// The interface as a path of wavelength `nm` meets it: Cauchy's index there.
+    /// The interface as a path of wavelength `nm` meets it: its index there.
     pub fn at_wavelength(&mut self, nm: f32) {
-        let eta = cauchy_index(self.eta, self.cauchy_b, nm);
-        // A negative B can take the index through zero: no interface then, as a non-positive
-        // index is everywhere else.
+        let eta = self.dispersion.index(self.eta, nm);
+        // A negative B can take the index through zero (and a Sellmeier pole to infinity): no
+        // interface then, as a non-positive index is everywhere else.
         self.eta = if eta > 0.0 && eta.is_finite() { eta } else { 1.0 };
-        self.cauchy_b = 0.0;
+        self.dispersion = Dispersion::None;
     }
 
     /// The tint of the mirror reflection at `cos` to the normal: Kr, and the film's

@@ -8,14 +8,14 @@
 //!
 //! | parameter | type | default |
 //! |---|---|---|
-//! | `Kr` | color texture (constants not clamped when read; clamped per hit) | 1 ([`DEFAULT_KR`]) |
-//! | `Kt` | color texture (likewise) | 1 ([`DEFAULT_KT`]) |
+//! | `Kr` | color texture (constants not clamped when read; clamped per hit), glass and roughglass | 1 ([`DEFAULT_KR`]); LuxRender's glass2 has none: it reflects white |
+//! | `Kt` | color texture (likewise) | 1 ([`DEFAULT_KT`]); white on glass2 |
 //! | `index` | float texture | 1.5 ([`DEFAULT_INDEX`]); glass2 has none: its index is its shape's `Interior` volume's `fresnel` over its `Exterior`'s, 1 for a side with no volume ([`GLASS2_INDEX_WITHOUT_VOLUMES`] when it has neither), set per shape by the parser |
 //! | `architectural` | bool | false: a thin pane (a window) that does not bend light; shadow rays cross it with its straight transmittance, as LuxRender's do ([`crate::integrator::Crossing::Pane`]) |
 //! | `uroughness`, `vroughness` | float textures, roughglass only | 0.001 ([`DEFAULT_ROUGHGLASS_ROUGHNESS`]); 0 (smooth) for glass and glass2 |
 //! | `film`, `filmindex` | float textures, glass only | thin-film interference on the reflection, as LuxRender's ([`super::film`]); LuxRender's roughglass and glass2 have none |
 //! | `cauchyb` | float texture, glass and roughglass | 0: Cauchy's B in um^2, the index at wavelength l being `index + cauchyb / l^2` (LuxRender's formula): a path crossing the interface takes one wavelength there ([`crate::wavelength`]); on architectural glass, which does not bend light, it is left out |
-//! | `dispersion` | bool, glass2 only | ignored |
+//! | `dispersion` | bool, glass2 only | false: with it, a path crossing the interface takes one wavelength there, as with `cauchyb`, where its volumes' `fresnel` textures vary with wavelength (`cauchy`, `abbe`, `sellmeier`, `sopra`, `luxpop`: [`crate::texture::fresnel`]), and refracts at the interior's index over the exterior's at that wavelength (set per shape by the parser, [`Glass::volume_dispersion`]); without it glass2 refracts every wavelength at the ratio of the textures' mean indices, as LuxRender's does |
 //!
 //! A non-positive index is treated as no interface (index 1).
 
@@ -29,7 +29,7 @@ use crate::refs::{ConstOrTexture, TextureId};
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::wavelength::CAUCHY_B_PER_UM2;
+use crate::wavelength::{Dispersion, CAUCHY_B_PER_UM2};
 
 pub const DEFAULT_KR: f32 = 1.0;
 pub const DEFAULT_KT: f32 = 1.0;
@@ -53,6 +53,11 @@ pub struct Glass {
     pub vroughness: ConstOrTexture,
     /// glass2: `index` is replaced, per shape, by its volumes' (see the table above).
     pub index_from_volumes: bool,
+    /// glass2's `dispersion`.
+    pub dispersion: bool,
+    /// glass2 with `dispersion`: how its volumes' relative index varies with wavelength, set
+    /// per shape by the parser with `index` (none where neither volume's index varies).
+    pub volume_dispersion: Dispersion,
     pub film: FilmParams,
 }
 
@@ -95,12 +100,18 @@ impl Glass {
             0.0
         };
         let glass2 = ty == "glass2";
-        if glass2 {
-            params.ignore("dispersion");
-        }
+        let white = ConstOrTexture::float(1.0);
         Ok(Self {
-            kr: ctx.color_param(params, "Kr", DEFAULT_KR, false)?,
-            kt: ctx.color_param(params, "Kt", DEFAULT_KT, false)?,
+            kr: if glass2 {
+                white
+            } else {
+                ctx.color_param(params, "Kr", DEFAULT_KR, false)?
+            },
+            kt: if glass2 {
+                white
+            } else {
+                ctx.color_param(params, "Kt", DEFAULT_KT, false)?
+            },
             index: if glass2 {
                 ConstOrTexture::float(GLASS2_INDEX_WITHOUT_VOLUMES)
             } else {
@@ -123,6 +134,8 @@ impl Glass {
                 ctx.float_param(params, "cauchyb", 0.0)?
             },
             index_from_volumes: glass2,
+            dispersion: glass2 && params.bool("dispersion", false)?,
+            volume_dispersion: Dispersion::None,
             film: if ty == "glass" {
                 FilmParams::read(params, ctx)?
             } else {
@@ -164,7 +177,11 @@ impl MaterialKind for Glass {
             eta: if eta > 0.0 { eta } else { 1.0 },
             surface,
             film: self.film.at(eval),
-            cauchy_b: dispersion(eval.float(self.cauchyb)),
+            dispersion: if self.index_from_volumes {
+                self.volume_dispersion
+            } else {
+                Dispersion::CauchyB(dispersion(eval.float(self.cauchyb)))
+            },
         })
     }
 }

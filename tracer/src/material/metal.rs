@@ -14,7 +14,8 @@
 //! | `uroughness`, `vroughness` | float textures | 0.1 ([`DEFAULT_ROUGHNESS`]) |
 //!
 //! A complex index (presets, `fresnelname` textures) uses the conductor Fresnel equations; an
-//! index alone a conductor without absorption; a reflectance colour Schlick's approximation.
+//! index alone a conductor without absorption (a dispersive fresnel texture's, `cauchy`,
+//! `sellmeier`..., at its mean index); a reflectance colour Schlick's approximation.
 
 use glam::Vec3;
 
@@ -84,7 +85,7 @@ impl MaterialKind for Metal {
     fn textures(&self) -> Vec<TextureId> {
         let fresnel = match &self.fresnel {
             Fresnel::Reflectance(x) | Fresnel::Index(x) => Some(x),
-            Fresnel::Conductor { .. } => None,
+            Fresnel::Conductor { .. } | Fresnel::Dispersive(_) => None,
         };
         let mut params: Vec<&ConstOrTexture> = fresnel.into_iter().collect();
         params.extend([&self.uroughness, &self.vroughness]);
@@ -92,13 +93,17 @@ impl MaterialKind for Metal {
     }
 
     fn bxdf(&self, eval: &HitTextures, _u: f32) -> Bxdf {
-        let fresnel = match self.fresnel {
-            Fresnel::Conductor { eta, k } => ConductorFresnel::Complex { eta, k },
-            Fresnel::Index(index) => ConductorFresnel::Complex {
+        let fresnel = match &self.fresnel {
+            &Fresnel::Conductor { eta, k } => ConductorFresnel::Complex { eta, k },
+            Fresnel::Dispersive(curve) => ConductorFresnel::Complex {
+                eta: Vec3::splat(curve.mean().max(1e-3)),
+                k: Vec3::ZERO,
+            },
+            &Fresnel::Index(index) => ConductorFresnel::Complex {
                 eta: Vec3::splat(eval.float(index).max(1e-3)),
                 k: Vec3::ZERO,
             },
-            Fresnel::Reflectance(r0) => ConductorFresnel::Schlick { r0: eval.color(r0) },
+            &Fresnel::Reflectance(r0) => ConductorFresnel::Schlick { r0: eval.color(r0) },
         };
         Bxdf::Conductor(Conductor {
             fresnel,

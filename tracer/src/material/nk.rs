@@ -143,8 +143,8 @@ fn at(samples: &[(f64, f64, f64)], nm: f64) -> (f64, f64) {
     (a.1 + (b.1 - a.1) * t, a.2 + (b.2 - a.2) * t)
 }
 
-/// The (eta, k) per RGB channel of an `.nk` file's bytes.
-pub fn read(bytes: &[u8]) -> Result<(Vec3, Vec3), NkError> {
+/// The (wavelength nm, n, k) samples of an `.nk` file's bytes, sorted by wavelength.
+fn sorted_samples(bytes: &[u8]) -> Result<Vec<(f64, f64, f64)>, NkError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let line = bytes[..e.valid_up_to()]
             .iter()
@@ -155,6 +155,22 @@ pub fn read(bytes: &[u8]) -> Result<(Vec3, Vec3), NkError> {
     })?;
     let mut samples = samples(text)?;
     samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(samples)
+}
+
+/// The real part of the index by wavelength, `(nm, n)` sorted by wavelength, of an `.nk`
+/// file's bytes: what the `sopra` and `luxpop` fresnel textures give a volume (glass2 refracts
+/// with n alone).
+pub fn read_index(bytes: &[u8]) -> Result<Vec<(f32, f32)>, NkError> {
+    Ok(sorted_samples(bytes)?
+        .into_iter()
+        .map(|(nm, n, _)| (nm as f32, n as f32))
+        .collect())
+}
+
+/// The (eta, k) per RGB channel of an `.nk` file's bytes.
+pub fn read(bytes: &[u8]) -> Result<(Vec3, Vec3), NkError> {
+    let samples = sorted_samples(bytes)?;
     let (mut eta, mut k) = (Vec3::ZERO, Vec3::ZERO);
     for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
         let (n, kk) = at(&samples, f64::from(*nm));

@@ -94,6 +94,8 @@ fn glass(index: f32, roughness: f32, architectural: bool) -> MaterialDesc {
         uroughness: c(roughness),
         vroughness: c(roughness),
         index_from_volumes: false,
+        dispersion: false,
+        volume_dispersion: crate::wavelength::Dispersion::None,
         film: Default::default(),
     })
 }

@@ -21,13 +21,16 @@ use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::wavelength::IndexCurve;
 
 pub const DEFAULT_ABSORPTION: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clear {
-    /// The `fresnel` index.
+    /// The `fresnel` index (a dispersive texture's mean).
     pub index: f32,
+    /// The `fresnel` texture's index over wavelength, where it varies.
+    pub dispersion: Option<IndexCurve>,
     /// sigma_a per scene unit.
     pub absorption: Vec3,
 }
@@ -39,8 +42,10 @@ impl Clear {
         ctx: &mut dyn ParseContext,
     ) -> Result<Self, ParseError> {
         let statement = "MakeNamedVolume \"clear\"";
+        let (index, dispersion) = read_index(params, statement, pos, ctx)?;
         Ok(Self {
-            index: read_index(params, statement, pos, ctx)?,
+            index,
+            dispersion,
             absorption: read_color(
                 params,
                 "absorption",
@@ -69,6 +74,7 @@ mod tests {
     fn beer_lambert_through_a_slab() {
         let clear = Clear {
             index: 1.5,
+            dispersion: None,
             absorption: Vec3::new(0.0, 0.7, 2.5),
         };
         for d in [0.0f32, 0.1, 0.37, 1.0, 2.2] {

@@ -1,7 +1,7 @@
 //! What every kind of volume shares and what the shapes and the path tracer refer to: the
 //! volume id, a shape's interior and exterior, the rule that picks the volume a ray is in
 //! after it meets a surface, and the reading of the parameters every volume takes (`fresnel`,
-//! constant colours). A leaf: the kinds of volume, the scene description and the path tracer
+//! perhaps varying with wavelength, and constant colours). A leaf: the kinds of volume, the scene description and the path tracer
 //! import it.
 
 use glam::Vec3;
@@ -11,6 +11,7 @@ use crate::parse::context::{BoundTexture, ParseContext};
 use crate::parse::error::ParseError;
 use crate::parse::params::{ConstOrTextureName, ParamList};
 use crate::refs::Fresnel;
+use crate::wavelength::IndexCurve;
 
 /// Index into [`Volumes::media`](super::Volumes::media).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -60,22 +61,30 @@ impl ShapeMedia {
 }
 
 /// A volume's `fresnel`: a float, a constant float texture, or a fresnel texture holding a
-/// real index. The index is what glass2 refracts with, so a volume's index is one number:
-/// anything that varies (or a conductor's complex index) warns and gives the default.
+/// real index, the last perhaps varying with wavelength (cauchy, abbe, sellmeier, sopra,
+/// luxpop). The index is what glass2 refracts with: the curve where it varies (what glass2
+/// with `dispersion` takes a wavelength of) and the one number glass2 uses where no wavelength
+/// is taken (a curve's mean, as LuxRender's). Anything that varies in space (or a conductor's
+/// complex index) warns and gives the default.
 pub fn read_index(
     params: &ParamList,
     statement: &str,
     pos: &SourcePos,
     ctx: &mut dyn ParseContext,
-) -> Result<f32, ParseError> {
-    let index = match params.tex_float("fresnel", DEFAULT_FRESNEL)? {
-        ConstOrTextureName::Const(c) => Some(c.x),
+) -> Result<(f32, Option<IndexCurve>), ParseError> {
+    let (index, curve) = match params.tex_float("fresnel", DEFAULT_FRESNEL)? {
+        ConstOrTextureName::Const(c) => (Some(c.x), None),
         ConstOrTextureName::Named { name, pos: at } => {
             let found = match ctx.find_texture(&name, false) {
-                Some(BoundTexture::Texture(id)) => {
-                    ctx.uniform_texture(crate::refs::ConstOrTexture::Texture(id))
+                Some(BoundTexture::Texture(id)) => ctx
+                    .uniform_texture(crate::refs::ConstOrTexture::Texture(id))
+                    .map(|v| (v.x, None)),
+                Some(BoundTexture::Fresnel(Fresnel::Index(t))) => {
+                    ctx.uniform_texture(t).map(|v| (v.x, None))
                 }
-                Some(BoundTexture::Fresnel(Fresnel::Index(t))) => ctx.uniform_texture(t),
+                Some(BoundTexture::Fresnel(Fresnel::Dispersive(curve))) => {
+                    Some((curve.mean(), curve.varies().then_some(curve)))
+                }
                 _ => None,
             };
             if found.is_none() {
@@ -84,11 +93,14 @@ pub fn read_index(
                     format!("{statement}: \"fresnel\" \"{name}\" is not a uniform real index; using {DEFAULT_FRESNEL}"),
                 );
             }
-            found.map(|v| v.x)
+            match found {
+                Some((index, curve)) => (Some(index), curve),
+                None => (None, None),
+            }
         }
     };
     Ok(match index {
-        Some(i) if i > 0.0 && i.is_finite() => i,
+        Some(i) if i > 0.0 && i.is_finite() => (i, curve),
         Some(i) => {
             ctx.warn(
                 pos,
@@ -96,9 +108,9 @@ pub fn read_index(
                     "{statement}: fresnel {i} is not a positive index; using {DEFAULT_FRESNEL}"
                 ),
             );
-            DEFAULT_FRESNEL
+            (DEFAULT_FRESNEL, None)
         }
-        None => DEFAULT_FRESNEL,
+        None => (DEFAULT_FRESNEL, None),
     })
 }
 

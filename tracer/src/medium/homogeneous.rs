@@ -27,14 +27,17 @@ use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::wavelength::IndexCurve;
 
 pub const DEFAULT_SIGMA: f32 = 0.0;
 pub const DEFAULT_G: f32 = 0.0;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Homogeneous {
-    /// The `fresnel` index.
+    /// The `fresnel` index (a dispersive texture's mean).
     pub index: f32,
+    /// The `fresnel` texture's index over wavelength, where it varies.
+    pub dispersion: Option<IndexCurve>,
     pub sigma_a: Vec3,
     pub sigma_s: Vec3,
     pub g: Vec3,
@@ -70,8 +73,10 @@ impl Homogeneous {
                 Vec3::splat(DEFAULT_G)
             }
         };
+        let (index, dispersion) = read_index(params, statement, pos, ctx)?;
         Ok(Self {
-            index: read_index(params, statement, pos, ctx)?,
+            index,
+            dispersion,
             sigma_a: read_color(params, "sigma_a", DEFAULT_SIGMA, statement, pos, ctx)?,
             sigma_s: read_color(params, "sigma_s", DEFAULT_SIGMA, statement, pos, ctx)?,
             g,
@@ -137,6 +142,7 @@ mod tests {
     fn flight_weights_are_unbiased() {
         let medium = Homogeneous {
             index: 1.0,
+            dispersion: None,
             sigma_a: Vec3::new(0.2, 0.0, 1.0),
             sigma_s: Vec3::new(1.0, 0.5, 0.3),
             g: Vec3::ZERO,

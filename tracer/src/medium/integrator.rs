@@ -64,6 +64,7 @@ impl VolumeIntegrator {
                     if let MediumDesc::Homogeneous(h) = medium {
                         *medium = MediumDesc::Clear(Clear {
                             index: h.index,
+                            dispersion: h.dispersion.clone(),
                             absorption: h.sigma_a + h.sigma_s,
                         });
                     }

@@ -9,7 +9,8 @@
 //! the camera sits in the `Exterior` current at `WorldEnd`, a `LightSource` in the `Exterior`
 //! current at it, and a side with no volume takes
 //! the volume of the ray that reaches it. Only glass2 reads a volume's `fresnel` index (as
-//! the interior's over the exterior's).
+//! the interior's over the exterior's; with its `dispersion`, at a path's wavelength where the
+//! index varies with it).
 
 pub mod clear;
 pub mod common;
@@ -28,6 +29,7 @@ use crate::diag::SourcePos;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::wavelength::IndexCurve;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum MediumDesc {
@@ -61,6 +63,16 @@ impl Volumes {
     pub fn index(&self, id: Option<MediumId>) -> f32 {
         id.and_then(|id| self.get(id))
             .map_or(1.0, MediumDesc::index)
+    }
+
+    /// A side's index as glass2 with `dispersion` takes it: [`Self::index`] and the volume's
+    /// index over wavelength where it varies.
+    pub fn index_curve(&self, id: Option<MediumId>) -> (f32, Option<&IndexCurve>) {
+        let medium = id.and_then(|id| self.get(id));
+        (
+            medium.map_or(1.0, MediumDesc::index),
+            medium.and_then(MediumDesc::dispersion),
+        )
     }
 }
 
@@ -101,6 +113,14 @@ impl MediumDesc {
         match self {
             Self::Clear(c) => c.index,
             Self::Homogeneous(h) => h.index,
+        }
+    }
+
+    /// The `fresnel` index over wavelength, where it varies.
+    pub fn dispersion(&self) -> Option<&IndexCurve> {
+        match self {
+            Self::Clear(c) => c.dispersion.as_ref(),
+            Self::Homogeneous(h) => h.dispersion.as_ref(),
         }
     }
 

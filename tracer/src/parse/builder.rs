@@ -30,6 +30,7 @@ use crate::mesh::{ply, TriangleMesh};
 use crate::refs::{ConstOrTexture, MaterialId, TextureId};
 use crate::shape::Geometry;
 use crate::texture::{self, Defined, Scale};
+use crate::wavelength::Dispersion;
 use image::ImageDecoder;
 
 /// Include files may nest this deep (the main file is depth 0).
@@ -838,8 +839,9 @@ impl<'s> Builder<'s> {
     }
 
     /// glass2 refracts with its volumes' indices (LuxRender's Glass2::GetBSDF): the shape's
-    /// interior index over its exterior's, 1 for a side with no volume. Returns the material
-    /// a shape with `media` uses in place of `material`.
+    /// interior index over its exterior's, 1 for a side with no volume; with `dispersion`, at a
+    /// path's wavelength where either varies with it. Returns the material a shape with `media`
+    /// uses in place of `material`.
     fn glass2_index(&mut self, material: MaterialId, media: ShapeMedia, pos: &Pos) -> MaterialId {
         let glass2 = |g: &Glass| g.index_from_volumes;
         let takes_index = match self.materials.get(material.0 as usize) {
@@ -866,15 +868,24 @@ impl<'s> Builder<'s> {
             return id;
         }
         let index = self.volumes.index(media.interior) / self.volumes.index(media.exterior);
+        let dispersion = Dispersion::between(
+            self.volumes.index_curve(media.interior),
+            self.volumes.index_curve(media.exterior),
+        );
         let mut desc = self.materials[material.0 as usize].clone();
-        match &mut desc {
-            MaterialDesc::Glass(g) => g.index = ConstOrTexture::float(index),
-            MaterialDesc::Bumped(inner, _) => {
-                if let MaterialDesc::Glass(g) = inner.as_mut() {
-                    g.index = ConstOrTexture::float(index);
-                }
+        let glass = match &mut desc {
+            MaterialDesc::Glass(g) => Some(g),
+            MaterialDesc::Bumped(inner, _) => match inner.as_mut() {
+                MaterialDesc::Glass(g) => Some(g),
+                _ => None,
+            },
+            _ => None,
+        };
+        if let Some(g) = glass {
+            g.index = ConstOrTexture::float(index);
+            if g.dispersion {
+                g.volume_dispersion = dispersion;
             }
-            _ => {}
         }
         let id = self.add_material(desc);
         self.glass2_with_index.insert((material, media), id);

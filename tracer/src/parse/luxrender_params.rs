@@ -1030,6 +1030,19 @@ const MIRROR_UNREAD: &[LuxParam] = &[
 const ROUGHNESS_UNREAD: &[LuxParam] = &[ignored("roughness", None)];
 /// Only LuxRender's glass has a thin film; its roughglass and glass2 read neither.
 const FILM_UNREAD: &[LuxParam] = &[ignored("film", None), ignored("filmindex", None)];
+/// LuxRender's glass2 reflects and transmits white, its index from its volumes.
+const GLASS2_UNREAD: &[LuxParam] = &[
+    ignored("Kr", None),
+    ignored("Kt", None),
+    ignored(
+        "index",
+        Some("glass2 takes its index from its Interior and Exterior volumes' fresnel"),
+    ),
+    ignored(
+        "cauchyb",
+        Some("glass2 disperses with its volumes' fresnel textures"),
+    ),
+];
 /// LuxRender's glossy chooses its separable (Kd under a coating) or combined model with it.
 const GLOSSY: &[LuxParam] = &[differs(
     "separable",
@@ -1137,7 +1150,7 @@ pub static PLUGINS: &[Plugin] = &[
     plugin_of(Statement::Material, "plastic", &[ROUGHNESS_UNREAD]),
     plugin_of(Statement::Material, "shinymetal", &[ROUGHNESS_UNREAD]),
     plugin_of(Statement::Material, "roughglass", &[FILM_UNREAD]),
-    plugin_of(Statement::Material, "glass2", &[FILM_UNREAD]),
+    plugin_of(Statement::Material, "glass2", &[FILM_UNREAD, GLASS2_UNREAD]),
     plugin_of(Statement::Material, "glossy", &[GLOSSY]),
     plugin_of(
         Statement::AreaLightSource,

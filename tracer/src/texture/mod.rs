@@ -3,7 +3,7 @@
 //! [`constant`], [`scale`], [`arithmetic`] (add, subtract), [`mix`], [`band`], [`bilerp`],
 //! [`uv`], [`harlequin`], [`dots`], [`brick`], [`fbm`], [`wrinkled`], [`windy`], [`marble`],
 //! the [`blender`] family (blender_clouds, _wood, _marble, _musgrave, _stucci, _noise,
-//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`], [`equalenergy`], [`lampspectrum`] and [`tabulateddata`] (tabulateddata, irregulardata) (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in).
+//! _voronoi, _distortednoise, _magic, _blend), [`blackbody`], [`gaussian`], [`equalenergy`], [`lampspectrum`] and [`tabulateddata`] (tabulateddata, irregulardata) (spectra, read as constant colours), and [`fresnel`] (the fresnel textures metal2 folds in and volumes take their index from).
 //! [`mapping`] holds the 2D mappings (uv, spherical, cylindrical, planar) and the 3D mapping
 //! (global, local, uv coordinates with scale, rotate, translate); [`noise`] the Perlin noise,
 //! fBm and turbulence of the procedural textures; [`common`] the surface point, the evaluator

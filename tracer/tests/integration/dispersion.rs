@@ -98,9 +98,14 @@ fn world_x(column: f64) -> f64 {
     SCREEN.1 - column / f64::from(COLUMNS) * (SCREEN.1 - SCREEN.0)
 }
 
-/// The predicted image of the prism's columns: each channel's radiance per column, averaged
-/// over 16 positions across the column.
-fn predicted(cauchy_b_um2: f64) -> Vec<DVec3> {
+/// The predicted image of the prism's columns, of Cauchy's `index + cauchy_b_um2 / lambda^2`.
+fn predicted(index: f64, cauchy_b_um2: f64) -> Vec<DVec3> {
+    predicted_with(|um| index + cauchy_b_um2 / (um * um))
+}
+
+/// The predicted image of the prism's columns for the index `index(lambda in um)`: each
+/// channel's radiance per column, averaged over 16 positions across the column.
+fn predicted_with(index: impl Fn(f64) -> f64) -> Vec<DVec3> {
     let weights = spectrum_rgb_weights(1.0);
     (0..PRISM_COLUMNS)
         .map(|c| {
@@ -108,8 +113,7 @@ fn predicted(cauchy_b_um2: f64) -> Vec<DVec3> {
             for k in 0..16 {
                 let x = world_x(f64::from(c) + (f64::from(k) + 0.5) / 16.0);
                 for &(nm, w) in &weights {
-                    let um = nm * 1e-3;
-                    sum += w.as_dvec3() * through_prism(x, INDEX + cauchy_b_um2 / (um * um));
+                    sum += w.as_dvec3() * through_prism(x, index(nm * 1e-3));
                 }
             }
             sum / 16.0
@@ -163,7 +167,7 @@ fn scene_text() -> String {
 #[test]
 fn a_prism_spreads_the_spectrum_where_snell_puts_each_wavelength() {
     let text = scene_text();
-    let (want_at, want_total) = moments(&predicted(CAUCHY_B_UM2));
+    let (want_at, want_total) = moments(&predicted(INDEX, CAUCHY_B_UM2));
     // Blue is bent the most: toward the apex, the low columns.
     assert!(want_at.z + 10.0 < want_at.x, "{want_at}");
     for (transport, spp) in [(Transport::Path, 64), (Transport::Bidirectional, 32)] {
@@ -210,7 +214,7 @@ fn a_prism_spreads_the_spectrum_where_snell_puts_each_wavelength() {
 #[test]
 fn without_cauchyb_the_channels_stay_together() {
     let text = scene_text().replace("\"float cauchyb\" [0.02]", "");
-    let (want_at, _) = moments(&predicted(0.0));
+    let (want_at, _) = moments(&predicted(INDEX, 0.0));
     let film = render(&text, 16, Transport::Path);
     let (got_at, _) = moments(&measured(&film));
     assert!(
@@ -245,4 +249,238 @@ fn dispersive_glass_in_white_light_stays_white() {
     // Each sample carries one wavelength's colour: the pixels through the prism are not grey.
     let chroma = pixels.iter().map(|p| (p.x - p.z).abs()).fold(0.0, f64::max);
     assert!(chroma > 0.05, "largest red-blue difference {chroma}");
+}
+
+/// The scene's glass prism as LuxRender's glass2, its index from its Interior: a clear volume
+/// whose `fresnel` is a cauchy texture of the glass's figures (`cauchya` the glass's index),
+/// with `material`'s parameters (`"bool dispersion" ["true"]` or none).
+fn glass2_text(material: &str) -> String {
+    let glass = "Material \"glass\" \"color Kr\" [0 0 0] \"color Kt\" [1 1 1] \"float index\" [1.5]\n    \"float cauchyb\" [0.02]";
+    let text = scene_text();
+    assert!(text.contains(glass), "the scene's glass");
+    text.replace(
+        "WorldBegin\n",
+        &format!(
+            "WorldBegin\nTexture \"bk\" \"fresnel\" \"cauchy\" \"float cauchya\" [{INDEX}] \
+             \"float cauchyb\" [{CAUCHY_B_UM2}]\n\
+             MakeNamedVolume \"prism\" \"clear\" \"texture fresnel\" \"bk\"\n"
+        ),
+    )
+    .replace(
+        glass,
+        &format!("Material \"glass2\" {material}\n  Interior \"prism\""),
+    )
+}
+
+/// The scene's glass, reflecting as glass2 does (Kr 1: glass2 has no Kr).
+fn reflecting_glass_text() -> String {
+    scene_text().replace("\"color Kr\" [0 0 0]", "\"color Kr\" [1 1 1]")
+}
+
+/// glass2 with `dispersion` between a cauchy volume and none takes one wavelength as glass
+/// with cauchyb does: the prism renders exactly what the same prism of glass renders, path
+/// traced and bidirectional, so its spectrum lies where Snell's law puts it (each channel's
+/// centroid within half a column of the prediction).
+#[test]
+fn glass2_disperses_with_its_volumes_cauchy_index() {
+    let (want_at, _) = moments(&predicted(INDEX, CAUCHY_B_UM2));
+    for (transport, spp) in [(Transport::Path, 64), (Transport::Bidirectional, 32)] {
+        let glass2 = render(
+            &glass2_text("\"bool dispersion\" [\"true\"]"),
+            spp,
+            transport,
+        );
+        let glass = render(&reflecting_glass_text(), spp, transport);
+        for y in 0..glass.height() {
+            for x in 0..glass.width() {
+                assert_eq!(
+                    glass2.pixel(x, y),
+                    glass.pixel(x, y),
+                    "{transport:?} ({x}, {y})"
+                );
+            }
+        }
+        let (at, _) = moments(&measured(&glass2));
+        eprintln!("{transport:?}: glass2 centroids {at}, predicted {want_at} (columns)");
+        assert!(
+            (at - want_at).abs().max_element() < 0.5,
+            "{transport:?}: centroids {at}, predicted {want_at}"
+        );
+    }
+}
+
+/// Without `dispersion` glass2 refracts every wavelength at its volume's mean index (LuxRender's
+/// cauchy texture's: cauchya + cauchyb / (0.38 x 0.72 um^2)): one centroid, where that index
+/// puts it.
+#[test]
+fn glass2_without_dispersion_refracts_at_the_mean_index() {
+    let mean = INDEX + CAUCHY_B_UM2 / (0.38 * 0.72);
+    let (want_at, _) = moments(&predicted(mean, 0.0));
+    let film = render(&glass2_text(""), 16, Transport::Path);
+    let (at, _) = moments(&measured(&film));
+    assert!(
+        (at - want_at).abs().max_element() < 0.1 && (at.x - at.z).abs() < 0.05,
+        "centroids {at}, predicted {want_at}"
+    );
+}
+
+/// BK7's Sellmeier coefficients (C in um^2).
+const BK7_B: [f64; 3] = [1.039_612_12, 0.231_792_344, 1.010_469_45];
+const BK7_C: [f64; 3] = [0.006_000_698_67, 0.020_017_914_4, 103.560_653];
+
+fn bk7(um: f64) -> f64 {
+    let l2 = um * um;
+    (1.0 + (0..3).map(|i| BK7_B[i] * l2 / (l2 - BK7_C[i])).sum::<f64>()).sqrt()
+}
+
+/// A cauchy index of Cauchy's A and B (um^2).
+fn cauchy(a: f64, b: f64) -> impl Fn(f64) -> f64 {
+    move |um| a + b / (um * um)
+}
+
+/// The prism of glass2 with `dispersion` between volumes of other dispersive fresnel textures:
+/// BK7 by Sellmeier's formula (exact); the glass's Cauchy index tabulated in a luxpop file
+/// every 20 nm (interpolated between its samples); the glass's Cauchy index inside a dispersive
+/// gas's Cauchy exterior (the ratio of the two, tabulated every 20 nm). Each spectrum lies where
+/// Snell's law at its relative index puts it: every channel's centroid within half a column of
+/// the prediction, the spread from red to blue within 5% of it.
+#[test]
+fn glass2_disperses_with_sellmeier_tabulated_and_two_dispersive_volumes() {
+    let list = |v: [f64; 3]| v.map(|x| x.to_string()).join(" ");
+    let sellmeier = format!(
+        "Texture \"bk\" \"fresnel\" \"sellmeier\" \"float B\" [{}] \"float C\" [{}]",
+        list(BK7_B),
+        list(BK7_C)
+    );
+    // Wavelengths in angstroms, 360 to 800 nm every 20.
+    let luxpop: String = (0..=22)
+        .map(|i| {
+            let nm = 360.0 + 20.0 * f64::from(i);
+            let um = nm * 1e-3;
+            format!("{} {:.7} 0\n", nm * 10.0, INDEX + CAUCHY_B_UM2 / (um * um))
+        })
+        .collect();
+    let table = |um: f64| {
+        // The file's samples, interpolated linearly.
+        let nm = um * 1e3;
+        let below = 360.0 + 20.0 * ((nm - 360.0) / 20.0).floor();
+        let n = |nm: f64| INDEX + CAUCHY_B_UM2 / (nm * nm * 1e-6);
+        let t = (nm - below) / 20.0;
+        n(below) * (1.0 - t) + n(below + 20.0) * t
+    };
+    let gas = cauchy(1.02, 0.002);
+    let glass = cauchy(INDEX, CAUCHY_B_UM2);
+    /// A relative index of refraction over wavelength (micrometres).
+    type Index = Box<dyn Fn(f64) -> f64>;
+    let cases: [(&str, String, &str, Index); 3] = [
+        ("sellmeier", sellmeier, "", Box::new(bk7)),
+        (
+            "luxpop",
+            "Texture \"bk\" \"fresnel\" \"luxpop\" \"string filename\" \"glass.nk\"".into(),
+            "",
+            Box::new(table),
+        ),
+        (
+            "two cauchy volumes",
+            format!(
+                "Texture \"bk\" \"fresnel\" \"cauchy\" \"float cauchya\" [{INDEX}] \
+                 \"float cauchyb\" [{CAUCHY_B_UM2}]\n\
+                 Texture \"gas\" \"fresnel\" \"cauchy\" \"float cauchya\" [1.02] \
+                 \"float cauchyb\" [0.002]\n\
+                 MakeNamedVolume \"gas\" \"clear\" \"texture fresnel\" \"gas\""
+            ),
+            "  Exterior \"gas\"\n",
+            Box::new(move |um| glass(um) / gas(um)),
+        ),
+    ];
+    for (name, texture, exterior, index) in cases {
+        let text = glass2_text("\"bool dispersion\" [\"true\"]");
+        let (head, tail) = text.split_at(text.find("Texture \"bk\"").expect("the texture"));
+        let tail = &tail[tail.find('\n').expect("one line") + 1..];
+        let text = format!("{head}{texture}\n{tail}").replace(
+            "  Interior \"prism\"\n",
+            &format!("  Interior \"prism\"\n{exterior}"),
+        );
+        let mut source = MemorySource::new();
+        source.insert("dispersion.lxs", Arc::from(text.as_bytes()));
+        source.insert("glass.nk", Arc::from(luxpop.as_bytes()));
+        let desc = parse_scene("dispersion.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
+        assert!(desc.warnings.is_empty(), "{name}: {:?}", desc.warnings);
+        let overrides = RenderOverrides {
+            spp: Some(64),
+            transport: Some(Transport::Path),
+            ..Default::default()
+        };
+        let film = render_whole_with(&desc, &source, &overrides);
+        let (want_at, _) = moments(&predicted_with(&*index));
+        let (at, _) = moments(&measured(&film));
+        let spread = (at.x - at.z, want_at.x - want_at.z);
+        eprintln!("{name}: centroids {at}, predicted {want_at} (columns)");
+        assert!(
+            (at - want_at).abs().max_element() < 0.5 && (spread.0 / spread.1 - 1.0).abs() < 0.05,
+            "{name}: centroids {at}, predicted {want_at}"
+        );
+    }
+}
+
+/// The dispersive fresnel textures read as LuxRender's: abbe's curve has index n at its
+/// lambda_D and Abbe number V over lambda_F and lambda_C (BK7's defaults and the e lines);
+/// cauchy's `index` is its mean over 380-720 nm; sellmeier's B and C go in pairs (else the
+/// texture is undefined, with a warning); glass2's index without dispersion is the mean.
+#[test]
+fn dispersive_fresnel_textures_read_as_luxrender_reads_them() {
+    use yat_tracer::wavelength::IndexCurve;
+    let volumes = |textures: &str| {
+        let text = format!(
+            "Camera \"perspective\"\nWorldBegin\n{textures}\nMakeNamedVolume \"v\" \"clear\" \"texture fresnel\" \"t\"\n\
+             Material \"glass2\" \"bool dispersion\" [\"true\"]\nInterior \"v\"\n\
+             Shape \"sphere\"\nWorldEnd\n"
+        );
+        let mut source = MemorySource::new();
+        source.insert("s.lxs", Arc::from(text.as_bytes()));
+        parse_scene("s.lxs", &source).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let curve = |textures: &str| -> IndexCurve {
+        let desc = volumes(textures);
+        assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+        desc.volumes.media[0]
+            .dispersion()
+            .expect("a dispersive index")
+            .clone()
+    };
+    for (ty, lines, n, v) in [
+        ("", [587.5618f32, 486.13, 656.28], 1.5168f32, 64.17f32),
+        (
+            "\"string type\" \"e\" \"float n\" [1.7] \"float V\" [30]",
+            [546.07, 479.99, 643.85],
+            1.7,
+            30.0,
+        ),
+    ] {
+        let c = curve(&format!("Texture \"t\" \"fresnel\" \"abbe\" {ty}"));
+        let [d, f, cl] = lines;
+        let abbe = (c.at(d) - 1.0) / (c.at(f) - c.at(cl));
+        assert!(
+            (c.at(d) - n).abs() < 1e-5 && (abbe / v - 1.0).abs() < 1e-3,
+            "{ty}: n {} V {abbe}",
+            c.at(d)
+        );
+    }
+    let c = curve(
+        "Texture \"t\" \"fresnel\" \"cauchy\" \"float index\" [1.6] \"float cauchyb\" [0.01]",
+    );
+    let mean: f64 = (380..720).map(|nm| f64::from(c.at(nm as f32))).sum::<f64>() / 340.0;
+    assert!(
+        (c.mean() - 1.6).abs() < 1e-6 && (mean - 1.6).abs() < 1e-4,
+        "{c:?}"
+    );
+    let desc =
+        volumes("Texture \"t\" \"fresnel\" \"sellmeier\" \"float B\" [1 0.2] \"float C\" [0.006]");
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.message.contains("2 B and 1 C")),
+        "{:?}",
+        desc.warnings
+    );
 }

@@ -117,6 +117,7 @@ WorldEnd
         media[0],
         MediumDesc::Clear(Clear {
             index: 1.000_292_6,
+            dispersion: None,
             absorption: Vec3::ZERO
         })
     );
@@ -124,6 +125,7 @@ WorldEnd
         media[1],
         MediumDesc::Clear(Clear {
             index: 1.5,
+            dispersion: None,
             absorption: Vec3::new(0.5, 1.0, 2.0)
         })
     );
@@ -131,6 +133,7 @@ WorldEnd
         media[2],
         MediumDesc::Homogeneous(Homogeneous {
             index: 1.5,
+            dispersion: None,
             sigma_a: Vec3::new(0.1, 0.2, 0.3),
             sigma_s: Vec3::splat(2.0),
             g: Vec3::splat(0.4),
@@ -349,6 +352,7 @@ fn the_default_volume_integrator_only_attenuates_as_luxrenders_does() {
             desc.volumes.media[0],
             MediumDesc::Clear(Clear {
                 index: 1.0,
+                dispersion: None,
                 absorption: Vec3::splat(1.5)
             }),
             "{integrator:?}"
