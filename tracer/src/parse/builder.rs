@@ -383,7 +383,32 @@ impl<'s> Builder<'s> {
                 }
                 self.warn_unused(&params);
             }
-            "LightGroup" | "SearchPath" => r.skip_statement()?,
+            "LightGroup" => {
+                // Its name and parameter list are read (so a malformed one is an error where
+                // LuxRender's parser gives one) and left, as LuxRender 1.x leaves them: what it
+                // writes is the sum of the groups.
+                let name = r.string("the light group's name")?;
+                r.params(format!("LightGroup \"{name}\""))?;
+                self.diagnose(
+                    Severity::NoEffect,
+                    "LightGroup".into(),
+                    pos,
+                    "LightGroup: LuxRender 1.x writes the sum of its light groups, each at \
+                     scale 1 (a group's scale and colour are set in its window and kept in its \
+                     .flm, not in the scene), which is YAT's image; no layer per group is kept"
+                        .into(),
+                );
+            }
+            "SearchPath" => {
+                r.string("the search path")?;
+                self.note_once(
+                    "SearchPath".into(),
+                    pos,
+                    "SearchPath is ignored, as LuxRender 1.x's parser ignores it: files are \
+                     found relative to the scene file"
+                        .into(),
+                );
+            }
             "Volume" => {
                 r.skip_statement()?;
                 self.warn_once(

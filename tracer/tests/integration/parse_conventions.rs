@@ -813,7 +813,7 @@ fn unknown_statements_and_parameters_warn_once_each() {
     let d = parse(
         "Frobnicate 1 2 \"x\"\nFrobnicate [3]\nCamera \"perspective\" \"float shutteropen\" 0 \"bool autofocus\" \"false\"\n\
          Film \"fleximage\" \"bool write_resume_flm\" \"true\" \"float colorspace_white\" [0.3 0.3] \"integer displayinterval\" 10\n\
-         WorldBegin\nLightGroup \"default\"\nAccelerator \"qbvh\"\n\
+         WorldBegin\nLightGroup \"default\"\nSearchPath \"textures\"\nAccelerator \"qbvh\"\n\
          Shape \"sphere\" \"float wobble\" 1 \"bool generatetangents\" \"false\" \"string name\" \"a\"\n\
          Shape \"sphere\" \"float wobble\" 2\nShape \"disk\" \"float wobble\" 2\nWorldEnd",
     );
@@ -835,12 +835,26 @@ fn unknown_statements_and_parameters_warn_once_each() {
     assert!(messages[2].ends_with("(2 times)"));
     assert!(messages[3].contains("Shape \"sphere\"") && messages[3].contains("generatetangents"));
     assert!(messages[4].contains("Shape \"disk\""));
-    // The exporter's output, display and shutter settings: listed as changing nothing.
+    // The exporter's output, display and shutter settings, and its light group (LuxRender
+    // writes the groups' sum): listed as changing nothing.
     let quiet = of(Severity::NoEffect);
-    assert_eq!(quiet.len(), 3, "{quiet:#?}");
-    for name in ["write_resume_flm", "displayinterval", "shutteropen"] {
+    assert_eq!(quiet.len(), 4, "{quiet:#?}");
+    for name in [
+        "write_resume_flm",
+        "displayinterval",
+        "shutteropen",
+        "main.lxs:6:1: note: LightGroup",
+    ] {
         assert!(quiet.iter().any(|m| m.contains(name)), "{name}: {quiet:#?}");
     }
+    // SearchPath, which LuxRender's parser leaves unimplemented: a note.
+    let notes = of(Severity::Note);
+    assert!(
+        notes
+            .iter()
+            .any(|m| m.starts_with("main.lxs:7:1: note: SearchPath")),
+        "{notes:#?}"
+    );
 }
 
 #[test]
