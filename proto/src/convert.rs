@@ -622,9 +622,7 @@ mod tests {
     use std::sync::Arc;
 
     use yat_tracer::assets::MemorySource;
-    use yat_tracer::filter::{
-        FilterDesc, FilterKind, PixelFilter, DEFAULT_MITCHELL_B, DEFAULT_MITCHELL_C,
-    };
+    use yat_tracer::filter::{FilterDesc, FilterKind, PixelFilter};
     use yat_tracer::parse::parse_scene;
     use yat_tracer::render::layers::Layers;
     use yat_tracer::render::{plan_units, RenderScene};
@@ -633,10 +631,7 @@ mod tests {
 
     use super::*;
 
-    const MITCHELL: FilterKind = FilterKind::Mitchell {
-        b: DEFAULT_MITCHELL_B,
-        c: DEFAULT_MITCHELL_C,
-    };
+    const MITCHELL: FilterKind = FilterKind::MITCHELL;
 
     fn weights_of(kind: FilterKind, xwidth: f32, ywidth: f32) -> WeightBounds {
         PixelFilter::new(&FilterDesc {
@@ -964,7 +959,16 @@ mod tests {
             (FilterKind::Gaussian { alpha: 2.0 }, 2.0, false),
             (FilterKind::BlackmanHarris, 2.0, false),
             (MITCHELL, 2.0, true),
-            (FilterKind::Mitchell { b: 0.0, c: 0.5 }, 2.0, true),
+            (
+                FilterKind::Mitchell {
+                    b: 0.0,
+                    c: 0.5,
+                    supersample: true,
+                },
+                2.0,
+                true,
+            ),
+            (FilterKind::CatmullRom, 2.0, true),
             (FilterKind::Sinc { tau: 3.0 }, 2.0, true),
         ] {
             let weights = weights_of(kind, width, width);

@@ -6,8 +6,8 @@
 //! | `box` | | 0.5 |
 //! | `triangle` | | 2 |
 //! | `gaussian` | `alpha` (2) | 2 |
-//! | `mitchell` (the default) | `B` (1/3), `C` (1/3) | 2 |
-//! | `catmullrom` | (Mitchell with B = 0, C = 1/2) | 2 |
+//! | `mitchell` (the default) | `B` (1/3), `C` (1/3), `supersample` (false) | 2 |
+//! | `catmullrom` | (the Mitchell cubic with B = 0, C = 1/2) | 2 |
 //! | `blackmanharris` | | 4 |
 //! | `sinc` | `tau` (3) | 4 |
 //!
@@ -15,10 +15,17 @@
 //! [`MAX_WIDTH`]: a wider one is a warning and renders at that width). An unknown type is a
 //! warning and renders with the default mitchell.
 //!
+//! As in LuxRender 1.x, mitchell is radial (its weight is that of the sample's distance measured
+//! in half-widths, `sqrt((dx / xwidth)^2 + (dy / ywidth)^2)`), the others (catmullrom too) separable (the
+//! product of the two axes' weights). A supersampled mitchell (LuxRender's `mitchell_ss`) is
+//! 5/3 as wide, its profile the sum of three mitchells a third of a width apart.
+//!
 //! Samples are splatted through the filter ([`PixelFilter`]): each one adds its radiance,
 //! weighted, to every pixel whose centre lies within the filter's half-widths, so a unit's
 //! buffer covers its tile and a border of [`FilterDesc::border`] pixels around it
 //! (docs/architecture.md). A pixel is the filter-weighted mean of the samples around it.
+
+use glam::Vec2;
 
 use crate::diag::SourcePos;
 use crate::math::floor_to_int;
@@ -49,10 +56,46 @@ pub const DEFAULT_SINC_TAU: f32 = 3.0;
 pub enum FilterKind {
     Box,
     Triangle,
-    Gaussian { alpha: f32 },
-    Mitchell { b: f32, c: f32 },
+    Gaussian {
+        alpha: f32,
+    },
+    Mitchell {
+        b: f32,
+        c: f32,
+        supersample: bool,
+    },
+    /// The Mitchell-Netravali cubic with B = 0, C = 1/2, separable (as LuxRender's).
+    CatmullRom,
     BlackmanHarris,
-    Sinc { tau: f32 },
+    Sinc {
+        tau: f32,
+    },
+}
+
+impl FilterKind {
+    /// LuxRender's default filter: mitchell with B = C = 1/3, not supersampled.
+    pub const MITCHELL: Self = Self::Mitchell {
+        b: DEFAULT_MITCHELL_B,
+        c: DEFAULT_MITCHELL_C,
+        supersample: false,
+    };
+
+    /// Whether the weight is a function of the sample's distance in half-widths (mitchell, as
+    /// LuxRender's), not a product of the axes' weights.
+    fn is_radial(self) -> bool {
+        matches!(self, Self::Mitchell { .. })
+    }
+
+    /// How much wider than its half-widths the filter reaches: 5/3 for a supersampled
+    /// mitchell (LuxRender's `mitchell_ss`), else 1.
+    fn widening(self) -> f32 {
+        match self {
+            Self::Mitchell {
+                supersample: true, ..
+            } => 5.0 / 3.0,
+            _ => 1.0,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,10 +110,7 @@ pub struct FilterDesc {
 impl Default for FilterDesc {
     fn default() -> Self {
         Self {
-            kind: FilterKind::Mitchell {
-                b: DEFAULT_MITCHELL_B,
-                c: DEFAULT_MITCHELL_C,
-            },
+            kind: FilterKind::MITCHELL,
             xwidth: DEFAULT_WIDTH,
             ywidth: DEFAULT_WIDTH,
         }
@@ -94,18 +134,15 @@ impl FilterDesc {
                 },
                 DEFAULT_WIDTH,
             ),
-            "mitchell" => {
-                params.ignore("supersample");
-                (
-                    FilterKind::Mitchell {
-                        b: params.float("B", DEFAULT_MITCHELL_B)?,
-                        c: params.float("C", DEFAULT_MITCHELL_C)?,
-                    },
-                    DEFAULT_WIDTH,
-                )
-            }
-            // Catmull-Rom is the Mitchell-Netravali filter with B = 0, C = 1/2.
-            "catmullrom" => (FilterKind::Mitchell { b: 0.0, c: 0.5 }, DEFAULT_WIDTH),
+            "mitchell" => (
+                FilterKind::Mitchell {
+                    b: params.float("B", DEFAULT_MITCHELL_B)?,
+                    c: params.float("C", DEFAULT_MITCHELL_C)?,
+                    supersample: params.bool("supersample", false)?,
+                },
+                DEFAULT_WIDTH,
+            ),
+            "catmullrom" => (FilterKind::CatmullRom, DEFAULT_WIDTH),
             "blackmanharris" => (FilterKind::BlackmanHarris, DEFAULT_WIDE_WIDTH),
             "sinc" => (
                 FilterKind::Sinc {
@@ -118,13 +155,7 @@ impl FilterDesc {
                     pos,
                     format!("PixelFilter \"{other}\" is unknown; using mitchell"),
                 );
-                (
-                    FilterKind::Mitchell {
-                        b: DEFAULT_MITCHELL_B,
-                        c: DEFAULT_MITCHELL_C,
-                    },
-                    DEFAULT_WIDTH,
-                )
+                (FilterKind::MITCHELL, DEFAULT_WIDTH)
             }
         };
         let mut width = |name: &str| -> Result<f32, ParseError> {
@@ -217,6 +248,15 @@ impl AxisWeights {
             .collect()
     }
 
+    /// The largest weight in magnitude at offsets from `near` on (the table entry before it
+    /// included: a weight is interpolated between the two entries around its offset).
+    fn max_from(&self, near: f32) -> f32 {
+        let first = ((near * self.steps_per_pixel) as usize).min(TABLE_SIZE);
+        self.table[first..]
+            .iter()
+            .fold(0.0f32, |m, v| m.max(v.abs()))
+    }
+
     /// The weight's integral over offsets in [-radius, radius], in pixels: the interpolated
     /// table's, exactly (a trapezoid rule over its entries).
     #[cfg(test)]
@@ -260,7 +300,8 @@ impl AxisWeights {
         self.table.iter().any(|&v| v < 0.0)
     }
 
-    /// The weight at `offset` pixels from the sample (what `weights4` computes four at a time).
+    /// The weight at `offset` pixels from the sample (what `weights4` computes four at a time;
+    /// the tests hold the SSE lanes to it).
     #[cfg(any(test, not(target_arch = "x86_64")))]
     fn weight(&self, offset: f32) -> f32 {
         use crate::math::{bin_at, count_f32};
@@ -273,6 +314,22 @@ impl AxisWeights {
     /// The pixels of `lo..hi` a sample at `pixel + u` (u in [0, 1)) reaches: those whose centre
     /// lies within (-radius, radius] of it, and their weights.
     fn taps(&self, pixel: u32, u: f32, lo: u32, hi: u32) -> Taps {
+        let mut taps = self.reach(pixel, u, lo, hi);
+        // Four weights at a time; the slots past `len` are computed and not read.
+        let k0 = i64::from(taps.first) - i64::from(pixel);
+        for (c, chunk) in taps.weights[..taps.len.next_multiple_of(4)]
+            .chunks_exact_mut(4)
+            .enumerate()
+        {
+            let k = [0, 1, 2, 3].map(|j| (k0 + (4 * c + j) as i64) as f32);
+            chunk.copy_from_slice(&self.weights4(k.map(|k| k + 0.5 - u)));
+        }
+        taps
+    }
+
+    /// The pixels [`Self::taps`] reaches, their weights left zero.
+    #[inline(always)]
+    fn reach(&self, pixel: u32, u: f32, lo: u32, hi: u32) -> Taps {
         let b = self.border as i64;
         // Offsets k of the pixels pixel + k reached, k in [-border, border] (clamped: f32
         // rounding of u + radius may reach one further when u is just under 1).
@@ -280,43 +337,32 @@ impl AxisWeights {
         let last = floor_to_int(u + self.radius - 0.5).clamp(-b, b);
         let start = (i64::from(pixel) + first).max(i64::from(lo));
         let end = (i64::from(pixel) + last + 1).min(i64::from(hi));
-        let mut taps = Taps {
+        Taps {
             first: start.max(0) as u32,
             len: (end - start).clamp(0, MAX_TAPS as i64) as usize,
             weights: [0.0; TAP_SLOTS],
-        };
-        // Four weights at a time; the slots past `len` are computed and not read.
-        let k0 = start - i64::from(pixel);
-        for (c, chunk) in taps.weights[..taps.len.next_multiple_of(4)]
-            .chunks_exact_mut(4)
-            .enumerate()
-        {
-            let k = [0, 1, 2, 3].map(|j| (k0 + (4 * c + j) as i64) as f32);
-            chunk.copy_from_slice(&self.weights4(k, u));
         }
-        taps
     }
 
-    /// `weight(k + 0.5 - u)` for four pixel offsets k.
+    /// `weight(offset)` for four offsets.
     #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
-    fn weights4(&self, k: [f32; 4], u: f32) -> [f32; 4] {
-        k.map(|k| self.weight(k + 0.5 - u))
+    fn weights4(&self, offsets: [f32; 4]) -> [f32; 4] {
+        offsets.map(|offset| self.weight(offset))
     }
 
-    /// `weight(k + 0.5 - u)` for four pixel offsets k, on SSE lanes (part of x86-64): each lane
-    /// does `weight`'s operations in its order, so the weights have the same bits.
+    /// `weight(offset)` for four offsets, on SSE lanes (part of x86-64): each lane does
+    /// `weight`'s operations in its order, so the weights have the same bits.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn weights4(&self, k: [f32; 4], u: f32) -> [f32; 4] {
+    fn weights4(&self, offsets: [f32; 4]) -> [f32; 4] {
         use std::arch::x86_64::*;
         // SAFETY: SSE2 is part of x86-64; the loads and stores use 4-float arrays. Each entry is
         // in 0..TABLE_SIZE (t is at least 0, a NaN offset becomes TABLE_SIZE at the first `min`,
         // and the second caps it below), so it and the next are inside the table's
         // TABLE_SIZE + 1 weights.
         unsafe {
-            let k = _mm_loadu_ps(k.as_ptr());
-            let offset = _mm_sub_ps(_mm_add_ps(k, _mm_set1_ps(0.5)), _mm_set1_ps(u));
+            let offset = _mm_loadu_ps(offsets.as_ptr());
             let magnitude = _mm_andnot_ps(_mm_set1_ps(-0.0), offset);
             // `min` returns its second operand for a NaN, as f32::min returns the number.
             let t = _mm_min_ps(
@@ -377,34 +423,81 @@ fn clamp_width(width: f32) -> f32 {
 
 /// The pixel filter as samples are splatted through it: every sample adds `w(p - x) L` and
 /// `w(p - x)` to each pixel p it reaches (LuxRender's film does the same), `w` the product of
-/// the two axes' weights (negative in mitchell's and sinc's lobes).
+/// the two axes' weights or, for a radial filter, the weight of the offset's length in
+/// half-widths (negative in mitchell's and sinc's lobes).
 #[derive(Clone, Debug)]
 pub struct PixelFilter {
+    /// Per axis, the pixels a sample reaches and, for a separable filter, their weights.
     x: AxisWeights,
     y: AxisWeights,
+    /// A radial filter's weight over the squared distance in half-widths, in [0, 1] (one axis
+    /// of radius 1: no square root per pixel), and the half-widths it is measured in.
+    radial: Option<(AxisWeights, [f32; 2])>,
 }
 
 impl PixelFilter {
     pub fn new(desc: &FilterDesc) -> Self {
         let kind = desc.kind;
-        let axis = |width: f32| {
-            let radius = clamp_width(width);
-            AxisWeights::new(radius, |x| filter_1d(kind, x, radius))
-        };
+        let [rx, ry] = desc.half_widths();
+        if kind.is_radial() {
+            // The axes only say which pixels a sample reaches: those of the bounding box.
+            let reach = |radius: f32| AxisWeights::new(radius, |_| 1.0);
+            return Self {
+                x: reach(rx),
+                y: reach(ry),
+                radial: Some((
+                    AxisWeights::new(1.0, |squared| filter_1d(kind, squared.sqrt(), 1.0)),
+                    [rx, ry],
+                )),
+            };
+        }
+        let axis = |radius: f32| AxisWeights::new(radius, |x| filter_1d(kind, x, radius));
         Self {
-            x: axis(desc.xwidth),
-            y: axis(desc.ywidth),
+            x: axis(rx),
+            y: axis(ry),
+            radial: None,
         }
     }
 
-    /// The weights a sample at `(x, y) + u` gives the columns `lo..hi`.
-    pub fn taps_x(&self, x: u32, u: f32, lo: u32, hi: u32) -> Taps {
-        self.x.taps(x, u, lo, hi)
-    }
-
-    /// The weights a sample at `(x, y) + u` gives the rows `lo..hi`.
-    pub fn taps_y(&self, y: u32, u: f32, lo: u32, hi: u32) -> Taps {
-        self.y.taps(y, u, lo, hi)
+    /// The pixels of columns `lo.0..hi.0` and rows `lo.1..hi.1` a sample at `pixel + u`
+    /// reaches, and their weights.
+    #[inline(always)]
+    pub fn footprint(
+        &self,
+        pixel: (u32, u32),
+        u: Vec2,
+        lo: (u32, u32),
+        hi: (u32, u32),
+    ) -> Footprint<'_> {
+        let Some((profile, [rx, ry])) = &self.radial else {
+            return Footprint {
+                columns: self.x.taps(pixel.0, u.x, lo.0, hi.0),
+                rows: self.y.taps(pixel.1, u.y, lo.1, hi.1),
+                radial: None,
+            };
+        };
+        // A radial filter's axes give only the pixels reached; each column's and row's squared
+        // offset in half-widths gives the weights.
+        let columns = self.x.reach(pixel.0, u.x, lo.0, hi.0);
+        let rows = self.y.reach(pixel.1, u.y, lo.1, hi.1);
+        let squares = |taps: &Taps, pixel: u32, u: f32, radius: f32| {
+            let mut out = [0.0; TAP_SLOTS];
+            let k0 = (i64::from(taps.first) - i64::from(pixel)) as f32;
+            for (j, v) in out[..taps.len].iter_mut().enumerate() {
+                let d = (k0 + j as f32 + 0.5 - u) / radius;
+                *v = d * d;
+            }
+            out
+        };
+        Footprint {
+            radial: Some(Radial {
+                profile,
+                columns: squares(&columns, pixel.0, u.x, *rx),
+                rows: squares(&rows, pixel.1, u.y, *ry),
+            }),
+            columns,
+            rows,
+        }
     }
 
     /// Each pixel's filter mass in a `width` x `height` film: what its weight sum grows by
@@ -414,38 +507,174 @@ impl PixelFilter {
     /// mass, so the pixel converges to the filtered mean its camera samples' weighted mean
     /// converges to, at the edges too.
     pub fn film_mass(&self, width: u32, height: u32) -> FilmMass {
-        FilmMass {
-            columns: self.x.film_mass(width),
-            rows: self.y.film_mass(height),
+        if self.radial.is_none() {
+            return FilmMass::Separable {
+                columns: self.x.film_mass(width),
+                rows: self.y.film_mass(height),
+            };
         }
+        // The weight a sample gives the pixel (kx, ky) pixels from its own, integrated over
+        // its position in its pixel (the midpoint rule on a grid).
+        let (bx, by) = (self.x.border as i64, self.y.border as i64);
+        let (nx, ny) = (2 * bx + 1, 2 * by + 1);
+        let mut per_offset = vec![0.0f64; (nx * ny) as usize];
+        let centre = (nx as u32, ny as u32);
+        let cell = 1.0 / (RADIAL_MASS_STEPS * RADIAL_MASS_STEPS) as f64;
+        for i in 0..RADIAL_MASS_STEPS {
+            for j in 0..RADIAL_MASS_STEPS {
+                let u = Vec2::new(
+                    (i as f32 + 0.5) / RADIAL_MASS_STEPS as f32,
+                    (j as f32 + 0.5) / RADIAL_MASS_STEPS as f32,
+                );
+                let f = self.footprint(centre, u, (0, 0), (2 * centre.0 + 1, 2 * centre.1 + 1));
+                for row in 0..f.rows.len {
+                    let ky = i64::from(f.rows.first) + row as i64 - i64::from(centre.1);
+                    let weights = f.row(row);
+                    for (column, &w) in weights[..f.columns.len].iter().enumerate() {
+                        let kx = i64::from(f.columns.first) + column as i64 - i64::from(centre.0);
+                        per_offset[((ky + by) * nx + kx + bx) as usize] += f64::from(w) * cell;
+                    }
+                }
+            }
+        }
+        // A pixel's mass sums the offsets whose samples lie in the film: all of them away from
+        // the edges.
+        let full: f64 = per_offset.iter().sum();
+        let (w, h) = (i64::from(width), i64::from(height));
+        let mut pixels = Vec::with_capacity((width as usize) * (height as usize));
+        for y in 0..h {
+            for x in 0..w {
+                let inside = x >= bx && x < w - bx && y >= by && y < h - by;
+                let mass = if inside {
+                    full
+                } else {
+                    let mut sum = 0.0;
+                    for ky in -by..=by {
+                        for kx in -bx..=bx {
+                            if (0..w).contains(&(x - kx)) && (0..h).contains(&(y - ky)) {
+                                sum += per_offset[((ky + by) * nx + kx + bx) as usize];
+                            }
+                        }
+                    }
+                    sum
+                };
+                pixels.push(mass as f32);
+            }
+        }
+        FilmMass::PerPixel { width, pixels }
     }
 
     /// What the filter lets one sample add to a pixel's weight sum: the bounds an honest unit's
     /// buffer keeps.
     pub fn weight_bounds(&self) -> WeightBounds {
-        WeightBounds {
-            negative: self.x.has_negative_weights() || self.y.has_negative_weights(),
-            x: self.x.max_weights(),
-            y: self.y.max_weights(),
+        match &self.radial {
+            // A pixel k columns and l rows away lies at least t_k = (|k| - 1/2) / rx half-widths
+            // away (and t_l), so its weight is at most M(max(t_k, t_l)) = min(M(t_k), M(t_l)),
+            // M(t) the profile's largest magnitude from t on; a product bound is the square
+            // roots', whose product is at least the smaller of the two.
+            Some((profile, [rx, ry])) => {
+                let axis = |border: u32, radius: f32| -> Vec<f32> {
+                    let b = i64::from(border);
+                    (-b..=b)
+                        .map(|k| {
+                            let near = (k.unsigned_abs() as f32 - 0.5).max(0.0) / radius;
+                            profile.max_from(near * near).sqrt().next_up()
+                        })
+                        .collect()
+                };
+                WeightBounds {
+                    negative: profile.has_negative_weights(),
+                    x: axis(self.x.border, *rx),
+                    y: axis(self.y.border, *ry),
+                }
+            }
+            None => WeightBounds {
+                negative: self.x.has_negative_weights() || self.y.has_negative_weights(),
+                x: self.x.max_weights(),
+                y: self.y.max_weights(),
+            },
         }
     }
 }
 
+/// The weights one sample gives the pixels it reaches ([`PixelFilter::footprint`]): a run of
+/// columns in each of a run of rows.
+pub struct Footprint<'a> {
+    pub columns: Taps,
+    pub rows: Taps,
+    radial: Option<Radial<'a>>,
+}
+
+/// A radial filter's profile and the squared offsets, in half-widths, of a footprint's columns
+/// and rows.
+struct Radial<'a> {
+    profile: &'a AxisWeights,
+    columns: [f32; TAP_SLOTS],
+    rows: [f32; TAP_SLOTS],
+}
+
+impl Footprint<'_> {
+    /// The number of rows reached (`rows.first` the first).
+    pub fn row_count(&self) -> usize {
+        self.rows.len
+    }
+
+    /// The number of columns reached in each row (`columns.first` the first).
+    pub fn column_count(&self) -> usize {
+        self.columns.len
+    }
+
+    /// The weights of row `row`'s pixels (the first [`Self::column_count`] slots): a separable
+    /// filter's `wx * wy`, a radial one's weight at the offset's length.
+    #[inline(always)]
+    pub fn row(&self, row: usize) -> [f32; TAP_SLOTS] {
+        let mut out = [0.0; TAP_SLOTS];
+        let n = self.columns.len;
+        match &self.radial {
+            None => {
+                let wy = self.rows.weights[row];
+                for (w, &wx) in out[..n].iter_mut().zip(&self.columns.weights[..n]) {
+                    *w = wx * wy;
+                }
+            }
+            Some(r) => {
+                // Four weights at a time; the slots past `n` are computed and not read.
+                let dy = r.rows[row];
+                let slots = n.next_multiple_of(4);
+                for (w, dx) in out[..slots]
+                    .chunks_exact_mut(4)
+                    .zip(r.columns[..slots].chunks_exact(4))
+                {
+                    w.copy_from_slice(&r.profile.weights4([0, 1, 2, 3].map(|j| dx[j] + dy)));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Sample positions per pixel and axis [`PixelFilter::film_mass`] integrates a radial filter
+/// over (a separable one's axes take [`MASS_STEPS`] each).
+const RADIAL_MASS_STEPS: usize = 256;
+
 /// Sample positions per pixel [`PixelFilter::film_mass`] integrates over.
 const MASS_STEPS: usize = 1024;
 
-/// Each pixel's filter mass in a film ([`PixelFilter::film_mass`]), per column and per row
-/// (the filter is separable).
+/// Each pixel's filter mass in a film ([`PixelFilter::film_mass`]): per column and per row for
+/// a separable filter, per pixel for a radial one.
 #[derive(Clone, Debug)]
-pub struct FilmMass {
-    columns: Vec<f32>,
-    rows: Vec<f32>,
+pub enum FilmMass {
+    Separable { columns: Vec<f32>, rows: Vec<f32> },
+    PerPixel { width: u32, pixels: Vec<f32> },
 }
 
 impl FilmMass {
     /// The mass of pixel (x, y), which must lie in the film.
     pub fn at(&self, x: u32, y: u32) -> f32 {
-        self.columns[x as usize] * self.rows[y as usize]
+        match self {
+            Self::Separable { columns, rows } => columns[x as usize] * rows[y as usize],
+            Self::PerPixel { width, pixels } => pixels[(y * width + x) as usize],
+        }
     }
 }
 
@@ -458,7 +687,7 @@ pub struct WeightBounds {
     /// of their parameters; box, triangle, gaussian and blackmanharris never do).
     pub negative: bool,
     /// Per axis, for offsets k from -border to border (index k + border): the largest weight in
-    /// magnitude along that axis (a sample's weight is the product of its two axes').
+    /// magnitude along that axis (a sample's weight is at most the product of its two axes').
     pub x: Vec<f32>,
     pub y: Vec<f32>,
 }
@@ -466,14 +695,39 @@ pub struct WeightBounds {
 impl FilterDesc {
     /// Pixels a sample reaches beyond its own, per axis: the border of every unit's buffer.
     pub fn border(&self) -> [u32; 2] {
-        [
-            border(clamp_width(self.xwidth)),
-            border(clamp_width(self.ywidth)),
-        ]
+        self.half_widths().map(border)
+    }
+
+    /// The half-widths as rendered: a supersampled mitchell's 5/3 of the file's, each at most
+    /// [`MAX_WIDTH`].
+    pub fn half_widths(&self) -> [f32; 2] {
+        let widening = self.kind.widening();
+        [self.xwidth, self.ywidth].map(|w| clamp_width(w * widening))
     }
 }
 
-/// One axis of LuxRender's separable filters, `x` in [-radius, radius].
+/// Mitchell-Netravali's cubic at `t` half-widths (LuxRender's `Mitchell1D`), 0 from one
+/// half-width on.
+fn mitchell_cubic(b: f32, c: f32, t: f32) -> f32 {
+    let x = (2.0 * t).abs();
+    if x >= 2.0 {
+        0.0
+    } else if x > 1.0 {
+        ((-b - 6.0 * c) * x * x * x
+            + (6.0 * b + 30.0 * c) * x * x
+            + (-12.0 * b - 48.0 * c) * x
+            + (8.0 * b + 24.0 * c))
+            / 6.0
+    } else {
+        ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
+            + (-18.0 + 12.0 * b + 6.0 * c) * x * x
+            + (6.0 - 2.0 * b))
+            / 6.0
+    }
+}
+
+/// One axis of LuxRender's separable filters, `x` in [-radius, radius]; for mitchell, which is
+/// radial, its profile over the distance `x` (in [0, radius]).
 fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
     use std::f32::consts::PI;
     match kind {
@@ -482,23 +736,22 @@ fn filter_1d(kind: FilterKind, x: f32, radius: f32) -> f32 {
         FilterKind::Gaussian { alpha } => {
             (libm::expf(-alpha * x * x) - libm::expf(-alpha * radius * radius)).max(0.0)
         }
-        FilterKind::Mitchell { b, c } => {
-            let x = (2.0 * x / radius).abs();
-            if x > 2.0 {
-                0.0
-            } else if x > 1.0 {
-                ((-b - 6.0 * c) * x * x * x
-                    + (6.0 * b + 30.0 * c) * x * x
-                    + (-12.0 * b - 48.0 * c) * x
-                    + (8.0 * b + 24.0 * c))
-                    / 6.0
+        FilterKind::Mitchell { b, c, supersample } => {
+            let t = x / radius;
+            if supersample {
+                // LuxRender's mitchell_ss: three cubics 0.4 half-widths apart, weighed so the
+                // sum's integral is the cubic's.
+                let a0 = (76.0 - 16.0 * b + 8.0 * c) / 81.0;
+                let a1 = (1.0 - a0) / 2.0;
+                let d = t.abs() / 0.6;
+                a1 * mitchell_cubic(b, c, d - 2.0 / 3.0)
+                    + a0 * mitchell_cubic(b, c, d)
+                    + a1 * mitchell_cubic(b, c, d + 2.0 / 3.0)
             } else {
-                ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
-                    + (-18.0 + 12.0 * b + 6.0 * c) * x * x
-                    + (6.0 - 2.0 * b))
-                    / 6.0
+                mitchell_cubic(b, c, t)
             }
         }
+        FilterKind::CatmullRom => mitchell_cubic(0.0, 0.5, x / radius),
         FilterKind::BlackmanHarris => {
             // The window spans [-radius, radius].
             let t = 2.0 * PI * (x / (2.0 * radius) + 0.5);
@@ -543,13 +796,6 @@ mod tests {
             (FilterKind::Box, 0.5),
             (FilterKind::Box, 1.5),
             (FilterKind::Gaussian { alpha: 2.0 }, 2.0),
-            (
-                FilterKind::Mitchell {
-                    b: 1.0 / 3.0,
-                    c: 1.0 / 3.0,
-                },
-                2.0,
-            ),
             (FilterKind::BlackmanHarris, 1.5),
         ] {
             let f = filter(kind, width);
@@ -557,7 +803,7 @@ mod tests {
             let mean: f64 = (0..n)
                 .map(|i| {
                     let u = (i as f32 + 0.5) / n as f32;
-                    f64::from(f.taps_x(10, u, 0, 20).weights().iter().sum::<f32>())
+                    f64::from(f.x.taps(10, u, 0, 20).weights().iter().sum::<f32>())
                 })
                 .sum::<f64>()
                 / f64::from(n);
@@ -576,7 +822,7 @@ mod tests {
                     // Samples in pixels 0, 1, 2 and 3 (the widest border here is 2) weigh pixel 0.
                     (0..4u32)
                         .map(|p| {
-                            let taps = f.taps_x(p, u, 0, 20);
+                            let taps = f.x.taps(p, u, 0, 20);
                             if taps.first == 0 {
                                 f64::from(taps.weights()[0])
                             } else {
@@ -600,7 +846,7 @@ mod tests {
         let f = filter(FilterKind::Box, 0.5);
         for i in 0..1000 {
             let u = i as f32 / 1000.0;
-            let taps = f.taps_x(7, u, 0, 20);
+            let taps = f.x.taps(7, u, 0, 20);
             assert_eq!((taps.first, taps.weights()), (7, &[1.0][..]), "{u}");
         }
     }
@@ -611,7 +857,7 @@ mod tests {
         let f = filter(kind, 2.0);
         for i in 0..100 {
             let u = (i as f32 + 0.5) / 100.0;
-            let taps = f.taps_x(10, u, 0, 20);
+            let taps = f.x.taps(10, u, 0, 20);
             // Pixel centres within (-2, 2] of the sample: always four pixels.
             assert_eq!(taps.weights().len(), 4, "{u}");
             for (k, &w) in taps.weights().iter().enumerate() {
@@ -648,13 +894,13 @@ mod tests {
                 }
             }
             // Offsets 0 and far past the radius: the table's first entry and its last.
-            let k = [-0.5, 999.5, -1000.5, 2.0];
-            let four = axis.weights4(k, 0.0);
+            let offsets = [0.0, 1000.0, -1000.0, 2.5];
+            let four = axis.weights4(offsets);
             for j in 0..4 {
                 assert_eq!(
                     four[j].to_bits(),
-                    axis.weight(k[j] + 0.5).to_bits(),
-                    "{k:?}"
+                    axis.weight(offsets[j]).to_bits(),
+                    "{offsets:?}"
                 );
             }
         }
@@ -665,11 +911,6 @@ mod tests {
     /// the table's interpolation), not a loose guess.
     #[test]
     fn weight_bounds_hold_every_weight_and_say_which_filters_weigh_negatively() {
-        let mitchell = FilterKind::Mitchell {
-            b: DEFAULT_MITCHELL_B,
-            c: DEFAULT_MITCHELL_C,
-        };
-        let catmullrom = FilterKind::Mitchell { b: 0.0, c: 0.5 };
         for (kind, radius, negative) in [
             (FilterKind::Box, 0.5, false),
             (FilterKind::Box, 2.5, false),
@@ -678,9 +919,7 @@ mod tests {
             (FilterKind::Gaussian { alpha: 0.5 }, 3.3, false),
             (FilterKind::BlackmanHarris, 2.0, false),
             (FilterKind::BlackmanHarris, 4.0, false),
-            (mitchell, 2.0, true),
-            (mitchell, 0.5, true),
-            (catmullrom, 2.0, true),
+            (FilterKind::CatmullRom, 2.0, true),
             (FilterKind::Sinc { tau: 3.0 }, 4.0, true),
             (FilterKind::Sinc { tau: 3.0 }, 0.9, false),
             (FilterKind::Triangle, MAX_WIDTH, false),
@@ -694,7 +933,7 @@ mod tests {
             let mut largest = vec![0.0f32; bounds.x.len()];
             for i in 0..1000 {
                 let u = (i as f32 / 1000.0).min(1.0f32.next_down());
-                let taps = filter.taps_x(20, u, 0, 40);
+                let taps = filter.x.taps(20, u, 0, 40);
                 for (j, &w) in taps.weights().iter().enumerate() {
                     let at = (taps.first + j as u32 + border - 20) as usize;
                     assert!(w.abs() <= bounds.x[at], "{kind:?} {radius}: {w} at {at}");
@@ -711,26 +950,135 @@ mod tests {
         }
     }
 
+    /// A radial filter's weights, in any footprint: within their bounds by offset, at most 1
+    /// (and negative for mitchell's parameters that have lobes), the offsets' length in half-widths through its
+    /// profile, so not the product of the axes' weights.
     #[test]
-    fn mitchell_weights_have_negative_lobes() {
-        let f = filter(
-            FilterKind::Mitchell {
-                b: DEFAULT_MITCHELL_B,
-                c: DEFAULT_MITCHELL_C,
-            },
-            2.0,
-        );
-        // A sample at 10.3 reaches the centres 8.5 to 11.5; those beyond half the radius
-        // (offsets -1.8 and 1.2) weigh less than nothing.
-        let taps = f.taps_x(10, 0.3, 0, 20);
-        assert_eq!(taps.first, 8);
-        let w = taps.weights();
-        assert_eq!(w.len(), 4);
+    fn mitchell_is_radial_as_luxrenders_and_within_its_bounds() {
+        let sharper = FilterKind::Mitchell {
+            b: 0.0,
+            c: 0.5,
+            supersample: false,
+        };
+        for (kind, rx, ry) in [(FilterKind::MITCHELL, 2.0, 1.5), (sharper, 2.0, 2.0)] {
+            let f = PixelFilter::new(&FilterDesc {
+                kind,
+                xwidth: rx,
+                ywidth: ry,
+            });
+            let bounds = f.weight_bounds();
+            assert!(bounds.negative, "{kind:?}");
+            let peak = filter_1d(kind, 0.0, 1.0);
+            let mut worst = 0.0f32;
+            for i in 0..40 {
+                let u = Vec2::new((i as f32 + 0.5) / 40.0, ((i * 7) % 40) as f32 / 40.0);
+                let fp = f.footprint((20, 20), u, (0, 0), (40, 40));
+                for row in 0..fp.row_count() {
+                    let weights = fp.row(row);
+                    let dy = (fp.rows.first + row as u32) as f32 + 0.5 - (20.0 + u.y);
+                    for (column, &w) in weights[..fp.column_count()].iter().enumerate() {
+                        let dx = (fp.columns.first + column as u32) as f32 + 0.5 - (20.0 + u.x);
+                        let d = ((dx / rx).powi(2) + (dy / ry).powi(2)).sqrt();
+                        let exact = filter_1d(kind, d.min(1.0), 1.0) / peak;
+                        let (kx, ky) = (
+                            (fp.columns.first + column as u32 + f.x.border - 20) as usize,
+                            (fp.rows.first + row as u32 + f.y.border - 20) as usize,
+                        );
+                        let bound = bounds.x[kx] * bounds.y[ky];
+                        assert!(w.abs() <= bound.min(1.0), "{kind:?}: {w} over {bound}");
+                        worst = worst.max((w - exact).abs());
+                    }
+                }
+            }
+            assert!(worst < 1e-3, "{kind:?}: off the radial profile by {worst}");
+        }
+        // At (1.2, 1.2) half-widths of 2 pixels from the sample, the product of the axes'
+        // weights would be positive (two negative lobes); the radial weight at 0.85 half-widths
+        // is negative.
+        let f = filter(FilterKind::MITCHELL, 2.0);
+        let fp = f.footprint((10, 10), Vec2::splat(0.3), (0, 0), (20, 20));
+        assert_eq!((fp.columns.first, fp.rows.first), (8, 8));
+        let w = fp.row(3)[3];
         assert!(
-            w[0] < 0.0 && w[3] < 0.0 && w[1] > 0.0 && w[2] > 0.0,
-            "{w:?}"
+            w < 0.0 && filter_1d(FilterKind::MITCHELL, 1.2, 2.0) < 0.0,
+            "{w}"
         );
-        assert!(w.iter().all(|w| w.abs() <= 1.0));
+    }
+
+    /// LuxRender's supersampled mitchell: 5/3 the half-widths, its profile three cubics whose
+    /// sum integrates as one does (along the distance, in pixels) and peaks at the centre.
+    #[test]
+    fn supersampled_mitchell_is_wider_with_three_lobes() {
+        let ss = FilterKind::Mitchell {
+            b: DEFAULT_MITCHELL_B,
+            c: DEFAULT_MITCHELL_C,
+            supersample: true,
+        };
+        let desc = FilterDesc {
+            kind: ss,
+            xwidth: 1.5,
+            ywidth: 1.5,
+        };
+        assert_eq!(desc.half_widths(), [2.5, 2.5]);
+        assert_eq!(desc.border(), [2, 2]);
+        let integral = |kind: FilterKind| -> f64 {
+            let n = 100_000;
+            (0..n)
+                .map(|i| f64::from(filter_1d(kind, (i as f32 + 0.5) / n as f32, 1.0)))
+                .sum::<f64>()
+                / f64::from(n)
+        };
+        // Over the distance in pixels, 5/3 as wide: the cubic's integral at the file's width.
+        let (one, three) = (integral(FilterKind::MITCHELL), integral(ss));
+        assert!(
+            (three * 5.0 / 3.0 / one - 1.0).abs() < 0.01,
+            "{three} vs {one}"
+        );
+        assert!(filter_1d(ss, 0.0, 1.0) > filter_1d(ss, 0.3, 1.0));
+        assert!(filter_1d(ss, 1.0, 1.0).abs() < 1e-6);
+    }
+
+    /// A radial filter's film mass: its 2D integral inside the film, the part whose samples lie
+    /// in the film at an edge and a corner (summed here sample by sample).
+    #[test]
+    fn a_radial_filters_film_mass_is_its_integral_within_the_film() {
+        let f = PixelFilter::new(&FilterDesc {
+            kind: FilterKind::MITCHELL,
+            xwidth: 2.0,
+            ywidth: 1.5,
+        });
+        let mass = f.film_mass(12, 10);
+        let n = 200;
+        let measured = |x: u32, y: u32| -> f64 {
+            let mut sum = 0.0;
+            for sy in 0..10u32 {
+                for sx in 0..12u32 {
+                    for i in 0..n {
+                        let u = Vec2::new(
+                            (i as f32 + 0.5) / n as f32,
+                            ((i * 37) % n) as f32 / n as f32 + 0.5 / n as f32,
+                        );
+                        let fp = f.footprint((sx, sy), u, (0, 0), (12, 10));
+                        if (fp.rows.first..fp.rows.first + fp.row_count() as u32).contains(&y)
+                            && (fp.columns.first..fp.columns.first + fp.column_count() as u32)
+                                .contains(&x)
+                        {
+                            let row = fp.row((y - fp.rows.first) as usize);
+                            sum += f64::from(row[(x - fp.columns.first) as usize]);
+                        }
+                    }
+                }
+            }
+            sum / f64::from(n)
+        };
+        for (x, y) in [(6, 5), (0, 5), (0, 0)] {
+            let (want, got) = (measured(x, y), f64::from(mass.at(x, y)));
+            assert!(
+                (got / want - 1.0).abs() < 0.01,
+                "({x}, {y}): {got} vs {want}"
+            );
+        }
+        assert!(mass.at(0, 0) < mass.at(0, 5) && mass.at(0, 5) < mass.at(6, 5));
     }
 
     #[test]
@@ -744,13 +1092,13 @@ mod tests {
             }
             .border()[0];
             for u in [0.0, 0.25, 0.5, 0.999_999_94] {
-                let taps = f.taps_x(20, u, 0, 100);
+                let taps = f.x.taps(20, u, 0, 100);
                 let n = taps.weights().len() as u32;
                 assert!(
                     taps.first >= 20 - b && taps.first + n <= 21 + b,
                     "{width} {u}"
                 );
-                let clipped = f.taps_x(20, u, 19, 21);
+                let clipped = f.x.taps(20, u, 19, 21);
                 assert!(
                     clipped.first >= 19 && clipped.first + clipped.weights().len() as u32 <= 21
                 );

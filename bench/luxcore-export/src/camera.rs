@@ -76,15 +76,23 @@ pub fn write_config(desc: &SceneDesc) -> String {
             c.set("film.filter.gaussian.alpha", alpha);
             "GAUSSIAN"
         }
-        FilterKind::Mitchell { b, c: cc } => {
+        // LuxCore's mitchell is separable, LuxRender's (and YAT's) radial: the nearest it
+        // has, at the width rendered (a supersampled one's 5/3 of the file's).
+        FilterKind::Mitchell { b, c: cc, .. } => {
             c.set("film.filter.mitchell.b", b);
             c.set("film.filter.mitchell.c", cc);
+            "MITCHELL"
+        }
+        FilterKind::CatmullRom => {
+            c.set("film.filter.mitchell.b", 0.0);
+            c.set("film.filter.mitchell.c", 0.5);
             "MITCHELL"
         }
         FilterKind::BlackmanHarris => "BLACKMANHARRIS",
     };
     c.set("film.filter.type", quoted(kind));
-    c.set("film.filter.xwidth", f.xwidth);
-    c.set("film.filter.ywidth", f.ywidth);
+    let [xwidth, ywidth] = f.half_widths();
+    c.set("film.filter.xwidth", xwidth);
+    c.set("film.filter.ywidth", ywidth);
     c.into_text()
 }

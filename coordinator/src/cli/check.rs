@@ -326,7 +326,11 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
         FilterKind::Box => "box".to_string(),
         FilterKind::Triangle => "triangle".to_string(),
         FilterKind::Gaussian { alpha } => format!("gaussian (alpha {alpha})"),
-        FilterKind::Mitchell { b, c } => format!("mitchell (B {b:.3}, C {c:.3})"),
+        FilterKind::Mitchell { b, c, supersample } => format!(
+            "mitchell (B {b:.3}, C {c:.3}, radial{})",
+            if supersample { ", supersampled" } else { "" }
+        ),
+        FilterKind::CatmullRom => "catmullrom".to_string(),
         FilterKind::BlackmanHarris => "blackmanharris".to_string(),
         FilterKind::Sinc { tau } => format!("sinc (tau {tau})"),
     };

@@ -940,12 +940,7 @@ const WIDTH_4: &[LuxParam] = &[
 const MITCHELL: &[LuxParam] = &[
     param("B", Float(1.0 / 3.0), Rendered),
     param("C", Float(1.0 / 3.0), Rendered),
-    differs(
-        "supersample",
-        Bool(false),
-        "LuxRender blends three shifted Mitchell lobes into a wider, smoother filter; YAT uses \
-         the plain one",
-    ),
+    param("supersample", Bool(false), Rendered),
 ];
 
 /// LuxRender's Catmull-Rom keeps its two-pixel lobes at any width (a width only cuts it

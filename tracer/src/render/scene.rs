@@ -428,14 +428,16 @@ impl RenderScene {
         if !(0.0..width as f32).contains(&px) || !(0.0..height as f32).contains(&py) {
             return;
         }
-        let (x, y) = (px as u32, py as u32);
-        let columns = self.filter.taps_x(x, splat.raster.x - px, 0, width);
-        let rows = self.filter.taps_y(y, splat.raster.y - py, 0, height);
-        for (row, &wy) in rows.weights().iter().enumerate() {
-            let y = rows.first + row as u32;
-            for (column, &wx) in columns.weights().iter().enumerate() {
-                let x = columns.first + column as u32;
-                let weight = wx * wy / mass.at(x, y);
+        let u = Vec2::new(splat.raster.x - px, splat.raster.y - py);
+        let f = self
+            .filter
+            .footprint((px as u32, py as u32), u, (0, 0), (width, height));
+        for row in 0..f.row_count() {
+            let y = f.rows.first + row as u32;
+            let weights = f.row(row);
+            for (column, &w) in weights[..f.column_count()].iter().enumerate() {
+                let x = f.columns.first + column as u32;
+                let weight = w / mass.at(x, y);
                 splat_sums.add(y * width + x, splat.radiance * weight);
             }
         }
@@ -547,24 +549,23 @@ impl RenderScene {
         half: bool,
     ) {
         let region = sums.buffer.region;
-        let columns = self.filter.taps_x(x, u.x, region.x0, region.x1);
-        let rows = self.filter.taps_y(y, u.y, region.y0, region.y1);
+        let f = self
+            .filter
+            .footprint((x, y), u, (region.x0, region.y0), (region.x1, region.y1));
         let width = region.width() as usize;
         let plane_len = region.pixel_count();
         let plane = self.plane_offset(&sums.buffer, (x, y));
-        let first_column = (columns.first - region.x0) as usize;
-        let taps = columns.weights().len();
+        let first_column = (f.columns.first - region.x0) as usize;
+        let taps = f.column_count();
         let sample = radiance.extend(1.0);
-        for (row, &wy) in rows.weights().iter().enumerate() {
-            let start = (rows.first - region.y0) as usize * width + row * width + first_column;
+        for row in 0..f.row_count() {
+            let start = (f.rows.first - region.y0) as usize * width + row * width + first_column;
+            let weights = f.row(row);
             // Each row's run of pixels is sliced once, so the loops below check no bounds (a
             // check per tap was a third of the splat's instructions).
             let add = |pixels: &mut [Vec4]| {
-                for (sum, &wx) in pixels[start..start + taps]
-                    .iter_mut()
-                    .zip(columns.weights())
-                {
-                    *sum += sample * (wx * wy);
+                for (sum, &w) in pixels[start..start + taps].iter_mut().zip(&weights) {
+                    *sum += sample * w;
                 }
             };
             add(&mut sums.all[plane..plane + plane_len]);
@@ -577,11 +578,12 @@ impl RenderScene {
             let values = layers.values(self.frame.layers);
             // The sample count's value is 0 here: it is counted in its own pixel alone.
             let values = &values[..k];
-            for (row, &wy) in rows.weights().iter().enumerate() {
-                let start = (rows.first - region.y0) as usize * width + row * width + first_column;
+            for row in 0..f.row_count() {
+                let start =
+                    (f.rows.first - region.y0) as usize * width + row * width + first_column;
+                let weights = f.row(row);
                 let run = &mut sums.layers[(plane + start) * k..(plane + start + taps) * k];
-                for (pixel, &wx) in run.chunks_exact_mut(k).zip(columns.weights()) {
-                    let w = wx * wy;
+                for (pixel, &w) in run.chunks_exact_mut(k).zip(&weights) {
                     for (sum, &v) in pixel.iter_mut().zip(values) {
                         *sum += v * w;
                     }

@@ -180,13 +180,7 @@ fn options_have_luxrender_defaults() {
         (d.film.filename.as_str(), d.film.haltspp, d.film.halttime),
         ("luxout", None, None)
     );
-    assert_eq!(
-        d.filter.kind,
-        FilterKind::Mitchell {
-            b: 1.0 / 3.0,
-            c: 1.0 / 3.0
-        }
-    );
+    assert_eq!(d.filter.kind, FilterKind::MITCHELL);
     assert_eq!((d.filter.xwidth, d.filter.ywidth), (2.0, 2.0));
     let i = &d.integrator;
     assert_eq!(

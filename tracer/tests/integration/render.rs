@@ -449,10 +449,7 @@ fn sky_only(size: u32, filter: FilterDesc) -> SceneDesc {
 
 fn mitchell(width: f32) -> FilterDesc {
     FilterDesc {
-        kind: FilterKind::Mitchell {
-            b: 1.0 / 3.0,
-            c: 1.0 / 3.0,
-        },
+        kind: FilterKind::MITCHELL,
         xwidth: width,
         ywidth: width,
     }
@@ -496,10 +493,14 @@ fn a_unit_splats_every_samples_whole_filter_weight() {
             for index in unit.sample_start..unit.sample_end {
                 let mut sampler = PixelSampler::new(x, y, index, settings.spp, settings.seed);
                 let u = sampler.get_2d();
-                let sum = |t: &[f32]| t.iter().map(|&w| f64::from(w)).sum::<f64>();
-                let wx = sum(filter.taps_x(x, u.x, 0, u32::MAX).weights());
-                let wy = sum(filter.taps_y(y, u.y, 0, u32::MAX).weights());
-                expected += wx * wy;
+                let f = filter.footprint((x, y), u, (0, 0), (u32::MAX, u32::MAX));
+                for row in 0..f.row_count() {
+                    let weights = f.row(row);
+                    expected += weights[..f.column_count()]
+                        .iter()
+                        .map(|&w| f64::from(w))
+                        .sum::<f64>();
+                }
             }
         }
     }
