@@ -320,7 +320,7 @@ impl Checkpoint {
             (HEADER_LEN + DIGEST_LEN) as u64 + (sampling.max_units(settings) as u64).div_ceil(8);
         let layers = frame.layers.len() as u64 * 8;
         match sampling {
-            Sampling::Uniform => fixed + pixels * (32 + layers) + splats_len(&frame, pixels) as u64,
+            Sampling::Uniform => fixed + pixels * (32 + layers) + splats_len(&frame) as u64,
             Sampling::Adaptive(_) => {
                 let blocks = BlockGrid::of(settings).len() as u64;
                 let planes = frame.source_planes() as u64;
@@ -332,7 +332,7 @@ impl Checkpoint {
             Sampling::Converging(_) => {
                 fixed
                     + pixels * (32 + layers)
-                    + splats_len(&frame, pixels) as u64
+                    + splats_len(&frame) as u64
                     + converging_rounds_len(pixels as usize) as u64
             }
         }
@@ -378,7 +378,7 @@ impl Checkpoint {
             Sampling::Adaptive(_) => ((planes + 1) * pixels, adaptive_rounds_len(blocks)),
             Sampling::Converging(_) => (pixels, converging_rounds_len(pixels)),
         };
-        let splat_len = splats_len(&frame, pixels as u64);
+        let splat_len = splats_len(&frame);
         let layer_planes = if sampling.adaptive().is_some() {
             planes
         } else {
@@ -480,9 +480,9 @@ fn converging_rounds_len(pixels: usize) -> usize {
 
 /// Bytes of a checkpoint's light splats: three i64 sums per pixel and the light paths (u64),
 /// for a render whose units carry them; none otherwise.
-fn splats_len(frame: &FilmFrame, pixels: u64) -> usize {
+fn splats_len(frame: &FilmFrame) -> usize {
     if frame.light_splats {
-        (pixels * 24 + 8) as usize
+        (frame.splat_entries() * 24 + 8) as usize
     } else {
         0
     }

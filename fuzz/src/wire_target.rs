@@ -391,6 +391,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 haltthreshold: None,
                 convergence_step: yat_tracer::film::DEFAULT_CONVERGENCE_STEP,
                 outputs: Default::default(),
+                light_groups: Default::default(),
             });
             8 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),
@@ -455,6 +456,7 @@ fn frame_for(settings: &RenderSettings) -> FilmFrame {
         layers: Layers {
             alpha: settings.seed & 2 != 0,
             aovs: settings.aovs,
+            light_groups: if settings.seed & 8 != 0 { 3 } else { 0 },
         },
     }
 }

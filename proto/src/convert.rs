@@ -372,20 +372,18 @@ pub fn encode_splats(splats: &LightSplats) -> Bytes {
 }
 
 /// Reads the light splats of unit `index` back from their wire form: whole pixels, no more than
-/// a unit of `frame` reports (none unless it has light splats; at most its pixels and
-/// [`MAX_SPLAT_PIXELS`]), checked before anything is allocated; then what
+/// a unit of `frame` reports (none unless it has light splats; at most the pixels of its
+/// splat planes, `FilmFrame::splat_entries`, and [`MAX_SPLAT_PIXELS`]), checked before
+/// anything is allocated; then what
 /// [`LightSplats::check`] asks (sorted pixels inside the film, values a unit reports).
 pub fn decode_splats(
     index: u32,
     frame: &FilmFrame,
     bytes: &[u8],
 ) -> Result<LightSplats, WireError> {
-    let film_pixels = u64::from(frame.width) * u64::from(frame.height);
-    let max = if frame.light_splats {
-        MAX_SPLAT_PIXELS.min(usize::try_from(film_pixels).unwrap_or(usize::MAX))
-    } else {
-        0
-    };
+    // The film's pixels in every plane (the image's light and each light group's).
+    let entries = frame.splat_entries();
+    let max = MAX_SPLAT_PIXELS.min(usize::try_from(entries).unwrap_or(usize::MAX));
     let count = bytes.len() / BYTES_PER_SPLAT;
     if !bytes.len().is_multiple_of(BYTES_PER_SPLAT) || count > max {
         return Err(WireError::SplatsLength {
@@ -1433,6 +1431,7 @@ mod tests {
             layers: Layers {
                 alpha: true,
                 aovs: Aovs::from_bits(15).unwrap(),
+                light_groups: 0,
             },
             ..plain
         };

@@ -448,11 +448,6 @@ fn a_bidirectional_render_is_the_same_bytes_on_workers_killed_or_not() {
     );
 }
 
-/// The PNG, TGA and EXR of `out` (the Film's three files).
-fn three_files(out: &Path) -> [Vec<u8>; 3] {
-    ["png", "tga", "exr"].map(|ext| std::fs::read(out.with_extension(ext)).unwrap())
-}
-
 /// A film that writes alpha (`scenes/exported/film-outputs.lxs`: a 16-bit RGBA PNG, an RGB
 /// TGA, a half RGBA EXR), with every AOV asked for, renders to the same bytes in-process and on
 /// two workers, uniform, or adaptive with one worker killed mid-render; its alpha is 0 on the
@@ -461,73 +456,147 @@ fn three_files(out: &Path) -> [Vec<u8>; 3] {
 /// of sums.
 #[test]
 fn alpha_and_aovs_are_the_same_bytes_in_process_and_on_workers() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = crate::workspace::workspace_root().join("scenes/exported/film-outputs.lxs");
     let overrides = RenderOverrides {
         spp: Some(16),
         aovs: yat_tracer::render::layers::Aovs::from_names("albedo,normal,depth,samples").unwrap(),
         ..SETTINGS_OVERRIDES
     };
+    let bytes_per_pixel = same_files_in_process_and_on_workers(
+        "film-outputs.lxs",
+        &overrides,
+        &["albedo.R", "N.Z", "Z", "samples"],
+        |name, reference| {
+            let png = image::open(reference).unwrap().to_rgba16();
+            let alphas: std::collections::BTreeSet<u16> = png.pixels().map(|p| p.0[3]).collect();
+            assert!(
+                alphas.contains(&0) && alphas.contains(&65535),
+                "{name}: transparent sky and opaque floor: {alphas:?}"
+            );
+            assert_eq!(png.get_pixel(48, 2).0[3], 0, "{name}: the sky");
+            assert_eq!(png.get_pixel(48, 60).0[3], 65535, "{name}: the floor");
+        },
+    );
+    assert_eq!(bytes_per_pixel, (16.0 + 40.0) * 12740.0 / 12288.0);
+}
+
+/// A scene with three light groups (`scenes/exported/lightgroups.lxs`) keeps each group's
+/// light as a layer: the same PNG and EXR bytes in-process and on two workers, uniform, or
+/// adaptive with one worker killed mid-render, and bidirectional (its light splats kept per
+/// group too) with one killed; the EXR has a layer per group, and each unit's reply carries 36
+/// bytes of layers a pixel (three groups' RGB sums) besides its 16 of sums.
+#[test]
+fn light_group_layers_are_the_same_bytes_in_process_and_on_workers() {
+    let channels = [
+        "lightgroup.daylight.R",
+        "lightgroup.ceiling.G",
+        "lightgroup.fill.B",
+    ];
+    let path = RenderOverrides {
+        spp: Some(16),
+        ..SETTINGS_OVERRIDES
+    };
+    let bytes_per_pixel =
+        same_files_in_process_and_on_workers("lightgroups.lxs", &path, &channels, |_, _| {});
+    assert_eq!(bytes_per_pixel, (16.0 + 36.0) * 12740.0 / 12288.0);
+    let bidirectional = RenderOverrides {
+        spp: Some(4),
+        transport: Some(Transport::Bidirectional),
+        ..SETTINGS_OVERRIDES
+    };
+    let bytes_per_pixel = same_files_in_process_and_on_workers(
+        "lightgroups.lxs",
+        &bidirectional,
+        &channels,
+        |_, _| {},
+    );
+    assert!(
+        bytes_per_pixel > (16.0 + 36.0) * 12740.0 / 12288.0,
+        "the results carry light splats: {bytes_per_pixel}"
+    );
+}
+
+/// Renders `scenes/exported/<scene>` (whose Film writes a PNG and an EXR, perhaps a TGA) with
+/// `overrides` in-process and on two workers, uniform, then (one worker killed mid-render)
+/// adaptive, or again uniform for a bidirectional render (which takes no adaptive sampling),
+/// and asserts every file is the same bytes both ways and the EXR has `channels`;
+/// `check(name, png)` looks at each in-process PNG. Returns the bytes a unit's reply carries
+/// per image pixel in the uniform render, 128x96 in 64-pixel tiles: with the 1-pixel border of
+/// the scenes' mitchell of half-width 1.5, regions of 65x65, 65x65, 65x33 and 65x33 pixels,
+/// 12740 for the 12288 of the image, 16 bytes of sums each and the layers'.
+fn same_files_in_process_and_on_workers(
+    scene: &str,
+    overrides: &RenderOverrides,
+    channels: &[&str],
+    check: impl Fn(&str, &Path),
+) -> f64 {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = crate::workspace::workspace_root()
+        .join("scenes/exported")
+        .join(scene);
     let adaptive = yat_tracer::render::adaptive::AdaptiveSettings {
         threshold: 0.05,
         min_spp: 4,
     };
     let throttle = ["--throttle-ms", "50"];
-    for (name, adaptive) in [("uniform", None), ("adaptive", Some(adaptive))] {
+    let mut bytes_per_pixel = None;
+    let bidirectional = overrides.transport == Some(Transport::Bidirectional);
+    let second = if bidirectional {
+        ("killed", None)
+    } else {
+        ("adaptive", Some(adaptive))
+    };
+    for (name, adaptive) in [("uniform", None), second] {
         let reference = dir.path().join(format!("{name}-in-process.png"));
         render_here(
-            request_with(&scene, &reference, &overrides, adaptive),
+            request_with(&scene, &reference, overrides, adaptive),
             two_threads(),
         )
         .unwrap();
-        let expected = three_files(&reference);
-        let png = image::open(&reference).unwrap().to_rgba16();
-        let alphas: std::collections::BTreeSet<u16> = png.pixels().map(|p| p.0[3]).collect();
-        assert!(
-            alphas.contains(&0) && alphas.contains(&65535),
-            "{name}: transparent sky and opaque floor: {alphas:?}"
-        );
-        assert_eq!(png.get_pixel(48, 2).0[3], 0, "{name}: the sky");
-        assert_eq!(png.get_pixel(48, 60).0[3], 65535, "{name}: the floor");
+        let expected = film_files(&reference);
+        check(name, &reference);
         let exr = exr::meta::MetaData::read_from_file(reference.with_extension("exr"), false);
-        let channels: Vec<String> = exr.unwrap().headers[0]
+        let found: Vec<String> = exr.unwrap().headers[0]
             .channels
             .list
             .iter()
             .map(|c| c.name.to_string())
             .collect();
-        for aov in ["albedo.R", "N.Z", "Z", "samples"] {
-            assert!(channels.iter().any(|c| c == aov), "{name}: {channels:?}");
+        for channel in channels {
+            assert!(found.iter().any(|c| c == channel), "{name}: {found:?}");
         }
 
         let (mut a, b) = (Worker::start(&throttle), Worker::start(&throttle));
         let out = dir.path().join(format!("{name}-workers.png"));
         let json = dir.path().join(format!("{name}.json"));
         let coordinator = spawn_render(
-            request_with(&scene, &out, &overrides, adaptive),
+            request_with(&scene, &out, overrides, adaptive),
             reporting_to(&json, workers_at(&[&a.address, &b.address])),
             Observers::none(),
             Interrupt::default(),
         );
-        if adaptive.is_some() {
+        if name != "uniform" {
             wait_for_units(&[&a, &b], 2);
             a.kill();
         }
         coordinator.join().unwrap().unwrap();
-        let got = three_files(&out);
-        for (i, ext) in ["PNG", "TGA", "EXR"].iter().enumerate() {
-            assert!(
-                got[i] == expected[i],
-                "{name}: the {ext} differs from in-process"
-            );
+        let got = film_files(&out);
+        assert_eq!(got.len(), expected.len(), "{name}: the files written");
+        for ((ext, got), (_, expected)) in got.iter().zip(&expected) {
+            assert!(got == expected, "{name}: the {ext} differs from in-process");
         }
-        if adaptive.is_none() {
-            // 128x96 in 64-pixel tiles with the 1-pixel border of the scene's mitchell of
-            // half-width 1.5: regions of 65x65, 65x65, 65x33 and 65x33 pixels, 12740 for the
-            // 12288 of the image, 16 + 40 bytes each.
+        if name == "uniform" {
             let report = workers_report(&json);
             let per_pixel = report["result_bytes_per_unit_pixel"].as_f64().unwrap();
-            assert_eq!(per_pixel, 56.0 * 12740.0 / 12288.0, "{report:#}");
+            bytes_per_pixel = Some(per_pixel);
         }
     }
+    bytes_per_pixel.expect("the uniform render's report")
+}
+
+/// The PNG, TGA and EXR of `out` that the render wrote, with their extensions.
+fn film_files(out: &Path) -> Vec<(&'static str, Vec<u8>)> {
+    ["png", "tga", "exr"]
+        .into_iter()
+        .filter_map(|ext| Some((ext, std::fs::read(out.with_extension(ext)).ok()?)))
+        .collect()
 }

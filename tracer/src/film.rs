@@ -34,9 +34,11 @@ use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
 use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
 
+pub mod light_groups;
 pub mod outputs;
 pub mod splats;
 
+pub use light_groups::{LightGroupDesc, LightGroups, MAX_LIGHT_GROUPS};
 pub use outputs::{AovImages, FilmImage, FilmOutputs, OutputError, OutputFile};
 pub use splats::{FilmSplats, LightSplats, SplatMisfit, SplatSums, MAX_SPLAT_PIXELS};
 
@@ -105,6 +107,9 @@ pub struct FilmDesc {
     pub convergence_step: f32,
     /// Which files the render writes, and how ([`outputs`]).
     pub outputs: FilmOutputs,
+    /// The scene's light groups ([`light_groups`]): the `LightGroup` statements of the world
+    /// block, which the parser adds once it has read them.
+    pub light_groups: LightGroups,
 }
 
 impl FilmDesc {
@@ -208,6 +213,7 @@ impl FilmDesc {
                 DEFAULT_CONVERGENCE_STEP
             },
             outputs: FilmOutputs::read(ctx, params, pos)?,
+            light_groups: LightGroups::default(),
         })
     }
 }
@@ -328,7 +334,9 @@ impl Film {
             sums: vec![[0; 4]; pixels],
             half: Vec::new(),
             block_samples: Vec::new(),
-            splats: frame.light_splats.then(|| FilmSplats::new(pixels)),
+            splats: frame
+                .light_splats
+                .then(|| FilmSplats::new(frame.splat_entries() as usize)),
             layers: vec![0; pixels * frame.layers.len()],
         }
     }
@@ -452,7 +460,7 @@ impl Film {
                 && !frame.light_splats
         };
         let splats_fit = match &splats {
-            Some(splats) => frame.light_splats && splats.sums.len() == pixels,
+            Some(splats) => frame.light_splats && splats.sums.len() as u64 == frame.splat_entries(),
             None => !frame.light_splats,
         };
         let layers_fit = layers.len() == sums.len() * frame.layers.len();
@@ -651,6 +659,11 @@ impl Film {
         (sum / weight) as f32
     }
 
+    /// The film's pixels.
+    fn pixel_count(&self) -> usize {
+        self.frame.width as usize * self.frame.height as usize
+    }
+
     /// Every pixel's value of `f(x, y)`, rows top to bottom.
     fn per_pixel<T>(&self, f: impl Fn(u32, u32) -> T) -> Vec<T> {
         (0..self.frame.height)
@@ -693,6 +706,39 @@ impl Film {
         }
     }
 
+    /// Each light group's linear radiance per pixel (rows top to bottom), with its name, when
+    /// the frame keeps them apart; empty otherwise.
+    pub fn light_group_images(&self, groups: &LightGroups) -> Vec<(String, Vec<Vec3>)> {
+        let Some(at) = self.frame.layers.offsets().light_groups else {
+            return Vec::new();
+        };
+        let count = usize::from(self.frame.layers.light_groups);
+        groups
+            .groups
+            .iter()
+            .take(count)
+            .enumerate()
+            .map(|(g, desc)| {
+                let k = at + 3 * g;
+                let pixels = self.pixel_count();
+                let light = self.per_pixel(|x, y| {
+                    let camera = Vec3::new(
+                        self.layer_pixel(x, y, k),
+                        self.layer_pixel(x, y, k + 1),
+                        self.layer_pixel(x, y, k + 2),
+                    );
+                    // A bidirectional render's light splats of the group, in its plane.
+                    let i = (y * self.frame.width + x) as usize;
+                    match &self.splats {
+                        Some(splats) => camera + splats.radiance((1 + g) * pixels + i, pixels),
+                        None => camera,
+                    }
+                });
+                (desc.name.clone(), light)
+            })
+            .collect()
+    }
+
     /// Every pixel's alpha (rows top to bottom), when the frame keeps it.
     pub fn alpha(&self) -> Option<Vec<f32>> {
         let at = self.frame.layers.offsets().alpha?;
@@ -718,7 +764,7 @@ impl Film {
     /// the film keeps them (and exactly `camera` when it does not).
     fn with_splats(&self, i: usize, camera: Vec3) -> Vec3 {
         match &self.splats {
-            Some(splats) => camera + splats.radiance(i),
+            Some(splats) => camera + splats.radiance(i, self.pixel_count()),
             None => camera,
         }
     }
@@ -745,7 +791,27 @@ impl Film {
     /// radiance, and how an 8- or 16-bit file limits and encodes it; what every file is
     /// written from ([`FilmImage::write`]).
     pub fn image(&self, film: &FilmDesc) -> FilmImage {
-        let linear = self.radiance();
+        let mut linear = self.radiance();
+        let light_groups = self.light_group_images(&film.light_groups);
+        if let Some(weighings) = film.light_groups.weighings() {
+            if light_groups.is_empty() {
+                // One group (or groups the render did not keep apart: bidirectional): the
+                // first group's weighing is the whole image's.
+                let single = film.light_groups.groups.len() == 1;
+                for rgb in linear.iter_mut().filter(|_| single) {
+                    *rgb = light_groups::weigh(&weighings[0], *rgb).as_vec3();
+                }
+            } else {
+                for (i, rgb) in linear.iter_mut().enumerate() {
+                    *rgb = weighings
+                        .iter()
+                        .zip(&light_groups)
+                        .map(|(w, (_, group))| light_groups::weigh(w, group[i]))
+                        .sum::<glam::DVec3>()
+                        .as_vec3();
+                }
+            }
+        }
         let mut tone_mapped = linear.clone();
         tone_map(&mut tone_mapped, &film.tonemap, film.gamma);
         FilmImage {
@@ -755,6 +821,7 @@ impl Film {
             tone_mapped,
             alpha: self.alpha(),
             aovs: self.aovs(),
+            light_groups,
             gamma: film.gamma,
             ldr_clamp: film.outputs.ldr_clamp,
         }

@@ -70,6 +70,24 @@ pub fn xyz_to_linear_srgb(xyz: DVec3) -> Vec3 {
     xyz_to_srgb(xyz).as_vec3()
 }
 
+/// Linear sRGB to CIE XYZ (D65 white): the inverse of [`xyz_to_linear_srgb`]'s matrix.
+pub fn linear_srgb_to_xyz(rgb: DVec3) -> DVec3 {
+    let (r, g, b) = (rgb.x, rgb.y, rgb.z);
+    DVec3::new(
+        0.4124 * r + 0.3576 * g + 0.1805 * b,
+        0.2126 * r + 0.7152 * g + 0.0722 * b,
+        0.0193 * r + 0.1192 * g + 0.9505 * b,
+    )
+}
+
+/// CIE XYZ of a blackbody at `kelvin` over LuxRender 1.x's film wavelengths, scaled to Y = 1:
+/// the white point a light group's colour temperature adapts to.
+pub fn blackbody_xyz(kelvin: f32) -> DVec3 {
+    let t = f64::from(kelvin.max(100.0));
+    let xyz = cie_xyz(|l| planck(l, t), FILM_NM, 1.0);
+    xyz / xyz.y
+}
+
 fn xyz_to_srgb(xyz: DVec3) -> DVec3 {
     let (x, y, z) = (xyz.x, xyz.y, xyz.z);
     DVec3::new(

@@ -18,6 +18,7 @@ use yat_tracer::desc::{
     AssetKind, CameraKind, FilterKind, Geometry, LightDesc, SceneDesc, ToneMap,
 };
 use yat_tracer::diag::{Severity, Warning};
+use yat_tracer::film::LightGroups;
 use yat_tracer::integrator::Transport;
 use yat_tracer::render::convergence::ConvergenceHalt;
 use yat_tracer::render::sampling::Sampling;
@@ -133,6 +134,49 @@ fn memory(scene: &ParsedScene) -> String {
 }
 
 /// The halts a render of the scene takes, the first met ending it, and where each comes from.
+/// The scene's light groups, each with its settings where they are not LuxRender's defaults,
+/// and what the render keeps of them; None without `LightGroup`s.
+fn light_groups(groups: &LightGroups) -> Option<String> {
+    if groups.groups.is_empty() || (groups.groups.len() == 1 && groups.groups[0].is_plain()) {
+        return None;
+    }
+    let named: Vec<String> = groups
+        .groups
+        .iter()
+        .map(|g| {
+            let mut settings = Vec::new();
+            if !g.enabled {
+                settings.push("disabled".to_string());
+            }
+            if g.scale != 1.0 {
+                settings.push(format!("scale {}", g.scale));
+            }
+            if g.rgb_scale != glam::Vec3::ONE {
+                let c = g.rgb_scale;
+                settings.push(format!("rgbscale {} {} {}", c.x, c.y, c.z));
+            }
+            if g.temperature > 0.0 {
+                settings.push(format!("{} K", g.temperature));
+            }
+            if settings.is_empty() {
+                g.name.clone()
+            } else {
+                format!("{} ({})", g.name, settings.join(", "))
+            }
+        })
+        .collect();
+    let kept = if groups.layered() {
+        "; the image is their weighed sum, each a layer of the EXR (lightgroup.<name>.R/G/B)"
+    } else {
+        "; the image is its light weighed"
+    };
+    Some(format!(
+        "{}: {}{kept}",
+        groups.groups.len(),
+        named.join(", ")
+    ))
+}
+
 fn halts(desc: &SceneDesc) -> String {
     let overrides = RenderOverrides::default();
     let settings = RenderSettings::resolve(desc, &overrides);
@@ -397,6 +441,9 @@ fn summary(path: &str, d: &SceneDesc, seconds: f64) -> String {
             .chain(std::iter::repeat_n("area (shapes)", emitters)),
     );
     let _ = writeln!(s, "lights       {lights}");
+    if let Some(groups) = light_groups(&f.light_groups) {
+        let _ = writeln!(s, "light groups {groups}");
+    }
     let materials = counts(d.materials.iter().map(|m| m.name()));
     let _ = writeln!(s, "materials    {} ({materials})", d.materials.len());
     let _ = writeln!(s, "textures     {}", d.textures.len());

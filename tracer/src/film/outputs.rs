@@ -39,7 +39,10 @@
 //! channels of the EXR: `albedo.R`, `albedo.G`, `albedo.B`, `N.X`, `N.Y`, `N.Z` in the EXR's
 //! precision, `Z` (depth: the mean camera distance of the pixel's samples that hit a surface,
 //! infinite where none did) and `samples` (the camera samples taken in the pixel) in full
-//! floats, as LuxRender writes its Z.
+//! floats, as LuxRender writes its Z. A render that keeps its light groups apart
+//! (`light_groups`) adds one layer per group, `lightgroup.<name>.R`, `.G`, `.B`: the group's
+//! linear radiance as rendered, before the weighing its settings give it in the image (the
+//! EXR's own RGB, the groups' weighed sum), for weighing again elsewhere.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -418,6 +421,9 @@ pub struct FilmImage {
     pub alpha: Option<Vec<f32>>,
     /// The AOVs the render kept, each None when it kept none.
     pub aovs: AovImages,
+    /// Each light group's linear radiance, as rendered (before its weighing), with the group's
+    /// name, when the render kept them apart (`film::light_groups`); empty otherwise.
+    pub light_groups: Vec<(String, Vec<Vec3>)>,
     /// The Film's gamma.
     pub gamma: f32,
     pub ldr_clamp: LdrClamp,
@@ -595,7 +601,11 @@ impl FilmImage {
                 source[i]
             }
         };
-        if format.channels == Channels::Rgb && !format.half && self.aovs.is_empty() {
+        if format.channels == Channels::Rgb
+            && !format.half
+            && self.aovs.is_empty()
+            && self.light_groups.is_empty()
+        {
             // The layout `image` writes (and YAT's EXR always had): the same bytes.
             Image::from_channels(
                 size,
@@ -640,6 +650,12 @@ impl FilmImage {
                 }
             }
         }
+        for (name, values) in &self.light_groups {
+            for (c, channel) in ["R", "G", "B"].into_iter().enumerate() {
+                let name = format!("{}.{channel}", light_group_layer(name));
+                list.push(AnyChannel::new(name.as_str(), plane(&|i| values[i][c])));
+            }
+        }
         let full = |values: &[f32]| FlatSamples::F32(values.to_vec());
         if let Some(depth) = &aovs.depth {
             list.push(AnyChannel::new("Z", full(depth)));
@@ -656,6 +672,22 @@ impl FilmImage {
         Image::from_layer(layer).write().to_file(path)?;
         Ok(())
     }
+}
+
+/// The EXR layer of light group `name`: `lightgroup.` and the name, its characters other than
+/// letters, digits, `_` and `-` made `_` (a dot would start another layer).
+pub fn light_group_layer(name: &str) -> String {
+    let name: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("lightgroup.{name}")
 }
 
 #[cfg(test)]
@@ -697,6 +729,7 @@ mod tests {
             linear,
             alpha: Some((0..n).map(|i| i as f32 / (n - 1) as f32).collect()),
             aovs: AovImages::default(),
+            light_groups: Vec::new(),
             gamma: 2.2,
             ldr_clamp,
         }

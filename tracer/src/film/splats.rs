@@ -40,7 +40,7 @@ pub enum SplatMisfit {
     TooMany(usize),
     #[error("light splat pixel {pixel} follows pixel {previous}: not strictly increasing")]
     Unsorted { previous: u32, pixel: u32 },
-    #[error("light splat pixel {pixel} lies outside the film's {pixels} pixels")]
+    #[error("light splat pixel {pixel} lies outside the film's {pixels} pixels (of every plane)")]
     OutOfRange { pixel: u32, pixels: u64 },
     #[error(
         "light splat pixel {pixel} holds {value}, which is not finite or exceeds {MAX_UNIT_SUM}"
@@ -59,7 +59,8 @@ impl LightSplats {
 
     /// Checks splats from a peer, hostile until they pass: none unless `frame` keeps light
     /// splats; as many values as pixels, at most [`MAX_SPLAT_PIXELS`]; pixels strictly
-    /// increasing inside the film (so no pixel is named twice); finite values no larger in
+    /// increasing inside the film's planes ([`FilmFrame::splat_entries`]: so no pixel is named
+    /// twice); finite values no larger in
     /// magnitude than a unit reports ([`unit_sum`]), so that no sum can saturate the film's.
     pub fn check(&self, frame: &FilmFrame) -> Result<(), SplatMisfit> {
         let count = self.pixels.len().max(self.rgb.len());
@@ -75,7 +76,7 @@ impl LightSplats {
         if self.pixels.len() > MAX_SPLAT_PIXELS {
             return Err(SplatMisfit::TooMany(self.pixels.len()));
         }
-        let film_pixels = u64::from(frame.width) * u64::from(frame.height);
+        let film_pixels = frame.splat_entries();
         let mut previous = None;
         for (&pixel, rgb) in self.pixels.iter().zip(&self.rgb) {
             if let Some(previous) = previous.filter(|&p| p >= pixel) {
@@ -196,7 +197,8 @@ impl SplatSums {
 /// and [`crate::film::Film::from_sums`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FilmSplats {
-    /// Per pixel of the film, row-major.
+    /// Per pixel of the film, row-major, a plane for the total and one per light group kept
+    /// apart ([`FilmFrame::splat_entries`]).
     pub sums: Vec<[i64; 3]>,
     /// Light subpaths of the units merged: one per camera sample of each
     /// ([`crate::render::WorkUnit::sample_count`]).
@@ -204,10 +206,10 @@ pub struct FilmSplats {
 }
 
 impl FilmSplats {
-    /// No splats yet, over a film of `pixels` pixels.
-    pub fn new(pixels: usize) -> Self {
+    /// No splats yet, over `entries` pixels (of every plane).
+    pub fn new(entries: usize) -> Self {
         Self {
-            sums: vec![[0; 3]; pixels],
+            sums: vec![[0; 3]; entries],
             light_paths: 0,
         }
     }
@@ -224,19 +226,20 @@ impl FilmSplats {
         self.light_paths = self.light_paths.saturating_add(light_paths);
     }
 
-    /// The light-tracing estimate of pixel `i`: its splat sum times the film's pixels over the
-    /// light paths (black before any). Each light path's splats are weighed for the pixel they
+    /// The light-tracing estimate of entry `at` (pixel `at % pixels` of plane `at / pixels`,
+    /// on a film of `pixels` pixels): its splat sum times the film's pixels over the light paths
+    /// (black before any). Each light path's splats are weighed for the pixel they
     /// land in as a camera sample of that pixel is (the camera's importance is normalised per
     /// pixel), so a pixel's estimate is the mean over the light paths *per pixel*: all the
     /// film's light paths reach every pixel alike, and there are `light_paths / pixels` of them
     /// per pixel, as there are `spp` camera samples. The same whichever units the splats came
     /// from, so it adds to the camera samples' weighted mean unchanged.
-    pub(super) fn radiance(&self, i: usize) -> Vec3 {
+    pub(super) fn radiance(&self, at: usize, pixels: usize) -> Vec3 {
         if self.light_paths == 0 {
             return Vec3::ZERO;
         }
-        let scale = self.sums.len() as f64 / (FIXED_ONE * self.light_paths as f64);
-        let [r, g, b] = self.sums[i].map(|s| (s as f64 * scale) as f32);
+        let scale = pixels as f64 / (FIXED_ONE * self.light_paths as f64);
+        let [r, g, b] = self.sums[at].map(|s| (s as f64 * scale) as f32);
         Vec3::new(r, g, b)
     }
 }
@@ -384,5 +387,25 @@ mod tests {
         let without = FilmFrame::unbordered(4, 2);
         assert_eq!(ok.check(&without), Err(SplatMisfit::NotKept(3)));
         assert_eq!(LightSplats::default().check(&without), Ok(()));
+        // With two light groups kept apart, three planes of the 8 pixels: 24 entries.
+        let grouped = FilmFrame {
+            layers: crate::render::layers::Layers {
+                light_groups: 2,
+                ..Default::default()
+            },
+            ..frame()
+        };
+        assert_eq!(grouped.splat_entries(), 24);
+        assert_eq!(
+            splats(vec![3, 11, 23], vec![[1.0; 3]; 3]).check(&grouped),
+            Ok(())
+        );
+        assert_eq!(
+            splats(vec![24], vec![[1.0; 3]]).check(&grouped),
+            Err(SplatMisfit::OutOfRange {
+                pixel: 24,
+                pixels: 24
+            })
+        );
     }
 }

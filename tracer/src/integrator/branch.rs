@@ -3,6 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::groups::GroupSink;
 use super::path::walk;
 use super::roulette::survives;
 use super::scene::PathScene;
@@ -24,15 +25,16 @@ use crate::sampler::PixelSampler;
 pub const MAX_BRANCHES: usize = 4;
 
 /// Traces `state` to its end by [`walk`], and where it reaches its branching vertex, every
-/// continuation from there; their light and rays go to `out`.
+/// continuation from there; their light and rays go to `out`, each light term to its light
+/// group in `groups` (a sink that keeps groups only comes with a state that does not branch).
 #[inline(always)]
-pub(super) fn walk_to_the_end<S: PathScene>(
+pub(super) fn walk_to_the_end<S: PathScene, G: GroupSink>(
     scene: &S,
     state: PathState,
     sampler: &mut PixelSampler,
-    out: &mut PathResult,
+    (out, groups): (&mut PathResult, &mut G),
 ) {
-    if let Some(point) = walk(scene, state, sampler, out) {
+    if let Some(point) = walk(scene, state, sampler, (out, groups)) {
         branch(scene, &point, sampler, out);
         out.radiance += point.radiance;
         out.rays += point.rays;
@@ -65,7 +67,7 @@ fn branch<S: PathScene>(
             (stream, u_rr)
         };
         if let Some(state) = continuation(scene, point, lobes[k], dirs[k], u_rr) {
-            let branched = walk(scene, state, &mut stream, out);
+            let branched = walk(scene, state, &mut stream, (out, &mut ()));
             debug_assert!(branched.is_none(), "a continuation branches once only");
         }
     }

@@ -10,6 +10,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::groups::{credit, GroupSink, LightTerm, LitBy};
 use super::mis::power_heuristic;
 use super::roulette::survives;
 use super::scene::PathScene;
@@ -111,12 +112,12 @@ pub(super) enum Travel {
 /// of a scattering vertex is added to `radiance`, the rays traced counted in `rays`. A path on
 /// its [`Segment::last`] ends where it would scatter.
 #[inline(always)]
-pub(super) fn travel<S: PathScene>(
+pub(super) fn travel<S: PathScene, G: GroupSink>(
     scene: &S,
     segment: &Segment,
     depth: u32,
     mut throughput: Vec3,
-    radiance: &mut Vec3,
+    (radiance, groups): (&mut Vec3, &mut G),
     sampler: &mut PixelSampler,
     rays: &mut u32,
 ) -> Travel {
@@ -140,8 +141,10 @@ pub(super) fn travel<S: PathScene>(
             let p = ray.at(distance);
             let wo = -ray.dir;
             let phase = m.phase();
-            *radiance += throughput
-                * direct_light_in_medium(scene, p, wo, &phase, segment.id, sampler, rays);
+            let term = direct_light_in_medium(scene, p, wo, &phase, segment.id, sampler, rays);
+            let light = throughput * term.light;
+            *radiance += light;
+            credit(groups, scene.lights(), term.from, light);
             let Some(PhaseSample { wi, pdf, weight }) = sample_phase(&phase, wo, sampler.get_2d())
             else {
                 return Travel::Ended;
@@ -176,23 +179,29 @@ fn direct_light_in_medium<S: PathScene>(
     medium: Option<MediumId>,
     sampler: &mut PixelSampler,
     rays: &mut u32,
-) -> Vec3 {
+) -> LightTerm {
     let u_select = sampler.get_1d();
     let u_light = sampler.get_2d();
     let Some(ls) = scene.lights().sample(p, None, u_select, u_light) else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let tr = shadow_transmittance(scene, p, ls.wi, shadow_tmax(p, p, ls.dist), medium, rays);
     if tr == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let weight = if ls.delta {
         1.0
     } else {
         power_heuristic(ls.pdf, phase.pdf(wo, ls.wi))
     };
-    tr * phase.eval(wo, ls.wi) * ls.li * (weight / ls.pdf)
+    LightTerm {
+        light: tr * phase.eval(wo, ls.wi) * ls.li * (weight / ls.pdf),
+        from: Some(LitBy::Choice {
+            u_select,
+            wi: ls.wi,
+        }),
+    }
 }

@@ -3,6 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::groups::{LightTerm, LitBy};
 use super::light_draw::LightDraw;
 use super::mis::power_heuristic;
 use super::scene::PathScene;
@@ -58,33 +59,33 @@ pub(super) fn direct_light_via_mirror<S: PathScene>(
     images: &ImageWeights,
     draw: LightDraw,
     rays: &mut u32,
-) -> Vec3 {
+) -> LightTerm {
     let lights = scene.lights();
     let Some(s) = lights.sample_image(images, draw.u_select, draw.u) else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if s.pdf.is_nan() || s.pdf <= 0.0 || s.li == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let f = bsdf.eval(wo, s.wi);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     *rays += 1;
     let origin = offset_origin(hit.p, hit.ng, s.wi);
     let ray = Ray::new(origin, s.wi);
     let Some(mirror) = scene.geometry().intersect(&ray, s.to_mirror * MIRROR_REACH) else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if lights.mirror_plane(&mirror) != Some(s.plane) {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     // A plain mirror: nothing to choose, and its reflection draws no random number.
     let Some(r) = scene.bsdf_at(&mirror, 0.0).sample(-s.wi, 0.0, Vec2::ZERO) else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if !r.specular || r.pdf.is_nan() || r.pdf <= 0.0 || !follows_plane(r.wi, s.reflected) {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let reflectance = r.f * (r.wi.dot(mirror.ns).abs() / r.pdf);
     let to_light = s.light_point - mirror.p;
@@ -100,11 +101,14 @@ pub(super) fn direct_light_via_mirror<S: PathScene>(
         rays,
     );
     if tr == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let pdf = draw.share * s.pdf;
     let weight = power_heuristic(pdf, draw.bsdf_counts.lamps * bsdf.pdf(wo, s.wi));
-    tr * f * reflectance * s.li * (s.wi.dot(hit.ns).abs() * weight / pdf)
+    LightTerm {
+        light: tr * f * reflectance * s.li * (s.wi.dot(hit.ns).abs() * weight / pdf),
+        from: Some(LitBy::Light(s.lamp)),
+    }
 }
 
 /// The flat mirror the vertex at `hit` (reached from `wo`) is, when the path's sample `bs`

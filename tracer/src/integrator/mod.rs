@@ -15,6 +15,7 @@ pub mod bdpt;
 mod branch;
 mod direct;
 mod glossy_split;
+mod groups;
 mod light_draw;
 mod media;
 mod mirror_images;
@@ -33,6 +34,7 @@ use crate::sampler::PixelSampler;
 
 pub use branch::MAX_BRANCHES;
 pub use glossy_split::GLOSSY_SPLIT;
+pub use groups::{GroupRadiance, GroupSink};
 pub use options::{IntegratorDesc, RussianRoulette, Transport};
 pub use scene::{Crossing, PathScene};
 pub use state::{PathResult, MAX_PASS_THROUGH};
@@ -56,6 +58,23 @@ pub fn trace_branching_path<S: PathScene>(
 ) -> PathResult {
     let mut out = PathResult::default();
     let state = state::PathState::camera(scene, ray, branches.clamp(1, MAX_BRANCHES));
-    branch::walk_to_the_end(scene, state, sampler, &mut out);
+    branch::walk_to_the_end(scene, state, sampler, (&mut out, &mut ()));
     out
+}
+
+/// [`trace_path`] with the light of each light group apart too, for a scene whose film keeps
+/// a layer per group: the path neither branches nor splits (the scene's
+/// [`PathScene::first_vertex_branches`] and [`PathScene::glossy_split`] say so for such a
+/// render), so every light term it adds comes from one light, or from the lights at infinity.
+pub fn trace_path_by_group<S: PathScene>(
+    scene: &S,
+    ray: Ray,
+    sampler: &mut PixelSampler,
+) -> (PathResult, GroupRadiance) {
+    let mut out = PathResult::default();
+    let mut groups = GroupRadiance::default();
+    let mut state = state::PathState::camera(scene, ray, 1);
+    state.may_split = false;
+    branch::walk_to_the_end(scene, state, sampler, (&mut out, &mut groups));
+    (out, groups)
 }

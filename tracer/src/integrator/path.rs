@@ -10,6 +10,7 @@
 use glam::Vec3;
 
 use super::glossy_split::{split_bsdf_light, splits_at};
+use super::groups::{credit, GroupSink, LitBy};
 use super::light_draw::BsdfCounts;
 use super::media::{meet_surface, travel, Segment, Travel};
 use super::mirror_images::mirror_after;
@@ -23,16 +24,17 @@ use crate::lights::IMAGE_SHARE;
 use crate::math::{offset_origin, Ray};
 use crate::sampler::PixelSampler;
 
-/// Traces `state` on, adding its light and rays to `out`, to its end or to the vertex where it
-/// branches (returned, with its light and rays so far not yet added: see
-/// [`super::branch::walk_to_the_end`]).
+/// Traces `state` on, adding its light and rays to `out` (and each light term to its light
+/// group's sum in `groups`: a sink that keeps groups is only handed in by a render whose paths
+/// neither split nor branch), to its end or to the vertex where it branches (returned, with
+/// its light and rays so far not yet added: see [`super::branch::walk_to_the_end`]).
 // Inlined into the unit loop, as `trace_path` is.
 #[inline(always)]
-pub(super) fn walk<S: PathScene>(
+pub(super) fn walk<S: PathScene, G: GroupSink>(
     scene: &S,
     state: PathState,
     sampler: &mut PixelSampler,
-    out: &mut PathResult,
+    (out, groups): (&mut PathResult, &mut G),
 ) -> Option<BranchPoint> {
     let integrator = scene.integrator();
     let max_depth = scene.max_depth();
@@ -79,7 +81,7 @@ pub(super) fn walk<S: PathScene>(
                 &segment,
                 depth,
                 throughput,
-                &mut radiance,
+                (&mut radiance, groups),
                 sampler,
                 &mut rays,
             ) {
@@ -109,7 +111,9 @@ pub(super) fn walk<S: PathScene>(
                     let pdf_light = (1.0 - prev.image_share) * pdf;
                     (le, power_heuristic(prev.pdf, pdf_light))
                 };
-                radiance += throughput * le * weight;
+                let light = throughput * le * weight;
+                radiance += light;
+                credit(groups, lights, Some(LitBy::Environment(ray.dir)), light);
             }
             out.escaped |= depth == 0;
             break;
@@ -126,7 +130,9 @@ pub(super) fn walk<S: PathScene>(
             } else {
                 1.0
             };
-            radiance += throughput * le * weight;
+            let light = throughput * le * weight;
+            radiance += light;
+            credit(groups, lights, Some(LitBy::Shape(hit.shape)), light);
         }
 
         // Every dimension a scattering vertex uses, drawn at once. A specular vertex draws the
@@ -174,9 +180,11 @@ pub(super) fn walk<S: PathScene>(
             depth,
             bsdf_counts,
         };
-        let (light, image_share) = vertex.light(scene, &u, &mut rays);
-        if let Some(light) = light {
-            radiance += throughput * light;
+        let (term, image_share) = vertex.light_term(scene, &u, &mut rays);
+        if let Some(term) = term {
+            let light = throughput * term.light;
+            radiance += light;
+            credit(groups, lights, term.from, light);
         }
         if split {
             may_split = false;

@@ -4,6 +4,7 @@
 use glam::Vec3;
 
 use super::direct::direct_light;
+use super::groups::LightTerm;
 use super::light_draw::{BsdfCounts, LightDraw};
 use super::mirror_images::{direct_light_via_mirror, split_light_sample};
 use super::scene::PathScene;
@@ -32,7 +33,7 @@ pub(super) struct Vertex<'a> {
 /// Where a vertex's light sample goes ([`Vertex::choose_light`]).
 pub(super) enum LightChoice {
     /// To a lamp image: the light it brings, weighed.
-    Image(Vec3),
+    Image(LightTerm),
     /// To the lights, with this draw.
     Lights(LightDraw),
 }
@@ -47,17 +48,29 @@ impl Vertex<'_> {
         u: &VertexSamples,
         rays: &mut u32,
     ) -> (Option<Vec3>, f32) {
+        let (term, image_share) = self.light_term(scene, u, rays);
+        (term.map(|t| t.light), image_share)
+    }
+
+    /// [`Self::light`] with the light its sample came from, for light groups.
+    #[inline(always)]
+    pub(super) fn light_term<S: PathScene>(
+        &self,
+        scene: &S,
+        u: &VertexSamples,
+        rays: &mut u32,
+    ) -> (Option<LightTerm>, f32) {
         if self.bsdf.is_specular() {
             return (None, 0.0);
         }
         let (choice, image_share) = self.choose_light(scene, u, rays);
-        let light = match choice {
-            LightChoice::Image(light) => light,
+        let term = match choice {
+            LightChoice::Image(term) => term,
             LightChoice::Lights(draw) => {
                 direct_light(scene, self.hit, self.wo, self.bsdf, self.sides, draw, rays)
             }
         };
-        (Some(light), image_share)
+        (Some(term), image_share)
     }
 
     /// Where the light sample of this vertex (not a specular one) goes, and the share of its

@@ -94,6 +94,7 @@ impl AreaLightParams {
             power: self.power,
             efficacy: self.efficacy,
             area,
+            group: 0,
         }
     }
 }
@@ -107,6 +108,7 @@ impl AreaLightDesc {
             power: 0.0,
             efficacy: 0.0,
             area: 0.0,
+            group: 0,
         }
     }
 

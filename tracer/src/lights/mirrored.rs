@@ -225,6 +225,8 @@ pub struct ImageSample {
     pub pdf: f32,
     /// The mirror plane (what [`super::Lights::mirror_plane`] says of the mirror point).
     pub plane: u16,
+    /// The lamp's index among the lights.
+    pub lamp: u32,
 }
 
 /// Whether a mirror's sampled reflection `wi` is the plane reflection `expected` (both unit).
@@ -412,6 +414,7 @@ impl MirrorImages {
             li: s.li,
             pdf: weight / total * s.pdf,
             plane: image.plane,
+            lamp: image.light,
         })
     }
 

@@ -297,6 +297,8 @@ pub struct Lights {
     distant_portals: Vec<(u32, Portals)>,
     /// The probability of choosing one of the lights at infinity, the mixture they form.
     environment_pmf: f32,
+    /// Each light's light group (`film::light_groups`; all 0 until [`Self::with_groups`]).
+    groups: Vec<u8>,
 }
 
 impl Lights {
@@ -315,6 +317,7 @@ impl Lights {
         let mut lights = Vec::new();
         let mut shape_light = Vec::new();
         let mut light_shape = Vec::new();
+        let mut groups = Vec::new();
         for (index, shape) in shapes.into_iter().enumerate() {
             shape_light.push(None);
             let Some(area_light) = &shape.area_light else {
@@ -335,6 +338,7 @@ impl Lights {
             if light.area() > 0.0 {
                 shape_light[index] = Some(lights.len() as u32);
                 light_shape.push(index as u32);
+                groups.push(area_light.group);
                 lights.push(Light::Area(light));
             }
         }
@@ -389,6 +393,11 @@ impl Lights {
         Ok(Self {
             lamp_spheres: LampSpheres::new(&lamp_boxes),
             triangle_lamps: TriangleLamps::new(lamps, &selection),
+            groups: groups
+                .into_iter()
+                .chain(std::iter::repeat(0))
+                .take(lights.len())
+                .collect(),
             lights,
             selection,
             shape_light,
@@ -686,6 +695,47 @@ impl Lights {
             .filter_map(|(index, tris)| Some((index, Portals::new(tris)?)))
             .collect();
         self
+    }
+
+    /// The lights with their light groups: `of_sources[i]` is the group of the scene
+    /// description's `LightSource` `i` (area lights have theirs from their shapes).
+    pub fn with_groups(mut self, of_sources: &[u8]) -> Self {
+        let area_lights = self.light_shape.len();
+        for (after_area, &source) in self.light_source.iter().enumerate() {
+            self.groups[area_lights + after_area] =
+                of_sources.get(source as usize).copied().unwrap_or(0);
+        }
+        self
+    }
+
+    /// The light group of `emitter`: of its light, or, for the lights at infinity, of them all
+    /// when they are in one group (None when they are in several: [`Self::environment_by_group`]
+    /// splits their light).
+    pub fn light_group(&self, emitter: Emitter) -> Option<u8> {
+        match emitter {
+            Emitter::Light(index) => self.groups.get(index as usize).copied(),
+            Emitter::Environment => {
+                let mut groups = self.infinite.iter().map(|&i| self.groups[i as usize]);
+                let first = groups.next().unwrap_or(0);
+                groups.all(|g| g == first).then_some(first)
+            }
+        }
+    }
+
+    /// Each light at infinity's group and radiance along an escaping ray's direction `dir`.
+    pub fn environment_by_group(&self, dir: Vec3, mut add: impl FnMut(u8, Vec3)) {
+        for (index, light) in self.infinite_lights() {
+            add(self.groups[index], light.radiance(dir));
+        }
+    }
+
+    /// The emitter [`Self::sample`] chooses with `u_select` (the lights at infinity as one).
+    pub fn chosen_emitter(&self, u_select: f32) -> Option<Emitter> {
+        let (index, _, _) = self.selection.sample_discrete(u_select)?;
+        Some(match self.lights[index] {
+            Light::Infinite(_) => Emitter::Environment,
+            _ => Emitter::Light(index as u32),
+        })
     }
 
     fn area_light(&self, shape: u32) -> Option<(u32, &AreaLight)> {

@@ -20,6 +20,7 @@ use crate::budget::{BudgetMeter, BuildGuard, Limit};
 use crate::desc::{LightDesc, MaterialDesc, SceneDesc, ShapeDesc, TextureDesc, TextureKind};
 use crate::diag::SourcePos as Pos;
 use crate::diag::{Severity, Warning};
+use crate::film::light_groups::{LightGroupDesc, LightGroups, DEFAULT_GROUP, MAX_LIGHT_GROUPS};
 use crate::geometry::placed_bytes;
 use crate::image_io::ImageCost;
 use crate::lights::{map_cost, AreaLightParams, PortalDesc, SkyLight, MAX_PORTAL_TRIANGLES};
@@ -28,7 +29,7 @@ use crate::medium::integrator::VolumeIntegrator;
 use crate::medium::{MediumDesc, MediumId, ShapeMedia, Volumes};
 use crate::mesh::{ply, TriangleMesh};
 use crate::refs::{ConstOrTexture, MaterialId, TextureId};
-use crate::shape::Geometry;
+use crate::shape::{AreaLightDesc, Geometry};
 use crate::texture::{self, Defined, Scale};
 use crate::wavelength::Dispersion;
 use image::ImageDecoder;
@@ -46,6 +47,9 @@ struct GraphicsState {
     /// The lights (indices into `lights`) of the last `LightSource` of this attribute block:
     /// what a `PortalShape` lets in (LuxRender's `currentLight`).
     current_lights: Option<std::ops::Range<u32>>,
+    /// The group of the `LightGroup` statement in force (an index into the builder's light
+    /// groups); None: "default".
+    light_group: Option<u8>,
 }
 
 #[derive(Clone, Debug)]
@@ -91,7 +95,8 @@ enum Block {
 #[derive(Clone, Debug)]
 pub struct PendingShape {
     pub desc: ShapeDesc,
-    pub emitter: Option<AreaLightParams>,
+    /// The area light and its light group.
+    pub emitter: Option<(AreaLightParams, u8)>,
 }
 
 pub struct Builder<'s> {
@@ -121,6 +126,7 @@ pub struct Builder<'s> {
     shapes: Vec<ShapeDesc>,
     portals: Vec<PortalDesc>,
     pub(super) lights: Vec<LightDesc>,
+    light_groups: LightGroups,
     /// `MakeNamedVolume` names; None for a kind that is not rendered (a warning).
     named_volumes: HashMap<String, Option<MediumId>>,
     volumes: Volumes,
@@ -166,6 +172,7 @@ impl<'s> Builder<'s> {
             shapes: Vec::new(),
             portals: Vec::new(),
             lights: Vec::new(),
+            light_groups: LightGroups::default(),
             named_volumes: HashMap::new(),
             volumes: Volumes::default(),
             volume_integrator: None,
@@ -384,20 +391,30 @@ impl<'s> Builder<'s> {
                 self.warn_unused(&params);
             }
             "LightGroup" => {
-                // Its name and parameter list are read (so a malformed one is an error where
-                // LuxRender's parser gives one) and left, as LuxRender 1.x leaves them: what it
-                // writes is the sum of the groups.
                 let name = r.string("the light group's name")?;
-                r.params(format!("LightGroup \"{name}\""))?;
-                self.diagnose(
-                    Severity::NoEffect,
-                    "LightGroup".into(),
-                    pos,
-                    "LightGroup: LuxRender 1.x writes the sum of its light groups, each at \
-                     scale 1 (a group's scale and colour are set in its window and kept in its \
-                     .flm, not in the scene), which is YAT's image; no layer per group is kept"
-                        .into(),
-                );
+                let params = r.params(format!("LightGroup \"{name}\""))?;
+                if self.block != Block::World {
+                    self.note(pos, "LightGroup outside the world block is ignored, as LuxRender 1.x ignores it".into());
+                    for p in &params.params {
+                        params.ignore(&p.name);
+                    }
+                    return Ok(());
+                }
+                let group = self.light_group_named(&name, pos)?;
+                self.light_groups.groups[usize::from(group)].read_settings(&params)?;
+                if !params.params.is_empty() {
+                    self.diagnose(
+                        Severity::Note,
+                        "LightGroup settings".into(),
+                        pos,
+                        "LightGroup settings (enabled, scale, rgbscale, temperature) weigh the \
+                         group in YAT's image, as LuxRender 1.x's window and .flm weigh it; \
+                         LuxRender's parser leaves them"
+                            .into(),
+                    );
+                }
+                self.gs.light_group = Some(group);
+                self.warn_unused(&params);
             }
             "SearchPath" => {
                 r.string("the search path")?;
@@ -498,6 +515,10 @@ impl<'s> Builder<'s> {
                 }
                 let exterior = self.gs.media.exterior;
                 self.volumes.lights.extend(lights.iter().map(|_| exterior));
+                let group = self.light_group(pos)?;
+                self.light_groups
+                    .of_sources
+                    .extend(lights.iter().map(|_| group));
                 let first = self.lights.len() as u32;
                 self.lights.extend(lights);
                 self.gs.current_lights = Some(first..self.lights.len() as u32);
@@ -747,7 +768,10 @@ impl<'s> Builder<'s> {
                 area_light: None,
                 media: self.gs.media,
             },
-            emitter: self.gs.area_light.clone(),
+            emitter: match self.gs.area_light.clone() {
+                Some(light) => Some((light, self.light_group(pos)?)),
+                None => None,
+            },
         };
         match &mut self.current_object {
             Some((_, shapes)) => shapes.push(shape),
@@ -857,7 +881,10 @@ impl<'s> Builder<'s> {
                     .into(),
             });
         }
-        desc.area_light = shape.emitter.map(|e| e.desc(desc.world_area()));
+        desc.area_light = shape.emitter.map(|(light, group)| AreaLightDesc {
+            group,
+            ..light.desc(desc.world_area())
+        });
         desc.material = self.glass2_index(desc.material, desc.media, pos);
         self.shapes.push(desc);
         Ok(())
@@ -917,6 +944,36 @@ impl<'s> Builder<'s> {
         id
     }
 
+    /// The light group of a light declared here: the `LightGroup` in force, or "default"
+    /// (created at its first light, as LuxRender's context creates it).
+    fn light_group(&mut self, pos: &Pos) -> Result<u8, ParseError> {
+        match self.gs.light_group {
+            Some(group) => Ok(group),
+            None => self.light_group_named(DEFAULT_GROUP, pos),
+        }
+    }
+
+    /// The index of the light group `name`, a new group when it is new; Err past
+    /// [`MAX_LIGHT_GROUPS`].
+    fn light_group_named(&mut self, name: &str, pos: &Pos) -> Result<u8, ParseError> {
+        let groups = &mut self.light_groups.groups;
+        if let Some(at) = groups.iter().position(|g| g.name == name) {
+            return Ok(at as u8);
+        }
+        if groups.len() >= MAX_LIGHT_GROUPS {
+            return Err(ParseError::Invalid {
+                pos: pos.clone(),
+                message: format!(
+                    "light group \"{name}\" would be the scene's {}th: YAT keeps at most \
+                     {MAX_LIGHT_GROUPS}",
+                    groups.len() + 1
+                ),
+            });
+        }
+        groups.push(LightGroupDesc::named(name));
+        Ok((groups.len() - 1) as u8)
+    }
+
     // -----------------------------------------------------------------------------------------
 
     pub fn finish(mut self) -> Result<SceneDesc, ParseError> {
@@ -939,7 +996,8 @@ impl<'s> Builder<'s> {
         volume_integrator.apply(&mut volumes, &mut self, &at);
         self.volumes = volumes;
         let options = std::mem::take(&mut self.options);
-        let (camera, film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
+        let (camera, mut film, filter, integrator, sampler) = options.finish(&mut self, &end)?;
+        film.light_groups = std::mem::take(&mut self.light_groups);
         Ok(SceneDesc {
             camera,
             film,

@@ -13,11 +13,16 @@
 //!   the camera ray's origin, a mean over the samples that hit: two sums, the weighted distance
 //!   and the weight), samples (the camera samples taken in the pixel, unfiltered).
 //!
+//! - Light groups (a scene with two or more `LightGroup`s, `film::light_groups`): each group's
+//!   light, three sums a group, as the colour's.
+//!
 //! Which layers a render keeps is part of its film frame, which every node derives from the
 //! scene and the settings alike, so a render that keeps none has the buffers, wire bytes and
 //! checkpoint it always had. A leaf.
 
 use glam::Vec3;
+
+use crate::film::light_groups::MAX_LIGHT_GROUPS;
 
 /// The AOVs a render is asked for (`--aovs`; depth also by the Film's `write_exr_ZBuf`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -103,6 +108,8 @@ impl Aovs {
 pub struct Layers {
     pub alpha: bool,
     pub aovs: Aovs,
+    /// The light groups whose light is kept apart: 0, or 2 ..= [`MAX_LIGHT_GROUPS`].
+    pub light_groups: u8,
 }
 
 /// Where each layer's sums sit among a pixel's [`Layers::len`] sums.
@@ -118,6 +125,8 @@ pub struct LayerOffsets {
     pub depth: Option<usize>,
     /// The samples taken in the pixel (not filtered): one sum.
     pub samples: Option<usize>,
+    /// Weight x each light group's light, three sums a group.
+    pub light_groups: Option<usize>,
 }
 
 impl Layers {
@@ -125,6 +134,7 @@ impl Layers {
     pub const NONE: Self = Self {
         alpha: false,
         aovs: Aovs::NONE,
+        light_groups: 0,
     };
 
     /// The f32 sums per pixel a unit's buffer holds for them (i64 in the film), laid out as
@@ -137,6 +147,7 @@ impl Layers {
             (o.normal, 3),
             (o.depth, 2),
             (o.samples, 1),
+            (o.light_groups, 3 * usize::from(self.light_groups)),
         ]
         .iter()
         .map(|&(at, n)| if at.is_some() { n } else { 0 })
@@ -147,8 +158,8 @@ impl Layers {
         self.len() == 0
     }
 
-    /// Where each layer's sums are: alpha, albedo, normal, depth, samples, in that order, those
-    /// the render keeps.
+    /// Where each layer's sums are: alpha, albedo, normal, depth, samples, light groups, in
+    /// that order, those the render keeps.
     pub fn offsets(self) -> LayerOffsets {
         let mut at = 0;
         let mut next = |on: bool, n: usize| {
@@ -163,17 +174,18 @@ impl Layers {
             normal: next(self.aovs.normal, 3),
             depth: next(self.aovs.depth, 2),
             samples: next(self.aovs.samples, 1),
+            light_groups: next(self.light_groups > 0, 3 * usize::from(self.light_groups)),
         }
     }
 
     /// Whether sum `k` of a pixel is a filtered value in [-1, 1] times the weight (alpha,
-    /// albedo, normal, depth's weight), the distance sum (finite, of any size), or the sample
-    /// count.
+    /// albedo, normal, depth's weight), a sum of any size (the distance, a light group's
+    /// light: finite, bounded only as the film's sums are), or the sample count.
     pub fn kind(self, k: usize) -> SumKind {
         let o = self.offsets();
         if o.samples == Some(k) {
             SumKind::Count
-        } else if o.depth == Some(k) {
+        } else if o.depth == Some(k) || o.light_groups.is_some_and(|at| k >= at) {
             SumKind::Unbounded
         } else {
             SumKind::Weighted
@@ -193,7 +205,7 @@ pub enum SumKind {
 }
 
 /// The most sums per pixel any set of layers has.
-pub const MAX_LAYER_SUMS: usize = 10;
+pub const MAX_LAYER_SUMS: usize = 10 + 3 * MAX_LIGHT_GROUPS;
 
 /// What one camera sample gives the filtered layers.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,6 +218,8 @@ pub struct LayerSample {
     pub normal: Vec3,
     /// The first surface's distance from the camera ray's origin; None without one.
     pub depth: Option<f32>,
+    /// Each light group's light (the first [`Layers::light_groups`] kept).
+    pub light_groups: [Vec3; MAX_LIGHT_GROUPS],
 }
 
 impl LayerSample {
@@ -216,6 +230,7 @@ impl LayerSample {
             albedo: Vec3::ZERO,
             normal: Vec3::ZERO,
             depth: None,
+            light_groups: [Vec3::ZERO; MAX_LIGHT_GROUPS],
         }
     }
 
@@ -237,6 +252,12 @@ impl LayerSample {
             out[at] = d;
             out[at + 1] = 1.0;
         }
+        if let Some(at) = o.light_groups {
+            let groups = &self.light_groups[..usize::from(layers.light_groups)];
+            for (sums, light) in out[at..].chunks_exact_mut(3).zip(groups) {
+                sums.copy_from_slice(&light.to_array());
+            }
+        }
         out
     }
 }
@@ -250,12 +271,20 @@ mod tests {
         let all = Layers {
             alpha: true,
             aovs: Aovs::from_names("albedo,normal, depth,samples").unwrap(),
+            light_groups: MAX_LIGHT_GROUPS as u8,
         };
         assert_eq!(all.len(), MAX_LAYER_SUMS);
         let o = all.offsets();
         assert_eq!(
-            (o.alpha, o.albedo, o.normal, o.depth, o.samples),
-            (Some(0), Some(1), Some(4), Some(7), Some(9))
+            (
+                o.alpha,
+                o.albedo,
+                o.normal,
+                o.depth,
+                o.samples,
+                o.light_groups
+            ),
+            (Some(0), Some(1), Some(4), Some(7), Some(9), Some(10))
         );
         assert_eq!(
             (all.kind(0), all.kind(7), all.kind(8), all.kind(9)),
@@ -266,9 +295,12 @@ mod tests {
                 SumKind::Count
             )
         );
+        // A light group's light is a sum of any size, as the colour's.
+        assert!((10..MAX_LAYER_SUMS).all(|k| all.kind(k) == SumKind::Unbounded));
         let depth = Layers {
             alpha: false,
             aovs: Aovs::from_names("depth").unwrap(),
+            light_groups: 0,
         };
         assert_eq!((depth.len(), depth.offsets().depth), (2, Some(0)));
         assert_eq!(Layers::NONE.len(), 0);

@@ -17,7 +17,8 @@ use crate::integrator::bdpt::{trace_bidirectional, BidirectionalScene, LightSpla
 use crate::integrator::options::{IntegratorDesc, Transport};
 use crate::integrator::packet;
 use crate::integrator::{
-    trace_path, Crossing, PathResult, PathScene, MAX_BRANCHES, MAX_PASS_THROUGH,
+    trace_path, trace_path_by_group, Crossing, GroupRadiance, PathResult, PathScene, MAX_BRANCHES,
+    MAX_PASS_THROUGH,
 };
 #[cfg(target_arch = "x86_64")]
 use crate::lanes::Avx2Cpu;
@@ -139,7 +140,8 @@ impl RenderScene {
             settings.latlong,
         )?
         .with_portals(&desc.portals)
-        .with_mirror_images(&flat_mirrors(desc, settings), &geometry);
+        .with_mirror_images(&flat_mirrors(desc, settings), &geometry)
+        .with_groups(&desc.film.light_groups.of_sources);
         guard.check_cancel()?;
         let mut camera = Camera::new(&desc.camera, settings.width, settings.height);
         if desc.camera.autofocus {
@@ -179,9 +181,13 @@ impl RenderScene {
             desc: desc.clone(),
             settings: settings.clone(),
         };
-        let branches = branching::choose(&scene);
-        scene.first_vertex_branches = branches;
-        scene.packets = packet::covers(&scene);
+        // A render that keeps its light groups apart traces each camera path as one path
+        // (`trace_path_by_group`): no branches, and no packets, whose lanes add no groups.
+        if scene.frame.layers.light_groups == 0 {
+            let branches = branching::choose(&scene);
+            scene.first_vertex_branches = branches;
+            scene.packets = packet::covers(&scene);
+        }
         Ok(scene)
     }
 
@@ -305,6 +311,7 @@ impl RenderScene {
         let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
         let mut stats = UnitStats::default();
         let adaptive = unit.mask.is_some();
+        let grouped = self.frame.layers.light_groups > 0;
         let seed = self.settings.seed;
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
@@ -331,14 +338,26 @@ impl RenderScene {
                             let (u, ray) = self.camera_sample(x, y, &mut sampler);
                             // A sample without a camera ray (outside a fisheye's circle) is black
                             // and sees nothing.
-                            let path = match ray {
-                                None => PathResult {
-                                    escaped: true,
-                                    ..PathResult::default()
-                                },
-                                Some(ray) => trace_path(self, ray, &mut sampler),
+                            let escaped = PathResult {
+                                escaped: true,
+                                ..PathResult::default()
                             };
-                            self.add_sample(&mut sums, &mut stats, (x, y, index), u, path);
+                            let (path, groups) = match ray {
+                                None => (escaped, None),
+                                Some(ray) if grouped => {
+                                    let (path, groups) =
+                                        trace_path_by_group(self, ray, &mut sampler);
+                                    (path, Some(groups))
+                                }
+                                Some(ray) => (trace_path(self, ray, &mut sampler), None),
+                            };
+                            self.add_sample(
+                                &mut sums,
+                                &mut stats,
+                                (x, y, index),
+                                u,
+                                (path, groups),
+                            );
                             index += 1;
                             continue;
                         }
@@ -355,7 +374,7 @@ impl RenderScene {
                         for i in 0..L::N {
                             let (sample, u) =
                                 ((x, y, index + i as u32), Vec2::new(film[0][i], film[1][i]));
-                            self.add_sample(&mut sums, &mut stats, sample, u, paths[i]);
+                            self.add_sample(&mut sums, &mut stats, sample, u, (paths[i], None));
                         }
                         index += L::N as u32;
                     }
@@ -387,7 +406,8 @@ impl RenderScene {
             .as_ref()
             .expect("a bidirectional scene has its film mass");
         let mut subpaths = Subpaths::new();
-        let mut splats = Vec::with_capacity(crate::integrator::bdpt::MAX_DEPTH as usize + 1);
+        let mut splats = Vec::with_capacity(crate::integrator::bdpt::MAX_SPLATS_PER_SAMPLE);
+        let grouped = self.frame.layers.light_groups > 0;
         for y in unit.y0..unit.y1 {
             for x in unit.x0..unit.x1 {
                 if !unit.renders(x, y) {
@@ -402,9 +422,23 @@ impl RenderScene {
                     let mut sampler = self.sample_stream(unit, (x, y, index));
                     let (u, ray) = self.camera_sample(x, y, &mut sampler);
                     splats.clear();
-                    let path =
-                        trace_bidirectional(self, ray, &mut sampler, &mut subpaths, &mut splats);
-                    self.add_sample(&mut sums, &mut stats, (x, y, index), u, path);
+                    let (path, groups) = if grouped {
+                        let mut groups = GroupRadiance::default();
+                        let path = trace_bidirectional(
+                            self,
+                            ray,
+                            &mut sampler,
+                            &mut subpaths,
+                            (&mut splats, &mut groups),
+                        );
+                        (path, Some(groups))
+                    } else {
+                        let sinks = (&mut splats, &mut ());
+                        let path =
+                            trace_bidirectional(self, ray, &mut sampler, &mut subpaths, sinks);
+                        (path, None)
+                    };
+                    self.add_sample(&mut sums, &mut stats, (x, y, index), u, (path, groups));
                     for splat in &splats {
                         self.add_light_splat(mass, &mut splat_sums, splat);
                     }
@@ -421,9 +455,11 @@ impl RenderScene {
 
     /// Adds a light subpath's splat to every film pixel its filter reaches, weighed by the
     /// filter over each pixel's filter mass (no weight sum divides a splat: see
-    /// [`PixelFilter::film_mass`]).
+    /// [`PixelFilter::film_mass`]), in the plane of the image's light or of its light group
+    /// ([`FilmFrame::splat_entries`]).
     fn add_light_splat(&self, mass: &FilmMass, splat_sums: &mut SplatSums, splat: &LightSplat) {
         let (width, height) = (self.frame.width, self.frame.height);
+        let plane = splat.group.map_or(0, |g| 1 + u64::from(g)) * u64::from(width * height);
         let (px, py) = (splat.raster.x.floor(), splat.raster.y.floor());
         if !(0.0..width as f32).contains(&px) || !(0.0..height as f32).contains(&py) {
             return;
@@ -438,7 +474,11 @@ impl RenderScene {
             for (column, &w) in weights[..f.column_count()].iter().enumerate() {
                 let x = f.columns.first + column as u32;
                 let weight = w / mass.at(x, y);
-                splat_sums.add(y * width + x, splat.radiance * weight);
+                // Within u32 for every film the memory budget admits; one beyond is dropped.
+                let Ok(at) = u32::try_from(plane + u64::from(y * width + x)) else {
+                    continue;
+                };
+                splat_sums.add(at, splat.radiance * weight);
             }
         }
     }
@@ -457,7 +497,8 @@ impl RenderScene {
     }
 
     /// Counts sample `index` of pixel (x, y), at `u` in the pixel, and splats its light and its
-    /// layers' values (a sample whose light is not finite is dropped, layers and all).
+    /// layers' values, its light groups' light among them when the render keeps them (a sample
+    /// whose light is not finite is dropped, layers and all).
     #[inline(always)]
     fn add_sample(
         &self,
@@ -465,7 +506,7 @@ impl RenderScene {
         stats: &mut UnitStats,
         (x, y, index): (u32, u32, u32),
         u: Vec2,
-        path: PathResult,
+        (path, groups): (PathResult, Option<GroupRadiance>),
     ) {
         stats.samples += 1;
         stats.rays += u64::from(path.rays);
@@ -483,7 +524,7 @@ impl RenderScene {
         }
         let half = sums.buffer.unit.mask.is_some() && index % 2 == 1;
         let alpha = if path.escaped { 0.0 } else { 1.0 };
-        let layers = if self.frame.layers.aovs.need_first_surface() {
+        let mut layers = if self.frame.layers.aovs.need_first_surface() {
             let mut layers = self.first_surface(&sums.buffer.unit, (x, y, index));
             layers.alpha = alpha;
             stats.rays += 1;
@@ -491,6 +532,9 @@ impl RenderScene {
         } else {
             LayerSample::alpha(alpha)
         };
+        if let Some(groups) = groups {
+            layers.light_groups = groups.0;
+        }
         self.splat(sums, (x, y), u, (path.radiance, layers), half);
     }
 
@@ -527,10 +571,10 @@ impl RenderScene {
             let bsdf = self.bsdf_at(&hit, 0.5);
             let wo = -ray.dir;
             return LayerSample {
-                alpha: 0.0,
                 albedo: bsdf.albedo(wo).clamp(Vec3::ZERO, Vec3::ONE),
                 normal: bsdf.shading_normal_toward(wo),
                 depth: Some(hit.p.distance(camera_ray.origin)),
+                ..nothing
             };
         }
         nothing

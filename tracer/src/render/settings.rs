@@ -132,7 +132,19 @@ impl RenderSettings {
                     depth: desc.film.outputs.exr_zbuf,
                     ..Aovs::NONE
                 }),
+                light_groups: self.light_group_layers(desc),
             },
+        }
+    }
+
+    /// The light groups whose light the render keeps apart: every group of a scene with two or
+    /// more (`film::light_groups`), none for one with fewer.
+    pub fn light_group_layers(&self, desc: &SceneDesc) -> u8 {
+        let groups = &desc.film.light_groups;
+        if groups.layered() {
+            groups.groups.len() as u8
+        } else {
+            0
         }
     }
 

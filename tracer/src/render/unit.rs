@@ -162,6 +162,19 @@ impl FilmFrame {
         (x / BLOCK_SIZE % k + k * (y / BLOCK_SIZE % k)) as usize
     }
 
+    /// The entries of the film's light splat sums: none without light splats; else a plane of
+    /// the film's pixels for the total and one for each light group kept apart, indexed
+    /// `plane * width * height + y * width + x` (plane 0 the total, `1 + g` group `g`'s).
+    pub fn splat_entries(&self) -> u64 {
+        if self.light_splats {
+            u64::from(self.width)
+                * u64::from(self.height)
+                * (1 + u64::from(self.layers.light_groups))
+        } else {
+            0
+        }
+    }
+
     /// The pixels `unit`'s samples reach: its tile grown by the border, clipped to the film;
     /// its sample buffer covers exactly these.
     pub fn region(&self, unit: &WorkUnit) -> PixelRect {

@@ -178,6 +178,8 @@ pub struct AreaLightDesc {
     pub efficacy: f32,
     /// The shape's world-space area.
     pub area: f32,
+    /// Its light group: an index into the film's light groups.
+    pub group: u8,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -20,6 +20,7 @@ mod glossy_split;
 mod hostile;
 mod hostile_scenes;
 mod image_formats;
+mod light_groups;
 mod luxrender_materials;
 mod mirror_images;
 mod panes;

@@ -633,6 +633,10 @@ mod tests {
         };
         assert!(check_handshake("h:1", &tight).is_ok());
         assert!(min_message_bytes() >= 16 * 64 * 64 && min_message_bytes() >= 128 << 10);
+        // Every node's own limit holds the largest reply (docs/security.md's figure), light
+        // group layers included.
+        assert_eq!(min_message_bytes(), 7_410_688);
+        assert!(min_message_bytes() <= yat_proto::DEFAULT_MAX_MESSAGE_BYTES as u64);
     }
 
     /// A reply that lists a blob again and again gets it once; one that lists a blob that is

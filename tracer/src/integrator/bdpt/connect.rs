@@ -13,6 +13,7 @@ use glam::Vec3;
 use super::scene::{BidirectionalScene, LightSplat, MAX_VERTICES};
 use super::vertex::{Carries, Kind, LightVertex, PathVertex};
 use super::weight::{mis_weight, Densities, Limits};
+use crate::integrator::groups::LightTerm;
 use crate::integrator::shadow::{shadow_tmax, shadow_transmittance};
 
 /// What reaches the point `dist` along unit `dir` from `from` (a scattering vertex, or the
@@ -80,37 +81,37 @@ pub(super) fn camera_hits_light<S: BidirectionalScene>(
     pt.beta * le * mis_weight(&[], &cam[..n], false, limits)
 }
 
-/// `s = 1`: the camera subpath's `t`th vertex samples a light.
+/// `s = 1`: the camera subpath's `t`th vertex samples a light (and which it reached).
 pub(super) fn camera_samples_light<S: BidirectionalScene>(
     scene: &S,
     camera: &[PathVertex],
     t: usize,
     limits: Limits,
     rays: &mut u32,
-) -> Vec3 {
+) -> LightTerm {
     let pt = &camera[t - 1];
     let Some(u) = pt.samples() else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if pt.delta {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let Some((ls, point)) = scene
         .lights()
         .sample_light_point(pt.p, u.light_select, u.light)
     else {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     };
     if ls.pdf <= 0.0 || ls.li == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let f = pt.scatters_toward(ls.wi, Carries::Radiance);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let tr = transmittance(scene, pt, ls.wi, ls.dist, rays);
     if tr == Vec3::ZERO {
-        return Vec3::ZERO;
+        return LightTerm::NONE;
     }
     let unweighted = pt.beta * f * ls.li * tr * (pt.cos_toward(ls.wi) / ls.pdf);
     let light_vertex = PathVertex {
@@ -137,7 +138,10 @@ pub(super) fn camera_samples_light<S: BidirectionalScene>(
     let (mut cam, n) = densities(&camera[..t]);
     cam[t - 1].rev = light_vertex.pdf_light(scene, pt);
     cam[t - 2].rev = pt.pdf_toward(scene, Some(&light_vertex), prev);
-    unweighted * mis_weight(&light, &cam[..n], light_vertex.is_delta_light(), limits)
+    LightTerm {
+        light: unweighted * mis_weight(&light, &cam[..n], light_vertex.is_delta_light(), limits),
+        from: light_vertex.lit_by(),
+    }
 }
 
 /// `t = 1`: the light subpath's `s`th vertex (a scattering one, `s >= 2`) seen by the camera
@@ -186,6 +190,7 @@ pub(super) fn camera_sees_light_vertex<S: BidirectionalScene>(
     Some(LightSplat {
         raster: view.raster,
         radiance,
+        group: None,
     })
 }
 

@@ -44,7 +44,9 @@ use self::scene::MAX_VERTICES;
 use self::vertex::{Carries, Kind, LightVertex, PathVertex};
 use self::walk::{walk, CrossedEmitter, SampleWavelength};
 use self::weight::Limits;
+use super::groups::{credit, GroupSink, LitBy};
 use super::state::PathResult;
+use crate::film::light_groups::MAX_LIGHT_GROUPS;
 use crate::integrator::shadow::shadow_transmittance;
 use crate::math::{offset_origin, Ray};
 use crate::sampler::PixelSampler;
@@ -71,12 +73,15 @@ impl Subpaths {
 /// One bidirectional sample: the radiance along `camera_ray` (None: the camera has no ray
 /// there, as outside a fisheye's circle; the light subpath is traced all the same, since the
 /// film counts one per camera sample), with the light subpath's splats pushed to `splats`.
-pub fn trace_bidirectional<S: BidirectionalScene>(
+/// Where `groups` keeps light groups, every strategy's light is credited to the group of the
+/// light its path starts at, and each splat is followed by its groups' shares as splats of
+/// their own ([`LightSplat::group`]: at most [`MAX_SPLATS_PER_SAMPLE`] in all).
+pub fn trace_bidirectional<S: BidirectionalScene, G: GroupSink>(
     scene: &S,
     camera_ray: Option<Ray>,
     sampler: &mut PixelSampler,
     subpaths: &mut Subpaths,
-    splats: &mut Vec<LightSplat>,
+    (splats, groups): (&mut Vec<LightSplat>, &mut G),
 ) -> PathResult {
     let integrator = scene.integrator();
     let limits = Limits {
@@ -133,30 +138,43 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
     );
 
     let w = &wavelength;
+    let lights = scene.lights();
+    let light_start = light.first().and_then(PathVertex::lit_by);
     let mut radiance = Vec3::ZERO;
+    let mut add = |light: Vec3, from: Option<LitBy>| {
+        radiance += light;
+        credit(groups, lights, from, light);
+    };
     for t in 2..=camera.len() {
         let pt = &camera[t - 1];
-        radiance += w.weigh(
-            camera[t - 2].dispersed,
-            connect::camera_hits_light(scene, &camera[..t - 1], pt, limits),
+        add(
+            w.weigh(
+                camera[t - 2].dispersed,
+                connect::camera_hits_light(scene, &camera[..t - 1], pt, limits),
+            ),
+            pt.lit_by(),
         );
         if t < camera.len() || !pt.at_infinity() {
-            radiance += w.weigh(
-                pt.dispersed,
-                connect::camera_samples_light(scene, camera, t, limits, &mut rays),
-            );
+            let term = connect::camera_samples_light(scene, camera, t, limits, &mut rays);
+            add(w.weigh(pt.dispersed, term.light), term.from);
         }
         for s in 2..=light.len() {
-            radiance += w.weigh(
-                pt.dispersed || light[s - 1].dispersed,
-                connect::join(scene, light, s, camera, t, limits, &mut rays),
+            add(
+                w.weigh(
+                    pt.dispersed || light[s - 1].dispersed,
+                    connect::join(scene, light, s, camera, t, limits, &mut rays),
+                ),
+                light_start,
             );
         }
     }
     for c in crossed.iter() {
-        radiance += w.weigh(
-            camera[c.at - 1].dispersed,
-            connect::camera_hits_light(scene, &camera[..c.at], &c.vertex, limits),
+        add(
+            w.weigh(
+                camera[c.at - 1].dispersed,
+                connect::camera_hits_light(scene, &camera[..c.at], &c.vertex, limits),
+            ),
+            c.vertex.lit_by(),
         );
     }
     for s in 2..=light.len() {
@@ -165,6 +183,10 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
         {
             splat.radiance = w.weigh(light[s - 1].dispersed, splat.radiance);
             splats.push(splat);
+            if G::ON {
+                let mut shares = GroupSplats { splat, splats };
+                credit(&mut shares, lights, light_start, splat.radiance);
+            }
         }
     }
     // The camera ray escaped where its subpath ends at infinity straight after the camera
@@ -176,6 +198,28 @@ pub fn trace_bidirectional<S: BidirectionalScene>(
         radiance,
         rays,
         escaped,
+    }
+}
+
+/// The most light splats one sample makes: one per light subpath vertex seen by the camera,
+/// each followed, where the render keeps light groups, by a share per group.
+pub const MAX_SPLATS_PER_SAMPLE: usize = (MAX_DEPTH as usize + 1) * (1 + MAX_LIGHT_GROUPS);
+
+/// Sends each light group's share of `splat` on as a splat of its own.
+struct GroupSplats<'a> {
+    splat: LightSplat,
+    splats: &'a mut Vec<LightSplat>,
+}
+
+impl GroupSink for GroupSplats<'_> {
+    const ON: bool = true;
+
+    fn add(&mut self, group: u8, light: Vec3) {
+        self.splats.push(LightSplat {
+            radiance: light,
+            group: Some(group),
+            ..self.splat
+        });
     }
 }
 

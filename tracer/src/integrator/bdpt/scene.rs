@@ -32,4 +32,7 @@ pub trait BidirectionalScene: PathScene {
 pub struct LightSplat {
     pub raster: Vec2,
     pub radiance: Vec3,
+    /// None: the splat of the image's light; Some(g): light group `g`'s share of one (a render
+    /// that keeps its light groups apart makes both).
+    pub group: Option<u8>,
 }

@@ -14,6 +14,7 @@ use glam::Vec3;
 
 use super::scene::BidirectionalScene;
 use crate::geometry::SurfaceHit;
+use crate::integrator::groups::LitBy;
 use crate::integrator::media::sample_phase;
 use crate::lights::Emitter;
 use crate::material::Bsdf;
@@ -365,6 +366,24 @@ impl PathVertex {
 
     /// The radiance a camera path's last vertex (on an area light, or at infinity) sends back
     /// along the path.
+    /// Where the light this vertex emits comes from, for light groups: the light of a light
+    /// vertex (the lights at infinity along `toward`), the area light of a surface vertex.
+    pub(super) fn lit_by(&self) -> Option<LitBy> {
+        match &self.kind {
+            Kind::Light(LightVertex {
+                emitter: Emitter::Light(index),
+                ..
+            }) => Some(LitBy::Light(*index)),
+            Kind::Light(LightVertex {
+                emitter: Emitter::Environment,
+                toward,
+                ..
+            }) => toward.map(LitBy::Environment),
+            Kind::Surface(s) => Some(LitBy::Shape(s.hit.shape)),
+            _ => None,
+        }
+    }
+
     pub(super) fn emitted<S: BidirectionalScene>(&self, scene: &S) -> Vec3 {
         match &self.kind {
             Kind::Light(LightVertex {

@@ -141,7 +141,7 @@ impl<L: Lanes> Packet<L> {
         self.live[i] = false;
         out.rays += self.rays[i];
         let state = self.lane_state(i, parts, traced);
-        walk_to_the_end(scene, state, &mut stream.lane(i), out);
+        walk_to_the_end(scene, state, &mut stream.lane(i), (out, &mut ()));
     }
 
     /// Ends lane `i`: its light and rays go to `out`.
@@ -362,7 +362,7 @@ impl LaneHits {
             let (choice, image_share) = vertex.choose_light(scene, &us[i], &mut rays);
             self.image_share[i] = image_share;
             match choice {
-                LightChoice::Image(light) => self.lit_alone[i] = Some(light),
+                LightChoice::Image(term) => self.lit_alone[i] = Some(term.light),
                 LightChoice::Lights(draw) => {
                     (self.draws.u_select[i], self.draws.share[i]) = (draw.u_select, draw.share);
                 }
