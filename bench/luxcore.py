@@ -5,7 +5,10 @@ depth, --light-depth the light path's) and writes linear RGB as EXR plus its fig
 bench.py runs it in the benchmark's virtualenv, one process per render (as it runs yat).
 
     luxcore.py EXPORT_DIR --spp N --depth D --threads T [--width W --height H] \
-        [--engine BIDIRCPU --light-depth L] --out rgb.exr --stats stats.json
+        [--engine BIDIRCPU --light-depth L] [--light-groups G] --out rgb.exr --stats stats.json
+
+With --light-groups G it also writes each light group's radiance (LuxCore's RADIANCE_GROUP
+output of light id g, which the export gives group g's lights) as rgb.group<g>.exr.
 
 Timing starts when RenderSession.Start() returns (scene and BVH ready) and stops when the
 halt condition is met, like yat's render_seconds; render_cpu_seconds is the process's CPU time
@@ -35,6 +38,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--width", type=int, help="image width (default: the export's film)")
     ap.add_argument("--height", type=int, help="image height (default: the export's film)")
+    ap.add_argument("--light-groups", type=int, default=0,
+                    help="light groups to write apart, as OUT's stem + .group<g>.exr")
     ap.add_argument("--out", required=True, help="linear RGB EXR")
     ap.add_argument("--stats", required=True, help="JSON figures")
     args = ap.parse_args()
@@ -60,6 +65,11 @@ def main():
         "film.outputs.0.type": "RGB",
         "film.outputs.0.filename": out,
     }
+    stem = os.path.splitext(out)[0]
+    for g in range(args.light_groups):
+        props[f"film.outputs.{1 + g}.type"] = "RADIANCE_GROUP"
+        props[f"film.outputs.{1 + g}.id"] = g
+        props[f"film.outputs.{1 + g}.filename"] = f"{stem}.group{g}.exr"
     if args.engine == "BIDIRCPU":
         props["path.maxdepth"] = args.depth
         props["light.maxdepth"] = args.light_depth or args.depth

@@ -90,6 +90,17 @@ pub fn export(
     let meshes = shapes::write_shapes(desc, opts, &mut p, &mut notes)?;
     for (i, light) in desc.lights.iter().enumerate() {
         lights::write_light(&mut p, i, light, scene_dir, opts, &mut notes);
+        // Light groups are LuxCore's light ids (0, the first group, its default).
+        let group = desc
+            .film
+            .light_groups
+            .of_sources
+            .get(i)
+            .copied()
+            .unwrap_or(0);
+        if group > 0 {
+            p.set(format!("scene.lights.light{i}.id"), group);
+        }
     }
     Ok(LuxCoreScene {
         scene: p.into_text(),

@@ -145,6 +145,9 @@ pub fn write_material(
             }
         }
     }
+    if let Some(group) = emission.map(|e| e.group).filter(|&g| g > 0) {
+        p.set(format!("{prefix}.emission.id"), group);
+    }
     match emission.map(|e| (e, e.radiance())) {
         Some((_, Some(radiance))) => {
             p.set(format!("{prefix}.emission"), v3(radiance));

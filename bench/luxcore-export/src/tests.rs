@@ -410,3 +410,23 @@ fn subdivided_heightfield_and_quadric_shapes_export_as_their_meshes() {
         lux.notes
     );
 }
+
+/// Light groups are LuxCore's light ids: a point light and a lamp of the second and third
+/// groups carry ids 1 and 2; the first group's light keeps LuxCore's default, 0 (no id).
+#[test]
+fn light_groups_are_light_ids() {
+    let lux = export_world(
+        "LightGroup \"sky\"\nLightSource \"infinite\" \"color L\" [0.1 0.1 0.1]\n\
+         LightGroup \"fill\"\nLightSource \"point\" \"point from\" [0 0 2]\n\
+         LightGroup \"lamp\"\nAreaLightSource \"area\" \"color L\" [1 1 1]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [0 0 1 1 0 1 0 1 1]",
+    );
+    let scn = &lux.scene;
+    assert!(!scn.contains("scene.lights.light0.id"), "{scn}");
+    assert_eq!(value(scn, "scene.lights.light1.id"), "1");
+    let lamp = scn
+        .lines()
+        .find(|l| l.contains(".emission.id = "))
+        .unwrap_or_else(|| panic!("no emission id in\n{scn}"));
+    assert!(lamp.ends_with(" = 2"), "{lamp}");
+}
