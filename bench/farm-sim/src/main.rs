@@ -20,12 +20,18 @@ use tonic::transport::server::TcpIncoming;
 use tonic::transport::Server;
 use tonic::{Request, Response, Status, Streaming};
 use yat_proto::{pb, RenderNode, RenderNodeServer, DEFAULT_MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
+use yat_tracer::assets::FsSource;
+use yat_tracer::parse::parse_scene;
+use yat_tracer::render::unit::{FilmFrame, WorkUnit};
+use yat_tracer::render::{RenderOverrides, RenderSettings};
 
 /// Core-microseconds per camera sample of captainfalcon.lxs (release build, depth 10:
 /// bench/RESULTS.md, "core-us/sample").
 const CAPTAIN_FALCON_SAMPLE_US: f64 = 2.12;
 /// Bytes of one pixel in a unit's result: r, g, b, weight as f32.
 const BYTES_PER_PIXEL: usize = 16;
+/// Bytes of one layer sum of a pixel (alpha, an AOV, a light group's channel) as f32.
+const BYTES_PER_LAYER_SUM: usize = 4;
 /// The tail of the render whose busy workers are counted.
 const TAIL_FRACTION: f64 = 0.05;
 
@@ -64,9 +70,12 @@ struct Busy {
     completed: bool,
 }
 
-/// A fake worker: `threads` units at a time, each taking its samples x `sample_time`.
+/// A fake worker: `threads` units at a time, each taking its samples x `sample_time`, each
+/// answered with the sums (all zero) a real worker's buffer of the render's film frame holds:
+/// the unit's tile and the filter's border, and the layers the scene's film keeps.
 struct FakeWorker {
     id: usize,
+    frame: FilmFrame,
     threads: u32,
     sample_time: Duration,
     slots: Semaphore,
@@ -145,9 +154,21 @@ impl RenderNode for FakeWorker {
         let pixels =
             u64::from(unit.x1.saturating_sub(unit.x0)) * u64::from(unit.y1.saturating_sub(unit.y0));
         let samples = pixels * u64::from(unit.sample_end.saturating_sub(unit.sample_start));
-        if pixels > 1 << 18 {
+        if pixels > 1 << 18 || unit.x1 > self.frame.width || unit.y1 > self.frame.height {
             return Err(Status::invalid_argument("unit too large"));
         }
+        let region = self.frame.region(&WorkUnit {
+            index: unit.index,
+            x0: unit.x0,
+            y0: unit.y0,
+            x1: unit.x1,
+            y1: unit.y1,
+            sample_start: unit.sample_start,
+            sample_end: unit.sample_end,
+            mask: None,
+        });
+        let region_pixels = region.pixel_count();
+        let layer_bytes = region_pixels * self.frame.layers.len() * BYTES_PER_LAYER_SUM;
         let _thread = self
             .slots
             .acquire()
@@ -163,14 +184,14 @@ impl RenderNode for FakeWorker {
         busy.completed = true;
         Ok(Response::new(pb::RenderUnitReply {
             index: unit.index,
-            pixels: vec![0; pixels as usize * BYTES_PER_PIXEL].into(),
+            pixels: vec![0; region_pixels * BYTES_PER_PIXEL].into(),
             stats: Some(pb::UnitStats {
                 samples,
                 ..Default::default()
             }),
             render_seconds: took.as_secs_f64(),
             light_splats: Default::default(),
-            layers: Default::default(),
+            layers: vec![0; layer_bytes].into(),
         }))
     }
 
@@ -194,11 +215,16 @@ fn speed_factor(args: &Args, id: usize) -> f64 {
 }
 
 /// Starts the fake workers on loopback ports; returns their addresses.
-async fn start_farm(args: &Args, log: &Arc<Mutex<Vec<Busy>>>) -> anyhow::Result<Vec<String>> {
+async fn start_farm(
+    args: &Args,
+    frame: FilmFrame,
+    log: &Arc<Mutex<Vec<Busy>>>,
+) -> anyhow::Result<Vec<String>> {
     let mut addresses = Vec::new();
     for id in 0..args.workers {
         let worker = FakeWorker {
             id,
+            frame,
             threads: args.threads,
             sample_time: Duration::from_secs_f64(args.sample_us * 1e-6 * speed_factor(args, id)),
             slots: Semaphore::new(args.threads as usize),
@@ -286,7 +312,20 @@ fn main() -> anyhow::Result<()> {
         .enable_all()
         .build()?;
     let log = Arc::new(Mutex::new(Vec::new()));
-    let addresses = runtime.block_on(start_farm(&args, &log))?;
+    // The film frame every node derives from the scene and the settings: what a unit's buffer
+    // covers (the coordinator checks it exactly).
+    let name = scene
+        .file_name()
+        .and_then(|n| n.to_str())
+        .context("the scene's file name")?;
+    let desc = parse_scene(name, &FsSource::for_main_file(&scene))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.display()))?;
+    let overrides = RenderOverrides {
+        spp: Some(args.spp),
+        ..Default::default()
+    };
+    let frame = RenderSettings::resolve(&desc, &overrides).film_frame(&desc);
+    let addresses = runtime.block_on(start_farm(&args, frame, &log))?;
 
     let dir = std::env::temp_dir().join(format!("yat-farm-sim-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
