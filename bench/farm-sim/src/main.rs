@@ -82,6 +82,34 @@ struct FakeWorker {
     log: Arc<Mutex<Vec<Busy>>>,
 }
 
+/// What a worker rendering `unit` (a tile inside `frame`'s film) for `took` sends back: all-zero
+/// sums over the unit's region in `frame` (its tile and the filter's border) and its layers,
+/// and the unit's samples.
+fn fake_reply(frame: &FilmFrame, unit: &pb::WorkUnit, took: Duration) -> pb::RenderUnitReply {
+    let tile = WorkUnit {
+        index: unit.index,
+        x0: unit.x0,
+        y0: unit.y0,
+        x1: unit.x1,
+        y1: unit.y1,
+        sample_start: unit.sample_start,
+        sample_end: unit.sample_end,
+        mask: None,
+    };
+    let region_pixels = frame.region(&tile).pixel_count();
+    pb::RenderUnitReply {
+        index: unit.index,
+        pixels: vec![0; region_pixels * BYTES_PER_PIXEL].into(),
+        stats: Some(pb::UnitStats {
+            samples: tile.sample_count(),
+            ..Default::default()
+        }),
+        render_seconds: took.as_secs_f64(),
+        light_splats: Default::default(),
+        layers: vec![0; region_pixels * frame.layers.len() * BYTES_PER_LAYER_SUM].into(),
+    }
+}
+
 /// Records a unit's busy interval when the call ends, completed or dropped by the client.
 struct BusyGuard<'a> {
     worker: &'a FakeWorker,
@@ -157,18 +185,6 @@ impl RenderNode for FakeWorker {
         if pixels > 1 << 18 || unit.x1 > self.frame.width || unit.y1 > self.frame.height {
             return Err(Status::invalid_argument("unit too large"));
         }
-        let region = self.frame.region(&WorkUnit {
-            index: unit.index,
-            x0: unit.x0,
-            y0: unit.y0,
-            x1: unit.x1,
-            y1: unit.y1,
-            sample_start: unit.sample_start,
-            sample_end: unit.sample_end,
-            mask: None,
-        });
-        let region_pixels = region.pixel_count();
-        let layer_bytes = region_pixels * self.frame.layers.len() * BYTES_PER_LAYER_SUM;
         let _thread = self
             .slots
             .acquire()
@@ -182,17 +198,7 @@ impl RenderNode for FakeWorker {
         let took = self.sample_time.mul_f64(samples as f64);
         tokio::time::sleep(took).await;
         busy.completed = true;
-        Ok(Response::new(pb::RenderUnitReply {
-            index: unit.index,
-            pixels: vec![0; region_pixels * BYTES_PER_PIXEL].into(),
-            stats: Some(pb::UnitStats {
-                samples,
-                ..Default::default()
-            }),
-            render_seconds: took.as_secs_f64(),
-            light_splats: Default::default(),
-            layers: vec![0; layer_bytes].into(),
-        }))
+        Ok(Response::new(fake_reply(&self.frame, &unit, took)))
     }
 
     async fn stats(
@@ -433,6 +439,47 @@ fn print_figures(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use yat_tracer::assets::MemorySource;
+    use yat_tracer::filter::PixelFilter;
+
+    /// The fake workers' replies pass the coordinator's checks of a real worker's (a scene
+    /// whose filter reaches a neighbour and whose film keeps alpha), at the film's edge and
+    /// inside it: the simulation measures a farm the coordinator accepts.
+    #[test]
+    fn fake_replies_pass_the_coordinators_checks() {
+        let text =
+            "Film \"fleximage\" \"integer xresolution\" [100] \"integer yresolution\" [70]\n\
+                    \x20 \"string write_png_channels\" [\"RGBA\"]\n\
+                    PixelFilter \"mitchell\" \"float xwidth\" [2] \"float ywidth\" [2]\n\
+                    WorldBegin\nWorldEnd\n";
+        let mut source = MemorySource::new();
+        source.insert("main.lxs", text.as_bytes().into());
+        let desc = parse_scene("main.lxs", &source).unwrap();
+        let overrides = RenderOverrides {
+            spp: Some(16),
+            ..Default::default()
+        };
+        let settings = RenderSettings::resolve(&desc, &overrides);
+        let frame = settings.film_frame(&desc);
+        assert!(frame.border[0] > 0 && frame.layers.alpha, "{frame:?}");
+        let weights = PixelFilter::new(&desc.filter).weight_bounds();
+        for (x0, y0, x1, y1) in [(0, 0, 64, 64), (64, 64, 100, 70)] {
+            let unit = pb::WorkUnit {
+                index: 3,
+                x0,
+                y0,
+                x1,
+                y1,
+                sample_start: 8,
+                sample_end: 16,
+                ..Default::default()
+            };
+            let reply = fake_reply(&frame, &unit, Duration::from_millis(1));
+            let tile = yat_proto::convert::unit_from_wire(&unit, &settings).unwrap();
+            let checked = yat_proto::convert::result_from_wire(tile, &frame, &weights, &reply);
+            assert!(checked.is_ok(), "{x0},{y0}: {checked:?}");
+        }
+    }
 
     #[test]
     fn busy_share_counts_each_workers_covered_time_once() {
