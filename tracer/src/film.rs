@@ -360,7 +360,7 @@ impl Film {
                 + block_count(&frame) as u64 * std::mem::size_of::<u32>() as u64
         } else {
             pixels * sum
-        } + u64::from(frame.light_splats) * pixels * splat_sum
+        } + frame.splat_entries() * splat_sum
             + planes * pixels * 8 * frame.layers.len() as u64;
         let layers = 2 * 4 * frame.layers.len() as u64;
         let output = pixels * (2 * std::mem::size_of::<Vec3>() as u64 + 4 + 16 + layers);
@@ -976,6 +976,27 @@ mod tests {
             light_splats: true,
             ..FilmFrame::unbordered(4, 2)
         }
+    }
+
+    /// A film's memory estimate counts a light splat plane per light group kept apart (two
+    /// copies of its 24 bytes a pixel, the film's and a checkpoint's), besides their layers.
+    #[test]
+    fn memory_counts_the_light_groups_splat_planes() {
+        let grouped = FilmFrame {
+            layers: Layers {
+                light_groups: 2,
+                ..Layers::NONE
+            },
+            ..splat_frame()
+        };
+        let ungrouped_layers = FilmFrame {
+            light_splats: false,
+            ..grouped
+        };
+        let planes =
+            Film::memory_bytes(grouped, false) - Film::memory_bytes(ungrouped_layers, false);
+        assert_eq!(planes, 2 * 3 * 8 * 24);
+        assert_eq!(Film::new(grouped).splats().unwrap().sums.len(), 3 * 8);
     }
 
     /// `u`'s buffer of [`splat_frame`] with sums from [`buffer`] and splats to `pixels`.
