@@ -793,25 +793,7 @@ impl Film {
     pub fn image(&self, film: &FilmDesc) -> FilmImage {
         let mut linear = self.radiance();
         let light_groups = self.light_group_images(&film.light_groups);
-        if let Some(weighings) = film.light_groups.weighings() {
-            if light_groups.is_empty() {
-                // One group (or groups the render did not keep apart: bidirectional): the
-                // first group's weighing is the whole image's.
-                let single = film.light_groups.groups.len() == 1;
-                for rgb in linear.iter_mut().filter(|_| single) {
-                    *rgb = light_groups::weigh(&weighings[0], *rgb).as_vec3();
-                }
-            } else {
-                for (i, rgb) in linear.iter_mut().enumerate() {
-                    *rgb = weighings
-                        .iter()
-                        .zip(&light_groups)
-                        .map(|(w, (_, group))| light_groups::weigh(w, group[i]))
-                        .sum::<glam::DVec3>()
-                        .as_vec3();
-                }
-            }
-        }
+        film.light_groups.weigh_image(&mut linear, &light_groups);
         let mut tone_mapped = linear.clone();
         tone_map(&mut tone_mapped, &film.tonemap, film.gamma);
         FilmImage {

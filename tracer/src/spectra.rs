@@ -3,7 +3,7 @@
 //! linear sRGB in LuxRender's absolute units (the sun light). A leaf module: the texture,
 //! material and light readers use it; `crate::parse` re-exports the first two functions.
 
-use glam::{DVec3, Vec3};
+use glam::{DMat3, DVec3, Vec3};
 
 use crate::math::luminance;
 
@@ -70,14 +70,15 @@ pub fn xyz_to_linear_srgb(xyz: DVec3) -> Vec3 {
     xyz_to_srgb(xyz).as_vec3()
 }
 
-/// Linear sRGB to CIE XYZ (D65 white): the inverse of [`xyz_to_linear_srgb`]'s matrix.
+/// Linear sRGB to CIE XYZ (D65 white), by columns: the inverse of [`xyz_to_linear_srgb`]'s
+/// matrix.
+pub const LINEAR_SRGB_TO_XYZ: DMat3 = DMat3::from_cols_array(&[
+    0.4124, 0.2126, 0.0193, 0.3576, 0.7152, 0.1192, 0.1805, 0.0722, 0.9505,
+]);
+
+/// Linear sRGB to CIE XYZ (D65 white).
 pub fn linear_srgb_to_xyz(rgb: DVec3) -> DVec3 {
-    let (r, g, b) = (rgb.x, rgb.y, rgb.z);
-    DVec3::new(
-        0.4124 * r + 0.3576 * g + 0.1805 * b,
-        0.2126 * r + 0.7152 * g + 0.0722 * b,
-        0.0193 * r + 0.1192 * g + 0.9505 * b,
-    )
+    LINEAR_SRGB_TO_XYZ * rgb
 }
 
 /// CIE XYZ of a blackbody at `kelvin` over LuxRender 1.x's film wavelengths, scaled to Y = 1:

@@ -33,7 +33,7 @@ use glam::{DMat3, DVec3, Vec3};
 
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
-use crate::spectra::{blackbody_xyz, linear_srgb_to_xyz};
+use crate::spectra::{blackbody_xyz, linear_srgb_to_xyz, LINEAR_SRGB_TO_XYZ};
 
 /// The most light groups a scene may have.
 pub const MAX_LIGHT_GROUPS: usize = 6;
@@ -89,10 +89,7 @@ impl LightGroupDesc {
         if self.temperature > 0.0 {
             xyz *= adaptation(white, blackbody_xyz(self.temperature));
         }
-        let to_xyz = DMat3::from_cols_array(&[
-            0.4124, 0.2126, 0.0193, 0.3576, 0.7152, 0.1192, 0.1805, 0.0722, 0.9505,
-        ]);
-        to_xyz.inverse() * xyz * to_xyz * f64::from(self.scale)
+        LINEAR_SRGB_TO_XYZ.inverse() * xyz * LINEAR_SRGB_TO_XYZ * f64::from(self.scale)
     }
 }
 
@@ -122,29 +119,31 @@ impl LightGroups {
         self.groups.len() >= 2
     }
 
-    /// The image's linear sRGB of a pixel whose total light is `total` and whose groups' light
-    /// is `group(g)` (asked only for a layered film whose groups are not all plain): the sum of
-    /// each group's weighed light. `total` itself when every group is plain.
-    pub fn combine(&self, total: Vec3, group: impl Fn(usize) -> Vec3) -> Vec3 {
-        if self.groups.iter().all(LightGroupDesc::is_plain) {
-            return total;
+    /// Weighs an image by the groups' settings, as the film's image is made: `linear` (the
+    /// total light, rows top to bottom) untouched when every group is plain (or the groups'
+    /// layers were not kept); a single group's
+    /// weighing applied to all of it; else each pixel made the sum of each group's weighed
+    /// light, `images` holding the groups' layers as `Film::light_group_images` gives them.
+    pub fn weigh_image(&self, linear: &mut [Vec3], images: &[(String, Vec<Vec3>)]) {
+        let layered = self.layered();
+        if self.groups.iter().all(LightGroupDesc::is_plain) || layered && images.is_empty() {
+            return;
         }
-        if !self.layered() {
-            return (self.groups[0].weighing() * total.as_dvec3()).as_vec3();
+        let weighings: Vec<DMat3> = self.groups.iter().map(LightGroupDesc::weighing).collect();
+        if !layered {
+            for rgb in linear.iter_mut() {
+                *rgb = weigh(&weighings[0], *rgb).as_vec3();
+            }
+            return;
         }
-        self.groups
-            .iter()
-            .enumerate()
-            .map(|(g, desc)| desc.weighing() * group(g).as_dvec3())
-            .sum::<DVec3>()
-            .as_vec3()
-    }
-
-    /// [`Self::combine`]'s matrices, computed once for a whole image: None when every group is
-    /// plain.
-    pub fn weighings(&self) -> Option<Vec<DMat3>> {
-        (!self.groups.iter().all(LightGroupDesc::is_plain))
-            .then(|| self.groups.iter().map(LightGroupDesc::weighing).collect())
+        for (i, rgb) in linear.iter_mut().enumerate() {
+            *rgb = weighings
+                .iter()
+                .zip(images)
+                .map(|(w, (_, group))| weigh(w, group[i]))
+                .sum::<DVec3>()
+                .as_vec3();
+        }
     }
 }
 
@@ -225,9 +224,7 @@ mod tests {
             ..LightGroupDesc::named("both")
         };
         let white_xyz = linear_srgb_to_xyz(DVec3::ONE);
-        let to_xyz = DMat3::from_cols_array(&[
-            0.4124, 0.2126, 0.0193, 0.3576, 0.7152, 0.1192, 0.1805, 0.0722, 0.9505,
-        ]);
+        let to_xyz = LINEAR_SRGB_TO_XYZ;
         let expected = to_xyz.inverse()
             * adaptation(white_xyz, linear_srgb_to_xyz(both.rgb_scale.as_dvec3()))
             * adaptation(white_xyz, blackbody_xyz(2700.0))
@@ -241,26 +238,43 @@ mod tests {
     }
 
     #[test]
-    fn combine_weighs_each_group_and_keeps_a_plain_total() {
+    fn images_weigh_each_group_and_keep_a_plain_total() {
         let mut groups = LightGroups {
             groups: vec![LightGroupDesc::named("sun"), LightGroupDesc::named("lamps")],
             of_sources: vec![0, 1],
         };
         let layers = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 0.5, 0.5)];
+        let images: Vec<(String, Vec<Vec3>)> =
+            layers.iter().map(|&l| (String::new(), vec![l])).collect();
         let total = layers[0] + layers[1];
-        assert_eq!(groups.combine(total, |g| layers[g]), total);
-        assert!(groups.weighings().is_none());
+        let image = |groups: &LightGroups| {
+            let mut linear = [total];
+            groups.weigh_image(&mut linear, &images);
+            linear[0]
+        };
+        assert_eq!(image(&groups), total);
         groups.groups[1].scale = 4.0;
-        let image = groups.combine(total, |g| layers[g]);
+        let weighed = image(&groups);
         assert!(
-            (image - Vec3::new(3.0, 4.0, 5.0)).abs().max_element() < 1e-5,
-            "{image}"
+            (weighed - Vec3::new(3.0, 4.0, 5.0)).abs().max_element() < 1e-5,
+            "{weighed}"
         );
         groups.groups[0].enabled = false;
-        let image = groups.combine(total, |g| layers[g]);
+        let weighed = image(&groups);
         assert!(
-            (image - Vec3::splat(2.0)).abs().max_element() < 1e-5,
-            "{image}"
+            (weighed - Vec3::splat(2.0)).abs().max_element() < 1e-5,
+            "{weighed}"
         );
+        // One group: its weighing is the whole image's.
+        let single = LightGroups {
+            groups: vec![LightGroupDesc {
+                scale: 0.5,
+                ..LightGroupDesc::named("default")
+            }],
+            of_sources: vec![0],
+        };
+        let mut linear = [total];
+        single.weigh_image(&mut linear, &[]);
+        assert!((linear[0] - total * 0.5).abs().max_element() < 1e-6);
     }
 }

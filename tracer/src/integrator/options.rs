@@ -216,9 +216,7 @@ impl IntegratorDesc {
                 })
             }
             other => {
-                for p in &params.params {
-                    params.ignore(&p.name);
-                }
+                params.ignore_all();
                 ctx.warn(pos, format!("SurfaceIntegrator \"{other}\" is not available; rendering with \"path\" and its defaults"));
                 Ok(Self::path_defaults(other))
             }

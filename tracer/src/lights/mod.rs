@@ -181,7 +181,7 @@ pub(crate) fn read(
         "sunsky2" => SkyLight::read_hosek,
         _ => {
             let Some(read) = LightDesc::reader(ty) else {
-                ignore_all(params);
+                params.ignore_all();
                 ctx.warn(pos, format!("unknown LightSource \"{ty}\" skipped"));
                 return Ok(Vec::new());
             };
@@ -192,12 +192,6 @@ pub(crate) fn read(
         LightDesc::Sun(SunLight::read(params, pos, ctx)?),
         LightDesc::Sky(sky(params, pos, ctx)?),
     ])
-}
-
-fn ignore_all(params: &ParamList) {
-    for p in &params.params {
-        params.ignore(&p.name);
-    }
 }
 
 enum Light {

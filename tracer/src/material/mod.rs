@@ -193,9 +193,7 @@ impl MaterialDesc {
                 format!("material \"{ty}\" is not supported; using matte (with its Kd when given)"),
             );
             let kd = ctx.color_param(params, "Kd", matte::DEFAULT_KD, true)?;
-            for p in &params.params {
-                params.ignore(&p.name);
-            }
+            params.ignore_all();
             return Ok(Self::Matte(Matte {
                 kd,
                 sigma: ConstOrTexture::float(matte::DEFAULT_SIGMA),

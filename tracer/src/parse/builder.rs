@@ -395,9 +395,7 @@ impl<'s> Builder<'s> {
                 let params = r.params(format!("LightGroup \"{name}\""))?;
                 if self.block != Block::World {
                     self.note(pos, "LightGroup outside the world block is ignored, as LuxRender 1.x ignores it".into());
-                    for p in &params.params {
-                        params.ignore(&p.name);
-                    }
+                    params.ignore_all();
                     return Ok(());
                 }
                 let group = self.light_group_named(&name, pos)?;

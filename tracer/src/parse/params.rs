@@ -171,6 +171,13 @@ impl ParamList {
         }
     }
 
+    /// Marks every parameter as knowingly ignored (a statement left whole).
+    pub fn ignore_all(&self) {
+        for p in &self.params {
+            p.used.set(true);
+        }
+    }
+
     pub fn error(&self, p: &Param, message: impl Into<String>) -> ParseError {
         ParseError::Parameter {
             pos: p.pos.clone(),

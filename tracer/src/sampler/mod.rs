@@ -67,9 +67,7 @@ impl SamplerDesc {
     pub fn read(ty: String, params: &ParamList) -> Result<Self, ParseError> {
         let n = params.int("pixelsamples", 0)?;
         // The sampler's algorithm is ours; only its sample count carries over.
-        for p in &params.params {
-            params.ignore(&p.name);
-        }
+        params.ignore_all();
         Ok(Self {
             pixel_samples: (n > 0).then_some(n as u32),
             requested: ty,

@@ -204,9 +204,7 @@ impl Geometry {
         pos: &SourcePos,
     ) -> Result<Option<Geometry>, ParseError> {
         let Some(read) = Self::reader(ty) else {
-            for p in &params.params {
-                params.ignore(&p.name);
-            }
+            params.ignore_all();
             ctx.warn(
                 pos,
                 format!("Shape \"{ty}\" is not supported; the shape is skipped"),

@@ -101,9 +101,7 @@ pub fn read(
             None => return Ok(None),
         },
         other => {
-            for p in &params.params {
-                params.ignore(&p.name);
-            }
+            params.ignore_all();
             ctx.warn(pos, format!("fresnel texture type \"{other}\" is not supported; the texture is left undefined"));
             return Ok(None);
         }

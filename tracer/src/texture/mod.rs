@@ -200,9 +200,7 @@ pub fn read(
     }
     let decl = Declared { name, is_color };
     let Some(kind) = TextureKind::read(class, &decl, params, pos, ctx)? else {
-        for p in &params.params {
-            params.ignore(&p.name);
-        }
+        params.ignore_all();
         ctx.warn(
             pos,
             format!("Texture \"{name}\": type \"{class}\" is not supported; the texture is left undefined"),
