@@ -392,6 +392,7 @@ fn handle(state: &mut State, frame: &Frame) -> u64 {
                 convergence_step: yat_tracer::film::DEFAULT_CONVERGENCE_STEP,
                 outputs: Default::default(),
                 light_groups: Default::default(),
+                outlier_k: 0,
             });
             8 + u64::from(display.pixels().any(|p| p.0 != [0, 0, 0]))
         }),

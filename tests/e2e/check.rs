@@ -70,12 +70,10 @@ fn check_summarises_a_seed_scene() {
         stdout.contains("path tracing: no caustics of point, spot or distant lights here"),
         "why path tracing runs: {stdout}"
     );
+    // LuxBlend's outlier rejection (k 2) is rendered: no difference is left.
     assert!(
-        stdout.contains(
-            "not rendered as LuxRender would: 1\n  cornell-box.lxs:61:2: Film \"fleximage\": \
-             \"integer outlierrejection_k\" [2] is not rendered: LuxRender drops samples"
-        ),
-        "the one difference, LuxBlend's outlier rejection: {stdout}"
+        !stdout.contains("not rendered as LuxRender would:"),
+        "no difference: {stdout}"
     );
     // LuxBlend's sampler, light strategy, output and shutter settings, each with why (its one
     // light group, "default", is rendered: the image, no word).
@@ -88,7 +86,7 @@ fn check_summarises_a_seed_scene() {
         "the notes, the integrator's first: {stdout}"
     );
     assert!(
-        stdout.ends_with("\n1 statements or parameters not rendered as LuxRender would\n"),
+        stdout.ends_with("\n0 statements or parameters not rendered as LuxRender would\n"),
         "{stdout}"
     );
 }
@@ -161,14 +159,6 @@ fn check_lists_and_counts_every_difference_at_its_position() {
     );
 }
 
-/// Differences the seed project's scenes are known to have, by what their message says and
-/// why they stay; every other difference in them, and any in our own scenes, fails.
-const SEED_GAPS: &[(&str, &str)] = &[(
-    "\"integer outlierrejection_k\" [2] is not rendered",
-    "LuxBlend asks for LuxRender's outlier rejection, which drops samples far from their \
-     neighbours (fireflies): a bias YAT does not implement",
-)];
-
 /// The differences `yat check` lists under "not rendered as LuxRender would": each kind's
 /// first line, and how many times it occurs (its "the same" lines and "and N more" counted).
 fn differences(stdout: &str) -> Vec<(&str, u64)> {
@@ -213,13 +203,15 @@ fn complete_scenes(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
+/// Every complete scene, ours and the seed project's, is rendered as LuxRender would render
+/// it: `yat check` lists no difference.
 #[test]
-fn complete_scenes_have_no_difference_but_the_known_gaps() {
-    let mut dirs = vec![(workspace_root().join("scenes"), &[][..])];
-    dirs.extend(seed_scenes().map(|dir| (dir, SEED_GAPS)));
+fn complete_scenes_have_no_difference() {
+    let mut dirs = vec![workspace_root().join("scenes")];
+    dirs.extend(seed_scenes());
     let mut checked = 0;
     let mut failures = Vec::new();
-    for (dir, gaps) in dirs {
+    for dir in dirs {
         for scene in complete_scenes(&dir) {
             let (ok, stdout, stderr) = check(&scene);
             // Some scenes lack their geometry files: not complete, not checkable.
@@ -228,17 +220,11 @@ fn complete_scenes_have_no_difference_but_the_known_gaps() {
                 continue;
             }
             let listed = differences(&stdout);
-            let (known, unknown): (Vec<_>, Vec<_>) = listed
-                .iter()
-                .partition(|(line, _)| gaps.iter().any(|(says, _)| line.contains(says)));
-            // Every occurrence of a known gap is counted, and nothing else.
-            let known: u64 = known.iter().map(|(_, n)| n).sum();
-            let counted = stdout.ends_with(&format!(
-                "\n{known} statements or parameters not rendered as LuxRender would\n"
-            ));
-            if !ok || !unknown.is_empty() || !counted {
+            let counted =
+                stdout.ends_with("\n0 statements or parameters not rendered as LuxRender would\n");
+            if !ok || !listed.is_empty() || !counted {
                 failures.push(format!(
-                    "{}: differences besides the known gaps: {unknown:?}\n{stdout}{stderr}",
+                    "{}: differences: {listed:?}\n{stdout}{stderr}",
                     scene.display()
                 ));
             }
@@ -308,10 +294,10 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
         "{stdout}"
     );
 
-    // Outlier rejection drops samples (fireflies) from LuxRender's image: a difference.
+    // Another white point than LuxRender's default changes LuxRender's colours: a difference.
     std::fs::write(
         &scene,
-        "Film \"fleximage\" \"integer outlierrejection_k\" [2] \"bool write_flm_direct\" [\"true\"]\n\
+        "Film \"fleximage\" \"float colorspace_white\" [0.3 0.3] \"bool write_flm_direct\" [\"true\"]\n\
          WorldBegin\nWorldEnd\n",
     )
     .unwrap();
@@ -319,9 +305,9 @@ fn parameters_without_effect_are_listed_apart_and_not_counted() {
     assert!(!ok, "{stdout}");
     assert!(
         stdout.contains(
-            "not rendered as LuxRender would: 1\n  quiet.lxs:1:18: Film \"fleximage\": \"integer \
-             outlierrejection_k\" [2] is not rendered: LuxRender drops samples far from their k \
-             nearest neighbours, which removes fireflies; YAT keeps every sample\n"
+            "not rendered as LuxRender would: 1\n  quiet.lxs:1:18: Film \"fleximage\": \"float \
+             colorspace_white\" [0.3 0.3] is not rendered: LuxRender's RGB has this white point; \
+             YAT's has LuxRender's default one\n"
         ),
         "{stdout}"
     );

@@ -16,6 +16,7 @@
 //! | `filename` | string | "luxout" |
 //! | `haltspp` | integer | none |
 //! | `halttime` | float | none |
+//! | `outlierrejection_k` | integer | 0 (off): LuxRender's outlier rejection (`render::outliers`) |
 //! | `haltthreshold` | float | none (LuxRender's -1): from 0 on, rendering halts once at most this fraction of the pixels still fails LuxRender's convergence test (a perceptual comparison of the image with itself every `convergencestep` samples per pixel); 1 halts at the first test |
 //! | `write_*`, `ldr_clamp_method` | | the files written: [`outputs`] |
 //!
@@ -32,6 +33,7 @@ use crate::math::luminance;
 use crate::parse::context::ParseContext;
 use crate::parse::error::ParseError;
 use crate::parse::params::ParamList;
+use crate::render::outliers::MAX_OUTLIER_K;
 use crate::render::unit::{FilmFrame, PixelRect, WorkUnit, BLOCK_SIZE};
 
 pub mod light_groups;
@@ -110,6 +112,10 @@ pub struct FilmDesc {
     /// The scene's light groups ([`light_groups`]): the `LightGroup` statements of the world
     /// block, which the parser adds once it has read them.
     pub light_groups: LightGroups,
+    /// LuxRender's `outlierrejection_k`: 0 keeps every sample, k > 0 drops the samples
+    /// `render::outliers` finds to be outliers among their k nearest (at most
+    /// [`MAX_OUTLIER_K`]).
+    pub outlier_k: u32,
 }
 
 impl FilmDesc {
@@ -194,6 +200,18 @@ impl FilmDesc {
         ] {
             params.ignore(name);
         }
+        let outlier_k = params.int("outlierrejection_k", 0)?;
+        if outlier_k > MAX_OUTLIER_K as i32 {
+            if let Some(pos) = pos {
+                ctx.warn(
+                    pos,
+                    format!(
+                        "outlierrejection_k {outlier_k} is read as {MAX_OUTLIER_K}, the most \
+                         neighbours YAT's outlier test asks for"
+                    ),
+                );
+            }
+        }
         let haltspp = params.int("haltspp", -1)?;
         let halttime = params.float("halttime", -1.0)?;
         let haltthreshold = params.float("haltthreshold", -1.0)?;
@@ -214,6 +232,7 @@ impl FilmDesc {
             },
             outputs: FilmOutputs::read(ctx, params, pos)?,
             light_groups: LightGroups::default(),
+            outlier_k: outlier_k.clamp(0, MAX_OUTLIER_K as i32) as u32,
         })
     }
 }

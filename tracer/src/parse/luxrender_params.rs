@@ -459,14 +459,7 @@ const FLEXIMAGE: &[LuxParam] = &[
         NoEffect::Progress,
     ),
     no_effect("displayinterval", Int(12), NoEffect::Progress),
-    // A sample whose (position, colour) point has fewer than k neighbours near it is dropped
-    // (film.cpp's RejectTileOutliers): fireflies vanish, and the image is biased darker.
-    differs(
-        "outlierrejection_k",
-        Int(0),
-        "LuxRender drops samples far from their k nearest neighbours, which removes fireflies; \
-         YAT keeps every sample",
-    ),
+    param("outlierrejection_k", Int(0), Rendered),
     no_effect("debug", Bool(false), NoEffect::Debug),
     param("haltspp", Int(-1), Rendered),
     param("halttime", Int(-1), Rendered),

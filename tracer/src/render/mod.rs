@@ -14,6 +14,7 @@ pub mod adaptive;
 pub mod branching;
 pub mod convergence;
 pub mod layers;
+pub mod outliers;
 pub mod perceptual_diff;
 pub mod plan;
 pub mod sampling;

@@ -33,8 +33,9 @@ use crate::texture::Textures;
 
 use super::branching::{self, PilotScene};
 use super::layers::LayerSample;
+use super::outliers::OutlierFilter;
 use super::settings::RenderSettings;
-use super::unit::{FilmFrame, UnitStats, WorkUnit};
+use super::unit::{FilmFrame, PixelRect, UnitStats, WorkUnit};
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
@@ -308,7 +309,7 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
-        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
+        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame), self.outliers(unit));
         let mut stats = UnitStats::default();
         let adaptive = unit.mask.is_some();
         let grouped = self.frame.layers.light_groups > 0;
@@ -398,7 +399,7 @@ impl RenderScene {
         unit: &WorkUnit,
         cancel: &AtomicBool,
     ) -> Option<(SampleBuffer, UnitStats)> {
-        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame));
+        let mut sums = UnitSums::new(SampleBuffer::new(*unit, &self.frame), self.outliers(unit));
         let mut stats = UnitStats::default();
         let mut splat_sums = SplatSums::new();
         let mass = self
@@ -522,6 +523,12 @@ impl RenderScene {
             stats.dropped += 1;
             return;
         }
+        if let Some(outliers) = &mut sums.outliers {
+            let at = Vec2::new(x as f32, y as f32) + u;
+            if outliers.rejects(at, crate::math::luminance(path.radiance)) {
+                return;
+            }
+        }
         let half = sums.buffer.unit.mask.is_some() && index % 2 == 1;
         let alpha = if path.escaped { 0.0 } else { 1.0 };
         let mut layers = if self.frame.layers.aovs.need_first_surface() {
@@ -536,6 +543,18 @@ impl RenderScene {
             layers.light_groups = groups.0;
         }
         self.splat(sums, (x, y), u, (path.radiance, layers), half);
+    }
+
+    /// The outlier filter of `unit`'s samples, when the Film rejects outliers.
+    fn outliers(&self, unit: &WorkUnit) -> Option<OutlierFilter> {
+        let tile = PixelRect {
+            x0: unit.x0,
+            y0: unit.y0,
+            x1: unit.x1,
+            y1: unit.y1,
+        };
+        let width = [self.desc.filter.xwidth, self.desc.filter.ywidth];
+        OutlierFilter::new(self.desc.film.outlier_k, width, tile)
     }
 
     /// Where the source plane of the block of pixel (x, y) starts in `buffer`'s sums (0 for a
@@ -660,6 +679,8 @@ impl OnLanes for UnitOnLanes<'_> {
 
 struct UnitSums {
     buffer: SampleBuffer,
+    /// The unit's outliers, where the Film rejects them (`render::outliers`).
+    outliers: Option<OutlierFilter>,
     all: Vec<Vec4>,
     half: Vec<Vec4>,
     /// The layers' sums, laid out as the buffer's.
@@ -667,8 +688,9 @@ struct UnitSums {
 }
 
 impl UnitSums {
-    fn new(mut buffer: SampleBuffer) -> Self {
+    fn new(mut buffer: SampleBuffer, outliers: Option<OutlierFilter>) -> Self {
         Self {
+            outliers,
             all: vec![Vec4::ZERO; buffer.weight.len()],
             half: vec![Vec4::ZERO; buffer.half_weight.len()],
             layers: std::mem::take(&mut buffer.layers),

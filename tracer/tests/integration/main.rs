@@ -23,6 +23,7 @@ mod image_formats;
 mod light_groups;
 mod luxrender_materials;
 mod mirror_images;
+mod outliers;
 mod panes;
 mod parse_conventions;
 mod parse_errors;
