@@ -476,6 +476,17 @@ def machine():
     return f"{cpu}, {os.cpu_count()} cores{vectors}"
 
 
+def yat_build(args):
+    """Which YAT build the figures are of, and the binary it ran as (the baseline build hands
+    over to its x86-64-v3 sibling on a CPU with AVX2: `--stats-json` says which rendered)."""
+    with tempfile.TemporaryDirectory() as d:
+        figures = render(ROOT / "scenes/cornell/cornell-box.lxs", 1, None, 1, Path(d),
+                         size=(16, 9))
+    build = ("profile-optimised (`deploy/build-pgo.sh`)" if args.pgo
+             else "the README's (`cargo build --release`)")
+    return f"{build}; rendering as its {figures.get('instruction_set', 'unknown')} binary"
+
+
 def side_by_side_section(args):
     """The side-by-side section of RESULTS.md (run now)."""
     sys.path.insert(0, str(ROOT / "bench"))
@@ -491,6 +502,7 @@ def side_by_side_section(args):
     return f"""## Side by side with LuxCoreRender and Mitsuba 3
 
 - machine: {machine()}; {args.threads} render threads for every renderer
+- YAT build: {yat_build(args)}
 - date: {datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
 - command: `python3 bench/bench.py {" ".join(sys.argv[1:])}` (setup: `bench/setup-env.sh`,
   which `bench.py` runs itself)

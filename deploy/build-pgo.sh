@@ -10,6 +10,8 @@
 #
 # Scenes given on the command line are rendered for the profile too (at 160x90, 16 spp), so a
 # farm's binary can be trained on the scenes it renders.
+# Each build is one binary (YAT_BUILD_V3=0: not the release build's nested x86-64-v3 one, which
+# this script makes profile-optimised itself).
 # Needs the toolchain's llvm-profdata (`rustup component add llvm-tools`, done here when missing).
 # On an x86-64 machine whose CPU has AVX2, FMA and BMI2 it also builds
 # target/pgo/yat-x86-64-v3, the same compiled for such CPUs, which target/pgo/yat hands its
@@ -46,7 +48,7 @@ build_for() {
     mkdir -p "$profile"
     # --target keeps the flags off build scripts and proc macros (they would profile
     # themselves).
-    RUSTFLAGS="-Ctarget-cpu=$cpu -Cprofile-generate=$profile" \
+    YAT_BUILD_V3=0 RUSTFLAGS="-Ctarget-cpu=$cpu -Cprofile-generate=$profile" \
         cargo build --release --locked -p yat --target "$host" \
         --target-dir "target/pgo/instrumented-$cpu"
     trainer="target/pgo/instrumented-$cpu/$host/release/yat"
@@ -69,7 +71,7 @@ build_for() {
             --checkpoint-every 0 --preview-every 0
     done
     "$profdata" merge -o "$profile/merged.profdata" "$profile"
-    RUSTFLAGS="-Ctarget-cpu=$cpu -Cprofile-use=$profile/merged.profdata -Cllvm-args=-pgo-warn-missing-function=false" \
+    YAT_BUILD_V3=0 RUSTFLAGS="-Ctarget-cpu=$cpu -Cprofile-use=$profile/merged.profdata -Cllvm-args=-pgo-warn-missing-function=false" \
         cargo build --release --locked -p yat --target "$host" \
         --target-dir "target/pgo/optimised-$cpu"
     install -m 0755 "target/pgo/optimised-$cpu/$host/release/yat" "$dest"

@@ -90,31 +90,11 @@ pub fn is_luxconsole_name(argv0: &OsStr) -> bool {
 /// hands over to reads its first argument as a subcommand, so it is handed `luxconsole` and
 /// then the options (a link named luxconsole resolves to the `yat` beside that build).
 pub fn start_isa() -> Result<(), String> {
-    let Ok(exe) = std::env::current_exe() else {
-        return Ok(());
-    };
-    let isa_env = std::env::var_os(isa::ISA_ENV);
-    let choice = isa::choose(
-        &exe,
-        isa::built_for_v3(),
-        isa::cpu_has_v3(),
-        isa_env.as_deref(),
-        isa::is_executable,
-    );
-    let IsaChoice::HandOver(sibling) = choice else {
-        // Staying, or this build cannot run here: isa::start decides and says the same.
+    let Some((_, IsaChoice::HandOver(sibling))) = isa::this_process() else {
+        // Staying, handing back, or this build cannot run here: isa::start decides.
         return isa::start();
     };
-    use std::os::unix::process::CommandExt;
-    let error = std::process::Command::new(&sibling)
-        .arg(LUXCONSOLE)
-        .args(std::env::args_os().skip(1))
-        .env(isa::ISA_ENV, isa::V3_NAME)
-        .exec();
-    tracing::warn!(
-        "could not run {} ({error}); rendering with this baseline build",
-        sibling.display()
-    );
+    isa::exec(&sibling, isa::V3_NAME, Some(LUXCONSOLE));
     Ok(())
 }
 
