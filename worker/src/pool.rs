@@ -107,6 +107,13 @@ impl RenderPool {
             }
         };
         let rendering = Rendering::enter(&self.rendering);
+        // A drain that began as this unit took its slot may have counted no unit rendering and
+        // be stopping the server: the unit goes back, not rendered for a reply nobody gets. The
+        // drain sets its flag before it counts the units rendering, and a unit counts itself
+        // before it reads the flag, so one of the two sees the other.
+        if *self.draining.borrow() {
+            return Err(NodeError::Draining(format!("unit {}", unit.index)));
+        }
         if !self.throttle.is_zero() {
             tokio::time::sleep(self.throttle).await;
         }
