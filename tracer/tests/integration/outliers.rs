@@ -8,38 +8,16 @@ use yat_tracer::parse::parse_scene;
 use yat_tracer::render::RenderOverrides;
 
 use crate::render::render_whole_with;
+use crate::util::workspace_root;
 
-/// A matte floor seen from straight above under a dim sky; out of view, a mirror ball and
-/// beyond it a tiny very bright lamp behind a low wall, which hides the lamp from the floor:
-/// the floor sees the lamp only in the mirror, when a diffuse bounce happens to find its
-/// reflection (no light sample can), so the image is the sky-lit floor and fireflies. `k` is
-/// the Film's outlierrejection_k.
+/// `scenes/exported/fireflies.lxs` (fireflies of a lamp seen only through a mirror, LuxBlend's
+/// `outlierrejection_k` 2) with `k` in its place.
 fn scene(k: i32) -> String {
-    format!(
-        "Film \"fleximage\" \"integer xresolution\" [32] \"integer yresolution\" [32]\n\
-         \x20 \"integer outlierrejection_k\" [{k}]\n\
-         PixelFilter \"box\" \"float xwidth\" [0.5] \"float ywidth\" [0.5]\n\
-         LookAt 0 0 5  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" [30]\n\
-         WorldBegin\n\
-         LightSource \"infinite\" \"color L\" [0.2 0.2 0.2]\n\
-         Material \"matte\" \"color Kd\" [0.7 0.7 0.7]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-         \x20 \"point P\" [-6 -6 0  6 -6 0  6 6 0  -6 6 0]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3]\n\
-         \x20 \"point P\" [2.9 -3 0  2.9 3 0  2.9 3 0.58  2.9 -3 0.58]\n\
-         AttributeBegin\n\
-         Material \"mirror\" \"color Kr\" [0.9 0.9 0.9]\n\
-         Translate 2.5 0 0.6\n\
-         Shape \"sphere\" \"float radius\" [0.5]\n\
-         AttributeEnd\n\
-         AttributeBegin\n\
-         AreaLightSource \"area\" \"color L\" [1 1 1] \"float gain\" [3000]\n\
-         Translate 3.2 0 0.6\n\
-         Shape \"sphere\" \"float radius\" [0.05]\n\
-         AttributeEnd\n\
-         WorldEnd\n"
-    )
+    let path = workspace_root().join("scenes/exported/fireflies.lxs");
+    let text = std::fs::read_to_string(&path).expect("scenes/exported/fireflies.lxs");
+    let line = "\"integer outlierrejection_k\" [2]";
+    assert!(text.contains(line), "{}", path.display());
+    text.replace(line, &format!("\"integer outlierrejection_k\" [{k}]"))
 }
 
 fn render(text: &str, spp: u32) -> Film {
@@ -74,7 +52,8 @@ fn outlier_rejection_removes_fireflies() {
         (median2 / median0 - 1.0).abs() < 0.01,
         "median {median2} with k = 2, {median0} without"
     );
-    let plain = scene(0).replace("\x20 \"integer outlierrejection_k\" [0]\n", "");
+    let plain = scene(0).replace("\t\"integer outlierrejection_k\" [0]\n", "");
+    assert_ne!(plain, scene(0), "the parameter's line is gone");
     assert_eq!(
         render(&plain, 4).radiance(),
         render(&scene(0), 4).radiance()
