@@ -24,9 +24,9 @@ CATEGORIES = [
     ("materials and textures",
      r"bilinear|bsdf_at|bxdf|Bxdf|texture|Textures|[Ii]mage[Mm]ap|[Mm]apping|Materials|"
      r"microfacet|Trowbridge|[Cc]onductor|fresnel|[Dd]ielectric|matte"),
-    ("film and camera", r"filter|AxisWeights|splat|[Cc]amera"),
+    ("film and camera", r"filter|AxisWeights|splat|[Cc]amera|outliers"),
     ("path loop, sampler, packets (inlined)",
-     r"render_unit|integrator|sampler|split_bsdf_light|walk|trace_"),
+     r"render_unit|integrator|sampler|split_bsdf_light|walk|trace_|lanes::run"),
 ]
 LOADING = r"decode|Environment::new|::build|parse|png|jpeg|zune|inflate|obvhs|WideBvh::(new|from)"
 
