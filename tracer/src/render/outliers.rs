@@ -286,9 +286,10 @@ mod tests {
         }
     }
 
-    /// The lane-wise tests for one and two nearest decide as the general k-nearest sum does,
-    /// over random stores of 1 to 64 points (ties included: coordinates on a coarse grid), and
-    /// the two smallest of eight lanes are the sorted array's first two.
+    /// The lane-wise tests for one and two nearest decide as the general k-nearest sum does, and
+    /// that one (up to 8 nearest) as the sorted distances do, over random stores of 1 to 64
+    /// points (ties included: coordinates on a coarse grid); the two smallest of eight lanes
+    /// are the sorted array's first two.
     #[test]
     fn the_lane_tests_agree_with_the_general_one() {
         let mut rng = fastrand::Rng::with_seed(7);
@@ -315,16 +316,20 @@ mod tests {
                 );
                 decided[usize::from(general)] += 1;
             }
+            // The general sum decides as the sum of the m smallest of all distances, sorted.
             let lanes: Vec<Vec4> = cell.squared_distances(p).collect();
+            let mut sorted: Vec<f32> = lanes.iter().flat_map(|d| d.to_array()).collect();
+            sorted.sort_by(f32::total_cmp);
+            for m in 1..=8.min(cell.len) {
+                let brute = sorted[..m].iter().sum::<f32>() <= m as f32;
+                assert_eq!(cell.m_nearest_sum(p, m) <= m as f32, brute, "m {m}");
+            }
             let (mut first, mut second) = (Vec4::INFINITY, Vec4::INFINITY);
             for &d2 in &lanes {
                 second = second.min(first.max(d2));
                 first = first.min(d2);
             }
-            let mut all: Vec<f32> = lanes.iter().flat_map(|d| d.to_array()).collect();
-            all.sort_by(f32::total_cmp);
-            let expected = (all[0], all.get(1).copied().unwrap_or(f32::INFINITY));
-            assert_eq!(two_smallest(first, second), expected);
+            assert_eq!(two_smallest(first, second), (sorted[0], sorted[1]));
         }
         // Both answers are common, so the agreement is not one-sided.
         assert!(decided.iter().all(|&n| n > 500), "{decided:?}");

@@ -35,7 +35,7 @@ use super::branching::{self, PilotScene};
 use super::layers::LayerSample;
 use super::outliers::OutlierFilter;
 use super::settings::RenderSettings;
-use super::unit::{FilmFrame, PixelRect, UnitStats, WorkUnit};
+use super::unit::{FilmFrame, UnitStats, WorkUnit};
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
@@ -547,14 +547,8 @@ impl RenderScene {
 
     /// The outlier filter of `unit`'s samples, when the Film rejects outliers.
     fn outliers(&self, unit: &WorkUnit) -> Option<OutlierFilter> {
-        let tile = PixelRect {
-            x0: unit.x0,
-            y0: unit.y0,
-            x1: unit.x1,
-            y1: unit.y1,
-        };
         let width = [self.desc.filter.xwidth, self.desc.filter.ywidth];
-        OutlierFilter::new(self.desc.film.outlier_k, width, tile)
+        OutlierFilter::new(self.desc.film.outlier_k, width, unit.tile())
     }
 
     /// Where the source plane of the block of pixel (x, y) starts in `buffer`'s sums (0 for a

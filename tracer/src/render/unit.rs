@@ -33,6 +33,16 @@ pub struct WorkUnit {
 }
 
 impl WorkUnit {
+    /// The tile's pixels (without the filter's border: [`FilmFrame::region`]).
+    pub fn tile(&self) -> PixelRect {
+        PixelRect {
+            x0: self.x0,
+            y0: self.y0,
+            x1: self.x1,
+            y1: self.y1,
+        }
+    }
+
     /// Pixels of the tile (its sample buffer covers the tile and the filter's border around
     /// it: [`FilmFrame::region`]).
     pub fn pixel_count(&self) -> usize {

@@ -16,7 +16,7 @@ use yat_tracer::parse::parse_scene;
 use yat_tracer::render::RenderOverrides;
 use yat_tracer::spectra::spectrum_rgb_weights;
 
-use crate::render::render_whole_with;
+use crate::render::{render_text, render_whole_with};
 use crate::util::workspace_root;
 
 /// The scene's figures (see the file).
@@ -143,16 +143,12 @@ fn moments(profile: &[DVec3]) -> (DVec3, DVec3) {
 }
 
 fn render(text: &str, spp: u32, transport: Transport) -> Film {
-    let mut source = MemorySource::new();
-    source.insert("dispersion.lxs", Arc::from(text.as_bytes()));
-    let desc = parse_scene("dispersion.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let overrides = RenderOverrides {
         spp: Some(spp),
         transport: Some(transport),
         ..Default::default()
     };
-    render_whole_with(&desc, &source, &overrides)
+    render_text(text, &overrides)
 }
 
 fn scene_text() -> String {

@@ -2,12 +2,10 @@
 //! a smooth image keeps its brightness to a small bias, and k = 0 renders every sample.
 
 use glam::Vec3;
-use yat_tracer::assets::MemorySource;
 use yat_tracer::film::Film;
-use yat_tracer::parse::parse_scene;
 use yat_tracer::render::RenderOverrides;
 
-use crate::render::render_whole_with;
+use crate::render::render_text;
 use crate::util::workspace_root;
 
 /// `scenes/exported/fireflies.lxs` (fireflies of a lamp seen only through a mirror, LuxBlend's
@@ -21,15 +19,11 @@ fn scene(k: i32) -> String {
 }
 
 fn render(text: &str, spp: u32) -> Film {
-    let mut source = MemorySource::new();
-    source.insert("main.lxs", text.as_bytes().into());
-    let desc = parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
-    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
     let overrides = RenderOverrides {
         spp: Some(spp),
         ..Default::default()
     };
-    render_whole_with(&desc, &source, &overrides)
+    render_text(text, &overrides)
 }
 
 /// Fireflies are single samples far brighter than their neighbours: the floor's pixels more

@@ -119,6 +119,16 @@ pub fn render_whole_with(
     film
 }
 
+/// [`render_whole_with`] of the scene `text` (one file, which must parse without a warning).
+pub fn render_text(text: &str, overrides: &yat_tracer::render::RenderOverrides) -> Film {
+    let mut source = MemorySource::new();
+    source.insert("main.lxs", text.as_bytes().into());
+    let desc =
+        yat_tracer::parse::parse_scene("main.lxs", &source).unwrap_or_else(|e| panic!("{e}"));
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    render_whole_with(&desc, &source, overrides)
+}
+
 fn mean(film: &Film, pixels: impl Iterator<Item = (u32, u32)>) -> Vec3 {
     let (sum, n) = pixels.fold((Vec3::ZERO, 0), |(s, n), (x, y)| {
         (s + film.pixel(x, y), n + 1)
